@@ -1,0 +1,179 @@
+"""
+Precomputed tables in ``luts/``, generated from colour-science, with a manifest.
+
+Each table is a ``.npy`` file listed in ``luts/manifest.json`` with its source, range, resolution,
+the parameters that generated it and a SHA-256 checksum. :func:`load` regenerates a table that is
+missing, altered, or generated with other parameters than the code's: a stale table is never used.
+
+Run ``python -m explorer.luts`` to regenerate every table.
+
+Tables
+------
+cmf_1nm
+    The CIE 1931 2° CMFs at every nm from 360 to 830, normalised so that ``sum(ybar) == 1`` (the
+    spectral reference integrates against them).
+cmf_cumulative
+    The cumulative integrals ``C(lambda)`` of those CMFs (Eq. 16 of Fourneau et al. 2024), at the
+    472 bin edges ``359.5 + k`` nm: the CMFs are constant over each 1 nm bin, so ``C`` is exactly
+    piecewise linear between nodes and a box spectrum integrates to ``C(hi) - C(lo)`` (Eq. 15).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from . import colorimetry
+
+LUT_DIR = Path(__file__).resolve().parent.parent / "luts"
+MANIFEST = "manifest.json"
+#: Bump when a generator changes what it writes.
+GENERATOR_VERSION = 1
+
+#: First node of ``cmf_cumulative`` (nm) and its spacing.
+CUMULATIVE_START = colorimetry.WAVELENGTH_MIN - 0.5
+CUMULATIVE_STEP = 1.0
+
+
+def _generate_cmf_1nm() -> np.ndarray:
+    return colorimetry.colour_matching_functions().astype(np.float64)
+
+
+def _generate_cmf_cumulative() -> np.ndarray:
+    cmf = colorimetry.colour_matching_functions()
+    return np.concatenate([np.zeros((1, 3)), np.cumsum(cmf, axis=0)]).astype(np.float64)
+
+
+def _source() -> str:
+    import colour
+
+    return f"colour-science {colour.__version__}: colour.MSDS_CMFS['{colorimetry.CMFS_NAME}']"
+
+
+TABLES: dict[str, dict] = {
+    "cmf_1nm": {
+        "generate": _generate_cmf_1nm,
+        "spec": {
+            "quantity": "CIE 1931 2 degree CMFs, normalised so that sum(ybar) = 1",
+            "range_nm": [colorimetry.WAVELENGTH_MIN, colorimetry.WAVELENGTH_MAX],
+            "resolution_nm": 1.0,
+            "shape": [471, 3],
+        },
+    },
+    "cmf_cumulative": {
+        "generate": _generate_cmf_cumulative,
+        "spec": {
+            "quantity": "cumulative integral of the normalised CMFs (Eq. 16), at 1 nm bin edges",
+            "range_nm": [CUMULATIVE_START, colorimetry.WAVELENGTH_MAX + 0.5],
+            "resolution_nm": CUMULATIVE_STEP,
+            "shape": [472, 3],
+        },
+    },
+}
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _read_manifest(directory: Path) -> dict:
+    try:
+        return json.loads((directory / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return {"tables": {}}
+
+
+def _expected_spec(name: str) -> dict:
+    return {**TABLES[name]["spec"], "generator_version": GENERATOR_VERSION, "dtype": "float64"}
+
+
+def staleness(name: str, directory: Path = LUT_DIR) -> str | None:
+    """Why table ``name`` cannot be used as it is (``None`` when it is up to date)."""
+    entry = _read_manifest(directory).get("tables", {}).get(name)
+    path = directory / f"{name}.npy"
+    if entry is None:
+        return "not in the manifest"
+    if not path.exists():
+        return "file missing"
+    if {k: entry.get(k) for k in _expected_spec(name)} != _expected_spec(name):
+        return "generated with other parameters"
+    if entry.get("sha256") != _sha256(path):
+        return "checksum mismatch"
+    return None
+
+
+def generate(name: str, directory: Path = LUT_DIR) -> np.ndarray:
+    """Generate table ``name``, write it to ``directory`` and record it in the manifest."""
+    table = np.ascontiguousarray(TABLES[name]["generate"]())
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / f"{name}.npy"
+    np.save(path, table)
+    manifest = _read_manifest(directory)
+    manifest.setdefault("tables", {})[name] = {
+        "file": path.name,
+        "source": _source(),
+        **_expected_spec(name),
+        "sha256": _sha256(path),
+    }
+    (directory / MANIFEST).write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n")
+    return table
+
+
+_cache: dict[tuple[str, Path], np.ndarray] = {}
+
+
+def load(name: str, directory: Path = LUT_DIR, log: Callable[[str], None] | None = None) -> np.ndarray:
+    """
+    Table ``name``, regenerated first when missing or stale (never silently used stale).
+
+    When ``directory`` cannot be written, the regenerated table is used from memory.
+    """
+    key = (name, Path(directory))
+    if key in _cache:
+        return _cache[key]
+    reason = staleness(name, directory)
+    if reason is None:
+        table = np.load(directory / f"{name}.npy")
+    else:
+        (log or (lambda m: print(m, file=sys.stderr)))(f"luts: regenerating {name} ({reason})")
+        try:
+            table = generate(name, directory)
+        except OSError:
+            table = np.ascontiguousarray(TABLES[name]["generate"]())
+    table.setflags(write=False)
+    _cache[key] = table
+    return table
+
+
+def cmf_cumulative_at(wavelength) -> np.ndarray:
+    """
+    ``C(lambda)`` by linear interpolation between the table's nodes, clamped outside them: exactly
+    what a linearly filtered, edge-clamped texture of the table returns.
+
+    Returns
+    -------
+    ndarray, shape ``wavelength.shape + (3,)``
+    """
+    table = load("cmf_cumulative")
+    x = (np.asarray(wavelength, dtype=np.float64) - CUMULATIVE_START) / CUMULATIVE_STEP
+    x = np.clip(x, 0.0, table.shape[0] - 1.0)
+    i = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
+    f = (x - i)[..., None]
+    return table[i] * (1.0 - f) + table[i + 1] * f
+
+
+def main() -> int:
+    for name in TABLES:
+        table = generate(name)
+        print(f"luts/{name}.npy  shape {table.shape}  {_sha256(LUT_DIR / f'{name}.npy')[:16]}…")
+    print(f"luts/{MANIFEST} written ({_source()})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
