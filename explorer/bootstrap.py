@@ -551,7 +551,11 @@ def setup_lock(path: Path = LOCK_PATH) -> Iterator[None]:
         yield
         return
     try:
-        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            log("waiting for another set-up of .venv to finish…")
+            fcntl.flock(fh, fcntl.LOCK_EX)
         yield
     finally:
         fh.close()
