@@ -49,6 +49,8 @@ STAMP_NAME = ".bragg-explorer-setup.json"
 PIP_LOG_NAME = ".bragg-explorer-pip.log"
 LOCK_PATH = REPO_ROOT / ".venv.lock"
 
+MIN_PYTHON = (3, 10)  # pyproject.toml: requires-python = ">=3.10"
+
 MODE_RUN = "run"
 MODE_TEST = "test"
 
@@ -610,6 +612,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if argv is None:
         argv = sys.argv[1:]
     mode, args, extras = parse_mode(argv)
+    if sys.version_info < MIN_PYTHON:
+        print(f"[setup] error: Python {'.'.join(map(str, MIN_PYTHON))} or newer is needed "
+              f"(this is {platform.python_version()} at {sys.executable})", file=sys.stderr)
+        return 1
     if os.environ.get(ENV_NO_SETUP, "") not in ("", "0"):
         run_in_process(mode, args)
     try:
