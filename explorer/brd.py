@@ -1,0 +1,687 @@
+"""Material files in Disney BRDF Explorer's analytic format.
+
+Our materials use the ``.brd`` extension; BRDF Explorer's own ``.brdf`` files
+load unchanged.  A file looks like this::
+
+    analytic
+
+    # Lambertian diffuse reflector.
+    # model: lambert
+
+    ::begin parameters
+    float reflectance 0 1 .8
+    bool  clamp_to_hemisphere 1
+    color tint 1 .9 .8
+    ::end parameters
+
+    ::begin shader
+    vec3 BRDF( vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y ) { ... }
+    ::end shader
+
+Rules, following BRDF Explorer's ``BRDFBase::loadBRDF`` where it has one:
+
+* The first non-blank, non-comment line is the kind; only ``analytic`` is
+  supported (BRDF Explorer itself insists on the very first line and ignores
+  any words after the kind; we accept both).
+* ``#`` lines are comments everywhere outside the shader section.  Inside it,
+  BRDF Explorer drops them too, so a ``#`` line that is not a GLSL
+  preprocessor directive is blanked there (keeping line numbers); real
+  directives (``#define``, ``#include``, ...) are kept.
+* Sections do not nest; ``::end X`` must close the open ``::begin X``.
+  Unknown sections (including BRDF Explorer's ``isFunc``) are skipped with a
+  warning.
+* ``# model: NAME`` outside the shader names the material's numpy twin.
+
+This module never imports GL: it only turns text into data and GLSL snippets.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, Union
+
+__all__ = [
+    "MaterialError",
+    "UnknownParameterError",
+    "Parameter",
+    "Material",
+    "parse_material",
+    "load_material",
+    "parse_assignment",
+    "GLSL_KEYWORDS",
+]
+
+Value = Union[float, bool, tuple]
+"""A resolved parameter value: float, bool or an (r, g, b) tuple of floats."""
+
+# A plain decimal number as BRDF Explorer's files write them: "1", "-2.", ".5",
+# "1e-3".  Stricter than float(), which also takes "nan", "inf" and "1_0".
+_NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
+_IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_MODEL_RE = re.compile(r"#\s*model\s*:\s*(.*?)\s*\Z", re.IGNORECASE)
+_MODEL_NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*\Z")
+# Preprocessor directives a GLSL compiler understands, plus our own #include.
+_GLSL_DIRECTIVE_RE = re.compile(
+    r"\s*#\s*(?:(?:define|undef|if|ifdef|ifndef|else|elif|endif|error|pragma"
+    r"|extension|version|line|include)\b.*)?\Z"
+)
+_NEWLINE_RE = re.compile(r"\r\n|\r|\n")
+
+# Keywords and reserved words of GLSL 3.30 up to 4.60: a uniform with one of
+# these names would not compile (now or when the shaders move to a newer GLSL).
+GLSL_KEYWORDS: frozenset[str] = frozenset(
+    """
+    attribute const uniform varying buffer shared coherent volatile restrict
+    readonly writeonly atomic_uint layout centroid flat smooth noperspective
+    patch sample invariant precise break continue do for while switch case
+    default if else subroutine in out inout int void bool true false float
+    double discard return vec2 vec3 vec4 ivec2 ivec3 ivec4 bvec2 bvec3 bvec4
+    uint uvec2 uvec3 uvec4 dvec2 dvec3 dvec4 mat2 mat3 mat4 mat2x2 mat2x3
+    mat2x4 mat3x2 mat3x3 mat3x4 mat4x2 mat4x3 mat4x4 dmat2 dmat3 dmat4
+    dmat2x2 dmat2x3 dmat2x4 dmat3x2 dmat3x3 dmat3x4 dmat4x2 dmat4x3 dmat4x4
+    lowp mediump highp precision struct
+    sampler1D sampler2D sampler3D samplerCube sampler1DShadow sampler2DShadow
+    samplerCubeShadow sampler1DArray sampler2DArray sampler1DArrayShadow
+    sampler2DArrayShadow isampler1D isampler2D isampler3D isamplerCube
+    isampler1DArray isampler2DArray usampler1D usampler2D usampler3D
+    usamplerCube usampler1DArray usampler2DArray sampler2DRect
+    sampler2DRectShadow isampler2DRect usampler2DRect samplerBuffer
+    isamplerBuffer usamplerBuffer sampler2DMS isampler2DMS usampler2DMS
+    sampler2DMSArray isampler2DMSArray usampler2DMSArray samplerCubeArray
+    samplerCubeArrayShadow isamplerCubeArray usamplerCubeArray
+    image1D iimage1D uimage1D image2D iimage2D uimage2D image3D iimage3D
+    uimage3D image2DRect iimage2DRect uimage2DRect imageCube iimageCube
+    uimageCube imageBuffer iimageBuffer uimageBuffer image1DArray
+    iimage1DArray uimage1DArray image2DArray iimage2DArray uimage2DArray
+    imageCubeArray iimageCubeArray uimageCubeArray image2DMS iimage2DMS
+    uimage2DMS image2DMSArray iimage2DMSArray uimage2DMSArray
+    common partition active asm class union enum typedef template this
+    resource goto inline noinline public static extern external interface
+    long short half fixed unsigned superp input output hvec2 hvec3 hvec4
+    fvec2 fvec3 fvec4 sampler3DRect filter sizeof cast namespace using
+    row_major
+    """.split()
+)
+
+_PARAMETER_USAGE = {
+    "float": "float NAME MIN MAX DEFAULT",
+    "bool": "bool NAME 0|1",
+    "color": "color NAME R G B",
+}
+_GLSL_TYPES = {"float": "float", "bool": "bool", "color": "vec3"}
+_TRUE_WORDS = frozenset({"1", "true", "yes", "on"})
+_FALSE_WORDS = frozenset({"0", "false", "no", "off"})
+
+
+class MaterialError(Exception):
+    """A material file, or a value meant for one, is wrong.
+
+    Parameters
+    ----------
+    path : str
+        The file (or other origin, such as ``"--set"``) the problem is in.
+    line : int or None
+        1-based line in `path`, or None when the problem has no line.
+    message : str
+        What is wrong, one line.
+
+    Notes
+    -----
+    ``str(error)`` is always one line, ``"{path}:{line}: {message}"`` or
+    ``"{path}: {message}"``, so that editors and terminals can jump to it.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], line: int | None, message: str) -> None:
+        # Pass all three to Exception so that the error pickles (multiprocessing).
+        super().__init__(os.fspath(path), line, message)
+        self.path: str = os.fspath(path)
+        self.line: int | None = line
+        self.message: str = message
+
+    def __str__(self) -> str:
+        where = self.path if self.line is None else f"{self.path}:{self.line}"
+        return " ".join(f"{where}: {self.message}".splitlines())
+
+
+class UnknownParameterError(MaterialError, KeyError):
+    """A parameter name that the material does not define.
+
+    Also a ``KeyError``, so ``Material.parameter`` behaves like a mapping.
+    """
+
+
+def _fmt(x: float) -> str:
+    """Format a number the way a material file would write it (no ``.0``)."""
+    return str(int(x)) if float(x).is_integer() and abs(x) < 1e15 else repr(float(x))
+
+
+def _parse_number(text: str) -> float | None:
+    """Return `text` as a float, or None when it is not a plain number."""
+    text = text.strip()
+    return float(text) if _NUMBER_RE.match(text) else None
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One line of a material's parameter section.
+
+    Attributes
+    ----------
+    name : str
+        The GLSL uniform name.
+    type : {'float', 'bool', 'color'}
+        The parameter kind.
+    min, max : float or None
+        The slider range of a float; None for bool and color.
+    default : float or bool or tuple of 3 floats
+        The value used when nothing overrides it.
+    line : int
+        1-based line of the declaration in the material file.
+    """
+
+    name: str
+    type: str
+    min: float | None
+    max: float | None
+    default: Value
+    line: int
+
+    @property
+    def glsl_type(self) -> str:
+        """The GLSL type of the uniform: ``float``, ``bool`` or ``vec3``."""
+        return _GLSL_TYPES[self.type]
+
+    def is_integer(self) -> bool:
+        """Whether a UI should show this parameter as an integer slider.
+
+        Returns
+        -------
+        bool
+            True for a float whose min, max and default are all integers
+            (exponents such as ``n``, counts, method switches).
+        """
+        if self.type != "float":
+            return False
+        values = (self.min, self.max, self.default)
+        return all(isinstance(v, float) and v.is_integer() for v in values)
+
+    def coerce(self, value: str | float | bool | Sequence[float]) -> Value:
+        """Validate a value for this parameter and convert it to its type.
+
+        Parameters
+        ----------
+        value : str or float or bool or sequence of float
+            A Python value, or a string as ``--set name=value`` gives it:
+            a number for a float; ``0|1|true|false|yes|no|on|off`` for a bool;
+            ``r,g,b`` or one number (grey) for a color.
+
+        Returns
+        -------
+        float or bool or tuple of 3 floats
+
+        Raises
+        ------
+        ValueError
+            With a one-line reason when the value does not fit (for a float,
+            naming the value and the range).
+        """
+        if self.type == "float":
+            return self._coerce_float(value)
+        if self.type == "bool":
+            return self._coerce_bool(value)
+        return self._coerce_color(value)
+
+    def _coerce_float(self, value: Any) -> float:
+        if isinstance(value, str):
+            number = _parse_number(value)
+            if number is None:
+                raise ValueError(f"{value!r} is not a number")
+        elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+            number = float(value)  # also numpy scalars
+        else:
+            raise ValueError(f"expected a number, got {value!r}")
+        assert self.min is not None and self.max is not None
+        # "not (a <= x <= b)" also rejects NaN.
+        if not self.min <= number <= self.max:
+            raise ValueError(
+                f"value {_fmt(number) if math.isfinite(number) else number} is outside "
+                f"its range [{_fmt(self.min)}, {_fmt(self.max)}]"
+            )
+        return number
+
+    @staticmethod
+    def _coerce_bool(value: Any) -> bool:
+        if isinstance(value, bool):
+            return value
+        if isinstance(value, numbers.Integral) and value in (0, 1):
+            return bool(value)
+        if isinstance(value, str):
+            word = value.strip().lower()
+            if word in _TRUE_WORDS:
+                return True
+            if word in _FALSE_WORDS:
+                return False
+        raise ValueError(f"{value!r} is not a boolean (use 0|1|true|false|yes|no|on|off)")
+
+    @staticmethod
+    def _coerce_color(value: Any) -> tuple[float, float, float]:
+        if isinstance(value, str):
+            parts = [_parse_number(p) for p in value.split(",")]
+            if len(parts) not in (1, 3) or None in parts:
+                raise ValueError(f"{value!r} is not a color (use r,g,b or one number for grey)")
+            components = [float(p) for p in parts if p is not None]
+        elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+            components = [float(value)]
+        else:
+            try:
+                components = [float(c) for c in value]
+            except (TypeError, ValueError):
+                raise ValueError(f"{value!r} is not a color (use r,g,b or one number for grey)") from None
+            if len(components) != 3:
+                raise ValueError(f"a color needs 3 components, got {len(components)}")
+        if not all(math.isfinite(c) for c in components):
+            raise ValueError(f"{value!r} is not a finite color")
+        r, g, b = components * 3 if len(components) == 1 else components
+        return (r, g, b)
+
+    def info(self) -> dict[str, Any]:
+        """JSON-friendly description: name, type, min, max, default."""
+        default: Any = list(self.default) if isinstance(self.default, tuple) else self.default
+        return {"name": self.name, "type": self.type, "min": self.min, "max": self.max, "default": default}
+
+
+@dataclass
+class Material:
+    """A parsed material file.
+
+    Attributes
+    ----------
+    path : str
+        Where it came from (used in every message).
+    parameters : list of Parameter
+        In file order.
+    shader : str
+        The shader section's text, lines ending in ``\\n``; verbatim except
+        that ``#`` comment lines (which BRDF Explorer drops) are blanked.
+    shader_line : int
+        1-based file line of the shader text's first line, so that GLSL
+        compile errors can be mapped back (see ``explorer.glsl``).
+    model : str or None
+        The numpy twin named by a ``# model: NAME`` comment.
+    warnings : list of str
+        One-line ``"{path}:{line}: ..."`` notes about things that were skipped.
+    """
+
+    path: str
+    parameters: list[Parameter]
+    shader: str
+    shader_line: int
+    model: str | None = None
+    warnings: list[str] = field(default_factory=list)
+
+    def parameter(self, name: str) -> Parameter:
+        """Return the parameter called `name`.
+
+        Raises
+        ------
+        UnknownParameterError
+            (a MaterialError and a KeyError) listing the valid names.
+        """
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        valid = ", ".join(p.name for p in self.parameters) or "(none)"
+        raise UnknownParameterError(self.path, None, f"unknown parameter {name!r}; valid names: {valid}")
+
+    def resolve(
+        self, overrides: Mapping[str, str | float | bool | Sequence[float]] = MappingProxyType({})
+    ) -> dict[str, Value]:
+        """Return every parameter's value: defaults, overridden by `overrides`.
+
+        Parameters
+        ----------
+        overrides : mapping of str to value
+            Values as Python objects or as strings from ``--set name=value``
+            (see `Parameter.coerce` for what each type accepts).
+
+        Returns
+        -------
+        dict
+            Name to float, bool or (r, g, b) tuple, in file order.
+
+        Raises
+        ------
+        MaterialError
+            For an unknown name (listing the valid ones) or a value that does
+            not fit (naming the parameter, the value and the range).
+        """
+        values: dict[str, Value] = {p.name: p.default for p in self.parameters}
+        for name, value in overrides.items():
+            p = self.parameter(name)
+            try:
+                values[name] = p.coerce(value)
+            except ValueError as exc:
+                raise MaterialError(self.path, None, f"parameter {name!r}: {exc}") from None
+        return values
+
+    def uniform_declarations(self) -> str:
+        """GLSL uniform declarations for the parameters, one per line.
+
+        Returns
+        -------
+        str
+            e.g. ``"uniform float n;\\nuniform bool divide_by_NdotL;\\n"``;
+            empty when there are no parameters.
+        """
+        return "".join(f"uniform {p.glsl_type} {p.name};\n" for p in self.parameters)
+
+    def info(self) -> dict[str, Any]:
+        """JSON-friendly summary for UIs and ``--info`` output.
+
+        Returns
+        -------
+        dict
+            ``{"parameters": [{"name", "type", "min", "max", "default"}, ...]}``
+            in file order; a color's default is a list of three numbers, a
+            bool's min and max are None and its default true/false.
+        """
+        return {"parameters": [p.info() for p in self.parameters]}
+
+
+class _Parser:
+    """Line-by-line state machine; one instance per file."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.warnings: list[str] = []
+        self.parameters: list[Parameter] = []
+        self.names: dict[str, int] = {}
+        self.model: str | None = None
+        self.model_line = 0
+        self.header_seen = False
+        self.section: str | None = None
+        self.section_line = 0
+        self.shader_lines: list[str] | None = None
+        self.shader_line = 0
+        self.shader_begin_line = 0
+
+    def error(self, line: int | None, message: str) -> MaterialError:
+        return MaterialError(self.path, line, message)
+
+    def warn(self, line: int, message: str) -> None:
+        self.warnings.append(f"{self.path}:{line}: {message}")
+
+    def parse(self, text: str) -> Material:
+        lines = _NEWLINE_RE.split(text.removeprefix("\ufeff"))
+        if lines and lines[-1] == "":
+            lines.pop()  # the final newline does not start another line
+        for number, line in enumerate(lines, start=1):
+            if self.section == "shader":
+                self.shader_text_line(number, line)
+            else:
+                self.line(number, line)
+        if self.section is not None:
+            raise self.error(
+                self.section_line,
+                f"section {self.section!r} is not terminated (missing '::end {self.section}')",
+            )
+        if not self.header_seen:
+            raise self.error(None, "missing 'analytic' header (the file has no content)")
+        if self.shader_lines is None:
+            raise self.error(None, "no shader section ('::begin shader' ... '::end shader')")
+        return Material(
+            path=self.path,
+            parameters=self.parameters,
+            shader="".join(s + "\n" for s in self.shader_lines),
+            shader_line=self.shader_line,
+            model=self.model,
+            warnings=self.warnings,
+        )
+
+    def line(self, number: int, line: str) -> None:
+        """Handle a line outside the shader section."""
+        stripped = line.strip()
+        if not stripped:
+            return
+        if stripped.startswith("#"):
+            self.comment(number, stripped)
+            return
+        tokens = stripped.split()
+        if not self.header_seen:
+            self.header(number, tokens)
+            return
+        if tokens[0] == "::begin":
+            self.begin(number, tokens)
+        elif tokens[0] == "::end":
+            self.end(number, tokens)
+        elif self.section == "parameters":
+            self.parameter(number, stripped)
+        elif self.section is None:
+            # BRDF Explorer silently ignores these; say so, they are likely typos.
+            self.warn(number, f"ignoring text outside any section: {stripped!r}")
+        # else: a line of an unknown section, skipped (warned at ::begin)
+
+    def comment(self, number: int, stripped: str) -> None:
+        match = _MODEL_RE.match(stripped)
+        if match is None:
+            return
+        name = match.group(1)
+        if not _MODEL_NAME_RE.match(name):
+            self.warn(number, f"ignoring '# model:' comment with invalid model name {name!r}")
+        elif self.model is None:
+            self.model, self.model_line = name, number
+        elif name != self.model:
+            self.warn(number, f"ignoring second model {name!r}; using {self.model!r} from line {self.model_line}")
+
+    def header(self, number: int, tokens: list[str]) -> None:
+        kind = tokens[0]
+        if kind == "analytic":
+            self.header_seen = True
+            if len(tokens) > 1:  # BRDF Explorer ignores these too
+                self.warn(number, f"ignoring text after 'analytic': {' '.join(tokens[1:])!r}")
+        elif kind == "bparam":
+            raise self.error(
+                number, "this is a BRDF Explorer parameter file ('bparam'); load the material it refers to"
+            )
+        elif kind.startswith("::"):
+            raise self.error(number, f"missing 'analytic' header before {kind!r}")
+        else:
+            raise self.error(
+                number, f"unsupported material kind {kind!r}; only 'analytic' materials can be loaded"
+            )
+
+    def begin(self, number: int, tokens: list[str]) -> None:
+        if len(tokens) < 2:
+            raise self.error(number, "'::begin' without a section name")
+        name = tokens[1]
+        if self.section is not None:
+            raise self.error(
+                number,
+                f"'::begin {name}' inside section {self.section!r} opened on line "
+                f"{self.section_line}; sections cannot nest",
+            )
+        self.section, self.section_line = name, number
+        if name == "shader":
+            if self.shader_lines is not None:  # BRDF Explorer keeps the last one
+                self.warn(number, f"second shader section replaces the one on line {self.shader_begin_line}")
+            self.shader_lines = []
+            self.shader_line = number + 1
+            self.shader_begin_line = number
+        elif name == "isFunc":
+            self.warn(number, "skipping section 'isFunc' (BRDF Explorer's importance sampling; not used here)")
+        elif name != "parameters":
+            self.warn(number, f"skipping unknown section {name!r}")
+
+    def end(self, number: int, tokens: list[str]) -> None:
+        name = tokens[1] if len(tokens) > 1 else ""
+        if self.section is None:
+            raise self.error(number, f"{' '.join(tokens[:2])!r} without a matching '::begin'")
+        if name != self.section:
+            raise self.error(
+                number,
+                f"'::end {name}' does not close section {self.section!r} opened on line {self.section_line}",
+            )
+        self.section = None
+
+    def shader_text_line(self, number: int, line: str) -> None:
+        """Handle a line inside the shader section."""
+        tokens = line.split(maxsplit=2)
+        if tokens and tokens[0] in ("::begin", "::end"):
+            if tokens[0] == "::begin":
+                self.begin(number, tokens)  # raises: sections cannot nest
+            self.end(number, tokens)
+            return
+        assert self.shader_lines is not None
+        stripped = line.strip()
+        if stripped.startswith("#") and not _GLSL_DIRECTIVE_RE.match(line):
+            # A comment line: BRDF Explorer drops it, a GLSL compiler would
+            # reject it.  Blank it so that line numbers still match the file.
+            if _MODEL_RE.match(stripped):
+                self.warn(number, "'# model:' inside the shader section is ignored")
+            line = ""
+        self.shader_lines.append(line)
+
+    def parameter(self, number: int, stripped: str) -> None:
+        # BRDF Explorer ignores anything after the last field; we only allow
+        # a trailing "# comment" there and insist on the exact field count.
+        tokens = stripped.split("#", 1)[0].split()
+        kind = tokens[0]
+        usage = _PARAMETER_USAGE.get(kind)
+        if usage is None:
+            raise self.error(number, f"unknown parameter type {kind!r} (expected float, bool or color)")
+        expected = len(usage.split())
+        if len(tokens) != expected:
+            raise self.error(
+                number, f"a {kind} parameter has {expected - 1} fields ({usage}), got {len(tokens) - 1}"
+            )
+        name = tokens[1]
+        self.check_name(number, name)
+        if kind == "bool":
+            if tokens[2] not in ("0", "1"):
+                raise self.error(number, f"bool {name!r}: default must be 0 or 1, got {tokens[2]!r}")
+            param = Parameter(name, "bool", None, None, tokens[2] == "1", number)
+        else:
+            fields = ("min", "max", "default") if kind == "float" else ("red", "green", "blue")
+            values: list[float] = []
+            for label, token in zip(fields, tokens[2:]):
+                value = _parse_number(token)
+                if value is None or not math.isfinite(value):
+                    raise self.error(number, f"{kind} {name!r}: {label} {token!r} is not a number")
+                values.append(value)
+            if kind == "float":
+                lo, hi, default = values
+                if lo > hi:
+                    raise self.error(number, f"float {name!r}: min {_fmt(lo)} is greater than max {_fmt(hi)}")
+                if not lo <= default <= hi:
+                    raise self.error(
+                        number, f"float {name!r}: default {_fmt(default)} is outside [{_fmt(lo)}, {_fmt(hi)}]"
+                    )
+                param = Parameter(name, "float", lo, hi, default, number)
+            else:
+                param = Parameter(name, "color", None, None, (values[0], values[1], values[2]), number)
+        self.names[name] = number
+        self.parameters.append(param)
+
+    def check_name(self, number: int, name: str) -> None:
+        if not _IDENTIFIER_RE.match(name):
+            raise self.error(number, f"parameter name {name!r} is not a valid GLSL identifier")
+        if name in GLSL_KEYWORDS:
+            raise self.error(number, f"parameter name {name!r} is a GLSL keyword")
+        if name.startswith("gl_"):
+            raise self.error(number, f"parameter name {name!r} uses the reserved prefix 'gl_'")
+        if name in self.names:
+            raise self.error(number, f"duplicate parameter {name!r} (first defined on line {self.names[name]})")
+        if "__" in name:  # reserved by the GLSL spec, though most drivers only warn
+            self.warn(number, f"parameter name {name!r} contains '__', which GLSL reserves")
+
+
+def parse_material(text: str, path: str | os.PathLike[str] = "<string>") -> Material:
+    """Parse the text of a material file.
+
+    Parameters
+    ----------
+    text : str
+        The whole file; LF, CRLF or CR line endings.
+    path : str or path-like
+        Name used in the material and in every message.
+
+    Returns
+    -------
+    Material
+
+    Raises
+    ------
+    MaterialError
+        With the offending line, for: a missing or non-``analytic`` header,
+        an unterminated, unmatched or nested section, a malformed parameter
+        (unknown type, wrong number of fields, non-numeric value, min > max,
+        default outside [min, max], bool default not 0/1, duplicate or invalid
+        name), or no shader section.
+    """
+    return _Parser(os.fspath(path)).parse(text)
+
+
+def load_material(path: str | os.PathLike[str]) -> Material:
+    """Read and parse a material file (``.brd`` or BRDF Explorer's ``.brdf``).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    Material
+
+    Raises
+    ------
+    MaterialError
+        When the file cannot be read, or does not parse (see `parse_material`).
+    """
+    name = os.fspath(path)
+    try:
+        with open(name, "rb") as f:
+            data = f.read()
+    except OSError as exc:
+        raise MaterialError(name, None, f"cannot read material file: {exc.strerror or exc}") from None
+    try:
+        return parse_material(data.decode("utf-8-sig"), name)
+    except UnicodeDecodeError:
+        pass
+    # Old files may carry Latin-1 comments; BRDF Explorer reads bytes and
+    # does not care, so neither do we (but say so).
+    material = parse_material(data.decode("latin-1"), name)
+    material.warnings.insert(0, f"{name}:1: file is not UTF-8; read as Latin-1")
+    return material
+
+
+def parse_assignment(text: str) -> tuple[str, str]:
+    """Split a CLI ``--set name=value`` argument.
+
+    Parameters
+    ----------
+    text : str
+        ``"name=value"``; whitespace around either part is dropped.
+
+    Returns
+    -------
+    (str, str)
+        The name and the value string (to pass to `Material.resolve`).
+
+    Raises
+    ------
+    MaterialError
+        (path ``"--set"``) when there is no ``=``, no name or no value.
+    """
+    name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name:
+        raise MaterialError("--set", None, f"expected name=value, got {text!r}")
+    if not value:
+        raise MaterialError("--set", None, f"missing value in {text!r}")
+    return name, value
