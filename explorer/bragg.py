@@ -125,6 +125,7 @@ def Omega(polarisation: str, n1, cos_theta_1, n2, cos_theta_2) -> np.ndarray:
         x = (n2 * cos_theta_2) / (n1 * cos_theta_1)
     else:
         x = (n1 * cos_theta_2) / (n2 * cos_theta_1)
+    x = np.where(np.abs(x) < 1e-10, 1e-10, x)  # exactly at a critical angle
     return x + 1.0 / x
 
 
@@ -547,3 +548,78 @@ def approximate_rgb(
         for pol in POLARISATIONS
     )
     return colorimetry.xyz_to_rgb(0.5 * xyz)
+
+
+# --------------------------------------------------------------------------------------------------
+# The tabulated method (ours): a homogeneous mirror's colour depends on cos(theta) alone.
+
+#: Entries of the table over cos(theta) in [0, 1].
+TABLE_SIZE = 256
+
+
+def _reflectance_real(omega, geometry: CellGeometry, rows) -> np.ndarray:
+    """
+    Eqs. 2, 8, 9, 10 in real float32 arithmetic, for angles where every wave propagates and
+    ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-6, several times faster (the
+    table is rebuilt on every parameter change), with
+    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels in Eq. 2).
+    """
+    f32 = np.float32
+    omega = omega.astype(f32)
+    p1 = geometry.p1.real[rows, None].astype(f32)
+    p2 = geometry.p2.real[rows, None].astype(f32)
+    r12_2 = (geometry.r12.real[rows, None] ** 2).astype(f32)
+    half_Omega = (0.5 * geometry.Omega.real[rows, None]).astype(f32)
+    N = f32(geometry.N)
+    psi, phi = omega * p1, omega * p2
+    sin_phi = np.sin(phi)
+    a = np.cos(psi) * np.cos(phi) - half_Omega * np.sin(psi) * sin_phi
+    r1_2 = f32(4.0) * r12_2 * sin_phi * sin_phi
+    t1_2 = (f32(1.0) - r12_2) ** 2
+    in_band = np.abs(a) < f32(1.0)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        a_band = np.clip(a, f32(-1.0), f32(1.0))
+        U_N1_2 = np.sin(N * np.arccos(a_band)) ** 2 / (f32(1.0) - a_band * a_band)
+        x = np.maximum(np.arccosh(np.maximum(np.abs(a), f32(1.0))), f32(1e-12))
+        h = lambda y: -np.expm1(f32(-2.0) * y)
+        scale = np.exp(-(N - f32(1.0)) * x) * h(x) / h(N * x)
+    numerator = r1_2 * np.where(in_band, U_N1_2, f32(1.0))
+    return numerator / (numerator + t1_2 * np.where(in_band, f32(1.0), scale * scale))
+
+
+def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
+    """
+    The spectral reference at ``cos theta = k / (size - 1)``, for the host to upload as a 1D texture.
+
+    Angles where a wave is evanescent, or under a host ``nh != n1``, take the general complex path.
+    """
+    cos_theta = np.linspace(0.0, 1.0, size)
+    omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
+
+    def polarised(pol: str) -> np.ndarray:
+        spectra = np.zeros((size, omega.size), dtype=np.float32)
+        geometry = cell_geometry(cos_theta, mirror, pol)
+        real = (geometry.p1.imag == 0) & (geometry.p2.imag == 0) & geometry.host_is_n1
+        spectra[real] = _reflectance_real(omega, geometry, real)
+        if not real.all():
+            general = cell_geometry(cos_theta[~real], mirror, pol)
+            spectra[~real] = reflectance_polarised(omega, _rows(general))
+        return spectra
+
+    spectra = polarised("s") + polarised("p")
+    return colorimetry.spectrum_to_rgb(0.5 * spectra.astype(np.float64)).astype(np.float32)
+
+
+def _rows(geometry: CellGeometry) -> CellGeometry:
+    """The geometry with a trailing axis, to broadcast angles against wavelengths."""
+    fields = {k: (v[:, None] if isinstance(v, np.ndarray) else v) for k, v in vars(geometry).items()}
+    return CellGeometry(**fields)
+
+
+def tabulated_rgb(table: np.ndarray, cos_theta) -> np.ndarray:
+    """Linear interpolation in the table, as a linearly filtered texture fetch does."""
+    size = table.shape[0]
+    x = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0) * (size - 1)
+    i = np.minimum(np.floor(x).astype(np.int64), size - 2)
+    f = (x - i)[..., None]
+    return table[i].astype(np.float64) * (1.0 - f) + table[i + 1].astype(np.float64) * f

@@ -1,0 +1,295 @@
+// Bragg mirrors: twin of explorer/bragg.py, function for function and under the same names.
+// Fourneau, Pacanowski, Barla (2024), Interactive Exploration of Vivid Material Iridescence using
+// Bragg Mirrors: Sections 3.1-3.2, Appendices A, B, D. Equation numbers are the paper's.
+//
+// A mirror is N cells of (n2, d2) then (n1, d1) under a host nh (nh < 1 means "the host is n1").
+// omega = 2 pi / lambda in rad/nm; angles are cosines in the host.
+#include "lib/fresnel.glsl"
+#include "lib/colorimetry.glsl"
+
+const int BISECTION_STEPS = 12;
+const float WAVELENGTH_LOW = 359.5;
+const float WAVELENGTH_HIGH = 830.5;
+const float OMEGA_LOW = 2.0 * PI / WAVELENGTH_HIGH;
+const float OMEGA_HIGH = 2.0 * PI / WAVELENGTH_LOW;
+const float COS_THETA_MIN = 1e-6;
+const float MAX_DECAY = 40.0;
+
+struct BraggMirror {
+    float n1, n2, Lambda, delta, N, nh;
+};
+
+float eta_h(BraggMirror mirror) { return mirror.nh < 1.0 ? mirror.n1 : mirror.nh; }
+
+// What a cell looks like at one angle and polarisation: p1 = n1 cos(theta_1) d1, p2 = n2 cos(theta_2) d2.
+struct CellGeometry {
+    vec2 cos_theta_1, cos_theta_2, p1, p2, r12, Omega, r_h1;
+    float correction, N;
+    bool host_is_n1;
+};
+
+float angular_correction(vec2 cos_theta_1, float n1, float n2);
+
+// Eqs. 6-7 (polarisation 0 = 's', 1 = 'p').
+vec2 Omega(int polarisation, float n1, vec2 cos_theta_1, float n2, vec2 cos_theta_2) {
+    vec2 x = polarisation == 0 ? cdiv(n2 * cos_theta_2, n1 * cos_theta_1) : cdiv(n1 * cos_theta_2, n2 * cos_theta_1);
+    if (cabs2(x) < 1e-20) x = vec2(1e-10, 0.0);  // exactly at a critical angle
+    return x + cinv(x);
+}
+
+CellGeometry cell_geometry(float cos_theta_h, BraggMirror mirror, int polarisation) {
+    cos_theta_h = max(cos_theta_h, COS_THETA_MIN);
+    float host = eta_h(mirror);
+    float d1 = mirror.delta * mirror.Lambda, d2 = (1.0 - mirror.delta) * mirror.Lambda;
+    CellGeometry g;
+    g.cos_theta_1 = cos_theta_transmitted(cos_theta_h, host, mirror.n1);
+    g.cos_theta_2 = cos_theta_transmitted(cos_theta_h, host, mirror.n2);
+    g.p1 = mirror.n1 * d1 * g.cos_theta_1;
+    g.p2 = mirror.n2 * d2 * g.cos_theta_2;
+    g.r12 = fresnel_r(polarisation, mirror.n1, g.cos_theta_1, mirror.n2, g.cos_theta_2);
+    g.Omega = Omega(polarisation, mirror.n1, g.cos_theta_1, mirror.n2, g.cos_theta_2);
+    g.r_h1 = fresnel_r(polarisation, host, vec2(cos_theta_h, 0.0), mirror.n1, g.cos_theta_1);
+    g.correction = angular_correction(g.cos_theta_1, mirror.n1, mirror.n2);
+    g.N = mirror.N;
+    g.host_is_n1 = host == mirror.n1;
+    return g;
+}
+
+// ---- Yeh's reflectance (Section 3.1) ---------------------------------------------------------------
+
+// Eq. 10: the Airy slab's r1 = r12 (1 - e^{2i phi}) / (1 - r12^2 e^{2i phi}), t1 = (1 - r12^2) e^{i phi} / (...).
+void airy_slab_coefficients(float omega, CellGeometry g, out vec2 r1, out vec2 t1) {
+    vec2 phase = cexpi(omega * g.p2);
+    vec2 phase2 = cmul(phase, phase);
+    vec2 r12_2 = cmul(g.r12, g.r12);
+    vec2 denominator = vec2(1.0, 0.0) - cmul(r12_2, phase2);
+    r1 = cdiv(cmul(g.r12, vec2(1.0, 0.0) - phase2), denominator);
+    t1 = cdiv(cmul(vec2(1.0, 0.0) - r12_2, phase), denominator);
+}
+
+float C_squared(vec2 r1, vec2 t1) { return cabs2(r1) / cabs2(t1); }
+
+vec2 clamp_decay(vec2 phase) { return vec2(phase.x, min(phase.y, MAX_DECAY)); }
+
+// Eq. 8, real also when a layer is evanescent.
+float cos_K_Lambda(float omega, CellGeometry g) {
+    vec2 psi = clamp_decay(omega * g.p1), phi = clamp_decay(omega * g.p2);
+    vec2 value = cmul(ccos(psi), ccos(phi)) - 0.5 * cmul(g.Omega, cmul(csin(psi), csin(phi)));
+    return value.x;
+}
+
+// 1 - exp(-2x) without cancellation for small x.
+float one_minus_exp_minus_2x(float x) {
+    return x < 0.05 ? 2.0 * x * (1.0 - x + x * x * (2.0 / 3.0 - x / 3.0)) : 1.0 - exp(-2.0 * x);
+}
+
+float acosh_stable(float a) { return a > 1e4 ? log(2.0 * a) : log(a + sqrt((a - 1.0) * (a + 1.0))); }
+
+// U_{N-1}, U_{N-2} of cos K Lambda, divided by U_{N-1} in band gaps (Eq. 9) where they overflow.
+void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float scale) {
+    if (abs(a) < 1.0) {
+        float t = acos(a), sin_t = sin(t);
+        U_N1 = sin(N * t) / sin_t;
+        U_N2 = sin((N - 1.0) * t) / sin_t;
+        scale = 1.0;
+    } else {
+        float x = max(acosh_stable(abs(a)), 1e-12);
+        float h_N = one_minus_exp_minus_2x(N * x);
+        U_N1 = 1.0;
+        U_N2 = sign(a) * exp(-x) * one_minus_exp_minus_2x((N - 1.0) * x) / h_N;
+        scale = exp(-(N - 1.0) * x) * one_minus_exp_minus_2x(x) / h_N;
+    }
+}
+
+// Eqs. 2 and 9: |r1|^2 U^2 / (|r1|^2 U^2 + |t1|^2 scale^2).
+float reflectance_yeh(vec2 r1, vec2 t1, float a, float N) {
+    float U_N1, U_N2, scale;
+    chebyshev_U(a, N, U_N1, U_N2, scale);
+    float numerator = cabs2(r1) * U_N1 * U_N1;
+    return numerator / (numerator + cabs2(t1) * scale * scale);
+}
+
+// Appendix D: r_N = r1 U_{N-1} / (U_{N-1} - U_{N-2} t1 e^{i k1z d1}).
+vec2 reflection_coefficient_bragg(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
+    float U_N1, U_N2, scale;
+    chebyshev_U(a, g.N, U_N1, U_N2, scale);
+    vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
+    return cdiv(r1 * U_N1, vec2(U_N1, 0.0) - U_N2 * t_cell);
+}
+
+// Appendix D: r_hN = (r_N + r_h1) / (1 + r_h1 r_N).
+vec2 reflection_coefficient_host(vec2 r_N, vec2 r_h1) {
+    return cdiv(r_N + r_h1, vec2(1.0, 0.0) + cmul(r_h1, r_N));
+}
+
+float reflectance_polarised(float omega, CellGeometry g) {
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    if (g.host_is_n1) return reflectance_yeh(r1, t1, a, g.N);
+    return cabs2(reflection_coefficient_host(reflection_coefficient_bragg(r1, t1, omega, g, a), g.r_h1));
+}
+
+// Unpolarised R_lambda.
+float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
+    float omega = 2.0 * PI / wavelength;
+    return 0.5 * (reflectance_polarised(omega, cell_geometry(cos_theta, mirror, 0)) +
+                  reflectance_polarised(omega, cell_geometry(cos_theta, mirror, 1)));
+}
+
+// The spectral reference: R_lambda at every nm from 360 to 830, both polarisations, against the CMFs.
+vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
+    CellGeometry g_s = cell_geometry(cos_theta, mirror, 0), g_p = cell_geometry(cos_theta, mirror, 1);
+    vec3 xyz = vec3(0.0);
+    for (int i = 0; i < CMF_COUNT; ++i) {
+        float omega = 2.0 * PI / (CMF_FIRST_WAVELENGTH + float(i));
+        float R = 0.5 * (reflectance_polarised(omega, g_s) + reflectance_polarised(omega, g_p));
+        xyz += R * colour_matching_functions(i);
+    }
+    return xyz_to_rgb(xyz);
+}
+
+// ---- Envelope and landmarks (Section 3.2.1, Appendices A, B) -------------------------------------
+
+// Incoherent host interface over a mirror reflectance (our extension for nh != n1).
+float under_host(float R_mirror, CellGeometry g) {
+    if (g.host_is_n1) return R_mirror;
+    float R_h1 = cabs2(g.r_h1);
+    return R_h1 + (1.0 - R_h1) * (1.0 - R_h1) * R_mirror / (1.0 - R_h1 * R_mirror);
+}
+
+// Eq. 11.
+float reflectance_envelope(float omega, CellGeometry g) {
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    float r1_2 = cabs2(r1);
+    return under_host(r1_2 / (r1_2 + cabs2(t1) * max(1.0 - a * a, 0.0)), g);
+}
+
+// Yeh's R averaged over its fringes: 1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda) (ours).
+float reflectance_fringe_average(float omega, CellGeometry g) {
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
+    return under_host(1.0 - sqrt(t1_2_sin2 / (cabs2(r1) + t1_2_sin2)), g);
+}
+
+// Appendix B: w~ = w~0 + (1 - w~0)(1 - cos theta_1)^5, w~0 = 0.735 R12 + 0.532.
+float angular_correction(vec2 cos_theta_1, float n1, float n2) {
+    float R12 = (n1 - n2) * (n1 - n2) / ((n1 + n2) * (n1 + n2));
+    float w0 = 0.735 * R12 + 0.532;
+    float m = 1.0 - clamp(cos_theta_1.x, 0.0, 1.0);
+    return w0 + (1.0 - w0) * (m * m) * (m * m) * m;
+}
+
+float optical_thickness(CellGeometry g) { return max(g.p1.x + g.p2.x, 1e-9); }
+
+// Eq. 13.
+float mode_frequency(float m, float n_plus) { return m * PI / n_plus; }
+
+float airy_point(CellGeometry g, float lo, float hi, float m) {
+    bool positive_at_lo = mod(m, 2.0) < 0.5;  // cos K Lambda has the sign (-1)^m at omega_m (Appendix A)
+    for (int i = 0; i < BISECTION_STEPS; ++i) {
+        float mid = 0.5 * (lo + hi);
+        if ((cos_K_Lambda(mid, g) >= 0.0) == positive_at_lo) lo = mid; else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+float band_edge(CellGeometry g, float lo, float hi, bool gap_at_lo) {
+    for (int i = 0; i < BISECTION_STEPS; ++i) {
+        float mid = 0.5 * (lo + hi);
+        if ((abs(cos_K_Lambda(mid, g)) - 1.0 >= 0.0) == gap_at_lo) lo = mid; else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// Eq. 12: the first zero point above omega (none while n2 is evanescent).
+float zero_point_after(CellGeometry g, float omega, out bool exists) {
+    exists = g.p2.y == 0.0 && g.p2.x > 0.0;
+    float p2 = exists ? g.p2.x : 1.0;
+    return (floor(omega * p2 / PI) + 1.0) * PI / p2;
+}
+
+// ---- The piecewise-constant approximation (Section 3.2.2) ----------------------------------------
+
+float wavelength_of(float omega) { return 2.0 * PI / max(omega, 1e-9); }
+
+// max(1, s - m), m counted from the first visible interval (relative) or from mode 0 (absolute).
+float subdivisions(float m, float m_first, float s, bool absolute_numbering) {
+    if (s <= 0.0) return 1.0;
+    return max(1.0, s - (absolute_numbering ? m : m - m_first));
+}
+
+// Sub-box j of pieces in [lo, hi]: equal (edge 0), or graded quadratically toward a band edge at lo
+// (edge -1) or hi (edge +1) and sampled at its centroid (ours).
+void sub_box(float lo, float hi, float j, float pieces, int edge, out float sub_lo, out float centre, out float sub_hi) {
+    float u0 = j / pieces, u1 = (j + 1.0) / pieces, width = hi - lo;
+    if (edge == 0) {
+        sub_lo = lo + width * u0; centre = lo + width * 0.5 * (u0 + u1); sub_hi = lo + width * u1;
+        return;
+    }
+    float uc = 2.0 * (u0 * u0 + u0 * u1 + u1 * u1) / (3.0 * (u0 + u1));
+    if (edge < 0) {
+        sub_lo = lo + width * u0 * u0; centre = lo + width * uc * uc; sub_hi = lo + width * u1 * u1;
+    } else {
+        sub_lo = hi - width * u1 * u1; centre = hi - width * uc * uc; sub_hi = hi - width * u0 * u0;
+    }
+}
+
+// Eq. 15 for one polarisation: boxes walked in increasing omega, one C lookup per landmark (Eq. 16).
+vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering, bool improved) {
+    float n_plus = optical_thickness(g);
+    float m_first = floor(OMEGA_LOW * n_plus / PI), m_last = floor(OMEGA_HIGH * n_plus / PI);
+    vec3 xyz = vec3(0.0);
+    for (float m = m_first; m <= m_last; m += 1.0) {
+        float omega_m = mode_frequency(m, n_plus);
+        float omega_next = min(mode_frequency(m + 1.0, n_plus), OMEGA_HIGH);
+        float omega_a = airy_point(g, omega_m, omega_next, m);
+        float edge_low = band_edge(g, omega_m, omega_a, true);
+        float edge_high = band_edge(g, omega_a, omega_next, false);
+        bool has_zero;
+        float omega_z = zero_point_after(g, edge_low, has_zero);
+        float z = has_zero && omega_z < edge_high ? omega_z : omega_a;
+        float x1 = min(z, omega_a), x2 = max(z, omega_a);
+
+        vec3 C_previous = cmf_cumulative_at(wavelength_of(omega_m));
+        vec3 C_next = cmf_cumulative_at(wavelength_of(edge_low));
+        xyz += C_previous - C_next;  // upper half of the gap around mode m: w = 1
+        C_previous = C_next;
+        float pieces = subdivisions(m, m_first, s, absolute_numbering);
+        for (int box = 0; box < 3; ++box) {
+            float lo = box == 0 ? edge_low : (box == 1 ? x1 : x2);
+            float hi = box == 0 ? x1 : (box == 1 ? x2 : edge_high);
+            if (hi <= lo) continue;
+            int edge = improved ? box - 1 : 0;
+            for (float k = 0.0; k < pieces; k += 1.0) {
+                float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
+                float sub_lo, centre, sub_hi;
+                sub_box(lo, hi, j, pieces, edge, sub_lo, centre, sub_hi);
+                float weight = improved ? reflectance_fringe_average(centre, g)
+                                        : g.correction * reflectance_envelope(centre, g);
+                C_next = cmf_cumulative_at(wavelength_of(sub_hi));
+                xyz += weight * (C_previous - C_next);
+                C_previous = C_next;
+            }
+        }
+        xyz += C_previous - cmf_cumulative_at(wavelength_of(omega_next));  // lower half of the next gap
+    }
+    return xyz;
+}
+
+// Section 3.2: s = 0 basic, s >= 1 subdivided; improved = our variant.
+vec3 approximate_rgb(float cos_theta, BraggMirror mirror, float s, bool absolute_numbering, bool improved) {
+    vec3 xyz = approximate_xyz_polarised(cell_geometry(cos_theta, mirror, 0), s, absolute_numbering, improved) +
+               approximate_xyz_polarised(cell_geometry(cos_theta, mirror, 1), s, absolute_numbering, improved);
+    return xyz_to_rgb(0.5 * xyz);
+}
+
+// The tabulated method: exact RGB over cos theta in [0, 1], table entry k at cos theta = k / (size - 1).
+vec3 tabulated_rgb(sampler1D table, float cos_theta) {
+    float size = float(textureSize(table, 0));
+    return texture(table, (clamp(cos_theta, 0.0, 1.0) * (size - 1.0) + 0.5) / size).rgb;
+}

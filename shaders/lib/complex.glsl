@@ -1,0 +1,23 @@
+// Complex arithmetic on vec2 (x = real part, y = imaginary part).
+// Waves travel as exp(+i k z), as in explorer/fresnel.py.
+
+const float PI = 3.14159265358979;
+
+vec2 cmul(vec2 a, vec2 b) { return vec2(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x); }
+vec2 cconj(vec2 a) { return vec2(a.x, -a.y); }
+float cabs2(vec2 a) { return dot(a, a); }
+vec2 cdiv(vec2 a, vec2 b) { return cmul(a, cconj(b)) / dot(b, b); }
+vec2 cinv(vec2 a) { return cconj(a) / dot(a, a); }
+
+// exp(i z) = exp(-y) (cos x + i sin x)
+vec2 cexpi(vec2 z) { return exp(-z.y) * vec2(cos(z.x), sin(z.x)); }
+
+// cos z and sin z for z = x + iy: one exp for cosh and sinh.
+vec2 ccos(vec2 z) {
+    float e = exp(z.y), ie = 1.0 / e;
+    return vec2(cos(z.x) * 0.5 * (e + ie), -sin(z.x) * 0.5 * (e - ie));
+}
+vec2 csin(vec2 z) {
+    float e = exp(z.y), ie = 1.0 / e;
+    return vec2(sin(z.x) * 0.5 * (e + ie), cos(z.x) * 0.5 * (e - ie));
+}
