@@ -289,7 +289,7 @@ vec3 approximate_rgb(float cos_theta, BraggMirror mirror, float s, bool absolute
 }
 
 // The tabulated method: exact RGB over cos theta in [0, 1], table entry k at cos theta = k / (size - 1).
-vec3 tabulated_rgb(sampler1D table, float cos_theta) {
-    float size = float(textureSize(table, 0));
-    return texture(table, (clamp(cos_theta, 0.0, 1.0) * (size - 1.0) + 0.5) / size).rgb;
+vec3 tabulated_rgb(sampler2D table, float cos_theta) {
+    float size = float(textureSize(table, 0).x);
+    return texture(table, vec2((clamp(cos_theta, 0.0, 1.0) * (size - 1.0) + 0.5) / size, 0.5)).rgb;
 }

@@ -1,10 +1,10 @@
 // The colour convention (explorer/colorimetry.py) and the CMF tables of luts/ (explorer/luts.py).
-// The host binds: cmf_1nm (471 texels, CMFs at 360..830 nm, sum(ybar) = 1), cmf_cumulative (472 texels,
+// Tables are 2D textures of height 1 (moderngl has no 1D textures). The host binds: cmf_1nm (471 texels, CMFs at 360..830 nm, sum(ybar) = 1), cmf_cumulative (472 texels,
 // their cumulative integral at the bin edges 359.5 + k nm, linear filtering, clamped to edge) and
 // xyz_to_rgb_matrix (XYZ with E white -> linear sRGB with white (1, 1, 1)).
 
-uniform sampler1D cmf_1nm;
-uniform sampler1D cmf_cumulative;
+uniform sampler2D cmf_1nm;         // 471 x 1
+uniform sampler2D cmf_cumulative;  // 472 x 1
 uniform mat3 xyz_to_rgb_matrix;
 
 const int CMF_COUNT = 471;
@@ -13,11 +13,11 @@ const float CUMULATIVE_START = 359.5;
 const float CUMULATIVE_SIZE = 472.0;
 
 // CMFs at wavelength 360 + index nm.
-vec3 colour_matching_functions(int index) { return texelFetch(cmf_1nm, index, 0).rgb; }
+vec3 colour_matching_functions(int index) { return texelFetch(cmf_1nm, ivec2(index, 0), 0).rgb; }
 
 // C(lambda) (Eq. 16): node k sits at the centre of texel k.
 vec3 cmf_cumulative_at(float wavelength) {
-    return texture(cmf_cumulative, (wavelength - CUMULATIVE_START + 0.5) / CUMULATIVE_SIZE).rgb;
+    return texture(cmf_cumulative, vec2((wavelength - CUMULATIVE_START + 0.5) / CUMULATIVE_SIZE, 0.5)).rgb;
 }
 
 vec3 xyz_to_rgb(vec3 xyz) { return xyz_to_rgb_matrix * xyz; }

@@ -1,0 +1,185 @@
+"""
+The OpenGL host: builds a material's shader program for a view, uploads the tables, renders.
+
+One program per (material, view): the preprocessor (:mod:`explorer.glsl`) assembles the material's
+parameter uniforms, its shader section and the view template; compile errors name the real file and
+line. Headless rendering uses a moderngl standalone EGL context (Mesa's llvmpipe without a GPU).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from . import colorimetry, luts
+from .brd import Material
+from .glsl import ShaderBuilder, ShaderError
+from .models import model_for
+
+SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+GLSL_VERSION = "330 core"
+
+EGL_PACKAGES = "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri"
+
+VERTEX_SHADER = f"""#version {GLSL_VERSION}
+// A full-screen triangle from gl_VertexID: no vertex buffer needed.
+void main() {{
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+}}
+"""
+
+
+class GLUnavailable(RuntimeError):
+    """No OpenGL 3.3 context could be created (one-line message naming what to install)."""
+
+
+def create_context():
+    """A headless moderngl context through EGL, or :class:`GLUnavailable` saying what is missing."""
+    try:
+        import moderngl
+    except ImportError as error:  # pragma: no cover - a dependency of the package
+        raise GLUnavailable(f"moderngl is not installed ({error}); run: python3 -m explorer") from None
+    try:
+        return moderngl.create_standalone_context(require=330, backend="egl")
+    except Exception as error:  # glcontext raises plain Exceptions
+        reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise GLUnavailable(
+            f"no OpenGL through EGL ({reason}); install Mesa's EGL: apt-get install {EGL_PACKAGES}"
+        ) from None
+
+
+def build_program_source(material: Material, view: str):
+    """The fragment shader of ``material`` in ``view`` (an :class:`explorer.glsl.Program`)."""
+    template = SHADER_DIR / "views" / f"{view}.glsl"
+    if not template.exists():
+        raise ShaderError(str(template), None, f"no such view {view!r}")
+    builder = ShaderBuilder(include_dirs=[SHADER_DIR], version=GLSL_VERSION)
+    builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
+    builder.add_source(material.shader, str(material.path), material.shader_line)
+    builder.add_file(template)
+    return builder.build()
+
+
+class Renderer:
+    """Renders material views into float32 images; caches programs and library textures."""
+
+    def __init__(self, ctx=None):
+        self.ctx = ctx if ctx is not None else create_context()
+        self._programs: dict[tuple, object] = {}
+        self._library = self._library_textures()
+        self._vertex_arrays: dict[int, object] = {}
+        self.last_table_ms: float | None = None
+
+    # -- resources ---------------------------------------------------------------------------------
+
+    def _texture_row(self, data: np.ndarray, linear: bool):
+        data = np.ascontiguousarray(data, dtype=np.float32).reshape(1, -1, 3)
+        texture = self.ctx.texture((data.shape[1], 1), 3, data.tobytes(), dtype="f4")
+        import moderngl
+
+        texture.filter = (moderngl.LINEAR, moderngl.LINEAR) if linear else (moderngl.NEAREST, moderngl.NEAREST)
+        texture.repeat_x = texture.repeat_y = False
+        return texture
+
+    def _library_textures(self) -> dict[str, object]:
+        return {
+            "cmf_1nm": self._texture_row(luts.load("cmf_1nm"), linear=False),
+            "cmf_cumulative": self._texture_row(luts.load("cmf_cumulative"), linear=True),
+        }
+
+    def program(self, material: Material, view: str):
+        """The compiled program (cached), or :class:`ShaderError` naming the file and line."""
+        key = (str(material.path), material.shader, material.uniform_declarations(), view)
+        if key not in self._programs:
+            import moderngl
+
+            source = build_program_source(material, view)
+            try:
+                program = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=source.code)
+            except moderngl.Error as error:
+                raise ShaderError(*_first_error(source, str(error))) from None
+            self._programs[key] = program
+        return self._programs[key]
+
+    # -- rendering ---------------------------------------------------------------------------------
+
+    def bind(self, program, material: Material, values: Mapping[str, object]) -> None:
+        """Set the material's uniforms and bind the library and model textures."""
+        for parameter in material.parameters:
+            if parameter.name not in program:
+                continue  # unused by the shader: optimised away
+            value = values[parameter.name]
+            if parameter.type == "bool":
+                program[parameter.name].value = bool(value)
+            elif parameter.type == "color":
+                program[parameter.name].value = tuple(float(v) for v in value)
+            else:
+                program[parameter.name].value = float(value)
+        if "xyz_to_rgb_matrix" in program:
+            matrix = colorimetry.xyz_to_rgb_matrix()
+            program["xyz_to_rgb_matrix"].write(matrix.T.astype(np.float32).tobytes())  # column-major
+        textures = dict(self._library)
+        model = model_for(material, values)
+        if model is not None:
+            start = time.perf_counter()
+            for name, table in model.textures().items():
+                if name in program:
+                    textures[name] = self._texture_row(table, linear=True)
+            self.last_table_ms = (time.perf_counter() - start) * 1e3
+        for unit, (name, texture) in enumerate(sorted(textures.items())):
+            if name in program:
+                texture.use(location=unit)
+                program[name].value = unit
+
+    def render(self, material: Material, values: Mapping[str, object], view: str, width: int, height: int) -> np.ndarray:
+        """``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped."""
+        program = self.program(material, view)
+        self.bind(program, material, values)
+        framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
+        try:
+            framebuffer.use()
+            framebuffer.clear(0.0, 0.0, 0.0, 1.0)
+            if "resolution" in program:
+                program["resolution"].value = (float(width), float(height))
+            vertex_array = self.ctx.vertex_array(program, [])
+            vertex_array.render(vertices=3)
+            data = framebuffer.read(components=4, dtype="f4")
+            vertex_array.release()
+        finally:
+            for attachment in framebuffer.color_attachments:
+                attachment.release()
+            framebuffer.release()
+        image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
+        return np.ascontiguousarray(image)
+
+    def time_frame(self, material: Material, values: Mapping[str, object], view: str, width: int, height: int) -> float:
+        """GPU time of one frame in ms (a timer query around the draw; tables already bound)."""
+        program = self.program(material, view)
+        self.bind(program, material, values)
+        framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
+        framebuffer.use()
+        if "resolution" in program:
+            program["resolution"].value = (float(width), float(height))
+        vertex_array = self.ctx.vertex_array(program, [])
+        query = self.ctx.query(time=True)
+        self.ctx.finish()
+        with query:
+            vertex_array.render(vertices=3)
+        self.ctx.finish()
+        elapsed = query.elapsed / 1e6
+        vertex_array.release()
+        framebuffer.color_attachments[0].release()
+        framebuffer.release()
+        return elapsed
+
+
+def _first_error(source, log: str) -> tuple[str, int | None, str]:
+    """(file, line, message) of the first error in a driver log, mapped to the real files."""
+    from .glsl import compile_error
+
+    error = compile_error(log, source.sources, source.line_stride)
+    return error.path, error.line, error.message

@@ -1,0 +1,73 @@
+"""
+The numpy twins of the material files: each model evaluates, in numpy, what its ``.brd`` shader
+evaluates in GLSL, and provides the tables its shader reads (uploaded by the host as textures).
+
+A material names its model in a comment line ``# model: NAME``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Mapping
+
+import numpy as np
+
+from . import bragg
+
+METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
+
+
+class BraggMirrorModel:
+    """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
+
+    name = "bragg_mirror"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.values = dict(values)
+        nh = float(values.get("nh", 0.0))
+        self.mirror = bragg.BraggMirror(
+            n1=float(values["n1"]),
+            n2=float(values["n2"]),
+            Lambda=float(values["Lambda"]),
+            delta=float(values["delta"]),
+            N=int(np.floor(float(values["N"]) + 0.5)),
+            nh=nh if nh >= 1.0 else None,  # below 1 the host is n1
+        )
+        self.method = int(np.floor(float(values.get("method", 0)) + 0.5))
+        self.s = int(np.floor(float(values.get("s", 3)) + 0.5))
+        self._table: np.ndarray | None = None
+
+    @property
+    def table(self) -> np.ndarray:
+        """The tabulated method's RGB over cos(theta) (built once per parameter set)."""
+        if self._table is None:
+            self._table = bragg.tabulated_rgb_table(self.mirror)
+        return self._table
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        """Linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
+        cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        if self.method == 0:
+            return bragg.reference_rgb(cos_theta, self.mirror)
+        if self.method == 1:
+            return bragg.approximate_rgb(cos_theta, self.mirror, 0)
+        if self.method == 2:
+            return bragg.approximate_rgb(cos_theta, self.mirror, self.s)
+        if self.method == 3:
+            return bragg.tabulated_rgb(self.table, cos_theta)
+        return bragg.approximate_rgb(cos_theta, self.mirror, self.s, variant="improved")
+
+    def textures(self) -> dict[str, np.ndarray]:
+        """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
+        # Only the tabulated method reads its table; the others get a placeholder texel.
+        return {"bragg_table": self.table if self.method == 3 else np.zeros((1, 3), np.float32)}
+
+
+MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
+    BraggMirrorModel.name: BraggMirrorModel,
+}
+
+
+def model_for(material, values: Mapping[str, object]):
+    """The numpy twin of ``material`` with parameter ``values`` (None when it names no known model)."""
+    factory = MODELS.get(material.model or "")
+    return factory(values) if factory else None
