@@ -367,7 +367,8 @@ class Material:
             try:
                 values[name] = p.coerce(value)
             except ValueError as exc:
-                raise MaterialError(self.path, None, f"parameter {name!r}: {exc}") from None
+                # Name the line that declares the parameter: that is where its range is.
+                raise MaterialError(self.path, p.line, f"parameter {name!r}: {exc}") from None
         return values
 
     def uniform_declarations(self) -> str:

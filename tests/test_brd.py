@@ -402,7 +402,10 @@ def test_resolve_errors(name: str, value: object, fragment: str) -> None:
     with pytest.raises(MaterialError) as info:
         material(MIXED).resolve({name: value})
     assert fragment in info.value.message
-    assert str(info.value).startswith("test.brd: parameter")
+    # The error names the line that declares the parameter (and its range).
+    declared = material(MIXED).parameter(name).line
+    assert info.value.line == declared
+    assert str(info.value).startswith(f"test.brd:{declared}: parameter")
 
 
 def test_unknown_parameter_lists_valid_names() -> None:

@@ -1,0 +1,197 @@
+"""
+``bragg-explorer``: render materials headless, inspect material files, benchmark the methods.
+
+Bad input (a malformed material file, an unknown or out-of-range ``--set``, a GLSL error, an
+unwritable ``--out``, no GL) ends with one line on stderr naming the file and line where there is
+one, and a non-zero exit; an output file is either complete or not written at all.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .brd import Material, MaterialError, load_material, parse_assignment
+from .glsl import ShaderError
+
+DEFAULT_MATERIAL = Path(__file__).resolve().parent.parent / "shaders" / "bragg_mirror.brd"
+PROG = "bragg-explorer"
+
+
+class OutputError(Exception):
+    """An output file cannot be written."""
+
+
+def _fail(message: str) -> None:
+    click.echo(f"{PROG}: error: {message}", err=True)
+    sys.exit(1)
+
+
+def _load(path: str | Path) -> Material:
+    material = load_material(path)
+    for warning in material.warnings:
+        click.echo(f"{PROG}: warning: {warning}", err=True)
+    return material
+
+
+def parse_size(text: str | None, view: str) -> tuple[int, int]:
+    """``W`` or ``WxH`` (a square for ``W`` alone, except the gradient, which keeps its height)."""
+    from .render import DEFAULT_SIZES
+
+    if text is None:
+        return DEFAULT_SIZES[view]
+    parts = text.lower().split("x")
+    try:
+        numbers = [int(p) for p in parts]
+    except ValueError:
+        numbers = []
+    if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > 16384:
+        raise click.BadParameter(f"{text!r} is not W or WxH with sizes in 1..16384", param_hint="--size")
+    if len(numbers) == 1:
+        return (numbers[0], DEFAULT_SIZES[view][1] if view == "gradient" else numbers[0])
+    return numbers[0], numbers[1]
+
+
+def write_image(image: np.ndarray, out: Path) -> None:
+    """``.npy``: float32 HxWx3 linear RGB; ``.png``: 8-bit sRGB, clamped. Written atomically."""
+    from PIL import Image
+
+    from .colorimetry import encode_srgb8
+
+    suffix = out.suffix.lower()
+    if suffix not in (".png", ".npy"):
+        raise OutputError(f"{out}: the output must end in .png or .npy")
+    directory = out.parent if str(out.parent) else Path(".")
+    if not directory.is_dir():
+        raise OutputError(f"{out}: directory {directory} does not exist")
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix, dir=directory)
+    except OSError as error:
+        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            if suffix == ".npy":
+                np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
+            else:
+                Image.fromarray(encode_srgb8(image), mode="RGB").save(stream, format="PNG")
+        os.replace(temporary, out)
+    except OSError as error:
+        Path(temporary).unlink(missing_ok=True)
+        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
+
+
+def render_material(material: Material, values: dict, view: str, width: int, height: int, engine: str) -> np.ndarray:
+    """One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``)."""
+    if engine == "numpy":
+        from .models import model_for
+        from .render import render_numpy
+
+        model = model_for(material, values)
+        if model is None:
+            raise MaterialError(material.path, None, "this material has no numpy twin (no known '# model:' line)")
+        return render_numpy(model, view, width, height)
+    from .gl import Renderer
+
+    return Renderer().render(material, values, view, width, height)
+
+
+@click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
+@click.pass_context
+def main(ctx: click.Context) -> None:
+    """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
+
+    Without a command: render the default Bragg mirror (sphere and angular gradient) to out/.
+    """
+    if ctx.invoked_subcommand is None:
+        ctx.invoke(default_job)
+
+
+def _errors(function):
+    """Turn the expected failures of bad input into one line and exit status 1."""
+    import functools
+
+    from .gl import GLUnavailable
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except (MaterialError, ShaderError, GLUnavailable, OutputError) as error:
+            _fail(str(error))
+
+    return wrapper
+
+
+@main.command()
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--view", type=click.Choice(["gradient", "sphere"]), default="sphere", show_default=True)
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
+@click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
+@click.option("--out", required=True, type=click.Path(dir_okay=False), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
+@click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
+@_errors
+def render(material, view, assignments, size, out, engine):
+    """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy."""
+    loaded = _load(material)
+    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    values = loaded.resolve(overrides)
+    width, height = parse_size(size, view)
+    image = render_material(loaded, values, view, width, height, engine)
+    write_image(image, Path(out))
+    bad = int((~np.isfinite(image)).sum())
+    click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
+
+
+@main.command()
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print the parameters as JSON.")
+@_errors
+def info(material, as_json):
+    """Print a material file's parameters."""
+    loaded = _load(material)
+    if as_json:
+        click.echo(json.dumps(loaded.info(), indent=2))
+        return
+    click.echo(f"{loaded.path}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
+    for p in loaded.parameters:
+        bounds = "" if p.min is None else f" in [{p.min:g}, {p.max:g}]"
+        click.echo(f"  {p.type:5} {p.name:12} default {p.default}{bounds}")
+
+
+@main.command()
+@click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
+@click.option("--size", default=512, show_default=True, help="Sphere size for GPU timings.")
+@click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
+@_errors
+def bench(as_json, size, repeats):
+    """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method."""
+    from .bench import run_bench
+
+    run_bench(as_json=as_json, size=size, repeats=repeats)
+
+
+@main.command("default", hidden=True)
+@_errors
+def default_job():
+    """Render the default mirror (the main job until the slider app exists)."""
+    material = _load(DEFAULT_MATERIAL)
+    values = material.resolve({"method": "3"})
+    out = Path("out")
+    out.mkdir(exist_ok=True)
+    from .gl import Renderer
+
+    renderer = Renderer()
+    for view, size in (("sphere", (512, 512)), ("gradient", (512, 48))):
+        image = renderer.render(material, values, view, *size)
+        write_image(image, out / f"bragg_mirror_{view}.png")
+        click.echo(f"wrote out/bragg_mirror_{view}.png ({size[0]}x{size[1]}, exact spectral colours, tabulated)")
+
+
+if __name__ == "__main__":
+    main()
