@@ -176,6 +176,17 @@ def bench(as_json, size, repeats):
     run_bench(as_json=as_json, size=size, repeats=repeats)
 
 
+@main.command()
+@click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Also write a PNG plot of median ΔE2000 against s.")
+@_errors
+def accuracy(as_json, plot):
+    """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings)."""
+    from .bench import run_accuracy
+
+    run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)
+
+
 @main.command("default", hidden=True)
 @_errors
 def default_job():

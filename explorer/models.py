@@ -12,6 +12,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from . import bragg
+from .fresnel import fresnel_schlick
 
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 
@@ -62,8 +63,25 @@ class BraggMirrorModel:
         return {"bragg_table": self.table if self.method == 3 else np.zeros((1, 3), np.float32)}
 
 
+class SchlickFresnelModel:
+    """Twin of ``shaders/schlick_fresnel.brd``."""
+
+    name = "schlick_fresnel"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.F0 = float(values["F0"])
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        value = fresnel_schlick(np.asarray(cos_theta, dtype=np.float64), self.F0)
+        return np.repeat(value[..., None], 3, axis=-1)
+
+    def textures(self) -> dict[str, np.ndarray]:
+        return {}
+
+
 MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     BraggMirrorModel.name: BraggMirrorModel,
+    SchlickFresnelModel.name: SchlickFresnelModel,
 }
 
 

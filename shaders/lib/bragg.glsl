@@ -73,6 +73,11 @@ vec2 clamp_decay(vec2 phase) { return vec2(phase.x, min(phase.y, MAX_DECAY)); }
 
 // Eq. 8, real also when a layer is evanescent.
 float cos_K_Lambda(float omega, CellGeometry g) {
+    if (g.p1.y == 0.0 && g.p2.y == 0.0) {
+        // Every wave propagates: Omega and both phases are real.
+        float psi = omega * g.p1.x, phi = omega * g.p2.x;
+        return cos(psi) * cos(phi) - 0.5 * g.Omega.x * sin(psi) * sin(phi);
+    }
     vec2 psi = clamp_decay(omega * g.p1), phi = clamp_decay(omega * g.p2);
     vec2 value = cmul(ccos(psi), ccos(phi)) - 0.5 * cmul(g.Omega, cmul(csin(psi), csin(phi)));
     return value.x;
@@ -86,19 +91,47 @@ float one_minus_exp_minus_2x(float x) {
 float acosh_stable(float a) { return a > 1e4 ? log(2.0 * a) : log(a + sqrt((a - 1.0) * (a + 1.0))); }
 
 // U_{N-1}, U_{N-2} of cos K Lambda, divided by U_{N-1} in band gaps (Eq. 9) where they overflow.
-void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float scale) {
-    if (abs(a) < 1.0) {
-        float t = acos(a), sin_t = sin(t);
-        U_N1 = sin(N * t) / sin_t;
-        U_N2 = sin((N - 1.0) * t) / sin_t;
+// d = 1 - |a| when known without cancellation (chebyshev_U_precise), else computed from a.
+void chebyshev_U_d(float a, float d, float N, out float U_N1, out float U_N2, out float scale) {
+    if (d > 0.0) {
+        // e^{i N t} = (cos t + i sin t)^N by binary powering, never t itself: drivers lower acos to
+        // low-precision polynomials, whose error sin(N t) would multiply by N.
+        a = a >= 0.0 ? 1.0 - d : d - 1.0;
+        float sin_t = sqrt(d * (2.0 - d));
+        vec2 z = vec2(a, sin_t), power = vec2(1.0, 0.0);
+        for (int n = int(N); n > 0; n >>= 1) {
+            if ((n & 1) != 0) power = cmul(power, z);
+            z = cmul(z, z);
+        }
+        U_N1 = power.y / sin_t;                                    // sin(N t) / sin t
+        U_N2 = (power.y * a - power.x * sin_t) / sin_t;            // sin((N - 1) t) / sin t
         scale = 1.0;
     } else {
-        float x = max(acosh_stable(abs(a)), 1e-12);
+        float x = max(acosh_stable(1.0 - d), 1e-12);
         float h_N = one_minus_exp_minus_2x(N * x);
         U_N1 = 1.0;
         U_N2 = sign(a) * exp(-x) * one_minus_exp_minus_2x((N - 1.0) * x) / h_N;
         scale = exp(-(N - 1.0) * x) * one_minus_exp_minus_2x(x) / h_N;
     }
+}
+
+void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float scale) {
+    chebyshev_U_d(a, 1.0 - abs(a), N, U_N1, U_N2, scale);
+}
+
+// float32 near band edges, real phases: 1 -+ cos K Lambda from Eq. 36, cos K Lambda =
+// (1 - Theta) cos(psi - phi) + Theta cos(psi + phi) with Theta = 1/2 + Omega/4, written as
+// 2 (1 - Theta) sin^2((psi -+ phi)/2) + 2 Theta sin^2(...) (cos^2 for 1 + a): no cancellation against 1,
+// so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda would amplify an
+// absolute error of cos K Lambda. float64 (explorer/bragg.py) needs none of this.
+void chebyshev_U_precise(float psi, float phi, float Omega_, float N, out float U_N1, out float U_N2, out float scale) {
+    float Theta = 0.5 + 0.25 * Omega_;
+    float a = (1.0 - Theta) * cos(psi - phi) + Theta * cos(psi + phi);
+    float h_minus = 0.5 * (psi - phi), h_plus = 0.5 * (psi + phi);
+    float d = a >= 0.0
+        ? 2.0 * ((1.0 - Theta) * sin(h_minus) * sin(h_minus) + Theta * sin(h_plus) * sin(h_plus))
+        : 2.0 * ((1.0 - Theta) * cos(h_minus) * cos(h_minus) + Theta * cos(h_plus) * cos(h_plus));
+    chebyshev_U_d(a, d, N, U_N1, U_N2, scale);
 }
 
 // Eqs. 2 and 9: |r1|^2 U^2 / (|r1|^2 U^2 + |t1|^2 scale^2).
@@ -123,6 +156,16 @@ vec2 reflection_coefficient_host(vec2 r_N, vec2 r_h1) {
 }
 
 float reflectance_polarised(float omega, CellGeometry g) {
+    if (g.host_is_n1 && g.p1.y == 0.0 && g.p2.y == 0.0) {
+        // Real arithmetic (as explorer.bragg._reflectance_real): |r1|^2 : |t1|^2 =
+        // 4 r12^2 sin^2 phi : (1 - r12^2)^2, their common denominator cancels in Eq. 2.
+        float psi = omega * g.p1.x, phi = omega * g.p2.x;
+        float sin_phi = sin(phi), r12_2 = g.r12.x * g.r12.x;
+        float U_N1, U_N2, scale;
+        chebyshev_U_precise(psi, phi, g.Omega.x, g.N, U_N1, U_N2, scale);
+        float numerator = 4.0 * r12_2 * sin_phi * sin_phi * U_N1 * U_N1;
+        return numerator / (numerator + (1.0 - r12_2) * (1.0 - r12_2) * scale * scale);
+    }
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);

@@ -1,0 +1,223 @@
+"""
+Benchmarks and accuracy studies: the paper's Table 1 on this machine, and the Figure 4 grid.
+
+``bragg-explorer bench``: GPU time per frame of a sphere for every method of ``bragg_mirror.brd``
+(interleaved repeats, medians, finish-bounded), each one's speed-up over the spectral reference, the
+median and maximum ΔE2000 of each against the reference over θ, and the table rebuild time of the
+tabulated method. ``bragg-explorer accuracy``: ΔE2000 of the approximations on the Figure 4 grid for
+s = 2..8, both readings of the mode numbering and both variants.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import bragg, colorimetry
+from .brd import load_material
+
+SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+BENCH_LAMBDAS = (244.0, 500.0, 988.0)
+FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)
+FIGURE4_DELTAS = (0.25, 0.5, 0.75)
+#: Incidence angles of the accuracy studies: theta in [0, 89.5] degrees.
+THETA_DEGREES = np.linspace(0.0, 89.5, 180)
+
+
+def _progress(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def delta_E_over_theta(mirror: bragg.BraggMirror, rgb_function) -> tuple[float, float]:
+    """Median and maximum ΔE2000 of ``rgb_function(cos_theta)`` against the spectral reference."""
+    cos_theta = np.cos(np.radians(THETA_DEGREES))
+    reference = bragg.reference_rgb(cos_theta, mirror)
+    dE = colorimetry.delta_E_2000(reference, rgb_function(cos_theta))
+    return float(np.median(dE)), float(np.max(dE))
+
+
+def _methods() -> list[tuple[str, int | None, dict]]:
+    """(method name, s, parameter overrides) in table order."""
+    rows = [("reference", None, {"method": 0}), ("basic", None, {"method": 1})]
+    rows += [("subdivided", s, {"method": 2, "s": s}) for s in (2, 3, 4, 5)]
+    rows += [("improved", 3, {"method": 4, "s": 3})]
+    rows += [("tabulated", None, {"method": 3})]
+    return rows
+
+
+def _accuracy(mirror: bragg.BraggMirror, method: str, s: int | None, table: np.ndarray | None):
+    if method == "reference":
+        return 0.0, 0.0
+    if method == "basic":
+        return delta_E_over_theta(mirror, lambda c: bragg.approximate_rgb(c, mirror, 0))
+    if method == "subdivided":
+        return delta_E_over_theta(mirror, lambda c: bragg.approximate_rgb(c, mirror, s))
+    if method == "improved":
+        return delta_E_over_theta(mirror, lambda c: bragg.approximate_rgb(c, mirror, s, variant="improved"))
+    if method == "tabulated":
+        return delta_E_over_theta(mirror, lambda c: bragg.tabulated_rgb(table, c))
+    return None, None
+
+
+def table_rebuild_ms(mirror: bragg.BraggMirror, repeats: int = 15) -> float:
+    """Median time (ms) to rebuild the tabulated method's 256-entry table."""
+    bragg.tabulated_rgb_table(mirror)
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        bragg.tabulated_rgb_table(mirror)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times) * 1e3)
+
+
+def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
+    """Measure and print Table 1 (see the module docstring). Returns the JSON document."""
+    from .gl import Renderer
+
+    renderer = Renderer()
+    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    device = renderer.ctx.info.get("GL_RENDERER", "unknown")
+    _progress(f"bench: {size}x{size} sphere on {device}, {repeats} interleaved repeats per method")
+
+    rows: list[dict] = []
+    table_ms: dict[str, float] = {}
+    for Lambda in BENCH_LAMBDAS:
+        base = {"n1": 1.0, "n2": 1.5, "Lambda": Lambda, "delta": 0.5, "N": 20}
+        mirror = bragg.BraggMirror(1.0, 1.5, Lambda, 0.5, 20)
+        table = bragg.tabulated_rgb_table(mirror)
+        table_ms[f"{Lambda:g}"] = table_rebuild_ms(mirror)
+        cases = [(name, s, mirror_material, mirror_material.resolve({**base, **o})) for name, s, o in _methods()]
+        cases.append(("schlick", None, schlick_material, schlick_material.resolve({})))
+        for _, _, material, values in cases:  # compile, JIT and warm every program first
+            renderer.time_frame(material, values, "sphere", 16, 16)
+        times: dict[int, list[float]] = {i: [] for i in range(len(cases))}
+        for r in range(repeats):
+            for i, (name, s, material, values) in enumerate(cases):
+                times[i].append(renderer.time_frame(material, values, "sphere", size, size))
+            _progress(f"bench: Lambda = {Lambda:g} nm, repeat {r + 1}/{repeats} done")
+        reference_ms = float(np.median(times[0]))
+        for i, (name, s, _, _) in enumerate(cases):
+            ms = float(np.median(times[i]))
+            dE_median, dE_max = _accuracy(mirror, name, s, table)
+            rows.append(
+                {"Lambda": int(Lambda), "method": name, "s": s, "ms": ms, "speedup": reference_ms / ms,
+                 "dE_median": dE_median, "dE_max": dE_max}
+            )
+    standard = [r for r in rows if r["method"] != "improved"]
+    document = {
+        "device": device,
+        "size": size,
+        "repeats": repeats,
+        "rows": standard,
+        "variants": [r for r in rows if r["method"] == "improved"],
+        "table_rebuild_ms": table_ms,
+    }
+    if as_json:
+        print(json.dumps(document, indent=2))
+    else:
+        print(format_table(rows, device, size, table_ms))
+    return document
+
+
+def format_table(rows: list[dict], device: str, size: int, table_ms: dict[str, float]) -> str:
+    """A readable Table 1."""
+    lines = [f"Frame time of a {size}x{size} sphere on {device}; ΔE2000 against the spectral reference over θ ∈ [0°, 89.5°]", ""]
+    header = f"{'Λ (nm)':>7}  {'method':<11} {'s':>2}  {'ms/frame':>9}  {'speed-up':>8}  {'ΔE median':>9}  {'ΔE max':>7}"
+    lines += [header, "-" * len(header)]
+    for r in rows:
+        s = "" if r["s"] is None else str(r["s"])
+        dE_median = "" if r["dE_median"] is None else f"{r['dE_median']:.2f}"
+        dE_max = "" if r["dE_max"] is None else f"{r['dE_max']:.2f}"
+        lines.append(
+            f"{r['Lambda']:>7}  {r['method']:<11} {s:>2}  {r['ms']:>9.2f}  {r['speedup']:>7.1f}x  {dE_median:>9}  {dE_max:>7}"
+        )
+    lines.append("")
+    lines.append("tabulated: table rebuild (256 entries, numpy) " + ", ".join(f"{v:.1f} ms at Λ = {k} nm" for k, v in table_ms.items()))
+    return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------------------------------
+# The Figure 4 grid
+
+
+def figure4_accuracy(s_values=range(2, 9)) -> list[dict]:
+    """ΔE2000 (median, max) on the Figure 4 grid for every approximation, variant and numbering."""
+    rows = []
+    for Lambda in FIGURE4_LAMBDAS:
+        for delta in FIGURE4_DELTAS:
+            mirror = bragg.BraggMirror(1.0, 1.5, Lambda, delta, 20)
+            _progress(f"accuracy: Lambda = {Lambda:g} nm, delta = {delta:g}")
+            cos_theta = np.cos(np.radians(THETA_DEGREES))
+            reference = bragg.reference_rgb(cos_theta, mirror)
+            for variant in ("paper", "improved"):
+                for numbering in ("relative", "absolute"):
+                    for s in [0, *s_values]:
+                        if s == 0 and numbering == "absolute":
+                            continue  # the basic method has no subdivisions
+                        rgb = bragg.approximate_rgb(cos_theta, mirror, s, numbering, variant)
+                        dE = colorimetry.delta_E_2000(reference, rgb)
+                        rows.append(
+                            {"Lambda": int(Lambda), "delta": delta, "variant": variant, "mode_numbering": numbering,
+                             "s": s, "dE_median": float(np.median(dE)), "dE_max": float(np.max(dE))}
+                        )
+    return rows
+
+
+def format_accuracy(rows: list[dict]) -> str:
+    """Markdown tables: median / max ΔE2000 per mirror, basic and s = 2..8."""
+    out = []
+    for variant, numbering in (("paper", "relative"), ("paper", "absolute"), ("improved", "relative")):
+        subset = [r for r in rows if r["variant"] == variant and (r["mode_numbering"] == numbering or r["s"] == 0)]
+        s_values = sorted({r["s"] for r in subset if r["s"] > 0})
+        out.append(f"**{variant}** variant, mode numbering **{numbering}** — median / max ΔE2000 over θ ∈ [0°, 89.5°]\n")
+        out.append("| Λ (nm) | δ | basic | " + " | ".join(f"s = {s}" for s in s_values) + " |")
+        out.append("|---|---|---|" + "---|" * len(s_values))
+        for Lambda in FIGURE4_LAMBDAS:
+            for delta in FIGURE4_DELTAS:
+                cell = {r["s"]: r for r in subset if r["Lambda"] == int(Lambda) and r["delta"] == delta}
+                values = [f"{cell[s]['dE_median']:.2f} / {cell[s]['dE_max']:.1f}" for s in [0, *s_values]]
+                out.append(f"| {Lambda:g} | {delta:g} | " + " | ".join(values) + " |")
+        out.append("")
+    return "\n".join(out)
+
+
+def plot_accuracy(rows: list[dict], path: Path) -> None:
+    """Median ΔE2000 against s per mirror, paper vs improved (a PNG through matplotlib)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, 3, figsize=(13, 3.8), sharey=True)
+    for axis, Lambda in zip(axes, FIGURE4_LAMBDAS):
+        for delta, colour in zip(FIGURE4_DELTAS, ("tab:blue", "tab:orange", "tab:green")):
+            for variant, style in (("paper", "--"), ("improved", "-")):
+                subset = sorted(
+                    (r for r in rows if r["Lambda"] == int(Lambda) and r["delta"] == delta
+                     and r["variant"] == variant and r["mode_numbering"] == "relative"),
+                    key=lambda r: r["s"],
+                )
+                axis.plot([r["s"] for r in subset], [r["dE_median"] for r in subset], style, color=colour,
+                          marker="o", markersize=3, label=f"δ = {delta:g}, {variant}")
+        axis.axhline(2.0, color="grey", linewidth=0.8)
+        axis.set_title(f"Λ = {Lambda:g} nm (n1 = 1, n2 = 1.5, N = 20)")
+        axis.set_xlabel("s (0 = basic)")
+    axes[0].set_ylabel("median ΔE2000 vs reference")
+    axes[-1].legend(fontsize=7, ncol=2)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def run_accuracy(as_json: bool = False, plot: Path | None = None) -> list[dict]:
+    rows = figure4_accuracy()
+    if plot is not None:
+        plot_accuracy(rows, plot)
+        _progress(f"accuracy: wrote {plot}")
+    print(json.dumps({"rows": rows}, indent=2) if as_json else format_accuracy(rows))
+    return rows
