@@ -221,3 +221,32 @@ def run_accuracy(as_json: bool = False, plot: Path | None = None) -> list[dict]:
         _progress(f"accuracy: wrote {plot}")
     print(json.dumps({"rows": rows}, indent=2) if as_json else format_accuracy(rows))
     return rows
+
+
+def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
+    """
+    The colour strips of Figure 4, rendered by the GPU shaders: per mirror (rows: Λ; columns: δ),
+    the spectral reference, the basic, subdivided (s = 3) and improved (s = 3) approximations.
+    """
+    from PIL import Image
+
+    from .colorimetry import encode_srgb8
+    from .gl import Renderer
+
+    renderer = Renderer()
+    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    gap = 6
+    rows = []
+    for Lambda in FIGURE4_LAMBDAS:
+        cells = []
+        for delta in FIGURE4_DELTAS:
+            strips = []
+            for method in (0, 1, 2, 4):
+                values = material.resolve({"Lambda": Lambda, "delta": delta, "N": 20, "method": method, "s": 3})
+                strips.append(renderer.render(material, values, "gradient", width, strip))
+                strips.append(np.ones((2, width, 3), np.float32))
+            cells.append(np.concatenate(strips))
+            cells.append(np.ones((cells[-1].shape[0], gap, 3), np.float32))
+        rows.append(np.concatenate(cells[:-1], axis=1))
+        rows.append(np.ones((gap, rows[-1].shape[1], 3), np.float32))
+    Image.fromarray(encode_srgb8(np.concatenate(rows[:-1]))).save(path)

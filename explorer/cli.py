@@ -179,11 +179,14 @@ def bench(as_json, size, repeats):
 @main.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False), help="Also write a PNG plot of median ΔE2000 against s.")
+@click.option("--strips", type=click.Path(dir_okay=False), help="Also write Figure 4's colour strips (GPU) to a PNG.")
 @_errors
-def accuracy(as_json, plot):
+def accuracy(as_json, plot, strips):
     """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings)."""
-    from .bench import run_accuracy
+    from .bench import figure4_strips, run_accuracy
 
+    if strips:
+        figure4_strips(Path(strips))
     run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)
 
 
