@@ -65,6 +65,7 @@ Value = Union[float, bool, tuple]
 _NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
 _IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _MODEL_RE = re.compile(r"#\s*model\s*:\s*(.*?)\s*\Z", re.IGNORECASE)
+_SPECIALISE_RE = re.compile(r"#\s*speciali[sz]e\s*:\s*(.*?)\s*\Z", re.IGNORECASE)
 _MODEL_NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*\Z")
 # Preprocessor directives a GLSL compiler understands, plus our own #include.
 _GLSL_DIRECTIVE_RE = re.compile(
@@ -323,6 +324,7 @@ class Material:
     shader: str
     shader_line: int
     model: str | None = None
+    specialised: tuple[str, ...] = ()
     warnings: list[str] = field(default_factory=list)
 
     def parameter(self, name: str) -> Parameter:
@@ -405,6 +407,7 @@ class _Parser:
         self.names: dict[str, int] = {}
         self.model: str | None = None
         self.model_line = 0
+        self.specialised: list[tuple[str, int]] = []
         self.header_seen = False
         self.section: str | None = None
         self.section_line = 0
@@ -442,6 +445,7 @@ class _Parser:
             shader="".join(s + "\n" for s in self.shader_lines),
             shader_line=self.shader_line,
             model=self.model,
+            specialised=self._check_specialised(),
             warnings=self.warnings,
         )
 
@@ -469,6 +473,10 @@ class _Parser:
         # else: a line of an unknown section, skipped (warned at ::begin)
 
     def comment(self, number: int, stripped: str) -> None:
+        special = _SPECIALISE_RE.match(stripped)
+        if special is not None:
+            self.specialised += [(name, number) for name in special.group(1).replace(",", " ").split()]
+            return
         match = _MODEL_RE.match(stripped)
         if match is None:
             return
@@ -479,6 +487,15 @@ class _Parser:
             self.model, self.model_line = name, number
         elif name != self.model:
             self.warn(number, f"ignoring second model {name!r}; using {self.model!r} from line {self.model_line}")
+
+    def _check_specialised(self) -> tuple[str, ...]:
+        """``# specialise: NAME``: integer-valued float parameters the host compiles in as constants."""
+        by_name = {p.name: p for p in self.parameters}
+        for name, number in self.specialised:
+            parameter = by_name.get(name)
+            if parameter is None or parameter.type != "float" or not parameter.is_integer():
+                raise self.error(number, f"'# specialise: {name}' needs an integer-valued float parameter of that name")
+        return tuple(dict.fromkeys(name for name, _ in self.specialised))
 
     def header(self, number: int, tokens: list[str]) -> None:
         kind = tokens[0]

@@ -52,12 +52,24 @@ def create_context():
         ) from None
 
 
-def build_program_source(material: Material, view: str):
-    """The fragment shader of ``material`` in ``view`` (an :class:`explorer.glsl.Program`)."""
+def specialisation(material: Material, values: Mapping[str, object]) -> tuple[tuple[str, int], ...]:
+    """The constants compiled into ``material``'s program: its ``# specialise:`` parameters' values."""
+    return tuple((name, int(round(float(values[name])))) for name in material.specialised)
+
+
+def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = ()):
+    """
+    The fragment shader of ``material`` in ``view`` (an :class:`explorer.glsl.Program`).
+
+    Each ``(name, value)`` of ``constants`` becomes ``#define SPECIALISED_name value``: the shader
+    can branch at compile time on a parameter such as ``method`` (one smaller program per value).
+    """
     template = SHADER_DIR / "views" / f"{view}.glsl"
     if not template.exists():
         raise ShaderError(str(template), None, f"no such view {view!r}")
     builder = ShaderBuilder(include_dirs=[SHADER_DIR], version=GLSL_VERSION)
+    for name, value in constants:
+        builder.define(f"SPECIALISED_{name}", value)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
     builder.add_source(material.shader, str(material.path), material.shader_line)
     builder.add_file(template)
@@ -104,13 +116,14 @@ class Renderer:
             "cmf_cumulative": self._texture_row(luts.load("cmf_cumulative"), linear=True),
         }
 
-    def program(self, material: Material, view: str):
+    def program(self, material: Material, view: str, values: Mapping[str, object] | None = None):
         """The compiled program (cached), or :class:`ShaderError` naming the file and line."""
-        key = (str(material.path), material.shader, material.uniform_declarations(), view)
+        constants = specialisation(material, values if values is not None else material.resolve())
+        key = (str(material.path), material.shader, material.uniform_declarations(), view, constants)
         if key not in self._programs:
             import moderngl
 
-            source = build_program_source(material, view)
+            source = build_program_source(material, view, constants)
             try:
                 program = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=source.code)
             except moderngl.Error as error:
@@ -150,7 +163,7 @@ class Renderer:
 
     def render(self, material: Material, values: Mapping[str, object], view: str, width: int, height: int) -> np.ndarray:
         """``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped."""
-        program = self.program(material, view)
+        program = self.program(material, view, values)
         self.bind(program, material, values)
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
         try:
@@ -175,7 +188,7 @@ class Renderer:
         software rasteriser such as llvmpipe this is the rendering time. Timer queries are avoided:
         their 32-bit nanosecond results wrap at 4.29 s.
         """
-        program = self.program(material, view)
+        program = self.program(material, view, values)
         self.bind(program, material, values)
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
         framebuffer.use()

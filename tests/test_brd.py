@@ -453,3 +453,28 @@ def test_uniform_declarations_order_and_empty() -> None:
         "uniform float n;\nuniform float rough;\nuniform bool flag;\nuniform vec3 tint;\n"
     )
     assert material("analytic\n").uniform_declarations() == ""
+
+
+SPECIALISED = """analytic
+# specialise: method
+::begin parameters
+float method 0 4 0
+float alpha 0 1 0.5
+::end parameters
+::begin shader
+vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(alpha); }
+::end shader
+"""
+
+
+def test_specialise_directive_lists_integer_parameters() -> None:
+    assert parse_material(SPECIALISED, "s.brd").specialised == ("method",)
+    assert parse_material(SPECIALISED.replace("# specialise: method\n", ""), "s.brd").specialised == ()
+
+
+@pytest.mark.parametrize("name", ["alpha", "missing"])
+def test_specialise_directive_rejects_non_integer_or_unknown_parameters(name: str) -> None:
+    with pytest.raises(MaterialError) as info:
+        parse_material(SPECIALISED.replace("specialise: method", f"specialise: {name}"), "s.brd")
+    assert info.value.line == 2
+    assert name in info.value.message

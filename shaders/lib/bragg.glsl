@@ -142,10 +142,16 @@ float reflectance_yeh(vec2 r1, vec2 t1, float a, float N) {
     return numerator / (numerator + cabs2(t1) * scale * scale);
 }
 
+// chebyshev_U for a cell at omega: without cancellation near band edges when both phases are real.
+void chebyshev_U_cell(float omega, CellGeometry g, float a, out float U_N1, out float U_N2, out float scale) {
+    if (g.p1.y == 0.0 && g.p2.y == 0.0) chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale);
+    else chebyshev_U(a, g.N, U_N1, U_N2, scale);
+}
+
 // Appendix D: r_N = r1 U_{N-1} / (U_{N-1} - U_{N-2} t1 e^{i k1z d1}).
 vec2 reflection_coefficient_bragg(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
     float U_N1, U_N2, scale;
-    chebyshev_U(a, g.N, U_N1, U_N2, scale);
+    chebyshev_U_cell(omega, g, a, U_N1, U_N2, scale);
     vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
     return cdiv(r1 * U_N1, vec2(U_N1, 0.0) - U_N2 * t_cell);
 }
@@ -169,7 +175,12 @@ float reflectance_polarised(float omega, CellGeometry g) {
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
-    if (g.host_is_n1) return reflectance_yeh(r1, t1, a, g.N);
+    if (g.host_is_n1) {
+        float U_N1, U_N2, scale;
+        chebyshev_U_cell(omega, g, a, U_N1, U_N2, scale);
+        float numerator = cabs2(r1) * U_N1 * U_N1;
+        return numerator / (numerator + cabs2(t1) * scale * scale);  // reflectance_yeh
+    }
     return cabs2(reflection_coefficient_host(reflection_coefficient_bragg(r1, t1, omega, g, a), g.r_h1));
 }
 
