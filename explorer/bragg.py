@@ -442,6 +442,21 @@ def subdivisions(m, m_first, s, mode_numbering: str = "relative"):
     return np.maximum(1.0, s - index)
 
 
+def subdivisions_by_mass(omega_low, omega_high, s):
+    """
+    Sub-boxes of the improved variant (ours): ``ceil(4 s mu)``, with ``mu`` the box's share of the
+    visible CMF mass (X + Y + Z), i.e. ``s`` sub-boxes per quarter of it. Boxes where the eye is most
+    sensitive get the subdivisions, wherever their mode number. On the grid of Figure 4 this spends
+    as many boxes as the paper's ``max(1, s - m)``; the mass comes from the box ends' lookups, which
+    the method makes anyway (Eq. 15).
+    """
+    if s <= 0:
+        return np.ones_like(omega_low)
+    mass = (cmf_cumulative_at(wavelength_of(omega_low)) - cmf_cumulative_at(wavelength_of(omega_high))).sum(axis=-1)
+    total = cmf_cumulative_at(WAVELENGTH_HIGH).sum()
+    return np.maximum(1.0, np.ceil(4.0 * s * mass / total))
+
+
 def _sub_box(lo, hi, j, pieces, edge):
     """
     Sub-box ``j`` of ``pieces`` in ``[lo, hi]`` and the point where its weight is sampled.
@@ -474,7 +489,9 @@ def piecewise_constant_boxes(
 
     ``variant='paper'``: equal sub-boxes, ``w = w~(theta) R^e(centre)`` (Section 3.2.2, Appendix B).
     ``variant='improved'`` (ours): ``w =`` :func:`reflectance_fringe_average` at the sub-box's
-    centroid, sub-boxes graded toward band edges (:func:`_sub_box`). Same landmarks, same lookups.
+    centroid, sub-boxes graded toward band edges (:func:`_sub_box`), their number set by the box's
+    share of the CMF mass (:func:`subdivisions_by_mass`; ``mode_numbering`` is then unused). Same
+    landmarks, same lookups per box.
 
     Yields
     ------
@@ -504,8 +521,11 @@ def piecewise_constant_boxes(
         x1 = np.minimum(z, omega_a)
         x2 = np.maximum(z, omega_a)
         yield omega_m, edge_low, ones, active
-        pieces = subdivisions(m, m_first, s, mode_numbering)
         for lo, hi, edge in ((edge_low, x1, -1), (x1, x2, 0), (x2, edge_high, 1)):
+            if improved:
+                pieces = subdivisions_by_mass(lo, hi, s)
+            else:
+                pieces = subdivisions(m, m_first, s, mode_numbering)
             for j in range(int(np.max(np.where(active, pieces, 1.0)))):
                 sub_lo, centre, sub_hi = _sub_box(lo, hi, j, pieces, edge if improved else 0)
                 if improved:
@@ -599,7 +619,7 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarr
     def polarised(pol: str) -> np.ndarray:
         spectra = np.zeros((size, omega.size), dtype=np.float32)
         geometry = cell_geometry(cos_theta, mirror, pol)
-        real = (geometry.p1.imag == 0) & (geometry.p2.imag == 0) & geometry.host_is_n1
+        real = (geometry.cos_theta_1.imag == 0) & (geometry.cos_theta_2.imag == 0) & geometry.host_is_n1
         spectra[real] = _reflectance_real(omega, geometry, real)
         if not real.all():
             general = cell_geometry(cos_theta[~real], mirror, pol)

@@ -277,6 +277,14 @@ float subdivisions(float m, float m_first, float s, bool absolute_numbering) {
     return max(1.0, s - (absolute_numbering ? m : m - m_first));
 }
 
+// Sub-boxes of the improved variant (ours): ceil(4 s mu), mu the box's share of the visible CMF mass,
+// from the C values at the box's ends.
+float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
+    if (s <= 0.0) return 1.0;
+    float total = dot(cmf_cumulative_at(WAVELENGTH_HIGH), vec3(1.0));
+    return max(1.0, ceil(4.0 * s * dot(C_low - C_high, vec3(1.0)) / total));
+}
+
 // Sub-box j of pieces in [lo, hi]: equal (edge 0), or graded quadratically toward a band edge at lo
 // (edge -1) or hi (edge +1) and sampled at its centroid (ours).
 void sub_box(float lo, float hi, float j, float pieces, int edge, out float sub_lo, out float centre, out float sub_hi) {
@@ -319,13 +327,15 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
             float hi = box == 0 ? x1 : (box == 1 ? x2 : edge_high);
             if (hi <= lo) continue;
             int edge = improved ? box - 1 : 0;
+            vec3 C_high = cmf_cumulative_at(wavelength_of(hi));
+            if (improved) pieces = subdivisions_by_mass(C_previous, C_high, s);
             for (float k = 0.0; k < pieces; k += 1.0) {
                 float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
                 float sub_lo, centre, sub_hi;
                 sub_box(lo, hi, j, pieces, edge, sub_lo, centre, sub_hi);
                 float weight = improved ? reflectance_fringe_average(centre, g)
                                         : g.correction * reflectance_envelope(centre, g);
-                C_next = cmf_cumulative_at(wavelength_of(sub_hi));
+                C_next = k + 1.0 < pieces ? cmf_cumulative_at(wavelength_of(sub_hi)) : C_high;
                 xyz += weight * (C_previous - C_next);
                 C_previous = C_next;
             }
