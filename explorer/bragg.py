@@ -577,34 +577,39 @@ def approximate_rgb(
 TABLE_SIZE = 256
 
 
-def _reflectance_real(omega, geometry: CellGeometry, rows) -> np.ndarray:
+def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows) -> np.ndarray:
     """
-    Eqs. 2, 8, 9, 10 in real float32 arithmetic, for angles where every wave propagates and
-    ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-6, several times faster (the
-    table is rebuilt on every parameter change), with
-    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels in Eq. 2).
+    Unpolarised Eqs. 2, 8, 9, 10 in real float32 arithmetic, for angles where every wave propagates
+    and ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-5, several times faster (the
+    table is rebuilt on every parameter change). Both polarisations share the phases ``psi, phi`` and
+    their sines and cosines. With Eq. 2's own term ``Q = (sin K Lambda / sin N K Lambda)^2`` (Eq. 9's
+    sinh ratio in band gaps), ``R = |r1|^2 / (|r1|^2 + |t1|^2 Q)``, where
+    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels).
     """
     f32 = np.float32
     omega = omega.astype(f32)
-    p1 = geometry.p1.real[rows, None].astype(f32)
-    p2 = geometry.p2.real[rows, None].astype(f32)
-    r12_2 = (geometry.r12.real[rows, None] ** 2).astype(f32)
-    half_Omega = (0.5 * geometry.Omega.real[rows, None]).astype(f32)
-    N = f32(geometry.N)
-    psi, phi = omega * p1, omega * p2
-    sin_phi = np.sin(phi)
-    a = np.cos(psi) * np.cos(phi) - half_Omega * np.sin(psi) * sin_phi
-    r1_2 = f32(4.0) * r12_2 * sin_phi * sin_phi
-    t1_2 = (f32(1.0) - r12_2) ** 2
-    in_band = np.abs(a) < f32(1.0)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        a_band = np.clip(a, f32(-1.0), f32(1.0))
-        U_N1_2 = np.sin(N * np.arccos(a_band)) ** 2 / (f32(1.0) - a_band * a_band)
-        x = np.maximum(np.arccosh(np.maximum(np.abs(a), f32(1.0))), f32(1e-12))
-        h = lambda y: -np.expm1(f32(-2.0) * y)
-        scale = np.exp(-(N - f32(1.0)) * x) * h(x) / h(N * x)
-    numerator = r1_2 * np.where(in_band, U_N1_2, f32(1.0))
-    return numerator / (numerator + t1_2 * np.where(in_band, f32(1.0), scale * scale))
+    first = geometries[0]
+    psi = omega * first.p1.real[rows, None].astype(f32)
+    phi = omega * first.p2.real[rows, None].astype(f32)
+    cos_psi, sin_psi, cos_phi, sin_phi = np.cos(psi), np.sin(psi), np.cos(phi), np.sin(phi)
+    cos_cos, sin_sin, sin2_phi = cos_psi * cos_phi, sin_psi * sin_phi, f32(4.0) * sin_phi * sin_phi
+    N = f32(first.N)
+    total = np.zeros_like(psi)
+    for geometry in geometries:
+        r12_2 = (geometry.r12.real[rows, None] ** 2).astype(f32)
+        a = cos_cos - (0.5 * geometry.Omega.real[rows, None]).astype(f32) * sin_sin
+        r1_2 = r12_2 * sin2_phi
+        t1_2 = (f32(1.0) - r12_2) ** 2
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            a_band = np.clip(a, f32(-1.0), f32(1.0))
+            Q_band = (f32(1.0) - a_band * a_band) / np.sin(N * np.arccos(a_band)) ** 2
+            abs_a = np.maximum(np.abs(a), f32(1.0))
+            x = np.maximum(np.log(abs_a + np.sqrt(abs_a * abs_a - f32(1.0))), f32(1e-12))  # acosh|a|
+            h = lambda y: -np.expm1(f32(-2.0) * y)
+            Q_gap = (np.exp(-(N - f32(1.0)) * x) * h(x) / h(N * x)) ** 2
+            Q = np.where(np.abs(a) < f32(1.0), Q_band, Q_gap)
+            total += r1_2 / (r1_2 + t1_2 * Q)
+    return f32(0.5) * total
 
 
 def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
@@ -615,19 +620,17 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarr
     """
     cos_theta = np.linspace(0.0, 1.0, size)
     omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
-
-    def polarised(pol: str) -> np.ndarray:
-        spectra = np.zeros((size, omega.size), dtype=np.float32)
-        geometry = cell_geometry(cos_theta, mirror, pol)
-        real = (geometry.cos_theta_1.imag == 0) & (geometry.cos_theta_2.imag == 0) & geometry.host_is_n1
-        spectra[real] = _reflectance_real(omega, geometry, real)
-        if not real.all():
-            general = cell_geometry(cos_theta[~real], mirror, pol)
-            spectra[~real] = reflectance_polarised(omega, _rows(general))
-        return spectra
-
-    spectra = polarised("s") + polarised("p")
-    return colorimetry.spectrum_to_rgb(0.5 * spectra.astype(np.float64)).astype(np.float32)
+    geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
+    real = (geometries[0].p1.imag == 0) & (geometries[0].p2.imag == 0) & geometries[0].host_is_n1
+    spectra = np.zeros((size, omega.size))
+    if real.any():
+        spectra[real] = _reflectance_real(omega, geometries, real)
+    if not real.all():
+        others = cos_theta[~real]
+        spectra[~real] = sum(
+            reflectance_polarised(omega, _rows(cell_geometry(others, mirror, pol))) for pol in POLARISATIONS
+        ) / len(POLARISATIONS)
+    return colorimetry.spectrum_to_rgb(spectra).astype(np.float32)
 
 
 def _rows(geometry: CellGeometry) -> CellGeometry:
