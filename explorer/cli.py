@@ -80,6 +80,9 @@ def write_image(image: np.ndarray, out: Path) -> None:
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
             else:
                 Image.fromarray(encode_srgb8(image), mode="RGB").save(stream, format="PNG")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
         os.replace(temporary, out)
     except OSError as error:
         Path(temporary).unlink(missing_ok=True)
