@@ -621,7 +621,7 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarr
     cos_theta = np.linspace(0.0, 1.0, size)
     omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
     geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
-    real = (geometries[0].p1.imag == 0) & (geometries[0].p2.imag == 0) & geometries[0].host_is_n1
+    real = (geometries[0].cos_theta_1.imag == 0) & (geometries[0].cos_theta_2.imag == 0) & geometries[0].host_is_n1
     spectra = np.zeros((size, omega.size))
     if real.any():
         spectra[real] = _reflectance_real(omega, geometries, real)
