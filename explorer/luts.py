@@ -16,6 +16,17 @@ cmf_cumulative
     The cumulative integrals ``C(lambda)`` of those CMFs (Eq. 16 of Fourneau et al. 2024), at the
     472 bin edges ``359.5 + k`` nm: the CMFs are constant over each 1 nm bin, so ``C`` is exactly
     piecewise linear between nodes and a box spectrum integrates to ``C(hi) - C(lo)`` (Eq. 15).
+sensitivity_fourier
+    The Fourier transform ``S^_j(mu)`` of the linear sRGB sensitivities ``s_j`` of the colour
+    convention, as functions of ``nu = 1/lambda`` (Belcour & Barla 2017, Eqs. 7-8):
+    ``S^_j(mu) = sum_lambda s_j(lambda) exp(-2 pi i mu / lambda)`` over the 471 nodes of the spectral
+    reference, with ``s_j = (M cmf)_j`` and ``M`` the XYZ -> RGB matrix, so ``S^_j(0) = 1`` (white).
+    Being the transform of the very sum the 1 nm reference computes, Eq. 10 with it converges to that
+    reference as ``m`` grows. Sampled at OPDs ``mu = 10 k`` nm, ``k = 0..4095``, and stored
+    demodulated, ``E_j(mu) = S^_j(mu) exp(+2 pi i mu / carrier_j)``, with each channel's carrier near
+    its centroid in ``nu``: the envelope ``E_j`` is smooth, so linear interpolation between nodes is
+    within 6e-5 of the transform (2.5e-3 without demodulation). Shape ``(2, 4096, 3)``: real parts,
+    imaginary parts (the paper's N x 2 three-channel texture, Section 5); zero beyond the last node.
 """
 
 from __future__ import annotations
@@ -49,6 +60,27 @@ def _generate_cmf_cumulative() -> np.ndarray:
     return np.concatenate([np.zeros((1, 3)), np.cumsum(cmf, axis=0)]).astype(np.float64)
 
 
+#: The ``sensitivity_fourier`` table: OPD step (nm), node count, and the carrier wavelengths (nm) of
+#: the R, G, B channels (their sensitivities' centroids in ``nu``, 653.2, 545.7 and 440.6 nm, rounded).
+SENSITIVITY_FOURIER_STEP = 10.0
+SENSITIVITY_FOURIER_COUNT = 4096
+SENSITIVITY_FOURIER_CARRIER_NM = (653.0, 546.0, 441.0)
+
+
+def _generate_sensitivity_fourier() -> np.ndarray:
+    # Element-wise products and numpy's pairwise sums, not BLAS: the same bits on every machine.
+    cmf, matrix = colorimetry.colour_matching_functions(), colorimetry.xyz_to_rgb_matrix()
+    sensitivities = (cmf[:, None, :] * matrix[None, :, :]).sum(axis=-1)
+    mu = np.arange(SENSITIVITY_FOURIER_COUNT, dtype=np.float64) * SENSITIVITY_FOURIER_STEP
+    nu = 1.0 / colorimetry.WAVELENGTHS
+    envelope = np.empty((mu.size, 3), dtype=np.complex128)
+    for j, carrier in enumerate(SENSITIVITY_FOURIER_CARRIER_NM):
+        # exp(-2 pi i mu nu) exp(+2 pi i mu / carrier), in one phase: no large phases cancel.
+        phase = np.exp(-2j * np.pi * mu[:, None] * (nu - 1.0 / carrier)[None, :])
+        envelope[:, j] = (phase * sensitivities[None, :, j]).sum(axis=-1)
+    return np.stack([envelope.real, envelope.imag]).astype(np.float64)
+
+
 def _source() -> str:
     import colour
 
@@ -72,6 +104,17 @@ TABLES: dict[str, dict] = {
             "range_nm": [CUMULATIVE_START, colorimetry.WAVELENGTH_MAX + 0.5],
             "resolution_nm": CUMULATIVE_STEP,
             "shape": [472, 3],
+        },
+    },
+    "sensitivity_fourier": {
+        "generate": _generate_sensitivity_fourier,
+        "spec": {
+            "quantity": "Fourier transform over nu = 1/lambda of the linear sRGB sensitivities (Belcour & "
+            "Barla 2017, Eqs. 7-8), demodulated by exp(+2 pi i mu / carrier); [real, imag]",
+            "range_nm": [0.0, SENSITIVITY_FOURIER_STEP * (SENSITIVITY_FOURIER_COUNT - 1)],
+            "resolution_nm": SENSITIVITY_FOURIER_STEP,
+            "carrier_nm": list(SENSITIVITY_FOURIER_CARRIER_NM),
+            "shape": [2, SENSITIVITY_FOURIER_COUNT, 3],
         },
     },
 }
