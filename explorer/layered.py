@@ -1,0 +1,492 @@
+"""
+Layered Bragg structures: the integrated transmissivity of rough Bragg layers and the single-reflection
+BRDF of a stack of 1 to 3 of them over a Lambertian base, under an optional smooth coating
+(Fourneau et al. 2024, Sections 4.2.2-4.3).
+
+A stack (:class:`LayeredBragg`) is, from top to bottom: a smooth interface from air to the host medium
+of index ``n1`` (the coating, present when ``n1 != 1``), then ``L`` rough Bragg layers
+(:class:`RoughBraggLayer`, each a GGX distribution of Bragg mirrors of its own ``n2, Lambda, delta, N,
+alpha`` in the host), then a Lambertian base of RGB albedo ``rho_d``. Transmission through a rough
+Bragg layer is ballistic (Section 4.2.1) and its transmitted fraction is Yeh's transmissivity filtered
+by ``F_alpha`` (Eq. 28); the single-reflection BRDF (Eq. 34) sums the paths that reflect once.
+
+The "LUT version" of Table 2: per layer, the host tabulates Yeh's reflectance ``R_lambda(theta)`` and
+the integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28) at 0.25 degrees and every nm from 360
+to 830 (:func:`layer_tables`), from the transmission filter of the layer's ``alpha``
+(:func:`explorer.microfacet.transmission_filter_table`, cached per ``alpha``). Spectra are multiplied
+per wavelength and integrated against the CMFs (:mod:`explorer.colorimetry`) only at the end; the
+base's albedo, given in RGB, multiplies the RGB of its spectral transmission factor (the only product
+taken in RGB, as ``rho_d`` has no spectrum).
+
+Directions ``i`` and ``o`` are unit vectors in the local frame (``n = +z``), above the surface, pointing
+away from it, in air. Numpy only.
+
+References
+----------
+Fourneau, Pacanowski, Barla (2024). Interactive Exploration of Vivid Material Iridescence using Bragg
+Mirrors. Computer Graphics Forum 43(2). Sections 4.1-4.3 (Eqs. 17-19, 28-30, 34), Table 2, Appendix C.
+"""
+
+from __future__ import annotations
+
+import functools
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import bragg, colorimetry, microfacet
+from .fresnel import fresnel_reflectance
+
+#: At most this many rough Bragg layers in a stack (the issue's 1 to 3).
+MAX_LAYERS = 3
+#: Rows of the reflectance table per block of the fast float32 path (arrays that stay in cache).
+REFLECTANCE_ROW_BLOCK = 64
+
+
+# --------------------------------------------------------------------------------------------------
+# Parameters
+
+
+def _one_line(message: str) -> str:
+    return " ".join(str(message).split())
+
+
+@dataclass(frozen=True)
+class RoughBraggLayer:
+    """
+    A rough Bragg layer (Section 4.1): Bragg mirrors of ``N`` cells ``(n2, d2), (n1, d1)`` oriented by
+    an isotropic GGX distribution of roughness ``alpha``, in the stack's host medium.
+
+    Parameters
+    ----------
+    n2 : float
+        Index of the mirror's high layers.
+    Lambda : float
+        Period ``d1 + d2`` in nm.
+    delta : float
+        ``d1 / Lambda`` in [0, 1].
+    N : int
+        Number of cells (1 is a thin film of ``n2``).
+    alpha : float
+        GGX roughness in [0, 1] (Eq. 18).
+    n1 : float, optional
+        The mirror's low index when it differs from the host (the jewel-beetle cuticles of Table 3:
+        Yeh's reflectance then follows Appendix D with ``nh`` the host); ``None``, the host's ``n1``.
+    """
+
+    n2: float = 1.5
+    Lambda: float = 500.0
+    delta: float = 0.5
+    N: int = 10
+    alpha: float = 0.1
+    n1: float | None = None
+
+    def __post_init__(self):
+        microfacet.check_alpha(self.alpha)
+        if not (float(self.N) >= 1 and float(self.N) == int(self.N)):
+            raise ValueError(f"N must be a whole number of cells >= 1, got {self.N}")
+        if not (self.Lambda > 0.0):
+            raise ValueError(f"Lambda must be positive (nm), got {self.Lambda}")
+        if not (0.0 <= self.delta <= 1.0):
+            raise ValueError(f"delta must be in [0, 1], got {self.delta}")
+        if not (self.n2 > 0.0 and (self.n1 is None or self.n1 > 0.0)):
+            raise ValueError(f"refractive indices must be positive, got n2={self.n2}, n1={self.n1}")
+
+    def mirror(self, host_n1: float) -> bragg.BraggMirror:
+        """The layer's Bragg mirror in a host of index ``host_n1`` (``nh`` only when it differs from ``n1``)."""
+        n1 = host_n1 if self.n1 is None else float(self.n1)
+        return bragg.BraggMirror(
+            n1=n1,
+            n2=float(self.n2),
+            Lambda=float(self.Lambda),
+            delta=float(self.delta),
+            N=int(self.N),
+            nh=None if n1 == host_n1 else float(host_n1),
+        )
+
+
+@dataclass(frozen=True)
+class LayeredBragg:
+    """
+    A layered Bragg structure (Figure 2(e)): 1 to 3 rough Bragg layers in a host of index ``n1``, over
+    a Lambertian base, under a smooth coating when ``n1 != 1``.
+
+    Parameters
+    ----------
+    layers : sequence of RoughBraggLayer
+        From top to bottom; 1 to :data:`MAX_LAYERS`.
+    n1 : float
+        Index of the host medium (>= 1). Eq. 34's coating is the interface from air to it.
+    rho_d : float or (float, float, float)
+        Linear-sRGB albedo of the Lambertian base, each in [0, 1] (0: an absorbing base).
+    coating : bool
+        ``False`` drops the coating's interface (no Fresnel reflection, no refraction, no ``1/n1^2``):
+        the stack seen from inside its host. With ``n1 = 1`` both give the same BRDF.
+    """
+
+    layers: tuple = ()
+    n1: float = 1.0
+    rho_d: tuple = (0.0, 0.0, 0.0)
+    coating: bool = True
+
+    def __post_init__(self):
+        layers = tuple(self.layers) if not isinstance(self.layers, RoughBraggLayer) else (self.layers,)
+        if not 1 <= len(layers) <= MAX_LAYERS:
+            raise ValueError(f"a layered Bragg structure has 1 to {MAX_LAYERS} layers, got {len(layers)}")
+        for layer in layers:
+            if not isinstance(layer, RoughBraggLayer):
+                raise ValueError(f"layers must be RoughBraggLayer, got {type(layer).__name__}")
+        try:
+            rho_d = np.broadcast_to(np.asarray(self.rho_d, dtype=np.float64), (3,))
+        except (TypeError, ValueError):
+            raise ValueError(f"rho_d must be one number or three (r, g, b), got {self.rho_d!r}") from None
+        if not np.all((rho_d >= 0.0) & (rho_d <= 1.0)):
+            raise ValueError(f"rho_d must be in [0, 1] per channel, got {tuple(float(x) for x in rho_d)}")
+        if not (self.n1 >= 1.0):
+            raise ValueError(f"the host index n1 must be >= 1, got {self.n1}")
+        object.__setattr__(self, "layers", layers)
+        object.__setattr__(self, "rho_d", tuple(float(x) for x in rho_d))
+        object.__setattr__(self, "n1", float(self.n1))
+
+
+# --------------------------------------------------------------------------------------------------
+# Eqs. 28 and 30
+
+
+def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter, transmissivity) -> np.ndarray:
+    """
+    The integrated transmissivity of a rough Bragg layer (Eq. 28), per wavelength:
+    ``f_t(theta_i) cos theta_i = int_0^{pi/2} T_lambda(theta_d) F_alpha(theta_i, theta_d) d theta_d``.
+
+    Parameters
+    ----------
+    transmission_filter : explorer.microfacet.TransmissionFilter
+        ``F_alpha`` of the layer's roughness; its cell weights are the quadrature weights.
+    transmissivity : array_like, shape (361, n_wavelengths)
+        ``T_lambda = 1 - R_lambda`` of the layer's mirror at the nodes ``theta_d = k * 0.25 deg``.
+
+    Returns
+    -------
+    ndarray, shape (361, n_wavelengths)
+        The fraction of light at ``theta_i = k * 0.25 deg`` that crosses the layer, ballistically;
+        at most ``G1(theta_i)`` (Eq. 30).
+
+    References
+    ----------
+    Fourneau et al. (2024), Eqs. 22-29.
+    """
+    return transmission_filter.weights @ np.asarray(transmissivity, dtype=np.float64)
+
+
+def absorption(cos_theta_i, alpha) -> np.ndarray:
+    """
+    The part of the light a rough Bragg layer absorbs (Eq. 30): ``A(theta_i) = 1 - G1(theta_i)``, the
+    paths that would scatter more than once among its microfacets (Eq. 28 with ``T = 1``, Appendix C).
+    """
+    return 1.0 - microfacet.smith_G1(cos_theta_i, alpha)
+
+
+def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
+    """
+    The weight of the coating's specular reflection ``f_r,0`` of Eq. 34 (a Dirac in the mirror
+    direction): the unpolarised Fresnel reflectance from air into the host ``n1`` (0 for ``n1 = 1``).
+    Point lights never meet a Dirac; the directional albedo adds it.
+    """
+    cos_theta_i = np.clip(np.asarray(cos_theta_i, dtype=np.float64), microfacet.COS_THETA_MIN, 1.0)
+    return fresnel_reflectance(cos_theta_i, 1.0, n1)
+
+
+# --------------------------------------------------------------------------------------------------
+# Per-layer tables (the "LUT version" of Table 2)
+
+
+def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
+    """
+    Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta`` and every
+    nm of :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``.
+
+    Angles where every wave propagates and ``nh == n1`` take the core's real float32 path of the
+    tabulated method (equal to the exact values to ~1e-5, and within 1e-3 near grazing), by blocks of
+    rows that stay in cache; the others (total internal reflection, Appendix D) the exact complex one.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
+    geometries = tuple(bragg.cell_geometry(cos_theta, mirror, pol) for pol in bragg.POLARISATIONS)
+    first = geometries[0]
+    # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
+    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
+    table = np.empty((cos_theta.size, omega.size))
+    real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
+    for start in range(0, real_rows.size, REFLECTANCE_ROW_BLOCK):
+        rows = real_rows[start : start + REFLECTANCE_ROW_BLOCK]
+        table[rows] = bragg._reflectance_real(omega, geometries, rows)
+    for start in range(0, other_rows.size, REFLECTANCE_ROW_BLOCK):
+        rows = other_rows[start : start + REFLECTANCE_ROW_BLOCK]
+        table[rows] = sum(
+            bragg.reflectance_polarised(omega, bragg._rows(bragg.cell_geometry(cos_theta[rows], mirror, pol)))
+            for pol in bragg.POLARISATIONS
+        ) / len(bragg.POLARISATIONS)
+    return table
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_filter(alpha: float) -> microfacet.TransmissionFilter:
+    return microfacet.transmission_filter_table(alpha)
+
+
+def transmission_filter_for(alpha) -> microfacet.TransmissionFilter:
+    """The transmission filter ``F_alpha`` (Eq. 29), built once per ``alpha`` and cached (8 of them)."""
+    return _cached_filter(float(microfacet.check_alpha(alpha)))
+
+
+@dataclass(frozen=True)
+class LayerTables:
+    """
+    A rough Bragg layer's tables, rebuilt whenever one of its parameters changes (Table 2, LUT version).
+
+    Attributes
+    ----------
+    layer : RoughBraggLayer
+    n1 : float
+        The host index they were built in.
+    theta : ndarray, shape (361,)
+        Rows: ``theta = k * 0.25 deg`` (radians), in the host medium.
+    reflectance : ndarray, shape (361, 471), float32
+        Yeh's unpolarised ``R_lambda(theta)`` (Eqs. 2, 9, 10; Appendix D): the microfacet reflectance
+        of Eq. 17, looked up at the half-vector angle.
+    transmissivity : ndarray, shape (361, 471), float32
+        The integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28): Eq. 34's ``f_t,k``.
+    seconds : float
+        Wall-clock build time of both (the filter excluded: it depends on ``alpha`` only).
+    """
+
+    layer: RoughBraggLayer
+    n1: float
+    theta: np.ndarray = field(repr=False)
+    reflectance: np.ndarray = field(repr=False)
+    transmissivity: np.ndarray = field(repr=False)
+    seconds: float = 0.0
+
+
+def layer_tables(layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=None) -> LayerTables:
+    """
+    Build a layer's tables: ``R_lambda`` over angle and the integrated transmissivity (Eq. 28).
+
+    Parameters
+    ----------
+    layer : RoughBraggLayer
+    n1 : float
+        Index of the host medium.
+    transmission_filter : explorer.microfacet.TransmissionFilter, optional
+        ``F_alpha`` for the layer's ``alpha``; the cached one by default.
+
+    Returns
+    -------
+    LayerTables
+
+    References
+    ----------
+    Fourneau et al. (2024), Eq. 28, Section 4.2.2 (per-layer tables), Table 2 (LUT version).
+    """
+    F = transmission_filter if transmission_filter is not None else transmission_filter_for(layer.alpha)
+    if abs(F.alpha - float(microfacet.check_alpha(layer.alpha))) > 1e-12:
+        raise ValueError(f"the transmission filter is for alpha={F.alpha:g}, the layer has alpha={layer.alpha:g}")
+    start = time.perf_counter()
+    theta = F.theta
+    reflectance = reflectance_table(layer.mirror(float(n1)), np.cos(theta)).astype(np.float32)
+    # Eq. 28 with T = 1 - R, in float32 (the tables' precision; twice as fast as float64).
+    transmissivity = F.weights.astype(np.float32) @ (np.float32(1.0) - reflectance)
+    seconds = time.perf_counter() - start
+    for array in (reflectance, transmissivity):
+        array.setflags(write=False)
+    return LayerTables(layer, float(n1), theta, reflectance, transmissivity, seconds)
+
+
+def stack_tables(stack: LayeredBragg) -> tuple[LayerTables, ...]:
+    """The tables of every layer of ``stack``, top to bottom."""
+    return tuple(layer_tables(layer, stack.n1) for layer in stack.layers)
+
+
+def lookup(table: np.ndarray, theta) -> np.ndarray:
+    """
+    Linear interpolation of a per-angle table (rows at ``k * 0.25 deg``) at ``theta`` (radians), as a
+    linearly filtered texture fetch does: shape ``theta.shape + table.shape[1:]``.
+    """
+    x = np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi) / microfacet.THETA_STEP
+    k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
+    f = (x - k)[..., None]
+    return table[k] * (1.0 - f) + table[k + 1] * f
+
+
+# --------------------------------------------------------------------------------------------------
+# The single-reflection BRDF (Eq. 34)
+
+
+def refract_into_host(direction, n1: float) -> np.ndarray:
+    """
+    Snell's law through the smooth coating, from air into the host ``n1 >= 1``: the direction keeps its
+    azimuth, ``sin theta' = sin theta / n1`` (Eq. 34's refracted ``i`` and ``o``), and stays above.
+    """
+    d = np.asarray(direction, dtype=np.float64)
+    tangent = d[..., :2] / n1
+    cos_t = np.sqrt(np.maximum(1.0 - np.sum(tangent * tangent, axis=-1), 0.0))
+    return np.concatenate([tangent, cos_t[..., None]], axis=-1)
+
+
+@dataclass(frozen=True)
+class SingleReflectionSpectra:
+    """
+    Eq. 34 split by what multiplies the base's RGB albedo, per wavelength (last axis, 471).
+
+    Attributes
+    ----------
+    layers : ndarray
+        ``(1/n1^2) sum_l f_r,l(i', o') prod_{k<l} f_t,k(i) f_t,k(o)`` over the Bragg layers (1/sr).
+    base : ndarray
+        The same product through every layer, times ``1/(pi n1^2)``: the base's term per unit albedo.
+    """
+
+    layers: np.ndarray
+    base: np.ndarray
+
+    def total(self, rho_d=1.0) -> np.ndarray:
+        """The spectral BRDF for a spectrally flat base albedo ``rho_d`` (a scalar or a spectrum)."""
+        return self.layers + np.asarray(rho_d) * self.base
+
+
+def single_reflection_spectra(
+    stack: LayeredBragg, i, o, tables=None, exact_reflectance: bool = False
+) -> SingleReflectionSpectra:
+    """
+    The single-reflection BRDF of a layered Bragg structure (Eq. 34), spectrally:
+    ``f_r(i, o) = f_r,0(i, o) + (1/n1^2) sum_{l=1}^{L+1} f_r,l(i', o') prod_{k=0}^{l-1} f_t,k(i) f_t,k(o)``,
+    where layer ``L + 1`` is the Lambertian base (``rho_d / pi``), ``f_r,l`` is Eq. 17 for Bragg layer
+    ``l`` at the refracted directions ``i', o'``, ``f_t,k`` its integrated transmissivity (Eq. 28) at
+    their angles, and ``f_t,0 = 1 - F`` the coating's Fresnel transmittance at the angles in air. The
+    coating's own reflection ``f_r,0`` is a Dirac (:func:`coating_reflectance`), left out here.
+
+    Parameters
+    ----------
+    stack : LayeredBragg
+    i, o : array_like, shape (..., 3)
+        Unit directions in air, ``n = +z``; 0 where either is at or below the horizon.
+    tables : sequence of LayerTables, optional
+        One per layer (:func:`stack_tables`); built (and their filters cached) when omitted.
+    exact_reflectance : bool
+        ``True`` evaluates Yeh's ``R_lambda`` at the exact half-vector angle (Table 2's "Model"),
+        ``False`` interpolates the layer's table (Table 2's "Model-LUT").
+
+    Returns
+    -------
+    SingleReflectionSpectra
+        Shapes ``(..., 471)``.
+
+    References
+    ----------
+    Fourneau et al. (2024), Eq. 34 (Section 4.3.1), Eqs. 17-19, 28, Table 2.
+    """
+    tables = stack_tables(stack) if tables is None else tuple(tables)
+    if len(tables) != len(stack.layers):
+        raise ValueError(f"{len(tables)} layer tables for {len(stack.layers)} layers")
+    i = np.asarray(i, dtype=np.float64)
+    o = np.asarray(o, dtype=np.float64)
+    cos_i, cos_o = i[..., 2], o[..., 2]
+    above = (cos_i > 0.0) & (cos_o > 0.0)
+    n1 = stack.n1
+    if stack.coating:
+        # f_t,0 = 1 - F at the angles in air; i, o refracted into the host; radiance scaled by 1/n1^2.
+        path = (1.0 - coating_reflectance(cos_i, n1)) * (1.0 - coating_reflectance(cos_o, n1)) / (n1 * n1)
+        i_host, o_host = refract_into_host(i, n1), refract_into_host(o, n1)
+    else:
+        path = np.ones(np.broadcast_shapes(cos_i.shape, cos_o.shape))
+        i_host, o_host = i, o
+    path = np.where(above, path, 0.0)[..., None]
+    theta_i = np.arccos(np.clip(i_host[..., 2], 0.0, 1.0))
+    theta_o = np.arccos(np.clip(o_host[..., 2], 0.0, 1.0))
+    h = microfacet.half_vector(i_host, o_host)
+    cos_theta_d = microfacet.half_vector_cosine(i_host, o_host)
+    theta_d = np.arccos(cos_theta_d)
+    cos_i_host = np.maximum(i_host[..., 2], 0.0)
+    cos_o_host = np.maximum(o_host[..., 2], 0.0)
+    layers = 0.0
+    for layer, table in zip(stack.layers, tables):
+        # Eq. 17: D(h) G1(i) G1(o) R(i.h) / (4 cos_i cos_o), G1/cos finite at grazing angles.
+        lobe = (
+            0.25
+            * microfacet.ggx_D(h[..., 2], layer.alpha)
+            * microfacet.smith_G1_over_cos(cos_i_host, layer.alpha)
+            * microfacet.smith_G1_over_cos(cos_o_host, layer.alpha)
+        )
+        if exact_reflectance:
+            R = bragg.bragg_reflectance(
+                np.maximum(cos_theta_d, microfacet.COS_THETA_MIN)[..., None], colorimetry.WAVELENGTHS, layer.mirror(n1)
+            )
+        else:
+            R = lookup(table.reflectance, theta_d)
+        layers = layers + lobe[..., None] * R * path
+        path = path * lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o)
+    return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
+
+
+def single_reflection_brdf(stack: LayeredBragg, i, o, tables=None, exact_reflectance: bool = False) -> np.ndarray:
+    """
+    The single-reflection BRDF of a layered Bragg structure (Eq. 34) in linear sRGB (1/sr): the Bragg
+    layers' spectral term integrated against the CMFs, plus the base's spectral transmission factor
+    integrated likewise and multiplied by its RGB albedo ``rho_d``. The coating's Dirac reflection is
+    left out (:func:`coating_reflectance`).
+
+    Parameters
+    ----------
+    stack : LayeredBragg
+    i, o : array_like, shape (..., 3)
+        Unit directions in air, ``n = +z``.
+    tables, exact_reflectance
+        As in :func:`single_reflection_spectra`.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Unclamped linear sRGB (vivid colours have negative channels).
+
+    References
+    ----------
+    Fourneau et al. (2024), Eq. 34; the colour convention of :mod:`explorer.colorimetry`.
+    """
+    spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance)
+    return colorimetry.spectrum_to_rgb(spectra.layers) + np.asarray(stack.rho_d) * colorimetry.spectrum_to_rgb(spectra.base)
+
+
+# --------------------------------------------------------------------------------------------------
+# Timings (the goals of issue #3: F_alpha for a new alpha within 100 ms, a layer's tables within 10 ms)
+
+
+def measure_timings(alphas=(0.025, 0.1, 0.4), layers=None, repeats: int = 5) -> dict:
+    """
+    Median wall-clock times (ms) of building ``F_alpha`` for each of ``alphas`` (uncached) and each
+    layer's tables (``layers``: the Figure 7 configurations A, B and A' by default).
+    """
+    if layers is None:
+        layers = {
+            "A (n1=1, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.0),
+            "B (n1=1, d1=d2=494 nm, N=10, alpha=0.05)": (RoughBraggLayer(1.5, 988.0, 0.5, 10, 0.05), 1.0),
+            "A' (n1=1.35, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.35),
+        }
+    filters = {}
+    for alpha in alphas:
+        times = [microfacet.transmission_filter_table(alpha).seconds for _ in range(repeats)]
+        filters[f"alpha={alpha:g}"] = 1e3 * float(np.median(times))
+    tables = {}
+    for name, (layer, n1) in layers.items():
+        F = transmission_filter_for(layer.alpha)
+        times = [layer_tables(layer, n1, F).seconds for _ in range(repeats)]
+        tables[name] = 1e3 * float(np.median(times))
+    return {"transmission_filter_ms": filters, "layer_tables_ms": tables}
+
+
+if __name__ == "__main__":  # python -m explorer.layered: print the timings
+    timings = measure_timings()
+    for alpha, ms in timings["transmission_filter_ms"].items():
+        print(f"F_alpha, {alpha}: {ms:.1f} ms (goal 100 ms; the paper: 600 ms)")
+    for name, ms in timings["layer_tables_ms"].items():
+        print(f"layer tables, {name}: {ms:.1f} ms (goal 10 ms; the paper: 40 ms)")
