@@ -402,11 +402,13 @@ def single_reflection_spectra(
         path = np.ones(np.broadcast_shapes(cos_i.shape, cos_o.shape))
         i_host, o_host = i, o
     path = np.where(above, path, 0.0)[..., None]
-    theta_i = np.arccos(np.clip(i_host[..., 2], 0.0, 1.0))
-    theta_o = np.arccos(np.clip(o_host[..., 2], 0.0, 1.0))
+    # Angles for the table lookups by atan2 (precise near 0, unlike acos; what the GLSL twin should do):
+    # theta = atan2(|v_xy|, v_z), and theta_d = angle(i, h) = atan2(|i - o|, |i + o|).
+    theta_i = np.arctan2(np.linalg.norm(i_host[..., :2], axis=-1), np.maximum(i_host[..., 2], 0.0))
+    theta_o = np.arctan2(np.linalg.norm(o_host[..., :2], axis=-1), np.maximum(o_host[..., 2], 0.0))
     h = microfacet.half_vector(i_host, o_host)
     cos_theta_d = microfacet.half_vector_cosine(i_host, o_host)
-    theta_d = np.arccos(cos_theta_d)
+    theta_d = np.arctan2(np.linalg.norm(i_host - o_host, axis=-1), np.linalg.norm(i_host + o_host, axis=-1))
     cos_i_host = np.maximum(i_host[..., 2], 0.0)
     cos_o_host = np.maximum(o_host[..., 2], 0.0)
     layers = 0.0
