@@ -316,6 +316,18 @@ def reference_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
 # The envelope and the spectral landmarks (Section 3.2.1, Appendix A)
 
 
+def under_host(R_mirror, geometry: CellGeometry) -> np.ndarray:
+    """
+    A mirror reflectance seen through the host interface ``nh -> n1``, added incoherently (our
+    extension for the approximations when ``nh != n1``): ``R_h1 + (1 - R_h1)^2 R / (1 - R_h1 R)``,
+    written as ``1 - (1 - R_h1)(1 - R) / (1 - R_h1 R)``, which stays 1 when both reflect totally.
+    """
+    if geometry.host_is_n1:
+        return R_mirror
+    R_h1 = np.minimum(np.abs(geometry.r_h1) ** 2, 1.0)
+    return 1.0 - (1.0 - R_h1) * (1.0 - R_mirror) / np.maximum(1.0 - R_h1 * R_mirror, 1e-300)
+
+
 def reflectance_envelope(omega, geometry: CellGeometry) -> np.ndarray:
     """
     The envelope ``R^e = |C|^2 / (|C|^2 + sin^2 K Lambda)`` (Eq. 11); 1 inside band gaps.
@@ -326,11 +338,9 @@ def reflectance_envelope(omega, geometry: CellGeometry) -> np.ndarray:
     r1, t1 = airy_slab_coefficients(omega, geometry)
     a = cos_K_Lambda(omega, geometry)
     r1_2 = np.abs(r1) ** 2
-    envelope = r1_2 / (r1_2 + np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0))
-    if geometry.host_is_n1:
-        return envelope
-    R_h1 = np.abs(geometry.r_h1) ** 2
-    return R_h1 + (1.0 - R_h1) ** 2 * envelope / (1.0 - R_h1 * envelope)
+    denominator = r1_2 + np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0)
+    # A cell that reflects nothing (delta = 1) has no gap either: 0, not 0/0.
+    return under_host(np.divide(r1_2, denominator, out=np.zeros_like(r1_2), where=denominator > 0.0), geometry)
 
 
 def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
@@ -344,13 +354,10 @@ def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
     """
     r1, t1 = airy_slab_coefficients(omega, geometry)
     a = cos_K_Lambda(omega, geometry)
-    r1_2 = np.abs(r1) ** 2
     t1_2_sin2 = np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0)
-    average = 1.0 - np.sqrt(t1_2_sin2 / (r1_2 + t1_2_sin2))
-    if geometry.host_is_n1:
-        return average
-    R_h1 = np.abs(geometry.r_h1) ** 2
-    return R_h1 + (1.0 - R_h1) ** 2 * average / (1.0 - R_h1 * average)
+    denominator = np.abs(r1) ** 2 + t1_2_sin2
+    ratio = np.divide(t1_2_sin2, denominator, out=np.ones_like(denominator), where=denominator > 0.0)
+    return under_host(1.0 - np.sqrt(ratio), geometry)
 
 
 def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:
@@ -506,8 +513,8 @@ def piecewise_constant_boxes(
     count = int(np.max(m_last - m_first)) + 1 if n_plus.size else 0
     ones = np.ones_like(n_plus)
     for k in range(count):
-        m = m_first + k
-        active = m <= m_last
+        active = m_first + k <= m_last
+        m = np.minimum(m_first + k, m_last)  # finished elements redo their last interval, masked out
         omega_m = mode_frequency(m, n_plus)
         omega_next = np.minimum(mode_frequency(m + 1.0, n_plus), OMEGA_HIGH)
         omega_a = airy_point(geometry, omega_m, omega_next, m)
@@ -577,16 +584,22 @@ def approximate_rgb(
 TABLE_SIZE = 256
 
 
+#: Up to this many cells the table's fast path runs in float32 (node error ~1e-5); above it the phase
+#: N K Lambda amplifies float32's rounding N times, and float64 keeps the table exact (~2.4x slower).
+FLOAT32_MAX_N = 100
+
+
 def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows) -> np.ndarray:
     """
-    Unpolarised Eqs. 2, 8, 9, 10 in real float32 arithmetic, for angles where every wave propagates
+    Unpolarised Eqs. 2, 8, 9, 10 in real (float32) arithmetic, for angles where every wave propagates
     and ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-5, several times faster (the
     table is rebuilt on every parameter change). Both polarisations share the phases ``psi, phi`` and
     their sines and cosines. With Eq. 2's own term ``Q = (sin K Lambda / sin N K Lambda)^2`` (Eq. 9's
     sinh ratio in band gaps), ``R = |r1|^2 / (|r1|^2 + |t1|^2 Q)``, where
     ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels).
+    float64 above :data:`FLOAT32_MAX_N` cells.
     """
-    f32 = np.float32
+    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N else np.float64
     omega = omega.astype(f32)
     first = geometries[0]
     psi = omega * first.p1.real[rows, None].astype(f32)

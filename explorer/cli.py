@@ -58,6 +58,20 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
     return numbers[0], numbers[1]
 
 
+def check_output(out: Path) -> Path:
+    """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
+    if out.suffix.lower() not in (".png", ".npy"):
+        raise OutputError(f"{out}: the output must end in .png or .npy")
+    if out.is_dir():
+        raise OutputError(f"{out}: is a directory")
+    directory = out.parent if str(out.parent) else Path(".")
+    if not directory.is_dir():
+        raise OutputError(f"{out}: directory {directory} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise OutputError(f"{out}: directory {directory} is not writable")
+    return directory
+
+
 def write_image(image: np.ndarray, out: Path) -> None:
     """``.npy``: float32 HxWx3 linear RGB; ``.png``: 8-bit sRGB, clamped. Written atomically."""
     from PIL import Image
@@ -65,11 +79,7 @@ def write_image(image: np.ndarray, out: Path) -> None:
     from .colorimetry import encode_srgb8
 
     suffix = out.suffix.lower()
-    if suffix not in (".png", ".npy"):
-        raise OutputError(f"{out}: the output must end in .png or .npy")
-    directory = out.parent if str(out.parent) else Path(".")
-    if not directory.is_dir():
-        raise OutputError(f"{out}: directory {directory} does not exist")
+    directory = check_output(out)
     try:
         handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix, dir=directory)
     except OSError as error:
@@ -106,7 +116,7 @@ def render_material(material: Material, values: dict, view: str, width: int, hei
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
 @click.pass_context
-def main(ctx: click.Context) -> None:
+def cli(ctx: click.Context) -> None:
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
     Without a command: render the default Bragg mirror (sphere and angular gradient) to out/.
@@ -131,16 +141,17 @@ def _errors(function):
     return wrapper
 
 
-@main.command()
+@cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--view", type=click.Choice(["gradient", "sphere"]), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
-@click.option("--out", required=True, type=click.Path(dir_okay=False), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
+@click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
 @click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
 @_errors
 def render(material, view, assignments, size, out, engine):
     """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy."""
+    check_output(Path(out))
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     values = loaded.resolve(overrides)
@@ -151,7 +162,7 @@ def render(material, view, assignments, size, out, engine):
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
 
 
-@main.command()
+@cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print the parameters as JSON.")
 @_errors
@@ -167,7 +178,7 @@ def info(material, as_json):
         click.echo(f"  {p.type:5} {p.name:12} default {p.default}{bounds}")
 
 
-@main.command()
+@cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--size", default=512, show_default=True, help="Sphere size for GPU timings.")
 @click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
@@ -179,7 +190,7 @@ def bench(as_json, size, repeats):
     run_bench(as_json=as_json, size=size, repeats=repeats)
 
 
-@main.command()
+@cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False), help="Also write a PNG plot of median ΔE2000 against s.")
 @click.option("--strips", type=click.Path(dir_okay=False), help="Also write Figure 4's colour strips (GPU) to a PNG.")
@@ -193,7 +204,7 @@ def accuracy(as_json, plot, strips):
     run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)
 
 
-@main.command("default", hidden=True)
+@cli.command("default", hidden=True)
 @_errors
 def default_job():
     """Render the default mirror (the main job until the slider app exists)."""
@@ -208,6 +219,19 @@ def default_job():
         image = renderer.render(material, values, view, *size)
         write_image(image, out / f"bragg_mirror_{view}.png")
         click.echo(f"wrote out/bragg_mirror_{view}.png ({size[0]}x{size[1]}, exact spectral colours, tabulated)")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: click's usage errors too end as one line (not click's usage block)."""
+    try:
+        cli.main(args=argv, prog_name=PROG, standalone_mode=False)
+    except click.exceptions.Exit as exit_:
+        sys.exit(exit_.exit_code)
+    except click.exceptions.Abort:
+        _fail("aborted")
+    except click.ClickException as error:
+        click.echo(f"{PROG}: error: {' '.join(error.format_message().split())}", err=True)
+        sys.exit(error.exit_code)
 
 
 if __name__ == "__main__":

@@ -208,8 +208,8 @@ vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
 // Incoherent host interface over a mirror reflectance (our extension for nh != n1).
 float under_host(float R_mirror, CellGeometry g) {
     if (g.host_is_n1) return R_mirror;
-    float R_h1 = cabs2(g.r_h1);
-    return R_h1 + (1.0 - R_h1) * (1.0 - R_h1) * R_mirror / (1.0 - R_h1 * R_mirror);
+    float R_h1 = min(cabs2(g.r_h1), 1.0);  // 1 - (1 - R_h1)(1 - R) / (1 - R_h1 R): 1 when both reflect totally
+    return 1.0 - (1.0 - R_h1) * (1.0 - R_mirror) / max(1.0 - R_h1 * R_mirror, 1e-30);
 }
 
 // Eq. 11.
@@ -218,7 +218,8 @@ float reflectance_envelope(float omega, CellGeometry g) {
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
     float r1_2 = cabs2(r1);
-    return under_host(r1_2 / (r1_2 + cabs2(t1) * max(1.0 - a * a, 0.0)), g);
+    float denominator = r1_2 + cabs2(t1) * max(1.0 - a * a, 0.0);
+    return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
 // Yeh's R averaged over its fringes: 1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda) (ours).
@@ -227,7 +228,8 @@ float reflectance_fringe_average(float omega, CellGeometry g) {
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
     float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
-    return under_host(1.0 - sqrt(t1_2_sin2 / (cabs2(r1) + t1_2_sin2)), g);
+    float denominator = cabs2(r1) + t1_2_sin2;
+    return under_host(denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0, g);
 }
 
 // Appendix B: w~ = w~0 + (1 - w~0)(1 - cos theta_1)^5, w~0 = 0.735 R12 + 0.532.
