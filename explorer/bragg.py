@@ -625,25 +625,41 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
     return f32(0.5) * total
 
 
-def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
-    """
-    The spectral reference at ``cos theta = k / (size - 1)``, for the host to upload as a 1D texture.
+#: Rows of angles per block of the fast path: 32 x 471 float32 temporaries stay in cache.
+ROW_BLOCK = 32
 
-    Angles where a wave is evanescent, or under a host ``nh != n1``, take the general complex path.
+
+def reflectance_spectra(cos_theta, mirror: BraggMirror) -> np.ndarray:
     """
-    cos_theta = np.linspace(0.0, 1.0, size)
+    Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every nm of
+    :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``; the host's tables.
+
+    Angles where every wave propagates and ``nh == n1`` take the real fast path
+    (:func:`_reflectance_real`), by blocks of rows; the others (total internal reflection, a host
+    ``nh != n1``) the exact complex one.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
     geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
-    real = (geometries[0].cos_theta_1.imag == 0) & (geometries[0].cos_theta_2.imag == 0) & geometries[0].host_is_n1
-    spectra = np.zeros((size, omega.size))
-    if real.any():
-        spectra[real] = _reflectance_real(omega, geometries, real)
-    if not real.all():
-        others = cos_theta[~real]
-        spectra[~real] = sum(
-            reflectance_polarised(omega, _rows(cell_geometry(others, mirror, pol))) for pol in POLARISATIONS
+    first = geometries[0]
+    # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
+    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
+    spectra = np.empty((cos_theta.size, omega.size))
+    real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
+    for start in range(0, real_rows.size, ROW_BLOCK):
+        rows = real_rows[start : start + ROW_BLOCK]
+        spectra[rows] = _reflectance_real(omega, geometries, rows)
+    for start in range(0, other_rows.size, ROW_BLOCK):
+        rows = other_rows[start : start + ROW_BLOCK]
+        spectra[rows] = sum(
+            reflectance_polarised(omega, _rows(cell_geometry(cos_theta[rows], mirror, pol))) for pol in POLARISATIONS
         ) / len(POLARISATIONS)
-    return colorimetry.spectrum_to_rgb(spectra).astype(np.float32)
+    return spectra
+
+
+def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
+    """The spectral reference at ``cos theta = k / (size - 1)``, for the host to upload as a 1D texture."""
+    return colorimetry.spectrum_to_rgb(reflectance_spectra(np.linspace(0.0, 1.0, size), mirror)).astype(np.float32)
 
 
 def _rows(geometry: CellGeometry) -> CellGeometry:

@@ -40,8 +40,6 @@ from .fresnel import fresnel_reflectance
 
 #: At most this many rough Bragg layers in a stack (the issue's 1 to 3).
 MAX_LAYERS = 3
-#: Rows of the reflectance table per block of the fast float32 path (arrays that stay in cache).
-REFLECTANCE_ROW_BLOCK = 64
 
 
 # --------------------------------------------------------------------------------------------------
@@ -206,28 +204,10 @@ def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
     Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta`` and every
     nm of :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``.
 
-    Angles where every wave propagates and ``nh == n1`` take the core's real float32 path of the
-    tabulated method (equal to the exact values to ~1e-5, and within 1e-3 near grazing), by blocks of
-    rows that stay in cache; the others (total internal reflection, Appendix D) the exact complex one.
+    The core's :func:`explorer.bragg.reflectance_spectra`: its fast real path where every wave
+    propagates and ``nh == n1`` (exact to ~1e-5), the exact complex one elsewhere.
     """
-    cos_theta = np.asarray(cos_theta, dtype=np.float64)
-    omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
-    geometries = tuple(bragg.cell_geometry(cos_theta, mirror, pol) for pol in bragg.POLARISATIONS)
-    first = geometries[0]
-    # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
-    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
-    table = np.empty((cos_theta.size, omega.size))
-    real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
-    for start in range(0, real_rows.size, REFLECTANCE_ROW_BLOCK):
-        rows = real_rows[start : start + REFLECTANCE_ROW_BLOCK]
-        table[rows] = bragg._reflectance_real(omega, geometries, rows)
-    for start in range(0, other_rows.size, REFLECTANCE_ROW_BLOCK):
-        rows = other_rows[start : start + REFLECTANCE_ROW_BLOCK]
-        table[rows] = sum(
-            bragg.reflectance_polarised(omega, bragg._rows(bragg.cell_geometry(cos_theta[rows], mirror, pol)))
-            for pol in bragg.POLARISATIONS
-        ) / len(bragg.POLARISATIONS)
-    return table
+    return bragg.reflectance_spectra(cos_theta, mirror)
 
 
 @functools.lru_cache(maxsize=8)
