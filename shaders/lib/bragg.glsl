@@ -119,19 +119,21 @@ void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float sca
     chebyshev_U_d(a, 1.0 - abs(a), N, U_N1, U_N2, scale);
 }
 
-// float32 near band edges, real phases: 1 -+ cos K Lambda from Eq. 36, cos K Lambda =
-// (1 - Theta) cos(psi - phi) + Theta cos(psi + phi) with Theta = 1/2 + Omega/4, written as
-// 2 (1 - Theta) sin^2((psi -+ phi)/2) + 2 Theta sin^2(...) (cos^2 for 1 + a): no cancellation against 1,
-// so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda would amplify an
-// absolute error of cos K Lambda. float64 (explorer/bragg.py) needs none of this.
-void chebyshev_U_precise(float psi, float phi, float Omega_, float N, out float U_N1, out float U_N2, out float scale) {
-    float Theta = 0.5 + 0.25 * Omega_;
-    float a = (1.0 - Theta) * cos(psi - phi) + Theta * cos(psi + phi);
+// float32 near band edges, real phases: with h+- = (psi +- phi)/2 and Theta = 1/2 + Omega/4, Eq. 36 gives
+// 1 - cos K Lambda = 2 (1 - Theta) sin^2 h- + 2 Theta sin^2 h+ and 1 + cos K Lambda = the same with cos^2:
+// no cancellation against 1, so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda
+// would amplify an absolute error of cos K Lambda. Four trig calls in all; sin phi = sin(h+ - h-) comes free.
+// float64 (explorer/bragg.py) needs none of this.
+void chebyshev_U_precise(float psi, float phi, float Omega_, float N,
+                         out float U_N1, out float U_N2, out float scale, out float sin_phi) {
     float h_minus = 0.5 * (psi - phi), h_plus = 0.5 * (psi + phi);
-    float d = a >= 0.0
-        ? 2.0 * ((1.0 - Theta) * sin(h_minus) * sin(h_minus) + Theta * sin(h_plus) * sin(h_plus))
-        : 2.0 * ((1.0 - Theta) * cos(h_minus) * cos(h_minus) + Theta * cos(h_plus) * cos(h_plus));
-    chebyshev_U_d(a, d, N, U_N1, U_N2, scale);
+    float sm = sin(h_minus), cm = cos(h_minus), sp = sin(h_plus), cp = cos(h_plus);
+    sin_phi = sp * cm - cp * sm;
+    float Theta = 0.5 + 0.25 * Omega_;
+    float one_minus_a = 2.0 * ((1.0 - Theta) * sm * sm + Theta * sp * sp);
+    float one_plus_a = 2.0 * ((1.0 - Theta) * cm * cm + Theta * cp * cp);
+    float a = one_minus_a <= one_plus_a ? 1.0 - one_minus_a : one_plus_a - 1.0;
+    chebyshev_U_d(a, a >= 0.0 ? one_minus_a : one_plus_a, N, U_N1, U_N2, scale);
 }
 
 // Eqs. 2 and 9: |r1|^2 U^2 / (|r1|^2 U^2 + |t1|^2 scale^2).
@@ -144,7 +146,8 @@ float reflectance_yeh(vec2 r1, vec2 t1, float a, float N) {
 
 // chebyshev_U for a cell at omega: without cancellation near band edges when both phases are real.
 void chebyshev_U_cell(float omega, CellGeometry g, float a, out float U_N1, out float U_N2, out float scale) {
-    if (g.p1.y == 0.0 && g.p2.y == 0.0) chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale);
+    float sin_phi;
+    if (g.p1.y == 0.0 && g.p2.y == 0.0) chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale, sin_phi);
     else chebyshev_U(a, g.N, U_N1, U_N2, scale);
 }
 
@@ -165,10 +168,9 @@ float reflectance_polarised(float omega, CellGeometry g) {
     if (g.host_is_n1 && g.p1.y == 0.0 && g.p2.y == 0.0) {
         // Real arithmetic (as explorer.bragg._reflectance_real): |r1|^2 : |t1|^2 =
         // 4 r12^2 sin^2 phi : (1 - r12^2)^2, their common denominator cancels in Eq. 2.
-        float psi = omega * g.p1.x, phi = omega * g.p2.x;
-        float sin_phi = sin(phi), r12_2 = g.r12.x * g.r12.x;
-        float U_N1, U_N2, scale;
-        chebyshev_U_precise(psi, phi, g.Omega.x, g.N, U_N1, U_N2, scale);
+        float r12_2 = g.r12.x * g.r12.x;
+        float U_N1, U_N2, scale, sin_phi;
+        chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale, sin_phi);
         float numerator = 4.0 * r12_2 * sin_phi * sin_phi * U_N1 * U_N1;
         return numerator / (numerator + (1.0 - r12_2) * (1.0 - r12_2) * scale * scale);
     }
