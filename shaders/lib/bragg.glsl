@@ -91,7 +91,7 @@ float one_minus_exp_minus_2x(float x) {
 float acosh_stable(float a) { return a > 1e4 ? log(2.0 * a) : log(a + sqrt((a - 1.0) * (a + 1.0))); }
 
 // U_{N-1}, U_{N-2} of cos K Lambda, divided by U_{N-1} in band gaps (Eq. 9) where they overflow.
-// d = 1 - |a| when known without cancellation (chebyshev_U_precise), else computed from a.
+// d = 1 - |a| when known without cancellation (chebyshev_U_half_angles), else computed from a.
 void chebyshev_U_d(float a, float d, float N, out float U_N1, out float U_N2, out float scale) {
     if (d > 0.0) {
         // e^{i N t} = (cos t + i sin t)^N by binary powering, never t itself: drivers lower acos to
@@ -124,17 +124,22 @@ void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float sca
 // no cancellation against 1, so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda
 // would amplify an absolute error of cos K Lambda. Four trig calls in all; sin phi = sin(h+ - h-) comes free.
 // float64 (explorer/bragg.py) needs none of this.
-void chebyshev_U_precise(float psi, float phi, float Omega_, float N,
-                         out float U_N1, out float U_N2, out float scale, out float sin_phi) {
-    float h_minus = 0.5 * (psi - phi), h_plus = 0.5 * (psi + phi);
-    float sm = sin(h_minus), cm = cos(h_minus), sp = sin(h_plus), cp = cos(h_plus);
-    sin_phi = sp * cm - cp * sm;
+void chebyshev_U_half_angles(vec4 half_angles, float Omega_, float N, out float U_N1, out float U_N2, out float scale) {
+    float sm = half_angles.x, cm = half_angles.y, sp = half_angles.z, cp = half_angles.w;
     float Theta = 0.5 + 0.25 * Omega_;
     float one_minus_a = 2.0 * ((1.0 - Theta) * sm * sm + Theta * sp * sp);
     float one_plus_a = 2.0 * ((1.0 - Theta) * cm * cm + Theta * cp * cp);
     float a = one_minus_a <= one_plus_a ? 1.0 - one_minus_a : one_plus_a - 1.0;
     chebyshev_U_d(a, a >= 0.0 ? one_minus_a : one_plus_a, N, U_N1, U_N2, scale);
 }
+
+// (sin h-, cos h-, sin h+, cos h+): the same for both polarisations.
+vec4 half_angles(float psi, float phi) {
+    float h_minus = 0.5 * (psi - phi), h_plus = 0.5 * (psi + phi);
+    return vec4(sin(h_minus), cos(h_minus), sin(h_plus), cos(h_plus));
+}
+
+float sin_phi_of(vec4 h) { return h.z * h.y - h.w * h.x; }  // sin(h+ - h-)
 
 // Eqs. 2 and 9: |r1|^2 U^2 / (|r1|^2 U^2 + |t1|^2 scale^2).
 float reflectance_yeh(vec2 r1, vec2 t1, float a, float N) {
@@ -146,8 +151,7 @@ float reflectance_yeh(vec2 r1, vec2 t1, float a, float N) {
 
 // chebyshev_U for a cell at omega: without cancellation near band edges when both phases are real.
 void chebyshev_U_cell(float omega, CellGeometry g, float a, out float U_N1, out float U_N2, out float scale) {
-    float sin_phi;
-    if (g.p1.y == 0.0 && g.p2.y == 0.0) chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale, sin_phi);
+    if (g.p1.y == 0.0 && g.p2.y == 0.0) chebyshev_U_half_angles(half_angles(omega * g.p1.x, omega * g.p2.x), g.Omega.x, g.N, U_N1, U_N2, scale);
     else chebyshev_U(a, g.N, U_N1, U_N2, scale);
 }
 
@@ -164,16 +168,20 @@ vec2 reflection_coefficient_host(vec2 r_N, vec2 r_h1) {
     return cdiv(r_N + r_h1, vec2(1.0, 0.0) + cmul(r_h1, r_N));
 }
 
+// Eq. 2 in real arithmetic (all waves propagate, nh = n1), from the half angles of the phases:
+// |r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2, their common denominator cancels.
+float reflectance_real(vec4 h, CellGeometry g) {
+    float r12_2 = g.r12.x * g.r12.x, sin_phi = sin_phi_of(h);
+    float U_N1, U_N2, scale;
+    chebyshev_U_half_angles(h, g.Omega.x, g.N, U_N1, U_N2, scale);
+    float numerator = 4.0 * r12_2 * sin_phi * sin_phi * U_N1 * U_N1;
+    return numerator / (numerator + (1.0 - r12_2) * (1.0 - r12_2) * scale * scale);
+}
+
+bool is_real_path(CellGeometry g) { return g.host_is_n1 && g.p1.y == 0.0 && g.p2.y == 0.0; }
+
 float reflectance_polarised(float omega, CellGeometry g) {
-    if (g.host_is_n1 && g.p1.y == 0.0 && g.p2.y == 0.0) {
-        // Real arithmetic (as explorer.bragg._reflectance_real): |r1|^2 : |t1|^2 =
-        // 4 r12^2 sin^2 phi : (1 - r12^2)^2, their common denominator cancels in Eq. 2.
-        float r12_2 = g.r12.x * g.r12.x;
-        float U_N1, U_N2, scale, sin_phi;
-        chebyshev_U_precise(omega * g.p1.x, omega * g.p2.x, g.Omega.x, g.N, U_N1, U_N2, scale, sin_phi);
-        float numerator = 4.0 * r12_2 * sin_phi * sin_phi * U_N1 * U_N1;
-        return numerator / (numerator + (1.0 - r12_2) * (1.0 - r12_2) * scale * scale);
-    }
+    if (is_real_path(g)) return reflectance_real(half_angles(omega * g.p1.x, omega * g.p2.x), g);
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
@@ -197,9 +205,16 @@ float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
 vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
     CellGeometry g_s = cell_geometry(cos_theta, mirror, 0), g_p = cell_geometry(cos_theta, mirror, 1);
     vec3 xyz = vec3(0.0);
+    bool real = is_real_path(g_s);  // both polarisations then share the phases' trig
     for (int i = 0; i < CMF_COUNT; ++i) {
         float omega = 2.0 * PI / (CMF_FIRST_WAVELENGTH + float(i));
-        float R = 0.5 * (reflectance_polarised(omega, g_s) + reflectance_polarised(omega, g_p));
+        float R;
+        if (real) {
+            vec4 h = half_angles(omega * g_s.p1.x, omega * g_s.p2.x);
+            R = 0.5 * (reflectance_real(h, g_s) + reflectance_real(h, g_p));
+        } else {
+            R = 0.5 * (reflectance_polarised(omega, g_s) + reflectance_polarised(omega, g_p));
+        }
         xyz += R * colour_matching_functions(i);
     }
     return xyz_to_rgb(xyz);
