@@ -174,7 +174,8 @@ def format_accuracy(rows: list[dict]) -> str:
     for variant, numbering in (("paper", "relative"), ("paper", "absolute"), ("improved", "relative")):
         subset = [r for r in rows if r["variant"] == variant and (r["mode_numbering"] == numbering or r["s"] == 0)]
         s_values = sorted({r["s"] for r in subset if r["s"] > 0})
-        out.append(f"**{variant}** variant, mode numbering **{numbering}** — median / max ΔE2000 over θ ∈ [0°, 89.5°]\n")
+        how = "sub-boxes by share of CMF mass" if variant == "improved" else f"mode numbering **{numbering}**"
+        out.append(f"**{variant}** variant, {how} — median / max ΔE2000 over θ ∈ [0°, 89.5°]\n")
         out.append("| Λ (nm) | δ | basic | " + " | ".join(f"s = {s}" for s in s_values) + " |")
         out.append("|---|---|---|" + "---|" * len(s_values))
         for Lambda in FIGURE4_LAMBDAS:
