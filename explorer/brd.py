@@ -46,6 +46,8 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Union
 
+from .errors import LocatedError
+
 __all__ = [
     "MaterialError",
     "UnknownParameterError",
@@ -120,34 +122,8 @@ _TRUE_WORDS = frozenset({"1", "true", "yes", "on"})
 _FALSE_WORDS = frozenset({"0", "false", "no", "off"})
 
 
-class MaterialError(Exception):
-    """A material file, or a value meant for one, is wrong.
-
-    Parameters
-    ----------
-    path : str
-        The file (or other origin, such as ``"--set"``) the problem is in.
-    line : int or None
-        1-based line in `path`, or None when the problem has no line.
-    message : str
-        What is wrong, one line.
-
-    Notes
-    -----
-    ``str(error)`` is always one line, ``"{path}:{line}: {message}"`` or
-    ``"{path}: {message}"``, so that editors and terminals can jump to it.
-    """
-
-    def __init__(self, path: str | os.PathLike[str], line: int | None, message: str) -> None:
-        # Pass all three to Exception so that the error pickles (multiprocessing).
-        super().__init__(os.fspath(path), line, message)
-        self.path: str = os.fspath(path)
-        self.line: int | None = line
-        self.message: str = message
-
-    def __str__(self) -> str:
-        where = self.path if self.line is None else f"{self.path}:{self.line}"
-        return " ".join(f"{where}: {self.message}".splitlines())
+class MaterialError(LocatedError):
+    """A material file, or a value meant for one, is wrong (see `explorer.errors.LocatedError`)."""
 
 
 class UnknownParameterError(MaterialError, KeyError):

@@ -18,7 +18,7 @@ import click
 import numpy as np
 
 from .brd import Material, MaterialError, load_material, parse_assignment
-from .glsl import ShaderError
+from .errors import LocatedError
 
 DEFAULT_MATERIAL = Path(__file__).resolve().parent.parent / "shaders" / "bragg_mirror.brd"
 PROG = "bragg-explorer"
@@ -135,7 +135,7 @@ def _errors(function):
     def wrapper(*args, **kwargs):
         try:
             return function(*args, **kwargs)
-        except (MaterialError, ShaderError, GLUnavailable, OutputError) as error:
+        except (LocatedError, GLUnavailable, OutputError) as error:
             _fail(str(error))
 
     return wrapper

@@ -36,6 +36,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .errors import LocatedError
+
 __all__ = [
     "LINE_STRIDE",
     "ShaderError",
@@ -58,33 +60,8 @@ _IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _NEWLINE_RE = re.compile(r"\r\n|\r|\n")
 
 
-class ShaderError(Exception):
-    """A shader could not be assembled or compiled.
-
-    Parameters
-    ----------
-    path : str
-        The file the problem is in (or a ``<name>`` for generated text).
-    line : int or None
-        1-based line in `path`, or None.
-    message : str
-        What is wrong.
-
-    Notes
-    -----
-    ``str(error)`` is one line: ``"{path}:{line}: {message}"`` (or
-    ``"{path}: {message}"`` without a line).
-    """
-
-    def __init__(self, path: str | os.PathLike[str], line: int | None, message: str) -> None:
-        super().__init__(os.fspath(path), line, message)
-        self.path: str = os.fspath(path)
-        self.line: int | None = line
-        self.message: str = message
-
-    def __str__(self) -> str:
-        where = self.path if self.line is None else f"{self.path}:{self.line}"
-        return " ".join(f"{where}: {self.message}".splitlines())
+class ShaderError(LocatedError):
+    """A shader could not be assembled or compiled (see `explorer.errors.LocatedError`)."""
 
 
 @dataclass(frozen=True)

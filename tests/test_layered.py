@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from explorer import bragg, colorimetry, layered, microfacet
-from explorer.bragg import BraggMirror
 from explorer.layered import LayeredBragg, RoughBraggLayer
 
 SEED = 20240604

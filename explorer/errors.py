@@ -1,0 +1,36 @@
+"""Errors that point at a place in a file: what bad input turns into before it reaches the user."""
+
+from __future__ import annotations
+
+import os
+
+
+class LocatedError(Exception):
+    """
+    Something is wrong at a place in a file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (or another origin, such as ``"--set"`` or a ``<name>`` for generated text).
+    line : int or None
+        1-based line in ``path``, or None when the problem has no line.
+    message : str
+        What is wrong.
+
+    Notes
+    -----
+    ``str(error)`` is always one line, ``"{path}:{line}: {message}"`` or ``"{path}: {message}"``, so that
+    editors and terminals can jump to it.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], line: int | None, message: str) -> None:
+        # Pass all three to Exception so that the error pickles (multiprocessing).
+        super().__init__(os.fspath(path), line, message)
+        self.path: str = os.fspath(path)
+        self.line: int | None = line
+        self.message: str = message
+
+    def __str__(self) -> str:
+        where = self.path if self.line is None else f"{self.path}:{self.line}"
+        return " ".join(f"{where}: {self.message}".splitlines())
