@@ -185,12 +185,7 @@ float reflectance_polarised(float omega, CellGeometry g) {
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
-    if (g.host_is_n1) {
-        float U_N1, U_N2, scale;
-        chebyshev_U_cell(omega, g, a, U_N1, U_N2, scale);
-        float numerator = cabs2(r1) * U_N1 * U_N1;
-        return numerator / (numerator + cabs2(t1) * scale * scale);  // reflectance_yeh
-    }
+    if (g.host_is_n1) return reflectance_yeh(r1, t1, a, g.N);  // an evanescent layer: complex phases
     return cabs2(reflection_coefficient_host(reflection_coefficient_bragg(r1, t1, omega, g, a), g.r_h1));
 }
 
