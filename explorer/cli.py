@@ -22,6 +22,8 @@ from .errors import LocatedError
 
 DEFAULT_MATERIAL = Path(__file__).resolve().parent.parent / "shaders" / "bragg_mirror.brd"
 PROG = "bragg-explorer"
+#: 8-bit colour of the scatter view's circles in PNG output (red, as in the paper's Figure 9).
+OVERLAY_RGB = (255, 0, 0)
 
 
 class OutputError(Exception):
@@ -58,6 +60,24 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
     return numbers[0], numbers[1]
 
 
+def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
+    """``THETA,PHI`` in degrees (theta in [0, 180] from +z, phi from +x; theta <= 90 for ``scatter``)."""
+    from .render import LIGHT_VIEWS
+
+    if text is None:
+        return None
+    if view not in LIGHT_VIEWS:
+        raise click.BadParameter(f"the {view} view has no light (--light is for {' and '.join(LIGHT_VIEWS)})", param_hint="--light")
+    try:
+        theta, phi = (float(part) for part in text.split(","))
+    except ValueError:
+        raise click.BadParameter(f"{text!r} is not THETA,PHI in degrees (e.g. 30,0)", param_hint="--light") from None
+    top = 90.0 if view == "scatter" else 180.0
+    if not (np.isfinite(theta) and np.isfinite(phi)) or not 0.0 <= theta <= top:
+        raise click.BadParameter(f"{text!r}: THETA must be in [0, {top:g}] and PHI finite", param_hint="--light")
+    return theta, phi
+
+
 def check_output(out: Path) -> Path:
     """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
     if out.suffix.lower() not in (".png", ".npy"):
@@ -72,8 +92,12 @@ def check_output(out: Path) -> Path:
     return directory
 
 
-def write_image(image: np.ndarray, out: Path) -> None:
-    """``.npy``: float32 HxWx3 linear RGB; ``.png``: 8-bit sRGB, clamped. Written atomically."""
+def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None) -> None:
+    """
+    ``.npy``: float32 HxWx3 linear RGB; ``.png``: 8-bit sRGB, clamped. Written atomically.
+
+    ``overlay``: a bool HxW mask of pixels painted red in the PNG only (the scatter view's circles).
+    """
     from PIL import Image
 
     from .colorimetry import encode_srgb8
@@ -89,7 +113,10 @@ def write_image(image: np.ndarray, out: Path) -> None:
             if suffix == ".npy":
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
             else:
-                Image.fromarray(encode_srgb8(image), mode="RGB").save(stream, format="PNG")
+                pixels = encode_srgb8(image)
+                if overlay is not None:
+                    pixels[overlay] = OVERLAY_RGB
+                Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
@@ -99,19 +126,24 @@ def write_image(image: np.ndarray, out: Path) -> None:
         raise OutputError(f"{out}: cannot write ({error.strerror})") from None
 
 
-def render_material(material: Material, values: dict, view: str, width: int, height: int, engine: str) -> np.ndarray:
+def render_material(
+    material: Material, values: dict, view: str, width: int, height: int, engine: str,
+    light: tuple[float, float] | None = None,
+) -> np.ndarray:
     """One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``)."""
     if engine == "numpy":
         from .models import model_for
-        from .render import render_numpy
+        from .render import BRDF_VIEWS, render_numpy
 
         model = model_for(material, values)
         if model is None:
             raise MaterialError(material.path, None, "this material has no numpy twin (no known '# model:' line)")
-        return render_numpy(model, view, width, height)
+        if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
+            raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
+        return render_numpy(model, view, width, height, light=light)
     from .gl import Renderer
 
-    return Renderer().render(material, values, view, width, height)
+    return Renderer().render(material, values, view, width, height, light=light)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -143,21 +175,30 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(["gradient", "sphere"]), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter"]), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
 @click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
+@click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit and scatter (default 45,0).")
 @_errors
-def render(material, view, assignments, size, out, engine):
-    """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy."""
+def render(material, view, assignments, size, out, engine, light):
+    """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy.
+
+    Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
+    directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
+    (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y).
+    """
+    from .render import scatter_circles
+
     check_output(Path(out))
+    light_angles = parse_light(light, view)
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     values = loaded.resolve(overrides)
     width, height = parse_size(size, view)
-    image = render_material(loaded, values, view, width, height, engine)
-    write_image(image, Path(out))
+    image = render_material(loaded, values, view, width, height, engine, light_angles)
+    write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None)
     bad = int((~np.isfinite(image)).sum())
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
 

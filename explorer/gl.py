@@ -161,10 +161,23 @@ class Renderer:
                 texture.use(location=unit)
                 program[name].value = unit
 
-    def render(self, material: Material, values: Mapping[str, object], view: str, width: int, height: int) -> np.ndarray:
-        """``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped."""
+    def render(
+        self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
+        *, light: tuple[float, float] | None = None,
+    ) -> np.ndarray:
+        """
+        ``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped.
+
+        ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
+        (default :data:`explorer.render.DEFAULT_LIGHT`); the other views ignore it.
+        """
+        from .render import light_direction
+
+        direction = light_direction(light)
         program = self.program(material, view, values)
         self.bind(program, material, values)
+        if "light_direction" in program:
+            program["light_direction"].value = tuple(float(c) for c in direction)
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
         try:
             framebuffer.use()

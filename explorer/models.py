@@ -17,6 +17,14 @@ from .fresnel import fresnel_schlick
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 
 
+def _cos_half_angle(L, V) -> np.ndarray:
+    """clamp(dot(normalize(L + V), L), 0, 1) for unit vectors ``(..., 3)``: the shaders' H.L."""
+    L = np.asarray(L, dtype=np.float64)
+    H = L + np.asarray(V, dtype=np.float64)
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    return np.clip(np.sum(H * L, axis=-1), 0.0, 1.0)
+
+
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
@@ -57,6 +65,10 @@ class BraggMirrorModel:
             return bragg.tabulated_rgb(self.table, cos_theta)
         return bragg.approximate_rgb(cos_theta, self.mirror, self.s, variant="improved")
 
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """The shader's ``BRDF``: the reflectance at the half-vector angle (unit vectors ``(..., 3)``)."""
+        return self.reflectance(_cos_half_angle(L, V))
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
@@ -74,6 +86,9 @@ class SchlickFresnelModel:
     def reflectance(self, cos_theta) -> np.ndarray:
         value = fresnel_schlick(np.asarray(cos_theta, dtype=np.float64), self.F0)
         return np.repeat(value[..., None], 3, axis=-1)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        return self.reflectance(_cos_half_angle(L, V))
 
     def textures(self) -> dict[str, np.ndarray]:
         return {}
