@@ -114,6 +114,8 @@ class Renderer:
         return {
             "cmf_1nm": self._texture_row(luts.load("cmf_1nm"), linear=False),
             "cmf_cumulative": self._texture_row(luts.load("cmf_cumulative"), linear=True),
+            # (2, 4096, 3): a 4096 x 2 texture, row 0 real and row 1 imaginary parts (lib/thinfilm.glsl texelFetches).
+            "sensitivity_fourier": self.ctx.texture((luts.SENSITIVITY_FOURIER_COUNT, 2), 3, luts.load("sensitivity_fourier").astype("f4").tobytes(), dtype="f4"),
         }
 
     def program(self, material: Material, view: str, values: Mapping[str, object] | None = None):

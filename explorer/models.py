@@ -13,6 +13,7 @@ import numpy as np
 
 from . import bragg
 from .fresnel import fresnel_schlick
+from .thinfilm_model import ThinFilmModel
 
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 
@@ -97,6 +98,7 @@ class SchlickFresnelModel:
 MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     BraggMirrorModel.name: BraggMirrorModel,
     SchlickFresnelModel.name: SchlickFresnelModel,
+    ThinFilmModel.name: ThinFilmModel,
 }
 
 

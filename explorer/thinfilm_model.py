@@ -1,0 +1,92 @@
+"""
+The numpy twin of ``shaders/thin_film.brd`` (Belcour & Barla 2017; physics in :mod:`explorer.thinfilm`).
+
+The material is a GGX microfacet BRDF whose Fresnel term is a thin film's Airy reflectance at the
+half-vector angle; ``method`` picks how that reflectance becomes a colour:
+
+====== ==========================================================================================
+method what the shader computes
+====== ==========================================================================================
+0      spectral reference: the Airy reflectance at every nm from 360 to 830, both polarisations
+1-3    the paper's Fourier-space spectral integration (Eq. 10) truncated at m = method, with the
+       tabulated transform of the convention's sensitivities (``luts/sensitivity_fourier``)
+4      the same at m = 3 with the paper's Gaussian fits of the XYZ sensitivities
+5      naive RGB: the Airy reflectance at :data:`explorer.thinfilm.NAIVE_WAVELENGTHS`
+====== ==========================================================================================
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from . import microfacet, thinfilm
+
+METHODS = {0: "reference", 1: "fourier m=1", 2: "fourier m=2", 3: "fourier m=3", 4: "gaussian m=3", 5: "naive rgb"}
+
+
+class ThinFilmModel:
+    """Twin of ``shaders/thin_film.brd``: ``reflectance(cos_theta)`` and ``brdf(L, V, N, X, Y)``, every method."""
+
+    name = "thin_film"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.values = dict(values)
+        self.thickness_d = float(values["d"])
+        self.eta_1 = float(values["eta1"])
+        self.eta_2 = float(values["eta2"])
+        self.eta_3 = float(values["eta3"])
+        self.kappa_3 = float(values["kappa3"])
+        self.alpha = float(values.get("alpha", 0.0))
+        self.method = int(np.floor(float(values.get("method", 0)) + 0.5))
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(map(str, METHODS))}, got {self.method}")
+        # One-line ValueErrors on a negative thickness, kappa3 < 0, non-positive or non-finite indices.
+        thinfilm.validate_film(self.eta_1, self.eta_2, self.eta_3, self.kappa_3, 1.0, self.thickness_d)
+        microfacet.check_alpha(self.alpha)
+
+    @property
+    def film(self) -> tuple[float, float, float, float]:
+        """``(eta_1, eta_2, eta_3, kappa_3)``."""
+        return self.eta_1, self.eta_2, self.eta_3, self.kappa_3
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        """The smooth film's linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
+        cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        d = self.thickness_d
+        if self.method == 0:
+            return thinfilm.reference_rgb(*self.film, cos_theta, d)
+        if self.method <= 3:
+            return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=self.method, sensitivity="table")
+        if self.method == 4:
+            return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=3, sensitivity="gaussian")
+        return thinfilm.naive_rgb(*self.film, cos_theta, d)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """
+        The shader's ``BRDF``: ``D(h) G1(L) G1(V) F(theta_d) / (4 cos theta_i cos theta_o)`` with GGX ``D``,
+        Smith's ``G1`` and ``F`` the film's reflectance at ``cos theta_d = |L + V| / 2``; 0 where ``L`` or
+        ``V`` is at or below the surface. Unit vectors of shape ``(..., 3)``; returns ``(..., 3)``.
+        """
+        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
+        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
+        above = (cos_i > 0.0) & (cos_o > 0.0)
+        result = np.zeros(np.broadcast_shapes(L.shape, V.shape, N.shape), dtype=np.float64)
+        if not above.any():
+            return result
+        S = np.broadcast_to(L + V, result.shape)[above]
+        norm = np.linalg.norm(S, axis=-1)
+        cos_h = np.sum(np.broadcast_to(N, result.shape)[above] * S, axis=-1) / norm
+        lobe = (
+            0.25
+            * microfacet.ggx_D(cos_h, self.alpha)
+            * microfacet.smith_G1_over_cos(np.broadcast_to(cos_i, above.shape)[above], self.alpha)
+            * microfacet.smith_G1_over_cos(np.broadcast_to(cos_o, above.shape)[above], self.alpha)
+        )
+        result[above] = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        return result
+
+    def textures(self) -> dict[str, np.ndarray]:
+        """None of its own: the ``sensitivity_fourier`` table is a library texture (:mod:`explorer.gl`)."""
+        return {}
