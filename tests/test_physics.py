@@ -680,11 +680,12 @@ def test_table_is_as_close_to_a_finer_reference_as_the_1nm_reference_is():
     import warnings
 
     with warnings.catch_warnings():
+        # colour-science warns at import without matplotlib, and that 0.1-nm floats are not uniform.
         warnings.simplefilter("ignore")
         import colour
 
-    shape = colour.SpectralShape(360, 830, 0.1)
-    cmf = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape).values
+        shape = colour.SpectralShape(360, 830, 0.1)
+        cmf = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape).values
     cmf = cmf / cmf[:, 1].sum()
     wavelengths = np.linspace(360.0, 830.0, cmf.shape[0])
     cos_theta = np.linspace(0.05, 1.0, 150)
