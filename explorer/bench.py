@@ -251,3 +251,88 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
         rows.append(np.concatenate(cells[:-1], axis=1))
         rows.append(np.ones((gap, rows[-1].shape[1], 3), np.float32))
     Image.fromarray(encode_srgb8(np.concatenate(rows[:-1]))).save(path)
+
+
+# --------------------------------------------------------------------------------------------------
+# Thin films (Belcour & Barla 2017): accuracy of each method and its cost relative to GGX + Schlick
+
+#: (name, method of thin_film.brd) in table order; method 0 is the spectral reference.
+THIN_FILM_METHODS = (
+    ("reference", 0), ("fourier m=1", 1), ("fourier m=2", 2), ("fourier m=3", 3), ("gaussian m=3", 4), ("naive rgb", 5),
+)
+
+
+def thin_film_accuracy(values: dict) -> dict[str, tuple[float, float]]:
+    """Median and maximum ΔE2000 of each approximate method against the 1-nm reference over θ (numpy)."""
+    from .thinfilm_model import ThinFilmModel
+
+    cos_theta = np.cos(np.radians(THETA_DEGREES))
+    reference = ThinFilmModel({**values, "method": 0}).reflectance(cos_theta)
+    result = {}
+    for name, method in THIN_FILM_METHODS[1:]:
+        dE = colorimetry.delta_E_2000(reference, ThinFilmModel({**values, "method": method}).reflectance(cos_theta))
+        result[name] = (float(np.median(dE)), float(np.max(dE)))
+    return result
+
+
+def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
+    """
+    ``bragg-explorer bench --thin-film``: ΔE2000 of every method on the Figure 7 film and on every
+    thin-film preset; the frame time of every method of ``thin_film.brd`` (Figure 7 film) on a lit
+    sphere relative to ``ggx_schlick.brd`` (plain GGX with Schlick's Fresnel), interleaved repeats, medians.
+    """
+    from .gl import Renderer
+    from .presets import presets_for
+
+    film_material = load_material(SHADER_DIR / "thin_film.brd")
+    presets = presets_for(SHADER_DIR / "thin_film.brd").presets
+    configurations = [("figure7", film_material.resolve({}))]  # the material's defaults are Figure 7's film
+    configurations += [(name, p.resolve()) for name, p in presets.items() if name != "figure7"]
+    accuracy = []
+    for name, values in configurations:
+        _progress(f"bench --thin-film: accuracy of {name}")
+        for method, (median, maximum) in thin_film_accuracy(values).items():
+            accuracy.append({"configuration": name, "method": method, "dE_median": median, "dE_max": maximum})
+
+    renderer = Renderer()
+    baseline_material = load_material(SHADER_DIR / "ggx_schlick.brd")
+    device = renderer.ctx.info.get("GL_RENDERER", "unknown")
+    figure7 = presets["figure7"].resolve() if "figure7" in presets else film_material.resolve({})
+    cases = [(name, film_material, {**figure7, "method": float(m)}) for name, m in THIN_FILM_METHODS]
+    cases.append(("ggx+schlick", baseline_material, baseline_material.resolve({"alpha": figure7["alpha"]})))
+    _progress(f"bench --thin-film: {size}x{size} lit sphere on {device}, {repeats} interleaved repeats per method")
+    for _, material, values in cases:  # compile, JIT and warm every program first
+        renderer.time_frame(material, values, "lit", 16, 16)
+    times: dict[str, list[float]] = {name: [] for name, _, _ in cases}
+    for r in range(repeats):
+        for name, material, values in cases:
+            times[name].append(renderer.time_frame(material, values, "lit", size, size))
+        _progress(f"bench --thin-film: repeat {r + 1}/{repeats} done")
+    baseline_ms = float(np.median(times["ggx+schlick"]))
+    timing = [
+        {"method": name, "ms": float(np.median(times[name])), "relative": float(np.median(times[name])) / baseline_ms}
+        for name, _, _ in cases
+    ]
+    document = {"device": device, "size": size, "repeats": repeats, "view": "lit",
+                "theta_degrees": [float(THETA_DEGREES[0]), float(THETA_DEGREES[-1]), len(THETA_DEGREES)],
+                "accuracy": accuracy, "timing": timing}
+    print(json.dumps(document, indent=2) if as_json else format_thin_film(document))
+    return document
+
+
+def format_thin_film(document: dict) -> str:
+    """The thin-film tables: ΔE2000 per configuration and method, and the relative frame times."""
+    methods = [name for name, _ in THIN_FILM_METHODS[1:]]
+    lines = ["Thin film: median / max ΔE2000 against the 1-nm spectral reference over θ ∈ [0°, 89.5°]", ""]
+    header = f"{'configuration':<22}" + "".join(f"{m:>15}" for m in methods)
+    lines += [header, "-" * len(header)]
+    cells: dict[str, dict[str, str]] = {}
+    for row in document["accuracy"]:
+        cells.setdefault(row["configuration"], {})[row["method"]] = f"{row['dE_median']:.2g} / {row['dE_max']:.2g}"
+    for configuration, row in cells.items():
+        lines.append(f"{configuration:<22}" + "".join(f"{row[m]:>15}" for m in methods))
+    size = document["size"]
+    lines += ["", f"Frame time of a {size}x{size} lit sphere (Figure 7 film) on {document['device']}, relative to GGX + Schlick", ""]
+    for row in document["timing"]:
+        lines.append(f"{row['method']:<14} {row['ms']:>10.2f} ms  ×{row['relative']:.2f}")
+    return "\n".join(lines)

@@ -181,8 +181,9 @@ def _errors(function):
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
 @click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit and scatter (default 45,0).")
+@click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @_errors
-def render(material, view, assignments, size, out, engine, light):
+def render(material, view, assignments, size, out, engine, light, preset):
     """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
@@ -195,6 +196,10 @@ def render(material, view, assignments, size, out, engine, light):
     light_angles = parse_light(light, view)
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    if preset is not None:
+        from .presets import presets_for
+
+        overrides = {**presets_for(material).get(preset).values, **overrides}
     values = loaded.resolve(overrides)
     width, height = parse_size(size, view)
     image = render_material(loaded, values, view, width, height, engine, light_angles)
@@ -220,14 +225,46 @@ def info(material, as_json):
 
 
 @cli.command()
+@click.argument("material", required=False)
+@click.option("--json", "as_json", is_flag=True, help="Print the presets as JSON.")
+@_errors
+def presets(material, as_json):
+    """List the presets (name, material, description) of MATERIAL (a .brd file or a name such as
+    thin_film), or of every material that has some."""
+    from .presets import all_preset_files, find_preset_file
+
+    files = [find_preset_file(material)] if material else all_preset_files()
+    rows = [
+        {"name": p.name, "material": os.path.relpath(p.material.path), "figure": p.figure,
+         "description": p.description, "values": p.values}
+        for f in files for p in f.presets.values()
+    ]
+    if as_json:
+        click.echo(json.dumps(rows, indent=2))
+        return
+    width = max((len(r["name"]) for r in rows), default=4)
+    material_width = max((len(r["material"]) for r in rows), default=8)
+    for r in rows:
+        click.echo(f"{r['name']:<{width}}  {r['material']:<{material_width}}  {r['figure']}: {r['description']}")
+
+
+@cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--size", default=512, show_default=True, help="Sphere size for GPU timings.")
 @click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
+@click.option("--thin-film", "thin_film", is_flag=True,
+              help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
 @_errors
-def bench(as_json, size, repeats):
-    """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method."""
-    from .bench import run_bench
+def bench(as_json, size, repeats, thin_film):
+    """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
+    With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
+    """
+    from .bench import run_bench, run_thin_film_bench
+
+    if thin_film:
+        run_thin_film_bench(as_json=as_json, size=size, repeats=repeats)
+        return
     run_bench(as_json=as_json, size=size, repeats=repeats)
 
 

@@ -197,14 +197,21 @@ class Renderer:
         image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
         return np.ascontiguousarray(image)
 
-    def time_frame(self, material: Material, values: Mapping[str, object], view: str, width: int, height: int) -> float:
+    def time_frame(
+        self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
+        *, light: tuple[float, float] | None = None,
+    ) -> float:
         """
         Time of one frame in ms, bounded by ``glFinish`` on both sides (tables already bound): on a
         software rasteriser such as llvmpipe this is the rendering time. Timer queries are avoided:
-        their 32-bit nanosecond results wrap at 4.29 s.
+        their 32-bit nanosecond results wrap at 4.29 s. ``light``: as in :meth:`render`.
         """
+        from .render import light_direction
+
         program = self.program(material, view, values)
         self.bind(program, material, values)
+        if "light_direction" in program:
+            program["light_direction"].value = tuple(float(c) for c in light_direction(light))
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
         framebuffer.use()
         if "resolution" in program:

@@ -11,7 +11,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from . import bragg
+from . import bragg, microfacet
 from .fresnel import fresnel_schlick
 from .thinfilm_model import ThinFilmModel
 
@@ -95,10 +95,54 @@ class SchlickFresnelModel:
         return {}
 
 
+class GGXSchlickModel:
+    """
+    Twin of ``shaders/ggx_schlick.brd``: a GGX microfacet BRDF (:mod:`explorer.microfacet`) with Schlick's
+    Fresnel, ``D(h) G1(L) G1(V) F(theta_d) / (4 cos theta_i cos theta_o)``; the thin-film bench's baseline.
+    """
+
+    name = "ggx_schlick"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.alpha = float(values["alpha"])
+        self.F0 = float(values["F0"])
+        microfacet.check_alpha(self.alpha)
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        value = fresnel_schlick(np.asarray(cos_theta, dtype=np.float64), self.F0)
+        return np.repeat(value[..., None], 3, axis=-1)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """The shader's ``BRDF`` for unit vectors ``(..., 3)``; 0 where ``L`` or ``V`` is at or below the surface."""
+        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
+        shape = np.broadcast_shapes(L.shape, V.shape, N.shape)
+        L, V, N = (np.broadcast_to(a, shape) for a in (L, V, N))
+        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
+        above = (cos_i > 0.0) & (cos_o > 0.0)
+        result = np.zeros(shape, dtype=np.float64)
+        if not above.any():
+            return result
+        S = (L + V)[above]
+        norm = np.linalg.norm(S, axis=-1)
+        cos_h = np.sum(N[above] * S, axis=-1) / norm
+        lobe = (
+            0.25
+            * microfacet.ggx_D(cos_h, self.alpha)
+            * microfacet.smith_G1_over_cos(cos_i[above], self.alpha)
+            * microfacet.smith_G1_over_cos(cos_o[above], self.alpha)
+        )
+        result[above] = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        return result
+
+    def textures(self) -> dict[str, np.ndarray]:
+        return {}
+
+
 MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     BraggMirrorModel.name: BraggMirrorModel,
     SchlickFresnelModel.name: SchlickFresnelModel,
     ThinFilmModel.name: ThinFilmModel,
+    GGXSchlickModel.name: GGXSchlickModel,
 }
 
 

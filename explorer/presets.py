@@ -1,0 +1,173 @@
+"""
+Presets: named sets of parameter values for one material file, reproducing the papers' figures.
+
+They live next to the materials, one TOML file per material (``shaders/presets/<material stem>.toml``)::
+
+    material = "thin_film.brd"          # the material, relative to the presets folder's parent
+
+    [figure7]                           # the preset's name
+    figure = "Figure 7"                 # what it reproduces
+    description = "..."                 # one line
+    d = 525                             # parameter values; the others keep their defaults
+    eta2 = 1.5
+
+Every value is checked against the material's declared parameters and ranges
+(:meth:`explorer.brd.Material.resolve`) when the file is loaded; a bad file is a one-line
+:class:`PresetError` naming the file and, where it can be found, the line.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .brd import Material, MaterialError, load_material
+from .errors import LocatedError
+
+SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+PRESET_DIR = SHADER_DIR / "presets"
+#: Keys of a preset table that are not parameter values.
+META_KEYS = ("figure", "description")
+_TOML_LINE = re.compile(r"\(at line (\d+), column \d+\)")
+
+
+class PresetError(LocatedError):
+    """A presets file is malformed, or a preset name is unknown."""
+
+
+@dataclass
+class Preset:
+    name: str
+    material: Material
+    figure: str
+    description: str
+    #: The preset's own values (as written), in file order.
+    values: dict[str, object]
+    line: int | None = None
+
+    def resolve(self, overrides=None) -> dict:
+        """The material's values: defaults, then this preset, then ``overrides`` (e.g. ``--set``)."""
+        return self.material.resolve({**self.values, **(overrides or {})})
+
+
+@dataclass
+class PresetFile:
+    path: Path
+    material: Material
+    presets: dict[str, Preset] = field(default_factory=dict)
+
+    def get(self, name: str) -> Preset:
+        """The preset called ``name``, or a one-line :class:`PresetError` listing the valid names."""
+        if name not in self.presets:
+            valid = ", ".join(self.presets) or "(none)"
+            raise PresetError(_display(self.path), None, f"unknown preset {name!r}; valid names: {valid}")
+        return self.presets[name]
+
+
+def _display(path: Path) -> str:
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)
+
+
+def _find_line(lines: list[str], table: str | None, key: str | None = None) -> int | None:
+    """1-based line of ``[table]``, or of ``key = ...`` inside it (``table`` None: the top level)."""
+    current: str | None = None
+    for number, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if stripped.startswith("["):
+            current = stripped.split("]")[0].strip("[ ").strip('"')
+            if key is None and current == table:
+                return number
+            continue
+        if key is not None and current == table and re.match(rf'^"?{re.escape(key)}"?\s*=', stripped):
+            return number
+    return None
+
+
+def load_presets(path: str | os.PathLike[str]) -> PresetFile:
+    """Read and validate one presets file (see the module docstring)."""
+    path = Path(path)
+    where = _display(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise PresetError(where, None, "no such presets file") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise PresetError(where, None, f"cannot read ({getattr(error, 'strerror', None) or error})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        message = str(error)
+        found = _TOML_LINE.search(message)
+        line = int(found.group(1)) if found else None
+        raise PresetError(where, line, "not valid TOML: " + _TOML_LINE.sub("", message).strip()) from None
+    lines = text.splitlines()
+    material_name = data.get("material")
+    if not isinstance(material_name, str):
+        raise PresetError(where, _find_line(lines, None, "material"), "needs a top-level material = \"FILE.brd\"")
+    material_path = path.parent.parent / material_name
+    if not material_path.is_file():
+        material_path = path.parent / material_name
+    try:
+        material = load_material(material_path)
+    except MaterialError as error:
+        raise PresetError(where, _find_line(lines, None, "material"), f"material {material_name!r}: {error}") from None
+    result = PresetFile(path, material)
+    for name, table in data.items():
+        if name == "material":
+            continue
+        line = _find_line(lines, name)
+        if not isinstance(table, dict):
+            raise PresetError(where, _find_line(lines, None, name), f"{name!r} is not a preset table ([{name}])")
+        for key in META_KEYS:
+            if not isinstance(table.get(key), str) or not table[key].strip():
+                raise PresetError(where, line, f"preset {name!r} needs a {key} = \"...\" line")
+        values = {k: v for k, v in table.items() if k not in META_KEYS}
+        for key, value in values.items():
+            key_line = _find_line(lines, name, key) or line
+            if isinstance(value, (dict, list)) and not (isinstance(value, list) and len(value) == 3):
+                raise PresetError(where, key_line, f"preset {name!r}: {key} must be a number, a boolean or a colour")
+            try:
+                material.resolve({key: value})
+            except MaterialError as error:
+                raise PresetError(where, key_line, f"preset {name!r}: {error.message}") from None
+        result.presets[name] = Preset(name, material, table["figure"], table["description"], values, line)
+    if not result.presets:
+        raise PresetError(where, None, "defines no presets")
+    return result
+
+
+def presets_path(material_path: str | os.PathLike[str]) -> Path:
+    """Where the presets of a material file live: ``<its folder>/presets/<its stem>.toml``."""
+    material_path = Path(material_path)
+    return material_path.parent / "presets" / f"{material_path.stem}.toml"
+
+
+def presets_for(material_path: str | os.PathLike[str]) -> PresetFile:
+    """The presets of a material file, or a one-line :class:`PresetError` when it has none."""
+    path = presets_path(material_path)
+    if not path.is_file():
+        raise PresetError(_display(Path(material_path)), None, f"this material has no presets (no {_display(path)})")
+    return load_presets(path)
+
+
+def all_preset_files(directory: Path = PRESET_DIR) -> list[PresetFile]:
+    """Every presets file of ``directory``, sorted by name."""
+    return [load_presets(p) for p in sorted(directory.glob("*.toml"))]
+
+
+def find_preset_file(material: str) -> PresetFile:
+    """``material``: a material file's path, or the stem of one in ``shaders/`` (``thin_film``)."""
+    candidate = Path(material)
+    if candidate.suffix in (".brd", ".brdf") or candidate.exists():
+        return presets_for(candidate)
+    path = PRESET_DIR / f"{candidate.name}.toml"
+    if not path.is_file():
+        valid = ", ".join(p.stem for p in sorted(PRESET_DIR.glob("*.toml"))) or "(none)"
+        raise PresetError(material, None, f"no presets for this material; materials with presets: {valid}")
+    return load_presets(path)
