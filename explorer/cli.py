@@ -67,7 +67,7 @@ def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     if text is None:
         return None
     if view not in LIGHT_VIEWS:
-        raise click.BadParameter(f"the {view} view has no light (--light is for {' and '.join(LIGHT_VIEWS)})", param_hint="--light")
+        raise click.BadParameter(f"the {view} view has no light (--light is for {', '.join(LIGHT_VIEWS)})", param_hint="--light")
     try:
         theta, phi = (float(part) for part in text.split(","))
     except ValueError:
@@ -128,9 +128,19 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None)
 
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
-    light: tuple[float, float] | None = None,
+    light: tuple[float, float] | None = None, thickness=None,
 ) -> np.ndarray:
-    """One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``)."""
+    """
+    One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
+    :class:`explorer.thickness.ThicknessTexture`) for the ``textured`` view.
+    """
+    if view == "textured":
+        from .thickness import ThicknessTexture, check_prefilter
+
+        if material.model != "thin_film":
+            raise MaterialError(material.path, None, "the textured view needs a thin-film material (# model: thin_film)")
+        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        check_prefilter(int(np.floor(float(values.get("method", 0)) + 0.5)), thickness.prefilter)
     if engine == "numpy":
         from .models import model_for
         from .render import BRDF_VIEWS, render_numpy
@@ -140,9 +150,14 @@ def render_material(
             raise MaterialError(material.path, None, "this material has no numpy twin (no known '# model:' line)")
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
-        return render_numpy(model, view, width, height, light=light)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness)
     from .gl import Renderer
 
+    if view == "textured":
+        return Renderer().render(
+            material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
+            uniforms={"prefilter": thickness.prefilter},
+        )
     return Renderer().render(material, values, view, width, height, light=light)
 
 
@@ -175,20 +190,24 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter"]), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured"]), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
 @click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
-@click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit and scatter (default 45,0).")
+@click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
+@click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
+@click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
+@click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @_errors
-def render(material, view, assignments, size, out, engine, light, preset):
+def render(material, view, assignments, size, out, engine, light, preset, texture, dinc_range, prefilter):
     """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
-    (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y).
+    (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y);
+    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range.
     """
     from .render import scatter_circles
 
@@ -202,7 +221,16 @@ def render(material, view, assignments, size, out, engine, light, preset):
         overrides = {**presets_for(material).get(preset).values, **overrides}
     values = loaded.resolve(overrides)
     width, height = parse_size(size, view)
-    image = render_material(loaded, values, view, width, height, engine, light_angles)
+    thickness = None
+    if view == "textured":
+        from .thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
+
+        thickness = ThicknessTexture.from_file(
+            texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
+        )
+    elif texture is not None or dinc_range is not None or prefilter == "on":
+        raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
+    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness)
     write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None)
     bad = int((~np.isfinite(image)).sum())
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))

@@ -84,6 +84,7 @@ class Renderer:
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
         self._model_textures: dict[str, object] = {}
+        self._inputs: dict[str, object] = {}
         self._vertex_arrays: dict[int, object] = {}
         self.last_table_ms: float | None = None
 
@@ -135,8 +136,31 @@ class Renderer:
 
     # -- rendering ---------------------------------------------------------------------------------
 
-    def bind(self, program, material: Material, values: Mapping[str, object]) -> None:
-        """Set the material's uniforms and bind the library and model textures."""
+    def _input_textures(self, inputs: Mapping[str, np.ndarray]) -> dict[str, object]:
+        """A view's per-render inputs (``(h, w)`` or ``(h, w, c)`` float arrays, row 0 = texel row 0) as NEAREST textures."""
+        import moderngl
+
+        for texture in self._inputs.values():
+            texture.release()
+        self._inputs = {}
+        for name, array in inputs.items():
+            data = np.ascontiguousarray(array, dtype=np.float32)
+            if data.ndim == 2:
+                data = data[..., None]
+            texture = self.ctx.texture((data.shape[1], data.shape[0]), data.shape[2], data.tobytes(), dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            texture.repeat_x = texture.repeat_y = False
+            self._inputs[name] = texture
+        return self._inputs
+
+    def bind(
+        self, program, material: Material, values: Mapping[str, object],
+        inputs: Mapping[str, np.ndarray] | None = None, uniforms: Mapping[str, object] | None = None,
+    ) -> None:
+        """
+        Set the material's uniforms and bind the library and model textures; ``inputs`` (a view's
+        textures, e.g. the textured view's D_inc) and ``uniforms`` (a view's flags) where the program has them.
+        """
         for parameter in material.parameters:
             if parameter.name not in program:
                 continue  # unused by the shader: optimised away
@@ -151,6 +175,20 @@ class Renderer:
             matrix = colorimetry.xyz_to_rgb_matrix()
             program["xyz_to_rgb_matrix"].write(matrix.T.astype(np.float32).tobytes())  # column-major
         textures = dict(self._library)
+        if "sensitivity_fourier_prefiltered" in program:  # Section 5's table: built on first use
+            if "sensitivity_fourier_prefiltered" not in self._library:
+                from .thinfilm import sensitivity_fourier_prefiltered
+
+                table = sensitivity_fourier_prefiltered()
+                self._library["sensitivity_fourier_prefiltered"] = self.ctx.texture(
+                    (table.shape[1], table.shape[0]), 3, np.ascontiguousarray(table, dtype=np.float32).tobytes(), dtype="f4"
+                )
+            textures["sensitivity_fourier_prefiltered"] = self._library["sensitivity_fourier_prefiltered"]
+        for name, value in (uniforms or {}).items():
+            if name in program:
+                program[name].value = value
+        if inputs:
+            textures.update({k: v for k, v in self._input_textures(inputs).items() if k in program})
         model = model_for(material, values)
         if model is not None:
             start = time.perf_counter()
@@ -165,19 +203,22 @@ class Renderer:
 
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
-        *, light: tuple[float, float] | None = None,
+        *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
+        uniforms: Mapping[str, object] | None = None,
     ) -> np.ndarray:
         """
         ``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped.
 
         ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
-        (default :data:`explorer.render.DEFAULT_LIGHT`); the other views ignore it.
+        (default :data:`explorer.render.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
+        ``uniforms``: a view's own textures and flags (the ``textured`` view's, from
+        :meth:`explorer.thickness.ThicknessTexture.gl_inputs`).
         """
         from .render import light_direction
 
         direction = light_direction(light)
         program = self.program(material, view, values)
-        self.bind(program, material, values)
+        self.bind(program, material, values, inputs, uniforms)
         if "light_direction" in program:
             program["light_direction"].value = tuple(float(c) for c in direction)
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
@@ -199,7 +240,8 @@ class Renderer:
 
     def time_frame(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
-        *, light: tuple[float, float] | None = None,
+        *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
+        uniforms: Mapping[str, object] | None = None,
     ) -> float:
         """
         Time of one frame in ms, bounded by ``glFinish`` on both sides (tables already bound): on a
@@ -209,7 +251,7 @@ class Renderer:
         from .render import light_direction
 
         program = self.program(material, view, values)
-        self.bind(program, material, values)
+        self.bind(program, material, values, inputs, uniforms)
         if "light_direction" in program:
             program["light_direction"].value = tuple(float(c) for c in light_direction(light))
         framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])

@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import numpy as np
 
-VIEWS = ("gradient", "sphere", "lit", "slice", "scatter")
-DEFAULT_SIZES = {"gradient": (256, 32), "sphere": (256, 256), "lit": (256, 256), "slice": (256, 256), "scatter": (256, 256)}
+VIEWS = ("gradient", "sphere", "lit", "slice", "scatter", "textured")
+DEFAULT_SIZES = {
+    "gradient": (256, 32), "sphere": (256, 256), "lit": (256, 256), "slice": (256, 256), "scatter": (256, 256),
+    "textured": (256, 256),
+}
 #: Views that evaluate the material's BRDF(L, V, N, X, Y); those that take a light direction.
 BRDF_VIEWS = ("lit", "slice", "scatter")
-LIGHT_VIEWS = ("lit", "scatter")
+LIGHT_VIEWS = ("lit", "scatter", "textured")
 #: (theta, phi) in degrees, theta from +z, phi from +x.
 DEFAULT_LIGHT = (45.0, 0.0)
 #: The scatter view's circles (theta_o in degrees), drawn on PNG output only (the paper's Figure 9).
@@ -52,7 +55,7 @@ def view_cos_theta(view: str, width: int, height: int) -> tuple[np.ndarray, np.n
 
 def rim_distance(view: str, width: int, height: int) -> np.ndarray:
     """|r^2 - 1| per pixel for the disc views (inf elsewhere): tests skip the float32 rim."""
-    if view not in ("sphere", "lit", "scatter"):
+    if view not in ("sphere", "lit", "scatter", "textured"):
         return np.full((height, width), np.inf)
     x = 2.0 * (np.arange(width) + 0.5) / width - 1.0
     y = 1.0 - 2.0 * (np.arange(height) + 0.5) / height
@@ -155,12 +158,30 @@ def scatter_circles(width: int, height: int) -> np.ndarray:
     return mask
 
 
-def render_numpy(model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None) -> np.ndarray:
+def render_numpy(
+    model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None
+) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
 
-    ``light`` (``lit`` and ``scatter``): ``(theta, phi)`` in degrees, default :data:`DEFAULT_LIGHT`.
+    ``light`` (``lit``, ``scatter``, ``textured``): ``(theta, phi)`` in degrees, default :data:`DEFAULT_LIGHT`.
+    ``thickness`` (``textured``): an :class:`explorer.thickness.ThicknessTexture` (default: the default
+    texture over the default D_inc range, without prefiltering).
     """
+    if view == "textured":
+        from .thickness import ThicknessTexture
+
+        if not callable(getattr(model, "textured_brdf", None)):
+            raise ValueError(f"the textured view needs the model's textured_brdf(); {type(model).__name__} has none")
+        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        L, V, N, X, Y, inside, factor = brdf_view_geometry("lit", width, height, light)
+        x, y, _ = _disc(width, height)
+        d_inc, sigma = thickness.per_pixel(x, y, width, height)
+        image = np.zeros((height, width, 3), dtype=np.float32)
+        vectors = [a[inside].astype(np.float64) for a in (L, V, N, X, Y)]
+        rgb = model.textured_brdf(*vectors, d_inc[inside], sigma[inside], thickness.prefilter)
+        image[inside] = np.asarray(rgb, dtype=np.float64) * factor[inside][:, None]
+        return image
     if view in BRDF_VIEWS:
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the {view} view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")

@@ -842,3 +842,122 @@ def film_from_D_inc(D_inc, eta_1, eta_2) -> tuple[np.ndarray, np.ndarray]:
     blend = t * t * (3.0 - 2.0 * t)
     eta_2_effective = eta_1 + (eta_2 - eta_1) * blend
     return eta_2_effective, D_inc / (2.0 * eta_2_effective)
+
+
+# --------------------------------------------------------------------------------------------------
+# Multi-scale rendering: Eq. 10 averaged over a Gaussian distribution of OPD (Section 5)
+
+#: The pre-filtered table's scale axis: standard deviations ``sigma = k PREFILTER_SIGMA_STEP`` nm of the
+#: OPD, ``k = 0 .. PREFILTER_LEVELS - 1`` (the last, 793.75 nm, damps every harmonic by 2e-8 or more, at 830 nm).
+PREFILTER_SIGMA_STEP = 6.25
+PREFILTER_LEVELS = 128
+
+
+def _sensitivity_fourier_prefiltered() -> np.ndarray:
+    """
+    The pre-filtered Fourier table (Section 5, "Multi-scale Rendering"): for each level ``sigma_k``, the
+    demodulated envelope of ``S^_j`` convolved with a centred Gaussian of standard deviation ``sigma_k``
+    in the OPD variable,
+
+        ``E_{j,k}(mu) = sum_lambda s_j(lambda) exp(-2 pi^2 sigma_k^2 / lambda^2) exp(-2 pi i mu (1/lambda - 1/carrier_j))``,
+
+    since ``S^_j`` is a sum of complex exponentials ``exp(-2 pi i mu / lambda)`` and a Gaussian's
+    characteristic function multiplies each by ``exp(-2 pi^2 sigma^2 / lambda^2)``. Level 0 is the
+    ``sensitivity_fourier`` table. Shape ``(2 PREFILTER_LEVELS, SENSITIVITY_FOURIER_COUNT, 3)``: the real parts
+    of every level, then the imaginary parts (the texture ``lib/thinfilm.glsl`` reads), float32.
+    Computed by the host on first use (one complex matrix product per channel, under a second).
+    """
+    sensitivities = sensitivities_rgb()
+    mu = np.arange(luts.SENSITIVITY_FOURIER_COUNT, dtype=np.float64) * luts.SENSITIVITY_FOURIER_STEP
+    wavelengths = colorimetry.WAVELENGTHS.astype(np.float64)
+    sigma = np.arange(PREFILTER_LEVELS, dtype=np.float64) * PREFILTER_SIGMA_STEP
+    damping = np.exp(-2.0 * np.pi**2 * (sigma[:, None] / wavelengths[None, :]) ** 2)  # (levels, 471)
+    table = np.empty((2, PREFILTER_LEVELS, mu.size, 3), dtype=np.float64)
+    for j, carrier in enumerate(luts.SENSITIVITY_FOURIER_CARRIER_NM):
+        phase = np.exp(-2j * np.pi * (1.0 / wavelengths - 1.0 / carrier)[:, None] * mu[None, :])  # (471, mu)
+        envelope = (damping * sensitivities[None, :, j]).astype(np.complex128) @ phase
+        table[0, :, :, j], table[1, :, :, j] = envelope.real, envelope.imag
+    return table.reshape(2 * PREFILTER_LEVELS, mu.size, 3).astype(np.float32)
+
+
+_PREFILTERED: list[np.ndarray] = []
+
+
+def sensitivity_fourier_prefiltered() -> np.ndarray:
+    """:func:`_sensitivity_fourier_prefiltered`, computed once per process."""
+    if not _PREFILTERED:
+        _PREFILTERED.append(_sensitivity_fourier_prefiltered())
+    return _PREFILTERED[0]
+
+
+def sensitivity_fourier_transform_prefiltered(mu, sigma) -> np.ndarray:
+    """
+    ``S^_j`` averaged over OPDs distributed as a Gaussian of mean ``mu`` and standard deviation ``sigma``
+    (nm): the pre-filtered table interpolated bilinearly in ``(mu, sigma)``, as ``lib/thinfilm.glsl``
+    does, times the carrier; 0 beyond the last ``mu`` node; ``sigma`` clamped to the last level.
+
+    Returns
+    -------
+    ndarray of complex, shape ``broadcast(mu, sigma).shape + (3,)``
+    """
+    table = sensitivity_fourier_prefiltered().astype(np.float64)
+    mu, sigma = np.broadcast_arrays(np.asarray(mu, dtype=np.float64), np.asarray(sigma, dtype=np.float64))
+    x = mu / luts.SENSITIVITY_FOURIER_STEP
+    last = luts.SENSITIVITY_FOURIER_COUNT - 1
+    inside = (x >= 0.0) & (x <= last)
+    x = np.clip(x, 0.0, last)
+    i = np.minimum(np.floor(x).astype(np.int64), last - 1)
+    f = (x - i)[..., None]
+    y = np.clip(sigma / PREFILTER_SIGMA_STEP, 0.0, PREFILTER_LEVELS - 1)
+    k = np.minimum(np.floor(y).astype(np.int64), PREFILTER_LEVELS - 2)
+    g = (y - k)[..., None]
+
+    def level(row_offset):
+        def at(rows, cols):
+            return table[rows + row_offset, cols]
+
+        low = at(k, i) * (1.0 - f) + at(k, i + 1) * f
+        high = at(k + 1, i) * (1.0 - f) + at(k + 1, i + 1) * f
+        return low * (1.0 - g) + high * g
+
+    envelope = level(0) + 1j * level(PREFILTER_LEVELS)
+    carrier = np.exp(-2j * np.pi * mu[..., None] / np.asarray(luts.SENSITIVITY_FOURIER_CARRIER_NM))
+    return np.where(inside[..., None], envelope * carrier, 0.0)
+
+
+def fourier_rgb_prefiltered(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, sigma_D_inc, m_max: int = 3) -> np.ndarray:
+    """
+    Eq. 10 integrated against a Gaussian distribution of thickness (Section 5, Multi-scale Rendering):
+
+        ``R̄_j = C_0 + 2 sum_m C_m [cos(m phi_2), sin(m phi_2)] . ∫ [Re, Im] S^_j(m D) P(d) dd``.
+
+    Only ``S^`` depends on ``d``; with ``D = D_inc cos theta_2`` the OPD of harmonic ``m`` has mean
+    ``m D̄`` and standard deviation ``m cos theta_2 sigma_D_inc`` (the paper's ``tau = m 2 eta_2 cos theta_2``
+    applied to ``d``), so each term is the pre-filtered table at that mean and scale
+    (:func:`sensitivity_fourier_transform_prefiltered`). ``thickness_d`` is the mean thickness,
+    ``sigma_D_inc`` the standard deviation of ``D_inc`` (nm). Evanescent film: as :func:`fourier_rgb`.
+    """
+    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d = validate_film(
+        eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d
+    )
+    sigma_D_inc = _real_array("sigma_D_inc", sigma_D_inc)
+    rgb = 0.0
+    propagates = True
+    for pol in POLARISATIONS:
+        terms = film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            D, phi_2 = terms.D, terms.phi_2
+            sigma_D = sigma_D_inc * np.where(terms.film_propagates, terms.cos_theta_2.real, 0.0)
+            part = C_0(terms)[..., None] * np.ones(3)
+            for m in range(1, int(m_max) + 1):
+                S = sensitivity_fourier_transform_prefiltered(m * D, m * sigma_D)
+                part = part + 2.0 * C_m(terms, m)[..., None] * (
+                    np.cos(m * phi_2)[..., None] * S.real + np.sin(m * phi_2)[..., None] * S.imag
+                )
+        rgb = rgb + 0.5 * part
+        propagates = propagates & terms.film_propagates
+    propagates = np.asarray(propagates)
+    if np.all(propagates):
+        return rgb
+    naive = naive_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d)
+    return np.where(propagates[..., None], rgb, naive)

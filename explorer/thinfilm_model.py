@@ -63,7 +63,38 @@ class ThinFilmModel:
             return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=3, sensitivity="gaussian")
         return thinfilm.naive_rgb(*self.film, cos_theta, d)
 
+    def textured_reflectance(self, cos_theta, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
+        """
+        The twin of the shader's ``textured_reflectance``: the film of OPD ``D_inc`` (nm, per sample) at
+        normal incidence (:func:`explorer.thinfilm.film_from_D_inc`) instead of ``d``; with ``prefiltered``
+        (methods 1-3), Eq. 10 averaged over a Gaussian of ``D_inc`` of standard deviation ``sigma_D_inc``
+        (:func:`explorer.thinfilm.fourier_rgb_prefiltered`, Section 5).
+        """
+        cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        eta_2, d = thinfilm.film_from_D_inc(D_inc, self.eta_1, self.eta_2)
+        film = (self.eta_1, eta_2, self.eta_3, self.kappa_3)
+        if prefiltered:
+            if self.method not in (1, 2, 3):
+                raise ValueError(f"prefiltering needs a tabulated Fourier method (method 1, 2 or 3), not method {self.method}")
+            return thinfilm.fourier_rgb_prefiltered(*film, cos_theta, d, sigma_D_inc, m_max=self.method)
+        if self.method == 0:
+            return thinfilm.reference_rgb(*film, cos_theta, d)
+        if self.method <= 3:
+            return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=self.method, sensitivity="table")
+        if self.method == 4:
+            return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=3, sensitivity="gaussian")
+        return thinfilm.naive_rgb(*film, cos_theta, d)
+
+    def textured_brdf(self, L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
+        """The shader's ``textured_BRDF``: :meth:`brdf` with :meth:`textured_reflectance` per sample."""
+        D_inc, sigma_D_inc = np.asarray(D_inc, np.float64), np.asarray(sigma_D_inc, np.float64)
+        return self._brdf(L, V, N, lambda cos_d, above: self.textured_reflectance(cos_d, D_inc[above], sigma_D_inc[above], prefiltered))
+
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """The shader's ``BRDF`` (see :meth:`_brdf`) with the film's uniform thickness ``d``."""
+        return self._brdf(L, V, N, lambda cos_d, above: self.reflectance(cos_d))
+
+    def _brdf(self, L, V, N, reflectance) -> np.ndarray:
         """
         The shader's ``BRDF``: ``D(h) G1(L) G1(V) F(theta_d) / (4 cos theta_i cos theta_o)`` with GGX ``D``,
         Smith's ``G1`` and ``F`` the film's reflectance at ``cos theta_d = |L + V| / 2``; 0 where ``L`` or
@@ -84,7 +115,7 @@ class ThinFilmModel:
             * microfacet.smith_G1_over_cos(np.broadcast_to(cos_i, above.shape)[above], self.alpha)
             * microfacet.smith_G1_over_cos(np.broadcast_to(cos_o, above.shape)[above], self.alpha)
         )
-        result[above] = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        result[above] = lobe[:, None] * reflectance(np.clip(0.5 * norm, 0.0, 1.0), above)
         return result
 
     def textures(self) -> dict[str, np.ndarray]:

@@ -1,0 +1,49 @@
+// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.render) with a film
+// thickness that varies over it (Belcour & Barla 2017, Section 5, Figures 12-15). The material must
+// define textured_BRDF(L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered) (shaders/thin_film.brd).
+// Planar parametrisation (explorer/thickness.py): pixel p = (x, y) reads D_inc (nm) from dinc_texture at
+// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinearly between texel centres, clamped.
+// prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
+// host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
+// Twin: explorer.render.render_numpy(model, 'textured', ..., thickness=...).
+uniform vec2 resolution;
+uniform vec3 light_direction;
+uniform sampler2D dinc_texture;
+uniform sampler2D dinc_moments;
+uniform bool prefilter;
+out vec4 frag_colour;
+
+float dinc_bilinear(vec2 uv) {
+    ivec2 size = textureSize(dinc_texture, 0);
+    vec2 t = clamp(uv * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    ivec2 i = min(ivec2(floor(t)), max(size - 2, ivec2(0)));
+    vec2 f = t - vec2(i);
+    ivec2 i1 = min(i + 1, size - 1);
+    float top = mix(texelFetch(dinc_texture, i, 0).r, texelFetch(dinc_texture, ivec2(i1.x, i.y), 0).r, f.x);
+    float bottom = mix(texelFetch(dinc_texture, ivec2(i.x, i1.y), 0).r, texelFetch(dinc_texture, i1, 0).r, f.x);
+    return mix(top, bottom, f.y);
+}
+
+void main() {
+    vec2 p = 2.0 * gl_FragCoord.xy / resolution - 1.0;  // gl_FragCoord.y counts from the bottom
+    float r2 = dot(p, p);
+    if (r2 >= 1.0) {
+        frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    vec3 normal = vec3(p, sqrt(1.0 - r2));
+    vec3 tangent = normalize(cross(vec3(0.0, 1.0, 0.0), normal));
+    vec3 bitangent = normalize(cross(normal, tangent));
+    vec3 view = vec3(0.0, 0.0, 1.0);
+    float D_inc_, sigma = 0.0;
+    if (prefilter) {
+        ivec2 pixel = ivec2(int(gl_FragCoord.x), int(resolution.y) - 1 - int(gl_FragCoord.y));
+        vec2 moments = texelFetch(dinc_moments, pixel, 0).rg;
+        D_inc_ = moments.x;
+        sigma = sqrt(max(moments.y, 0.0));
+    } else {
+        D_inc_ = dinc_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y)));
+    }
+    vec3 radiance = textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter) * max(0.0, dot(normal, light_direction));
+    frag_colour = vec4(radiance, 1.0);
+}
