@@ -9,9 +9,11 @@ from __future__ import annotations
 
 from typing import Callable, Mapping
 
+import functools
+
 import numpy as np
 
-from . import bragg, microfacet
+from . import bragg, colorimetry, layered, microfacet
 from .fresnel import fresnel_schlick
 from .thinfilm_model import ThinFilmModel
 
@@ -74,6 +76,77 @@ class BraggMirrorModel:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
         return {"bragg_table": self.table if self.method == 3 else np.zeros((1, 3), np.float32)}
+
+
+@functools.lru_cache(maxsize=16)
+def _transmission_rgb_table(mirror: bragg.BraggMirror, alpha: float, size: int) -> np.ndarray:
+    """
+    The RGB of a rough Bragg layer's integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28) at
+    ``cos theta = k / (size - 1)``: ``1 - R_lambda`` of ``mirror`` at the 0.25 degree nodes, filtered by
+    the cached ``F_alpha`` (:func:`explorer.layered.transmission_filter_for`), integrated to RGB and
+    interpolated linearly in ``theta`` (:func:`explorer.layered.lookup`).
+    """
+    F = layered.transmission_filter_for(alpha)
+    R = layered.reflectance_table(mirror, np.cos(F.theta))
+    T_rgb = colorimetry.spectrum_to_rgb(layered.integrated_transmissivity(F, 1.0 - R))
+    theta = np.arccos(np.linspace(0.0, 1.0, size))
+    table = layered.lookup(T_rgb, theta).astype(np.float32)
+    table.setflags(write=False)
+    return table
+
+
+class BraggLayerModel(BraggMirrorModel):
+    """
+    Twin of ``shaders/bragg_layer.brd``: one rough Bragg layer (Eq. 17, GGX microfacets that are Bragg
+    mirrors) over a Lambertian base of RGB albedo ``rho_d``:
+    ``D G1(L) G1(V) R_rgb(theta_d) / (4 cos_i cos_o) + (rho_d / pi) T_rgb(theta_i) T_rgb(theta_o)``, with
+    ``R_rgb`` the ``method``'s RGB reflectance of the smooth mirror (:class:`BraggMirrorModel`) and
+    ``T_rgb`` the RGB of the layer's integrated transmissivity (Eq. 28), tabulated over ``cos theta``
+    (:func:`_transmission_rgb_table`): an RGB approximation of Eq. 34's base term for one layer, n1 = 1.
+    """
+
+    name = "bragg_layer"
+
+    def __init__(self, values: Mapping[str, object]):
+        super().__init__(values)
+        self.alpha = float(values["alpha"])
+        microfacet.check_alpha(self.alpha)
+        self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
+
+    @property
+    def transmission_table(self) -> np.ndarray:
+        """``T_rgb`` at ``cos theta = k / 255`` (Eq. 28 in RGB), ``(256, 3)`` float32."""
+        return _transmission_rgb_table(self.mirror, float(microfacet.check_alpha(self.alpha)), bragg.TABLE_SIZE)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """The shader's ``BRDF`` for unit vectors ``(..., 3)``; 0 where ``L`` or ``V`` is at or below the surface."""
+        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
+        shape = np.broadcast_shapes(L.shape, V.shape, N.shape)
+        L, V, N = (np.broadcast_to(a, shape) for a in (L, V, N))
+        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
+        above = (cos_i > 0.0) & (cos_o > 0.0)
+        result = np.zeros(shape, dtype=np.float64)
+        if not above.any():
+            return result
+        S = (L + V)[above]
+        norm = np.linalg.norm(S, axis=-1)
+        cos_h = np.sum(N[above] * S, axis=-1) / norm
+        ci, co = cos_i[above], cos_o[above]
+        lobe = (
+            0.25
+            * microfacet.ggx_D(cos_h, self.alpha)
+            * microfacet.smith_G1_over_cos(ci, self.alpha)
+            * microfacet.smith_G1_over_cos(co, self.alpha)
+        )
+        specular = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        table = self.transmission_table
+        base = (self.rho_d / np.pi) * bragg.tabulated_rgb(table, ci) * bragg.tabulated_rgb(table, co)
+        result[above] = specular + base
+        return result
+
+    def textures(self) -> dict[str, np.ndarray]:
+        """The method-3 reflectance table (a placeholder texel otherwise) and ``T_rgb``."""
+        return {**super().textures(), "transmission_table": self.transmission_table}
 
 
 class SchlickFresnelModel:
@@ -140,6 +213,7 @@ class GGXSchlickModel:
 
 MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     BraggMirrorModel.name: BraggMirrorModel,
+    BraggLayerModel.name: BraggLayerModel,
     SchlickFresnelModel.name: SchlickFresnelModel,
     ThinFilmModel.name: ThinFilmModel,
     GGXSchlickModel.name: GGXSchlickModel,
