@@ -336,3 +336,93 @@ def format_thin_film(document: dict) -> str:
     for row in document["timing"]:
         lines.append(f"{row['method']:<14} {row['ms']:>10.2f} ms  ×{row['relative']:.2f}")
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------------------------------
+# Rough layers (issue #3): host-table timings and the slice view's accuracy
+
+#: Roughnesses of the slice study and of the F_alpha timings.
+LAYER_ALPHAS = (0.025, 0.1, 0.4)
+#: The Figure 8 configuration of the slice study (rho_d = 0: the specular lobe alone).
+FIGURE8_LAYER = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.5, "N": 20, "rho_d": "0", "s": 3}
+#: Pixels whose reference luminance Y (white = 1) is at or below this are left out (L* <= 9).
+SLICE_LUMINANCE_THRESHOLD = 0.01
+#: (name, method of bragg_layer.brd) compared with the spectral reference (method 0) by ΔE2000.
+SLICE_METHODS = (("basic", 1), ("subdivided s=3", 2), ("improved s=3", 4))
+LAYER_GOALS = {"transmission_filter_ms": 100.0, "layer_tables_ms": 10.0}
+LAYER_PAPER = {"transmission_filter_ms": 600.0, "layer_tables_ms": 40.0}
+
+
+def slice_accuracy(alpha: float, size: int = 64) -> dict:
+    """
+    ΔE2000 of methods 1, 2 (s = 3) and 4 (s = 3) of ``bragg_layer.brd`` against method 0 in the ``slice``
+    view (numpy twin) of the Figure 8 layer at ``alpha``, per pixel over pixels with reference luminance
+    Y > :data:`SLICE_LUMINANCE_THRESHOLD`; the pixels are the BRDF values as rendered (unit exposure,
+    white = 1). And the tabulated method (3) against the reference: the maximum absolute linear
+    difference, and the maximum relative to a pixel's largest channel (the twin tests' rule).
+    """
+    from .models import model_for
+    from .render import render_numpy
+
+    material = load_material(SHADER_DIR / "bragg_layer.brd")
+
+    def image(method: int) -> np.ndarray:
+        values = material.resolve({**FIGURE8_LAYER, "alpha": alpha, "method": method})
+        return render_numpy(model_for(material, values), "slice", size, size).astype(np.float64)
+
+    reference = image(0)
+    counted = colorimetry.rgb_to_xyz(reference)[..., 1] > SLICE_LUMINANCE_THRESHOLD
+    row: dict = {"alpha": alpha, "size": size, "pixels": int(counted.sum())}
+    for name, method in SLICE_METHODS:
+        dE = colorimetry.delta_E_2000(reference, image(method))[counted]
+        row[name] = {"dE_median": float(np.median(dE)), "dE_max": float(np.max(dE))}
+    difference = np.abs(image(3) - reference).max(axis=-1)
+    peak = np.abs(reference).max(axis=-1)
+    relative = np.where(peak > 1e-3, difference / np.maximum(peak, 1e-30), difference)
+    row["tabulated"] = {"max_abs": float(difference.max()), "max_relative": float(relative.max())}
+    return row
+
+
+def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64) -> dict:
+    """
+    ``bragg-explorer bench --layers``: the host tables' build times (F_alpha for a new alpha, one layer's
+    tables for Figure 7's A, B, A'; interleaved repeats, medians; :func:`explorer.layered.measure_timings`)
+    and the slice view's accuracy at each of :data:`LAYER_ALPHAS` (:func:`slice_accuracy`).
+    """
+    from . import layered
+
+    _progress(f"bench --layers: host tables, {repeats} interleaved repeats")
+    timings = layered.measure_timings(alphas=LAYER_ALPHAS, repeats=repeats)
+    accuracy = []
+    for alpha in LAYER_ALPHAS:
+        _progress(f"bench --layers: slice view {size}x{size}, alpha = {alpha:g}")
+        accuracy.append(slice_accuracy(alpha, size))
+    document = {
+        "timings": {**timings, "goal_ms": LAYER_GOALS, "paper_ms": LAYER_PAPER},
+        "slice": {"configuration": {k: v for k, v in FIGURE8_LAYER.items() if k != "s"},
+                  "luminance_threshold": SLICE_LUMINANCE_THRESHOLD, "rows": accuracy},
+    }
+    print(json.dumps(document, indent=2) if as_json else format_layers(document))
+    return document
+
+
+def format_layers(document: dict) -> str:
+    """The two tables of ``bench --layers``."""
+    timings = document["timings"]
+    lines = [f"Host tables: wall-clock medians of {timings['repeats']} interleaved repeats (numpy, this machine)", ""]
+    for key, label in (("transmission_filter_ms", "F_alpha (new alpha)"), ("layer_tables_ms", "layer tables")):
+        goal, paper = timings["goal_ms"][key], timings["paper_ms"][key]
+        for name, ms in timings[key].items():
+            lines.append(f"{label:<20} {name:<44} {ms:>7.1f} ms  (goal {goal:g} ms; paper {paper:g} ms)")
+    study = document["slice"]
+    rows = study["rows"]
+    lines += ["", f"slice view {rows[0]['size']}x{rows[0]['size']} (numpy twin of bragg_layer.brd, Λ = 500 nm, δ = 0.5, "
+              f"n1 = 1, n2 = 1.5, N = 20, rho_d = 0): median / max ΔE2000 against the spectral reference over pixels "
+              f"with reference Y > {study['luminance_threshold']:g}", ""]
+    names = [name for name, _ in SLICE_METHODS]
+    header = f"{'alpha':>6} {'pixels':>7}" + "".join(f"{n:>17}" for n in names) + f"{'tabulated abs':>15}{'tabulated rel':>15}"
+    lines += [header, "-" * len(header)]
+    for r in rows:
+        cells = "".join(f"{r[n]['dE_median']:>9.2f} / {r[n]['dE_max']:<5.1f}" for n in names)
+        lines.append(f"{r['alpha']:>6g} {r['pixels']:>7}{cells}{r['tabulated']['max_abs']:>15.3g}{r['tabulated']['max_relative']:>15.2e}")
+    return "\n".join(lines)

@@ -282,14 +282,23 @@ def presets(material, as_json):
 @click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
 @click.option("--thin-film", "thin_film", is_flag=True,
               help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
+@click.option("--layers", is_flag=True,
+              help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @_errors
-def bench(as_json, size, repeats, thin_film):
+def bench(as_json, size, repeats, thin_film, layers):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
+    With --layers: issue #3's host-table timings and the slice view's accuracy (64x64; --repeats, default 5 here).
     """
-    from .bench import run_bench, run_thin_film_bench
+    from .bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if layers:
+        if thin_film:
+            raise click.UsageError("--layers and --thin-film are exclusive")
+        source = click.get_current_context().get_parameter_source("repeats")
+        run_layers_bench(as_json=as_json, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
+        return
     if thin_film:
         run_thin_film_bench(as_json=as_json, size=size, repeats=repeats)
         return

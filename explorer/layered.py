@@ -443,27 +443,42 @@ def single_reflection_brdf(stack: LayeredBragg, i, o, tables=None, exact_reflect
 # Timings (the goals of issue #3: F_alpha for a new alpha within 100 ms, a layer's tables within 10 ms)
 
 
+def figure7_layers() -> dict[str, tuple[RoughBraggLayer, float]]:
+    """Figure 7's layers A, B and A' as ``{name: (layer, host n1)}``."""
+    return {
+        "A (n1=1, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.0),
+        "B (n1=1, d1=d2=494 nm, N=10, alpha=0.05)": (RoughBraggLayer(1.5, 988.0, 0.5, 10, 0.05), 1.0),
+        "A' (n1=1.35, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.35),
+    }
+
+
 def measure_timings(alphas=(0.025, 0.1, 0.4), layers=None, repeats: int = 5) -> dict:
     """
-    Median wall-clock times (ms) of building ``F_alpha`` for each of ``alphas`` (uncached) and each
-    layer's tables (``layers``: the Figure 7 configurations A, B and A' by default).
+    Median wall-clock times (ms) of building ``F_alpha`` for each of ``alphas`` and each layer's tables
+    (``layers``: the Figure 7 configurations A, B and A' by default), over ``repeats`` interleaved
+    rounds (every case once per round) after one warm-up round.
+
+    Every ``F_alpha`` is built from scratch (:func:`explorer.microfacet.transmission_filter_table`,
+    never the cache of :func:`transmission_filter_for`): a new ``alpha`` each time. A layer's tables
+    are timed without its filter (which depends on ``alpha`` only, as in :func:`layer_tables`).
     """
-    if layers is None:
-        layers = {
-            "A (n1=1, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.0),
-            "B (n1=1, d1=d2=494 nm, N=10, alpha=0.05)": (RoughBraggLayer(1.5, 988.0, 0.5, 10, 0.05), 1.0),
-            "A' (n1=1.35, d1=d2=250 nm, N=10, alpha=0.1)": (RoughBraggLayer(1.5, 500.0, 0.5, 10, 0.1), 1.35),
-        }
-    filters = {}
-    for alpha in alphas:
-        times = [microfacet.transmission_filter_table(alpha).seconds for _ in range(repeats)]
-        filters[f"alpha={alpha:g}"] = 1e3 * float(np.median(times))
-    tables = {}
-    for name, (layer, n1) in layers.items():
-        F = transmission_filter_for(layer.alpha)
-        times = [layer_tables(layer, n1, F).seconds for _ in range(repeats)]
-        tables[name] = 1e3 * float(np.median(times))
-    return {"transmission_filter_ms": filters, "layer_tables_ms": tables}
+    layers = figure7_layers() if layers is None else layers
+    filters = {layer.alpha: microfacet.transmission_filter_table(layer.alpha) for layer, _ in layers.values()}
+    cases = [(f"alpha={alpha:g}", functools.partial(microfacet.transmission_filter_table, alpha)) for alpha in alphas]
+    cases += [(name, functools.partial(layer_tables, layer, n1, filters[layer.alpha])) for name, (layer, n1) in layers.items()]
+    times: dict[str, list[float]] = {name: [] for name, _ in cases}
+    for round_ in range(repeats + 1):
+        for name, build in cases:
+            start = time.perf_counter()
+            build()
+            if round_:  # round 0 warms up
+                times[name].append(time.perf_counter() - start)
+    medians = {name: 1e3 * float(np.median(t)) for name, t in times.items()}
+    return {
+        "transmission_filter_ms": {f"alpha={alpha:g}": medians[f"alpha={alpha:g}"] for alpha in alphas},
+        "layer_tables_ms": {name: medians[name] for name in layers},
+        "repeats": repeats,
+    }
 
 
 if __name__ == "__main__":  # python -m explorer.layered: print the timings
