@@ -200,6 +200,35 @@ def half_vector_cosine(i, o) -> np.ndarray:
     return np.clip(0.5 * np.linalg.norm(s, axis=-1), 0.0, 1.0)
 
 
+def microfacet_lobe(i, o, n, alpha) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Eq. 17 without its reflectance, about any normal ``n``: ``D(h) G1(i) G1(o) / (4 |i.n| |o.n|)``, the
+    twin of ``microfacet_lobe`` in ``shaders/lib/microfacet.glsl``.
+
+    Parameters
+    ----------
+    i, o, n : array_like, shape (..., 3)
+        Unit vectors (broadcast together); ``i`` and ``o`` point away from the surface.
+    alpha : float
+        GGX roughness in [0, 1].
+
+    Returns
+    -------
+    lobe, cos_theta_d, above : ndarray, shape (...)
+        The lobe (0 unless both ``i`` and ``o`` are above the surface), ``cos theta_d = |i + o| / 2``
+        (:func:`half_vector_cosine`) at which a material reads its reflectance, and the mask of pairs
+        above the surface.
+    """
+    i, o, n = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (i, o, n)))
+    cos_i, cos_o = np.sum(n * i, axis=-1), np.sum(n * o, axis=-1)
+    above = (cos_i > 0.0) & (cos_o > 0.0)
+    s = i + o
+    norm = np.linalg.norm(s, axis=-1)
+    cos_h = np.sum(n * s, axis=-1) / np.maximum(norm, 1e-300)
+    lobe = 0.25 * ggx_D(cos_h, alpha) * smith_G1_over_cos(cos_i, alpha) * smith_G1_over_cos(cos_o, alpha)
+    return np.where(above, lobe, 0.0), np.clip(0.5 * norm, 0.0, 1.0), above
+
+
 def microfacet_brdf(i, o, alpha, reflectance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     """
     A GGX microfacet BRDF with a given microfacet reflectance (Eq. 17):
@@ -224,15 +253,7 @@ def microfacet_brdf(i, o, alpha, reflectance: Callable[[np.ndarray], np.ndarray]
     ----------
     Fourneau et al. (2024), Eq. 17; Walter et al. (2007), Eq. 20.
     """
-    i = np.asarray(i, dtype=np.float64)
-    o = np.asarray(o, dtype=np.float64)
-    h = half_vector(i, o)
-    cos_i, cos_o = i[..., 2], o[..., 2]
-    cos_theta_d = half_vector_cosine(i, o)
-    above = (cos_i > 0.0) & (cos_o > 0.0)
-    # D G1(i) G1(o) / (4 cos_i cos_o), with G1/cos finite at grazing angles.
-    lobe = 0.25 * ggx_D(h[..., 2], alpha) * smith_G1_over_cos(cos_i, alpha) * smith_G1_over_cos(cos_o, alpha)
-    lobe = np.where(above, lobe, 0.0)
+    lobe, cos_theta_d, _ = microfacet_lobe(i, o, (0.0, 0.0, 1.0), alpha)
     return lobe[..., None] * reflectance(cos_theta_d[..., None])
 
 

@@ -120,27 +120,16 @@ class BraggLayerModel(BraggMirrorModel):
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         """The shader's ``BRDF`` for unit vectors ``(..., 3)``; 0 where ``L`` or ``V`` is at or below the surface."""
-        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
-        shape = np.broadcast_shapes(L.shape, V.shape, N.shape)
-        L, V, N = (np.broadcast_to(a, shape) for a in (L, V, N))
-        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
-        above = (cos_i > 0.0) & (cos_o > 0.0)
-        result = np.zeros(shape, dtype=np.float64)
+        lobe, cos_theta_d, above = microfacet.microfacet_lobe(L, V, N, self.alpha)
+        result = np.zeros(lobe.shape + (3,))
         if not above.any():
             return result
-        S = (L + V)[above]
-        norm = np.linalg.norm(S, axis=-1)
-        cos_h = np.sum(N[above] * S, axis=-1) / norm
-        ci, co = cos_i[above], cos_o[above]
-        lobe = (
-            0.25
-            * microfacet.ggx_D(cos_h, self.alpha)
-            * microfacet.smith_G1_over_cos(ci, self.alpha)
-            * microfacet.smith_G1_over_cos(co, self.alpha)
-        )
-        specular = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        N = np.broadcast_to(N, lobe.shape + (3,))
+        cos_i = np.sum(N * np.broadcast_to(L, N.shape), axis=-1)[above]
+        cos_o = np.sum(N * np.broadcast_to(V, N.shape), axis=-1)[above]
+        specular = lobe[above, None] * self.reflectance(cos_theta_d[above])
         table = self.transmission_table
-        base = (self.rho_d / np.pi) * bragg.tabulated_rgb(table, ci) * bragg.tabulated_rgb(table, co)
+        base = (self.rho_d / np.pi) * bragg.tabulated_rgb(table, cos_i) * bragg.tabulated_rgb(table, cos_o)
         result[above] = specular + base
         return result
 
@@ -187,24 +176,9 @@ class GGXSchlickModel:
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         """The shader's ``BRDF`` for unit vectors ``(..., 3)``; 0 where ``L`` or ``V`` is at or below the surface."""
-        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
-        shape = np.broadcast_shapes(L.shape, V.shape, N.shape)
-        L, V, N = (np.broadcast_to(a, shape) for a in (L, V, N))
-        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
-        above = (cos_i > 0.0) & (cos_o > 0.0)
-        result = np.zeros(shape, dtype=np.float64)
-        if not above.any():
-            return result
-        S = (L + V)[above]
-        norm = np.linalg.norm(S, axis=-1)
-        cos_h = np.sum(N[above] * S, axis=-1) / norm
-        lobe = (
-            0.25
-            * microfacet.ggx_D(cos_h, self.alpha)
-            * microfacet.smith_G1_over_cos(cos_i[above], self.alpha)
-            * microfacet.smith_G1_over_cos(cos_o[above], self.alpha)
-        )
-        result[above] = lobe[:, None] * self.reflectance(np.clip(0.5 * norm, 0.0, 1.0))
+        lobe, cos_theta_d, above = microfacet.microfacet_lobe(L, V, N, self.alpha)
+        result = np.zeros(lobe.shape + (3,))
+        result[above] = lobe[above, None] * self.reflectance(cos_theta_d[above])
         return result
 
     def textures(self) -> dict[str, np.ndarray]:

@@ -100,22 +100,10 @@ class ThinFilmModel:
         Smith's ``G1`` and ``F`` the film's reflectance at ``cos theta_d = |L + V| / 2``; 0 where ``L`` or
         ``V`` is at or below the surface. Unit vectors of shape ``(..., 3)``; returns ``(..., 3)``.
         """
-        L, V, N = (np.asarray(a, dtype=np.float64) for a in (L, V, N))
-        cos_i, cos_o = np.sum(N * L, axis=-1), np.sum(N * V, axis=-1)
-        above = (cos_i > 0.0) & (cos_o > 0.0)
-        result = np.zeros(np.broadcast_shapes(L.shape, V.shape, N.shape), dtype=np.float64)
-        if not above.any():
-            return result
-        S = np.broadcast_to(L + V, result.shape)[above]
-        norm = np.linalg.norm(S, axis=-1)
-        cos_h = np.sum(np.broadcast_to(N, result.shape)[above] * S, axis=-1) / norm
-        lobe = (
-            0.25
-            * microfacet.ggx_D(cos_h, self.alpha)
-            * microfacet.smith_G1_over_cos(np.broadcast_to(cos_i, above.shape)[above], self.alpha)
-            * microfacet.smith_G1_over_cos(np.broadcast_to(cos_o, above.shape)[above], self.alpha)
-        )
-        result[above] = lobe[:, None] * reflectance(np.clip(0.5 * norm, 0.0, 1.0), above)
+        lobe, cos_theta_d, above = microfacet.microfacet_lobe(L, V, N, self.alpha)
+        result = np.zeros(lobe.shape + (3,))
+        if above.any():
+            result[above] = lobe[above, None] * reflectance(cos_theta_d[above], above)
         return result
 
     def textures(self) -> dict[str, np.ndarray]:
