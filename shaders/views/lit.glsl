@@ -4,20 +4,21 @@
 // N = (x, y, sqrt(1 - x^2 - y^2)) and the pixel is BRDF(L, V, N, X, Y) max(0, N.L), outside 0. The frame is
 // BRDF Explorer's lit sphere (src/shaderTemplates/brdftemplatesphere.frag): X = normalize(cross((0, 1, 0),
 // N)), Y = normalize(cross(N, X)). Twin: explorer.render.render_numpy(model, 'lit', ...).
+#include "lib/views.glsl"
+
 uniform vec2 resolution;
 uniform vec3 light_direction;
 out vec4 frag_colour;
 
 void main() {
-    vec2 p = 2.0 * gl_FragCoord.xy / resolution - 1.0;  // gl_FragCoord.y counts from the bottom
-    float r2 = dot(p, p);
-    if (r2 >= 1.0) {
+    vec2 p;
+    float r2;
+    if (!disc_point(resolution, p, r2)) {
         frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    vec3 normal = vec3(p, sqrt(1.0 - r2));
-    vec3 tangent = normalize(cross(vec3(0.0, 1.0, 0.0), normal));
-    vec3 bitangent = normalize(cross(normal, tangent));
+    vec3 normal, tangent, bitangent;
+    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     vec3 radiance = BRDF(light_direction, view, normal, tangent, bitangent) * max(0.0, dot(normal, light_direction));
     frag_colour = vec4(radiance, 1.0);

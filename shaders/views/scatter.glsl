@@ -4,14 +4,16 @@
 // right, +y up), N = (0, 0, 1), X = (1, 0, 0), Y = (0, 1, 0); the pixel is BRDF(L, V, N, X, Y) cos(theta_o),
 // outside 0. The 5, 30, 60 and 90 deg circles are drawn by the host on PNG output only.
 // Twin: explorer.render.render_numpy(model, 'scatter', ...).
+#include "lib/views.glsl"
+
 uniform vec2 resolution;
 uniform vec3 light_direction;
 out vec4 frag_colour;
 
 void main() {
-    vec2 p = 2.0 * gl_FragCoord.xy / resolution - 1.0;  // gl_FragCoord.y counts from the bottom
-    float r2 = dot(p, p);
-    if (r2 >= 1.0) {
+    vec2 p;
+    float r2;
+    if (!disc_point(resolution, p, r2)) {
         frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }

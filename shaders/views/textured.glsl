@@ -6,6 +6,8 @@
 // prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
 // host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
 // Twin: explorer.render.render_numpy(model, 'textured', ..., thickness=...).
+#include "lib/views.glsl"
+
 uniform vec2 resolution;
 uniform vec3 light_direction;
 uniform sampler2D dinc_texture;
@@ -25,15 +27,14 @@ float dinc_bilinear(vec2 uv) {
 }
 
 void main() {
-    vec2 p = 2.0 * gl_FragCoord.xy / resolution - 1.0;  // gl_FragCoord.y counts from the bottom
-    float r2 = dot(p, p);
-    if (r2 >= 1.0) {
+    vec2 p;
+    float r2;
+    if (!disc_point(resolution, p, r2)) {
         frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    vec3 normal = vec3(p, sqrt(1.0 - r2));
-    vec3 tangent = normalize(cross(vec3(0.0, 1.0, 0.0), normal));
-    vec3 bitangent = normalize(cross(normal, tangent));
+    vec3 normal, tangent, bitangent;
+    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     float D_inc_, sigma = 0.0;
     if (prefilter) {
