@@ -302,13 +302,40 @@ void sensitivity_fourier_transform(float mu, int sensitivity, out vec3 re, out v
 // S^(m D) for m = 0..m_max: they depend on the film's OPD only, so both polarisations share them. For
 // the table, S^(0) = 1 and the carriers of m D are the m-th powers of those of D: four texel fetches and
 // no trig per harmonic.
-void sensitivity_samples(float D_, int m_max, int sensitivity, out vec3 re[M_MAX_LIMIT + 1], out vec3 im[M_MAX_LIMIT + 1]) {
-    for (int m = 0; m <= M_MAX_LIMIT; ++m) { re[m] = vec3(0.0); im[m] = vec3(0.0); }
-    if (sensitivity != SENSITIVITY_TABLE) {
-        for (int m = 0; m <= M_MAX_LIMIT; ++m)
-            if (m <= m_max) sensitivity_fourier_transform(float(m) * D_, sensitivity, re[m], im[m]);
-        return;
+// The pre-filtered table (explorer.thinfilm.sensitivity_fourier_prefiltered), bound by the host on first
+// use: 4096 x (2 x PREFILTER_LEVELS) texels, rows k = 0..127 the real parts and rows 128 + k the imaginary
+// parts of the envelope convolved with a Gaussian of standard deviation k PREFILTER_SIGMA_STEP nm.
+uniform sampler2D sensitivity_fourier_prefiltered;
+const float PREFILTER_SIGMA_STEP = 6.25;
+const int PREFILTER_LEVELS = 128;
+
+// The envelope at OPD mean mu and standard deviation sigma, bilinear in (mu, sigma) by texelFetch as numpy
+// does; false beyond the last mu node; sigma clamped to the last level.
+bool sensitivity_fourier_envelope_prefiltered(float mu, float sigma, out vec3 re, out vec3 im) {
+    int last = textureSize(sensitivity_fourier_prefiltered, 0).x - 1;
+    float x = mu / SENSITIVITY_FOURIER_STEP;
+    re = vec3(0.0);
+    im = vec3(0.0);
+    if (!(x >= 0.0 && x <= float(last))) return false;
+    int i = min(int(floor(x)), last - 1);
+    float f = x - float(i);
+    float y = clamp(sigma / PREFILTER_SIGMA_STEP, 0.0, float(PREFILTER_LEVELS - 1));
+    int k = min(int(floor(y)), PREFILTER_LEVELS - 2);
+    float g = y - float(k);
+    for (int part = 0; part < 2; ++part) {
+        int row = k + part * PREFILTER_LEVELS;
+        vec3 low = mix(texelFetch(sensitivity_fourier_prefiltered, ivec2(i, row), 0).rgb, texelFetch(sensitivity_fourier_prefiltered, ivec2(i + 1, row), 0).rgb, f);
+        vec3 high = mix(texelFetch(sensitivity_fourier_prefiltered, ivec2(i, row + 1), 0).rgb, texelFetch(sensitivity_fourier_prefiltered, ivec2(i + 1, row + 1), 0).rgb, f);
+        if (part == 0) re = mix(low, high, g); else im = mix(low, high, g);
     }
+    return true;
+}
+
+// Table-based S^(m D) for m = 0..m_max: the carrier exp(+2 pi i m D / carrier) by powers times the
+// demodulated envelope, read from the prefiltered table at standard deviation m sigma_D when sigma_D >= 0
+// (Section 5), from sensitivity_fourier otherwise.
+void sensitivity_samples_table(float D_, float sigma_D, int m_max, out vec3 re[M_MAX_LIMIT + 1], out vec3 im[M_MAX_LIMIT + 1]) {
+    for (int m = 0; m <= M_MAX_LIMIT; ++m) { re[m] = vec3(0.0); im[m] = vec3(0.0); }
     re[0] = vec3(1.0);  // S^(0) = E(0) = sum_lambda s_j(lambda) = 1 (white): the table's node 0, exactly
     vec3 c, s, power_c = vec3(1.0), power_s = vec3(0.0);
     sensitivity_fourier_carrier(D_, c, s);
@@ -318,9 +345,22 @@ void sensitivity_samples(float D_, int m_max, int sensitivity, out vec3 re[M_MAX
         power_s = power_c * s + power_s * c;
         power_c = next_c;
         vec3 env_re, env_im;
-        if (!sensitivity_fourier_envelope(float(m) * D_, env_re, env_im)) break;  // and beyond for larger m
+        bool inside = sigma_D >= 0.0 ? sensitivity_fourier_envelope_prefiltered(float(m) * D_, float(m) * sigma_D, env_re, env_im)
+                                     : sensitivity_fourier_envelope(float(m) * D_, env_re, env_im);
+        if (!inside) break;  // and beyond for larger m
         re[m] = env_re * power_c - env_im * power_s;
         im[m] = env_re * power_s + env_im * power_c;
+    }
+}
+
+void sensitivity_samples(float D_, int m_max, int sensitivity, out vec3 re[M_MAX_LIMIT + 1], out vec3 im[M_MAX_LIMIT + 1]) {
+    if (sensitivity == SENSITIVITY_TABLE) {
+        sensitivity_samples_table(D_, -1.0, m_max, re, im);
+        return;
+    }
+    for (int m = 0; m <= M_MAX_LIMIT; ++m) {
+        re[m] = vec3(0.0); im[m] = vec3(0.0);
+        if (m <= m_max) sensitivity_fourier_transform(float(m) * D_, sensitivity, re[m], im[m]);
     }
 }
 
@@ -422,35 +462,6 @@ void film_from_D_inc(float D_inc_, float eta_1, float eta_2, out float eta_2_eff
 
 // ---- Multi-scale rendering: Eq. 10 averaged over a Gaussian distribution of OPD (Section 5) ------
 
-// The pre-filtered table (explorer.thinfilm.sensitivity_fourier_prefiltered), bound by the host on first
-// use: 4096 x (2 x PREFILTER_LEVELS) texels, rows k = 0..127 the real parts and rows 128 + k the imaginary
-// parts of the envelope convolved with a Gaussian of standard deviation k PREFILTER_SIGMA_STEP nm.
-uniform sampler2D sensitivity_fourier_prefiltered;
-const float PREFILTER_SIGMA_STEP = 6.25;
-const int PREFILTER_LEVELS = 128;
-
-// The envelope at OPD mean mu and standard deviation sigma, bilinear in (mu, sigma) by texelFetch as numpy
-// does; false beyond the last mu node; sigma clamped to the last level.
-bool sensitivity_fourier_envelope_prefiltered(float mu, float sigma, out vec3 re, out vec3 im) {
-    int last = textureSize(sensitivity_fourier_prefiltered, 0).x - 1;
-    float x = mu / SENSITIVITY_FOURIER_STEP;
-    re = vec3(0.0);
-    im = vec3(0.0);
-    if (!(x >= 0.0 && x <= float(last))) return false;
-    int i = min(int(floor(x)), last - 1);
-    float f = x - float(i);
-    float y = clamp(sigma / PREFILTER_SIGMA_STEP, 0.0, float(PREFILTER_LEVELS - 1));
-    int k = min(int(floor(y)), PREFILTER_LEVELS - 2);
-    float g = y - float(k);
-    for (int part = 0; part < 2; ++part) {
-        int row = k + part * PREFILTER_LEVELS;
-        vec3 low = mix(texelFetch(sensitivity_fourier_prefiltered, ivec2(i, row), 0).rgb, texelFetch(sensitivity_fourier_prefiltered, ivec2(i + 1, row), 0).rgb, f);
-        vec3 high = mix(texelFetch(sensitivity_fourier_prefiltered, ivec2(i, row + 1), 0).rgb, texelFetch(sensitivity_fourier_prefiltered, ivec2(i + 1, row + 1), 0).rgb, f);
-        if (part == 0) re = mix(low, high, g); else im = mix(low, high, g);
-    }
-    return true;
-}
-
 // Eq. 10 against a Gaussian distribution of thickness: each harmonic's S^(m D) is replaced by its
 // average over OPDs of mean m D and standard deviation m cos(theta_2) sigma_D_inc (D = D_inc cos theta_2).
 // thickness_d is the mean thickness; the naive colour where the film is evanescent, as fourier_rgb.
@@ -466,19 +477,6 @@ vec3 fourier_rgb_prefiltered(float eta_1, float eta_2, float eta_3, float kappa_
     }
     float D_ = D(s), sigma_D = sigma_D_inc * s.cos_theta_2.x;
     vec3 re[M_MAX_LIMIT + 1], im[M_MAX_LIMIT + 1];
-    for (int m = 0; m <= M_MAX_LIMIT; ++m) { re[m] = vec3(0.0); im[m] = vec3(0.0); }
-    re[0] = vec3(1.0);
-    vec3 c, sn, power_c = vec3(1.0), power_s = vec3(0.0);
-    sensitivity_fourier_carrier(D_, c, sn);
-    for (int m = 1; m <= M_MAX_LIMIT; ++m) {
-        if (m > m_max) break;
-        vec3 next_c = power_c * c - power_s * sn;
-        power_s = power_c * sn + power_s * c;
-        power_c = next_c;
-        vec3 env_re, env_im;
-        if (!sensitivity_fourier_envelope_prefiltered(float(m) * D_, float(m) * sigma_D, env_re, env_im)) break;
-        re[m] = env_re * power_c - env_im * power_s;
-        im[m] = env_re * power_s + env_im * power_c;
-    }
+    sensitivity_samples_table(D_, sigma_D, m_max, re, im);
     return 0.5 * (spectral_integration_fourier_samples(s, m_max, re, im) + spectral_integration_fourier_samples(p, m_max, re, im));
 }
