@@ -436,6 +436,13 @@ def airy_reflection_coefficient(
     return airy_reflection_coefficient_from_terms(terms, wavelength)
 
 
+def _polarisation_average(of_terms, film, wavelength, polarisation: str | None) -> np.ndarray:
+    """``of_terms(film_terms(*film, pol), wavelength)`` for one polarisation, or averaged over both."""
+    wavelength = _validate_wavelength(wavelength)
+    pols = _polarisations(polarisation)
+    return sum(of_terms(film_terms(*film, pol), wavelength) for pol in pols) / len(pols)
+
+
 def airy_reflectance(
     eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, wavelength, polarisation: str | None = None
 ) -> np.ndarray:
@@ -477,14 +484,9 @@ def airy_reflectance(
     ----------
     Belcour & Barla (2017), Eqs. 2-3 and the Appendix ("Derivation of Cm and R in closed form").
     """
-    wavelength = _validate_wavelength(wavelength)
-    pols = _polarisations(polarisation)
-    total = 0.0
-    for pol in pols:
-        total = total + airy_reflectance_from_terms(
-            film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol), wavelength
-        )
-    return total / len(pols)
+    return _polarisation_average(
+        airy_reflectance_from_terms, (eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d), wavelength, polarisation
+    )
 
 
 def airy_transmittance(
@@ -505,14 +507,9 @@ def airy_transmittance(
     ----------
     Belcour & Barla (2017), Appendix: ``T = T* (1 + 2 (R_l cos Phi - R_l^2) / (1 - 2 R_l cos Phi + R_l^2))``.
     """
-    wavelength = _validate_wavelength(wavelength)
-    pols = _polarisations(polarisation)
-    total = 0.0
-    for pol in pols:
-        total = total + airy_transmittance_from_terms(
-            film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol), wavelength
-        )
-    return total / len(pols)
+    return _polarisation_average(
+        airy_transmittance_from_terms, (eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d), wavelength, polarisation
+    )
 
 
 # --------------------------------------------------------------------------------------------------
