@@ -649,10 +649,16 @@ def D_max(epsilon: float = 0.05, sensitivity: str = "table") -> float:
 # Analytic spectral integration (Eq. 10)
 
 
-def spectral_integration_fourier(terms: FilmTerms, m_max: int = 3, sensitivity: str = "table") -> np.ndarray:
+def spectral_integration_fourier(
+    terms: FilmTerms, m_max: int = 3, sensitivity: str = "table", sigma_D_inc=None
+) -> np.ndarray:
     """
     Eq. 10 for one polarisation: ``R_j = C_0 S^_j(0) + 2 sum_{m=1}^{m_max} C_m [cos(m phi_2) Re S^_j(mD)
     + sin(m phi_2) Im S^_j(mD)]``, with ``S^_j(0) = 1`` for the table (white).
+
+    With ``sigma_D_inc`` (the standard deviation of ``D_inc``, nm; Section 5) each ``S^_j(mD)`` is the
+    pre-filtered table at standard deviation ``m cos(theta_2) sigma_D_inc``
+    (:func:`sensitivity_fourier_transform_prefiltered`; the table sensitivity only).
 
     Valid where the film propagates (Eq. 5 is a Fourier series in ``nu`` only there).
 
@@ -669,8 +675,13 @@ def spectral_integration_fourier(terms: FilmTerms, m_max: int = 3, sensitivity: 
     D = terms.D
     phi_2 = terms.phi_2
     rgb = C_0(terms)[..., None] * np.real(sensitivity_fourier_transform(np.zeros_like(D), sensitivity))
+    if sigma_D_inc is not None:
+        sigma_D = sigma_D_inc * np.where(terms.film_propagates, terms.cos_theta_2.real, 0.0)
     for m in range(1, int(m_max) + 1):
-        S = sensitivity_fourier_transform(m * D, sensitivity)
+        if sigma_D_inc is None:
+            S = sensitivity_fourier_transform(m * D, sensitivity)
+        else:
+            S = sensitivity_fourier_transform_prefiltered(m * D, m * sigma_D)
         rgb = rgb + 2.0 * C_m(terms, m)[..., None] * (
             np.cos(m * phi_2)[..., None] * S.real + np.sin(m * phi_2)[..., None] * S.imag
         )
@@ -746,7 +757,8 @@ def naive_rgb(
 
 
 def fourier_rgb(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, m_max: int = 3, sensitivity: str = "table"
+    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, m_max: int = 3, sensitivity: str = "table",
+    sigma_D_inc=None,
 ) -> np.ndarray:
     """
     The paper's analytic spectral integration (Eq. 10) truncated at ``m_max``, both polarisations.
@@ -759,6 +771,9 @@ def fourier_rgb(
         Highest harmonic kept (the paper uses 1 to 3; 0 gives ``C_0``, the fringe average).
     sensitivity : {'table', 'gaussian', 'exact'}
         See :func:`sensitivity_fourier_transform`.
+    sigma_D_inc : array_like, optional
+        Standard deviation of ``D_inc`` (nm): Eq. 10 averaged over a Gaussian distribution of thickness
+        (Section 5; see :func:`fourier_rgb_prefiltered`).
 
     Returns
     -------
@@ -784,7 +799,7 @@ def fourier_rgb(
     for pol in POLARISATIONS:
         terms = film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            rgb = rgb + 0.5 * spectral_integration_fourier(terms, m_max, sensitivity)
+            rgb = rgb + 0.5 * spectral_integration_fourier(terms, m_max, sensitivity, sigma_D_inc)
         propagates = propagates & terms.film_propagates
     propagates = np.asarray(propagates)
     if np.all(propagates):
@@ -934,27 +949,7 @@ def fourier_rgb_prefiltered(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness
     (:func:`sensitivity_fourier_transform_prefiltered`). ``thickness_d`` is the mean thickness,
     ``sigma_D_inc`` the standard deviation of ``D_inc`` (nm). Evanescent film: as :func:`fourier_rgb`.
     """
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d = validate_film(
-        eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d
+    return fourier_rgb(
+        eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, m_max,
+        sigma_D_inc=_real_array("sigma_D_inc", sigma_D_inc),
     )
-    sigma_D_inc = _real_array("sigma_D_inc", sigma_D_inc)
-    rgb = 0.0
-    propagates = True
-    for pol in POLARISATIONS:
-        terms = film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol)
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            D, phi_2 = terms.D, terms.phi_2
-            sigma_D = sigma_D_inc * np.where(terms.film_propagates, terms.cos_theta_2.real, 0.0)
-            part = C_0(terms)[..., None] * np.ones(3)
-            for m in range(1, int(m_max) + 1):
-                S = sensitivity_fourier_transform_prefiltered(m * D, m * sigma_D)
-                part = part + 2.0 * C_m(terms, m)[..., None] * (
-                    np.cos(m * phi_2)[..., None] * S.real + np.sin(m * phi_2)[..., None] * S.imag
-                )
-        rgb = rgb + 0.5 * part
-        propagates = propagates & terms.film_propagates
-    propagates = np.asarray(propagates)
-    if np.all(propagates):
-        return rgb
-    naive = naive_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d)
-    return np.where(propagates[..., None], rgb, naive)
