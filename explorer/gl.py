@@ -100,15 +100,25 @@ class Renderer:
         return texture
 
     def _model_texture(self, name: str, table: np.ndarray):
-        """The texture of a model's table: rewritten in place when its size is unchanged."""
-        data = np.ascontiguousarray(table, dtype=np.float32).reshape(1, -1, 3)
+        """
+        The linearly filtered texture of a model's table, rewritten in place when its shape is unchanged:
+        ``(width, 3)`` is a row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0).
+        """
+        import moderngl
+
+        data = np.ascontiguousarray(table, dtype=np.float32)
+        if data.ndim == 2:
+            data = data.reshape(1, -1, 3)
+        size = (data.shape[1], data.shape[0])
         texture = self._model_textures.get(name)
-        if texture is not None and texture.size == (data.shape[1], 1):
+        if texture is not None and texture.size == size:
             texture.write(data.tobytes())
             return texture
         if texture is not None:
             texture.release()
-        texture = self._model_textures[name] = self._texture_row(data, linear=True)
+        texture = self._model_textures[name] = self.ctx.texture(size, 3, data.tobytes(), dtype="f4")
+        texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        texture.repeat_x = texture.repeat_y = False
         return texture
 
     def _library_textures(self) -> dict[str, object]:
