@@ -439,6 +439,68 @@ def single_reflection_brdf(stack: LayeredBragg, i, o, tables=None, exact_reflect
     return colorimetry.spectrum_to_rgb(spectra.layers) + np.asarray(stack.rho_d) * colorimetry.spectrum_to_rgb(spectra.base)
 
 
+def _host_angle(cos_theta, n1: float, coating: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(theta', coating Fresnel F): the angle in the host of incidence ``cos_theta`` in air, by atan2."""
+    c = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
+    if not coating:
+        return np.arctan2(s, c), np.zeros_like(c)
+    F = coating_reflectance(c, n1)
+    s = s / n1
+    return np.arctan2(s, np.sqrt(np.maximum(1.0 - s * s, 0.0))), F
+
+
+def stack_specular_rgb(stack: LayeredBragg, cos_theta, tables=None) -> np.ndarray:
+    """
+    The smooth limit's specular colour of a stack at incidence ``cos_theta`` (in air), in linear sRGB: the
+    weight of the mirror reflection, ``F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} t_k(theta')^2``, with
+    ``F`` the coating's Fresnel reflectance, ``theta'`` the refracted angle, ``R_l`` Yeh's reflectance and
+    ``t_k`` the integrated transmissivity (Eq. 28) of the layers above. What the ``sphere`` and
+    ``gradient`` views show for ``shaders/bragg_stack.brd``; not part of Eq. 34 (which has no Dirac term
+    for rough layers).
+    """
+    tables = stack_tables(stack) if tables is None else tuple(tables)
+    theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
+    through = ((1.0 - F) ** 2)[..., None]
+    spectrum = 0.0
+    for table in tables:
+        spectrum = spectrum + through * lookup(table.reflectance, theta)
+        through = through * lookup(table.transmissivity, theta) ** 2
+    return colorimetry.spectrum_to_rgb(spectrum) + F[..., None]  # F is flat: white is (1, 1, 1)
+
+
+def transmission_probability(mean_transmissivity, cos_theta, alpha) -> np.ndarray:
+    """
+    The probability of transmission through a rough Bragg layer (Eq. 31), with the numerator averaged
+    over wavelengths (the "multiplexed" form of Section 4.2.3): ``2 <f_t cos theta>_lambda / (1 + G1)``.
+    """
+    p = 2.0 * np.asarray(mean_transmissivity) / (1.0 + microfacet.smith_G1(cos_theta, alpha))
+    return np.clip(p, 0.0, 1.0)
+
+
+def layer_choice_probabilities(stack: LayeredBragg, cos_theta, tables=None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The probability that a path entering at ``cos_theta`` (in air) reflects on Bragg layer ``l`` (Eq. 35),
+    ``p_refl,l = (1 - p_trans,l) prod_{k<l} p_trans,k`` with ``p_trans,0 = 1 - F`` through the coating,
+    and the probability of reaching the base. Importance sampling's layer choice (Section 4.3.2).
+
+    Returns
+    -------
+    p_refl : ndarray, shape (..., number of layers)
+    p_base : ndarray, shape (...)
+    """
+    tables = stack_tables(stack) if tables is None else tuple(tables)
+    theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
+    reach = 1.0 - F
+    p_refl = []
+    for layer, table in zip(stack.layers, tables):
+        mean_t = lookup(table.transmissivity.mean(axis=1, dtype=np.float64)[:, None], theta)[..., 0]
+        p_trans = transmission_probability(mean_t, np.cos(theta), layer.alpha)
+        p_refl.append((1.0 - p_trans) * reach)
+        reach = reach * p_trans
+    return np.stack(p_refl, axis=-1), reach
+
+
 # --------------------------------------------------------------------------------------------------
 # Timings (the goals of issue #3: F_alpha for a new alpha within 100 ms, a layer's tables within 10 ms)
 

@@ -138,6 +138,79 @@ class BraggLayerModel(BraggMirrorModel):
         return {**super().textures(), "transmission_table": self.transmission_table}
 
 
+@functools.lru_cache(maxsize=32)
+def _layer_tables(layer: layered.RoughBraggLayer, n1: float) -> layered.LayerTables:
+    """A layer's tables, cached: changing one layer of a stack rebuilds that layer's only."""
+    return layered.layer_tables(layer, n1)
+
+
+def _number(values: Mapping[str, object], name: str) -> float:
+    return float(values[name])
+
+
+class BraggStackModel:
+    """
+    Twin of ``shaders/bragg_stack.brd``: the single-reflection BRDF (Eq. 34) of 1 to 3 rough Bragg layers
+    in a host ``nh`` over a Lambertian base, under a coating (:func:`explorer.layered.single_reflection_brdf`
+    from the per-layer tables, the "LUT version" of Table 2), and the tables its shader reads.
+
+    Parameters ``layers``, ``nh``, ``coating``, ``rho_d`` and, per layer ``k`` in 1..3, ``n1_k``, ``n2_k``,
+    ``Lambda_k``, ``delta_k``, ``N_k``, ``alpha_k`` (layers beyond ``layers`` are ignored).
+    """
+
+    name = "bragg_stack"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.values = dict(values)
+        count = int(np.floor(_number(values, "layers") + 0.5))
+        if not 1 <= count <= layered.MAX_LAYERS:
+            raise ValueError(f"layers must be 1 to {layered.MAX_LAYERS}, got {values['layers']}")
+        nh = _number(values, "nh")
+        layers = []
+        for k in range(1, count + 1):
+            n1_k = _number(values, f"n1_{k}")
+            layers.append(layered.RoughBraggLayer(
+                n2=_number(values, f"n2_{k}"), Lambda=_number(values, f"Lambda_{k}"),
+                delta=_number(values, f"delta_{k}"), N=int(np.floor(_number(values, f"N_{k}") + 0.5)),
+                alpha=_number(values, f"alpha_{k}"), n1=None if n1_k == nh else n1_k,
+            ))
+        self.stack = layered.LayeredBragg(
+            layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
+        )
+        self.tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        """The smooth limit's specular colour (:func:`explorer.layered.stack_specular_rgb`)."""
+        return layered.stack_specular_rgb(self.stack, cos_theta, self.tables)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        """The shader's ``BRDF``: Eq. 34 in the frame (X, Y, N); 0 where L or V is at or below the surface."""
+        def local(d):
+            d = np.asarray(d, dtype=np.float64)
+            return np.stack([np.sum(d * X, axis=-1), np.sum(d * Y, axis=-1), np.sum(d * N, axis=-1)], axis=-1)
+
+        X, Y, N = (np.asarray(a, dtype=np.float64) for a in (X, Y, N))
+        return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables)
+
+    def textures(self) -> dict[str, np.ndarray]:
+        """
+        ``stack_reflectance`` and ``stack_transmissivity``: ``(361, 471, 3)``, rows theta = k 0.25 deg,
+        columns the wavelengths, channel l layer l (zeros beyond the used layers); ``stack_sampling``:
+        ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator).
+        """
+        shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
+        reflectance = np.zeros(shape, np.float32)
+        transmissivity = np.zeros(shape, np.float32)
+        for l, table in enumerate(self.tables):
+            reflectance[..., l] = table.reflectance
+            transmissivity[..., l] = table.transmissivity
+        return {
+            "stack_reflectance": reflectance,
+            "stack_transmissivity": transmissivity,
+            "stack_sampling": transmissivity.mean(axis=1, dtype=np.float64).astype(np.float32),
+        }
+
+
 class SchlickFresnelModel:
     """Twin of ``shaders/schlick_fresnel.brd``."""
 
@@ -188,6 +261,7 @@ class GGXSchlickModel:
 MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     BraggMirrorModel.name: BraggMirrorModel,
     BraggLayerModel.name: BraggLayerModel,
+    BraggStackModel.name: BraggStackModel,
     SchlickFresnelModel.name: SchlickFresnelModel,
     ThinFilmModel.name: ThinFilmModel,
     GGXSchlickModel.name: GGXSchlickModel,

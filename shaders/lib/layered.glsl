@@ -1,0 +1,140 @@
+// Layered Bragg structures: twin of explorer/layered.py (Fourneau et al. 2024, Sections 4.2-4.3).
+// Per-layer tables come from the host, one layer per channel (r, g, b = layers 1, 2, 3; zeros unused):
+// rows theta = k THETA_STEP (k = 0..360, in the host medium), columns lambda = 360 + j nm (j = 0..470).
+// They are read with texelFetch and interpolated here in float32, as explorer.layered.lookup does:
+// a linearly filtered fetch would blend neighbouring wavelengths and round its weights to 8 bits.
+#include "lib/microfacet.glsl"
+#include "lib/fresnel.glsl"
+#include "lib/colorimetry.glsl"
+
+const int MAX_LAYERS = 3;
+const int THETA_ROWS = 361;
+const float THETA_STEP = 0.25 * PI / 180.0;
+const float COS_THETA_MIN = 1e-9;
+
+// The polar angle of a direction above the surface, by atan2 (precise near 0, unlike acos).
+float polar_angle(vec3 v) { return atan(length(v.xy), max(v.z, 0.0)); }
+
+// Row k and weight f of angle theta in the 0.25 degree tables, clamped to [0, 90] degrees.
+void table_row(float theta, out int k, out float f) {
+    float x = clamp(theta, 0.0, 0.5 * PI) / THETA_STEP;
+    k = min(int(floor(x)), THETA_ROWS - 2);
+    f = x - float(k);
+}
+
+vec3 table_fetch(sampler2D table, int wavelength_index, int k, float f) {
+    return mix(texelFetch(table, ivec2(wavelength_index, k), 0).rgb, texelFetch(table, ivec2(wavelength_index, k + 1), 0).rgb, f);
+}
+
+// Snell's law through the smooth coating, from air into the host nh: same azimuth, sin' = sin / nh.
+vec3 refract_into_host(vec3 direction, float nh) {
+    vec2 tangent = direction.xy / nh;
+    return vec3(tangent, sqrt(max(1.0 - dot(tangent, tangent), 0.0)));
+}
+
+// The coating's Fresnel reflectance from air into nh (Eq. 34's f_r,0 weight; 0 for nh = 1).
+float coating_reflectance(float cos_theta_i, float nh) {
+    return fresnel_reflectance(clamp(cos_theta_i, COS_THETA_MIN, 1.0), 1.0, nh);
+}
+
+// 1 for the layers in use, 0 beyond.
+vec3 layer_mask(int layer_count) { return vec3(1.0, layer_count >= 2 ? 1.0 : 0.0, layer_count >= 3 ? 1.0 : 0.0); }
+
+// The single-reflection BRDF (Eq. 34) in linear sRGB, from the host's tables. i, o: unit directions in
+// air in the local frame (n = +z). Each wavelength's paths through the layers are multiplied before the
+// CMF integration; the base's RGB albedo multiplies the RGB of its spectral term (it has no spectrum).
+vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
+                           sampler2D reflectance_table, sampler2D transmissivity_table) {
+    if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
+    float path = 1.0;
+    vec3 ih = i, oh = o;
+    if (coating) {
+        // f_t,0 = 1 - F at the angles in air; directions refracted; radiance scaled by 1 / nh^2.
+        path = (1.0 - coating_reflectance(i.z, nh)) * (1.0 - coating_reflectance(o.z, nh)) / (nh * nh);
+        ih = refract_into_host(i, nh);
+        oh = refract_into_host(o, nh);
+    }
+    vec3 used = layer_mask(layer_count);
+    // Eq. 17 per layer: D(h) G1(i) G1(o) / (4 cos_i cos_o), G1 / cos finite at grazing angles.
+    vec3 h = normalize(ih + oh);
+    vec3 lobe = vec3(0.0);
+    for (int l = 0; l < MAX_LAYERS; ++l) {
+        lobe[l] = used[l] * 0.25 * ggx_D(h.z, alphas[l]) * smith_G1_over_cos(max(ih.z, 0.0), alphas[l])
+                * smith_G1_over_cos(max(oh.z, 0.0), alphas[l]);
+    }
+    int k_i, k_o, k_d;
+    float f_i, f_o, f_d;
+    table_row(polar_angle(ih), k_i, f_i);
+    table_row(polar_angle(oh), k_o, f_o);
+    table_row(atan(length(ih - oh), length(ih + oh)), k_d, f_d);  // theta_d = angle(i, h)
+    vec3 xyz_layers = vec3(0.0), xyz_base = vec3(0.0);
+    for (int j = 0; j < CMF_COUNT; ++j) {
+        vec3 R = table_fetch(reflectance_table, j, k_d, f_d);
+        vec3 t = mix(vec3(1.0), table_fetch(transmissivity_table, j, k_i, f_i) * table_fetch(transmissivity_table, j, k_o, f_o), used);
+        float p2 = path * t.x, p3 = p2 * t.y;  // the paths down to layers 2 and 3
+        float layers_term = lobe.x * R.x * path + lobe.y * R.y * p2 + lobe.z * R.z * p3;
+        vec3 cmf = colour_matching_functions(j);
+        xyz_layers += cmf * layers_term;
+        xyz_base += cmf * (p3 * t.z);
+    }
+    return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
+}
+
+// The smooth limit's specular colour at incidence cos_theta (what the gradient and sphere views show):
+// F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} t_k(theta')^2, with t_k the integrated transmissivity and
+// theta' the refracted angle (without a coating: theta' = theta, F = 0).
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count,
+                        sampler2D reflectance_table, sampler2D transmissivity_table) {
+    float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
+    float F = 0.0, through = 1.0;
+    if (coating) {
+        F = coating_reflectance(c, nh);
+        through = (1.0 - F) * (1.0 - F);
+        s /= nh;
+        c = sqrt(max(1.0 - s * s, 0.0));
+    }
+    int k;
+    float f;
+    table_row(atan(s, c), k, f);
+    vec3 used = layer_mask(layer_count);
+    vec3 xyz = vec3(0.0);
+    float flat_sum = 0.0;
+    for (int j = 0; j < CMF_COUNT; ++j) {
+        vec3 R = table_fetch(reflectance_table, j, k, f) * used;
+        vec3 t = mix(vec3(1.0), table_fetch(transmissivity_table, j, k, f), used);
+        float t1 = t.x * t.x, t2 = t1 * t.y * t.y;
+        xyz += colour_matching_functions(j) * (through * (R.x + t1 * R.y + t2 * R.z));
+    }
+    return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)
+}
+
+// Eq. 31 with the wavelength-averaged numerator: the probability of transmission through a layer.
+float transmission_probability(float mean_transmissivity, float cos_theta, float alpha) {
+    return clamp(2.0 * mean_transmissivity / (1.0 + smith_G1(cos_theta, alpha)), 0.0, 1.0);
+}
+
+// Eq. 35: the probability that the reflection happens on layer l (returned in p_refl, 0 beyond the used
+// layers), the coating's transmission being p_trans_0 = 1 - F; returns the probability of reaching the base.
+// sampling_table: 361 x 1, channel l the wavelength average of layer l's f_t cos theta.
+float layer_choice_probabilities(float cos_theta, float nh, bool coating, int layer_count, vec3 alphas,
+                                 sampler2D sampling_table, out vec3 p_refl) {
+    float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
+    float reach = 1.0;
+    if (coating) {
+        reach = 1.0 - coating_reflectance(c, nh);
+        s /= nh;
+        c = sqrt(max(1.0 - s * s, 0.0));
+    }
+    int k;
+    float f;
+    table_row(atan(s, c), k, f);
+    vec3 mean_t = mix(texelFetch(sampling_table, ivec2(k, 0), 0).rgb, texelFetch(sampling_table, ivec2(k + 1, 0), 0).rgb, f);
+    p_refl = vec3(0.0);
+    for (int l = 0; l < MAX_LAYERS; ++l) {
+        if (l >= layer_count) break;
+        float p_trans = transmission_probability(mean_t[l], c, alphas[l]);
+        p_refl[l] = (1.0 - p_trans) * reach;
+        reach *= p_trans;
+    }
+    return reach;
+}
