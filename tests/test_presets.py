@@ -47,11 +47,31 @@ def test_preset_resolves_within_range(stem, preset):
     assert preset.figure and preset.description
     for name, value in preset.values.items():
         parameter = preset.material.parameter(name)
-        if parameter.type == "color":  # no range: one number (grey) or r, g, b
+        if parameter.type in ("color", "bool"):  # no range: one number (grey) or r, g, b; true or false
             assert values[name] == parameter.coerce(value)
             continue
         assert parameter.min <= float(values[name]) <= parameter.max
         assert float(values[name]) == pytest.approx(float(value))
+
+
+def test_stack_presets_cover_the_issue_figures():
+    presets = load_presets(PRESET_DIR / "bragg_stack.toml").presets
+    for prefix, count in {"figure1_": 11, "figure7_": 4, "figure10_": 24, "figure11_": 7, "figure12_": 9, "table3_": 3,
+                          "supplemental10_": 9, "supplemental11_": 9}.items():
+        assert len([n for n in presets if n.startswith(prefix)]) == count, prefix
+    left = presets["figure1_left_alpha04"].resolve()  # d1 = 125 nm, d2 = 375 nm
+    assert (left["Lambda_1"] * left["delta_1"], left["Lambda_1"] * (1 - left["delta_1"]), left["N_1"], left["alpha_1"]) == (125, 375, 20, 0.4)
+    pair = presets["figure1_stacked_pair"].resolve()
+    assert pair["layers"] == 2 and pair["Lambda_1"] == 500 and pair["Lambda_2"] == 244 and pair["alpha_2"] == 0.1
+    assert pair["Lambda_2"] * pair["delta_2"] == pytest.approx(101, abs=1e-3)
+    prime = presets["figure7_A_prime"].resolve()
+    assert (prime["nh"], prime["n1_1"], prime["Lambda_1"], prime["N_1"], prime["alpha_1"]) == (1.35, 1.35, 500, 10, 0.1)
+    beetle = presets["table3_purple"].resolve()
+    assert (beetle["nh"], beetle["n1_1"], beetle["n2_1"], beetle["Lambda_1"], beetle["delta_1"], beetle["N_1"], beetle["alpha_1"]) == (
+        1, 1.6, 1.68, 205, 0.51, 6, 0.05)
+    assert tuple(beetle["rho_d"]) == (0, 0, 0)
+    coated = presets["supplemental11_L500_d50"].resolve()
+    assert (coated["nh"], coated["n1_1"], coated["n2_1"], coated["alpha_1"]) == (1.4, 1.4, 1.6, 0.1)
 
 
 def test_figure_values_from_the_papers():
@@ -70,7 +90,7 @@ def test_figure_values_from_the_papers():
 @pytest.mark.gl
 def test_every_preset_renders_finite_in_gl(gl_renderer):
     for stem, preset in all_presets():
-        values = preset.resolve({"method": FAST_METHOD[stem]})
+        values = preset.resolve({"method": FAST_METHOD[stem]} if stem in FAST_METHOD else {})
         image = gl_renderer.render(preset.material, values, "lit", 8, 8)
         assert np.isfinite(image).all(), (stem, preset.name)
         assert image.max() > 0.0, (stem, preset.name)
