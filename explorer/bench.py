@@ -397,17 +397,73 @@ def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64) ->
     for alpha in LAYER_ALPHAS:
         _progress(f"bench --layers: slice view {size}x{size}, alpha = {alpha:g}")
         accuracy.append(slice_accuracy(alpha, size))
+    _progress("bench --layers: bragg_stack.brd, Figure 7's presets and Table 3's green area")
     document = {
         "timings": {**timings, "goal_ms": LAYER_GOALS, "paper_ms": LAYER_PAPER},
         "slice": {"configuration": {k: v for k, v in FIGURE8_LAYER.items() if k != "s"},
                   "luminance_threshold": SLICE_LUMINANCE_THRESHOLD, "rows": accuracy},
+        "stack": stack_study(repeats=max(repeats // 2, 1)),
     }
     print(json.dumps(document, indent=2) if as_json else format_layers(document))
     return document
 
 
+#: Presets of bragg_stack.brd timed and compared by :func:`stack_study`.
+STACK_PRESETS = ("figure7_A", "figure7_A_on_B", "figure7_A_prime", "table3_green_blue", "figure12_middle_alpha01")
+#: Direction pairs of the LUT study (cos theta in [0.05, 1], uniform azimuths; fixed seed).
+STACK_PAIRS = 4000
+
+
+def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> list[dict]:
+    """
+    Per preset of ``bragg_stack.brd``: the host's table rebuild when a parameter changes (every layer's
+    tables, F_alpha cached), the GL time of a ``size``-square ``lit`` frame (finish-bounded, median of
+    ``repeats``), and the ΔE2000 between Eq. 34 with Yeh's reflectance read from the 0.25-degree table
+    (Table 2's "Model-LUT", what the shader does) and computed exactly at the half-vector angle ("Model"),
+    over :data:`STACK_PAIRS` random direction pairs where the exact BRDF's luminance exceeds 0.01.
+    """
+    from . import layered
+    from .gl import Renderer
+    from .models import BraggStackModel, _layer_tables
+    from .presets import load_presets
+
+    preset_file = load_presets(SHADER_DIR / "presets" / "bragg_stack.toml")
+    material = preset_file.material
+    renderer = Renderer()
+    rng = np.random.default_rng(2024)
+
+    def directions(count):
+        cos_theta = rng.uniform(0.05, 1.0, count)
+        phi = rng.uniform(0.0, 2.0 * np.pi, count)
+        sin_theta = np.sqrt(1.0 - cos_theta**2)
+        return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta], axis=-1)
+
+    i, o = directions(STACK_PAIRS), directions(STACK_PAIRS)
+    rows = []
+    for name in presets:
+        values = preset_file.presets[name].resolve()
+        rebuilds = []
+        for _ in range(repeats + 1):
+            _layer_tables.cache_clear()
+            start = time.perf_counter()
+            model = BraggStackModel(values)
+            rebuilds.append(1e3 * (time.perf_counter() - start))
+        renderer.render(material, values, "lit", 8, 8)  # compile and upload once
+        frames = [renderer.time_frame(material, values, "lit", size, size) for _ in range(repeats)]
+        lut = layered.single_reflection_brdf(model.stack, i, o, model.tables)
+        exact = layered.single_reflection_brdf(model.stack, i, o, model.tables, exact_reflectance=True)
+        counted = colorimetry.rgb_to_xyz(exact)[..., 1] > SLICE_LUMINANCE_THRESHOLD
+        dE = colorimetry.delta_E_2000(exact[counted], lut[counted])
+        rows.append({
+            "preset": name, "layers": len(model.stack.layers), "tables_ms": float(np.median(rebuilds[1:])),
+            "frame_ms": float(np.median(frames)), "size": size, "pairs": int(counted.sum()),
+            "lut_dE_median": float(np.median(dE)), "lut_dE_max": float(np.max(dE)),
+        })
+    return rows
+
+
 def format_layers(document: dict) -> str:
-    """The two tables of ``bench --layers``."""
+    """The three tables of ``bench --layers``."""
     timings = document["timings"]
     lines = [f"Host tables: wall-clock medians of {timings['repeats']} interleaved repeats (numpy, this machine)", ""]
     for key, label in (("transmission_filter_ms", "F_alpha (new alpha)"), ("layer_tables_ms", "layer tables")):
@@ -425,4 +481,15 @@ def format_layers(document: dict) -> str:
     for r in rows:
         cells = "".join(f"{r[n]['dE_median']:>9.2f} / {r[n]['dE_max']:<5.1f}" for n in names)
         lines.append(f"{r['alpha']:>6g} {r['pixels']:>7}{cells}{r['tabulated']['max_abs']:>15.3g}{r['tabulated']['max_relative']:>15.2e}")
+    stack = document.get("stack")
+    if stack:
+        lines += ["", f"bragg_stack.brd (Eq. 34, 471 wavelengths per pixel): host table rebuild (all layers), GL lit frame "
+                  f"{stack[0]['size']}x{stack[0]['size']} (this machine's renderer), and ΔE2000 of the tabulated R_λ (Model-LUT) "
+                  f"against Yeh's R_λ at the exact half-vector angle (Model), median / max over random pairs with Y > "
+                  f"{SLICE_LUMINANCE_THRESHOLD:g}", ""]
+        header = f"{'preset':<26}{'layers':>7}{'tables':>11}{'frame':>11}{'pairs':>7}{'LUT ΔE2000':>16}"
+        lines += [header, "-" * len(header)]
+        for r in stack:
+            lines.append(f"{r['preset']:<26}{r['layers']:>7}{r['tables_ms']:>8.1f} ms{r['frame_ms']:>8.0f} ms{r['pairs']:>7}"
+                         f"{r['lut_dE_median']:>9.2f} / {r['lut_dE_max']:<5.2f}")
     return "\n".join(lines)

@@ -26,3 +26,9 @@ def test_bench_layers_json():
         assert ours["dE_median"] <= 2.0
         # The tabulated method follows the reference within the 256-entry table's known limit (README).
         assert 0.0 < r["tabulated"]["max_relative"] < 1.5e-2
+    stack = document["stack"]
+    assert [r["preset"] for r in stack][:3] == ["figure7_A", "figure7_A_on_B", "figure7_A_prime"]
+    for r in stack:
+        assert r["tables_ms"] > 0.0 and r["frame_ms"] > 0.0 and r["pairs"] > 0
+        # Table 2: the LUT version of Eq. 34 is close to the exact one (ΔE2000 well below 1 at the median).
+        assert 0.0 <= r["lut_dE_median"] < 0.5 and r["lut_dE_max"] < 3.0
