@@ -21,6 +21,7 @@ from explorer import bragg, colorimetry, layered
 from explorer.brd import load_material
 from explorer.models import BraggStackModel, model_for
 from explorer.render import render_numpy, rim_distance
+from test_bragg_layer import directions
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 
 STACK_MATERIAL = REPO_ROOT / "shaders" / "bragg_stack.brd"
@@ -43,15 +44,6 @@ CASES = {
 @pytest.fixture(scope="module")
 def stack_material():
     return load_material(STACK_MATERIAL)
-
-
-def directions(count: int, seed: int) -> np.ndarray:
-    """Unit directions above the surface (n = +z), cos theta in [0.02, 1]."""
-    rng = np.random.default_rng(seed)
-    cos_theta = rng.uniform(0.02, 1.0, count)
-    phi = rng.uniform(0.0, 2.0 * np.pi, count)
-    sin_theta = np.sqrt(1.0 - cos_theta**2)
-    return np.stack([sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta], axis=-1)
 
 
 @pytest.mark.gl
