@@ -493,3 +493,73 @@ def format_layers(document: dict) -> str:
             lines.append(f"{r['preset']:<26}{r['layers']:>7}{r['tables_ms']:>8.1f} ms{r['frame_ms']:>8.0f} ms{r['pairs']:>7}"
                          f"{r['lut_dE_median']:>9.2f} / {r['lut_dE_max']:<5.2f}")
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------------------------------
+# bench --app (issue #4): the explorer's frame times while a slider is dragged
+
+
+#: The methods of bragg_mirror.brd timed by ``bench --app``, fastest first.
+APP_METHODS = ((3, "tabulated"), (1, "basic"), (2, "subdivided s = 3"), (4, "improved s = 3"), (0, "reference"))
+
+
+def app_bench_script(frames: int = 60) -> list:
+    """The scripted session of ``bench --app``: per method, drag Lambda through the UI for ``frames`` frames."""
+    script: list = [{"wait": 3}, {"wait_complete": True, "timeout": 600}]
+    for method, _name in APP_METHODS:
+        script += [
+            {"set": {"method": method}}, {"wait": 8},
+            {"mark": f"method {method}"},
+            {"drag": "param:Lambda", "from": 0.30, "to": 0.42, "frames": frames},
+            {"mark": None}, {"wait": 3},
+        ]
+    return script + [{"quit": True}]
+
+
+def summarise_app_frames(frames: list[dict]) -> list[dict]:
+    """Per method: frame times (ms) of the frames spent dragging, and the resolution shown meanwhile."""
+    rows = []
+    for method, name in APP_METHODS:
+        chosen = [f for f in frames if f.get("mark") == f"method {method}" and f.get("dragging")]
+        if not chosen:
+            continue
+        ms = np.array([f["ms"] for f in chosen[2:] or chosen])
+        previews = [tuple(f["main"]["preview"]) for f in chosen if f["main"]["has_preview"] and not f["main"]["complete"]]
+        shown = f"{previews[-1][0]}x{previews[-1][1]} preview" if previews else f"{chosen[-1]['main']['size'][0]}x{chosen[-1]['main']['size'][1]} full"
+        rows.append({
+            "method": method, "name": name, "frames": int(ms.size), "median_ms": float(np.median(ms)),
+            "p90_ms": float(np.percentile(ms, 90)), "max_ms": float(ms.max()), "fps": float(1e3 / np.median(ms)),
+            "while_dragging": shown,
+            "gl_ms": float(np.median([f["gl_ms"] for f in chosen])), "ui_ms": float(np.median([f["ui_ms"] for f in chosen])),
+        })
+    return rows
+
+
+def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> list[dict]:
+    """
+    Open the explorer (on a virtual display when there is none) on the default mirror with a ``size``²
+    sphere, drag the Lambda slider through the UI for ``frames`` frames per method and print the frame
+    times (wall clock between frames: UI, drawing, table rebuilds and all).
+    """
+    import os
+    import tempfile
+
+    from .app import App
+    from .cli import DEFAULT_MATERIAL
+    from .xvfb import display_environment
+
+    with display_environment() as display, tempfile.TemporaryDirectory() as directory:
+        report = Path(directory) / "report.json"
+        _progress(f"bench --app: scripted session on DISPLAY={display}, {size}x{size} sphere, {frames} frames of drag per method")
+        App(DEFAULT_MATERIAL, script=app_bench_script(frames), report=report, view_size=size, is_default=True).run()
+        document = json.loads(report.read_text())
+    rows = summarise_app_frames(document["frames"])
+    if as_json:
+        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows}, indent=2))
+        return rows
+    print(f"Explorer frame times while dragging Lambda ({size}x{size} sphere, 1280x800 window, {os.cpu_count()} CPUs):")
+    print(f"{'method':<22} {'median':>8} {'p90':>8} {'max':>8} {'fps':>6}  {'GL work':>8} {'UI':>6}  shown while dragging")
+    for row in rows:
+        print(f"{row['method']} {row['name']:<20} {row['median_ms']:7.1f}ms {row['p90_ms']:7.1f}ms {row['max_ms']:7.1f}ms "
+              f"{row['fps']:6.1f}  {row['gl_ms']:7.1f}ms {row['ui_ms']:5.1f}ms  {row['while_dragging']}")
+    return rows

@@ -166,10 +166,59 @@ def render_material(
 def cli(ctx: click.Context) -> None:
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
-    Without a command: render the default Bragg mirror (sphere and angular gradient) to out/.
+    Without a command: open the explorer on the default Bragg mirror when a display exists; without
+    one, say so and render it (sphere and angular gradient) to out/.
     """
     if ctx.invoked_subcommand is None:
+        from .app import display_available
+
+        if display_available():
+            ctx.invoke(open_material, material=str(DEFAULT_MATERIAL), preset=None, script=None, report=None, window_size=None)
+            return
+        click.echo(f"{PROG}: no display (DISPLAY is not set or cannot be opened): writing the headless render of the default view to out/", err=True)
         ctx.invoke(default_job)
+
+
+@cli.command("open")
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets).")
+@click.option("--script", type=click.Path(dir_okay=False), hidden=True, help="A scripted session (JSON list of actions; tests, bench --app).")
+@click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
+@click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
+def open_material(material, preset, script, report, window_size):
+    """Open the interactive explorer on MATERIAL (.brd, or BRDF Explorer's .brdf)."""
+    from .app import DEFAULT_WINDOW, AppError, display_available, run_app
+    from .gl import GLUnavailable
+
+    try:
+        loaded = _load(material)
+        if preset is not None:
+            from .presets import presets_for
+
+            presets_for(material).get(preset)
+        actions = None
+        if script is not None:
+            try:
+                actions = json.loads(Path(script).read_text(encoding="utf-8"))
+            except (OSError, ValueError) as error:
+                raise click.BadParameter(f"{script}: {error}", param_hint="--script") from None
+        size = DEFAULT_WINDOW
+        if window_size is not None:
+            try:
+                size = tuple(int(v) for v in window_size.lower().split("x"))
+                assert len(size) == 2 and min(size) >= 200
+            except (ValueError, AssertionError):
+                raise click.BadParameter(f"{window_size!r} is not WxH (at least 200x200)", param_hint="--window-size") from None
+        if not display_available():
+            raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
+                           "for images without a window use: bragg-explorer render")
+        status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
+                         is_default=Path(material).resolve() == DEFAULT_MATERIAL)
+    except ImportError as error:
+        _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
+    except (LocatedError, GLUnavailable, OutputError, AppError) as error:
+        _fail(str(error))
+    sys.exit(status)
 
 
 def _errors(function):
@@ -284,8 +333,10 @@ def presets(material, as_json):
               help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
 @click.option("--layers", is_flag=True,
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
+@click.option("--app", "app", is_flag=True,
+              help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers):
+def bench(as_json, size, repeats, thin_film, layers, app):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -293,6 +344,11 @@ def bench(as_json, size, repeats, thin_film, layers):
     """
     from .bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if app:
+        from .bench import run_app_bench
+
+        run_app_bench(as_json=as_json, size=size)
+        return
     if layers:
         if thin_film:
             raise click.UsageError("--layers and --thin-film are exclusive")

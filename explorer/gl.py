@@ -9,6 +9,7 @@ line. Headless rendering uses a moderngl standalone EGL context (Mesa's llvmpipe
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from pathlib import Path
 from typing import Mapping
 
@@ -23,6 +24,9 @@ SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 GLSL_VERSION = "330 core"
 
 EGL_PACKAGES = "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri"
+#: Numpy models (and their tables) kept by :meth:`Renderer.bind`: an interactive session goes back and
+#: forth between a few parameter sets (a slider and its start, compare A | B), and a table costs ~10 ms.
+MODEL_CACHE_SIZE = 8
 
 VERTEX_SHADER = f"""#version {GLSL_VERSION}
 // A full-screen triangle from gl_VertexID: no vertex buffer needed.
@@ -87,6 +91,9 @@ class Renderer:
         self._inputs: dict[str, object] = {}
         self._vertex_arrays: dict[int, object] = {}
         self.last_table_ms: float | None = None
+        # (material path, model, values) -> [model, its textures() or None], least recently used first.
+        self._models: OrderedDict[tuple, list] = OrderedDict()
+        self._model_texture_keys: dict[str, tuple] = {}  # which model's table each model texture holds
 
     # -- resources ---------------------------------------------------------------------------------
 
@@ -199,17 +206,42 @@ class Renderer:
                 program[name].value = value
         if inputs:
             textures.update({k: v for k, v in self._input_textures(inputs).items() if k in program})
-        model = model_for(material, values)
-        if model is not None:
-            start = time.perf_counter()
-            for name, table in model.textures().items():
+        start = time.perf_counter()
+        key, entry = self._model_entry(material, values)
+        if entry is not None:
+            if entry[1] is None:
+                entry[1] = entry[0].textures()
+            for name, table in entry[1].items():
                 if name in program:
-                    textures[name] = self._model_texture(name, table)
+                    if key is None or self._model_texture_keys.get(name) != key or name not in self._model_textures:
+                        self._model_texture(name, table)
+                        self._model_texture_keys[name] = key
+                    textures[name] = self._model_textures[name]
             self.last_table_ms = (time.perf_counter() - start) * 1e3
         for unit, (name, texture) in enumerate(sorted(textures.items())):
             if name in program:
                 texture.use(location=unit)
                 program[name].value = unit
+
+    def _model_entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
+        """``(key, [model, tables])`` of :func:`explorer.models.model_for`, from a small LRU cache (key None: uncached)."""
+        try:
+            key = (str(material.path), material.model, tuple(sorted(values.items())))
+            hash(key)
+        except TypeError:  # an unhashable value (a list): no caching
+            model = model_for(material, values)
+            return None, ([model, None] if model is not None else None)
+        entry = self._models.get(key)
+        if entry is not None:
+            self._models.move_to_end(key)
+            return key, entry
+        model = model_for(material, values)
+        if model is None:
+            return key, None
+        self._models[key] = entry = [model, None]
+        while len(self._models) > MODEL_CACHE_SIZE:
+            self._models.popitem(last=False)
+        return key, entry
 
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,

@@ -1,0 +1,152 @@
+"""
+The explorer app's plots and comparisons, in numpy (no GUI): the spectrum of Figure 3 at one angle,
+the polar plot from the scatter view, the ΔE2000 heat-map of a comparison.
+
+Everything comes from the project's physics (:mod:`explorer.bragg`) and colorimetry; nothing here is a
+second implementation of a formula.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import bragg, colorimetry
+
+#: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
+BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
+#: Names of the Bragg materials' methods (explorer.models.METHODS), and the gradient rows of Figure 4.
+BRAGG_METHOD_NAMES = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
+BRAGG_STRIP_METHODS = (0, 1, 2, 4, 3)
+THIN_FILM_METHOD_NAMES = {0: "reference", 1: "Fourier m=1", 2: "Fourier m=2", 3: "Fourier m=3", 4: "Gaussian fits", 5: "naive RGB"}
+
+
+def method_names(material) -> dict[int, str]:
+    """``{value: name}`` of a material's ``method`` parameter ({} without one)."""
+    try:
+        parameter = material.parameter("method")
+    except KeyError:
+        return {}
+    known = BRAGG_METHOD_NAMES if material.model in BRAGG_MODELS else THIN_FILM_METHOD_NAMES if material.model == "thin_film" else {}
+    return {m: known.get(m, f"method {m}") for m in range(int(parameter.min), int(parameter.max) + 1)}
+
+
+def mirror_of(values) -> bragg.BraggMirror:
+    """The Bragg mirror of a material's values (``nh`` below 1: the host is ``n1``, as the shaders do)."""
+    nh = float(values.get("nh", 0.0))
+    return bragg.BraggMirror(
+        n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+        N=int(np.floor(float(values["N"]) + 0.5)), nh=nh if nh >= 1.0 else None,
+    )
+
+
+@dataclass
+class Spectrum:
+    """R_lambda at one angle and its approximation's structure, per polarisation (``'s'``, ``'p'``)."""
+
+    wavelengths: np.ndarray
+    R: dict[str, np.ndarray]
+    envelope: dict[str, np.ndarray]
+    gaps: list[tuple[float, float]] = field(default_factory=list)  # band gaps (nm) of either polarisation
+    landmarks: np.ndarray = field(default_factory=lambda: np.zeros(0))  # nm
+    boxes: dict[str, list[tuple[float, float, float]]] = field(default_factory=dict)  # (nm low, nm high, weight)
+
+
+def _in_visible(nm_low, nm_high) -> bool:
+    return nm_high > bragg.WAVELENGTH_LOW and nm_low < bragg.WAVELENGTH_HIGH
+
+
+def spectrum(values, theta_degrees: float, method: int | None = None, s: int = 3, structure: bool = True) -> Spectrum:
+    """
+    The mirror's spectrum at incidence ``theta_degrees`` (Figure 3): ``R_s``, ``R_p`` (their average is
+    what the eye sees), the envelope ``R^e``, the band gaps, the landmarks (the boundaries of the basic
+    approximation's boxes: modes, band edges, Airy and zero points) and the boxes of ``method`` (1 basic,
+    2 subdivided, 4 improved; none for the others).
+
+    ``structure=False``: the curves alone (~2 ms; the landmarks' bisections take ~10 ms per polarisation
+    and box set, too much for every frame of a slider drag).
+    """
+    mirror = mirror_of(values)
+    cos_theta = np.array([np.cos(np.radians(min(max(theta_degrees, 0.0), 89.9)))])
+    wavelengths = colorimetry.WAVELENGTHS
+    omega = 2.0 * np.pi / wavelengths
+    result = Spectrum(wavelengths, {}, {})
+    landmarks: list[float] = []
+    for polarisation in bragg.POLARISATIONS:
+        geometry = bragg.cell_geometry(cos_theta, mirror, polarisation)
+        rows = bragg.cell_geometry(np.full(omega.shape, cos_theta[0]), mirror, polarisation)
+        result.R[polarisation] = bragg.reflectance_polarised(omega, rows)
+        result.envelope[polarisation] = bragg.reflectance_envelope(omega, rows)
+        if not structure:
+            continue
+        for low, high, weight, active in bragg.piecewise_constant_boxes(geometry, 0):
+            if not active[0]:
+                continue
+            nm_low, nm_high = float(bragg.wavelength_of(high)[0]), float(bragg.wavelength_of(low)[0])
+            if not _in_visible(nm_low, nm_high):
+                continue
+            landmarks.extend(x for x in (nm_low, nm_high) if bragg.WAVELENGTH_LOW <= x <= bragg.WAVELENGTH_HIGH)
+            if np.all(weight == 1.0) and high[0] > low[0]:  # the gap halves have unit weight
+                result.gaps.append((nm_low, nm_high))
+        if method in (1, 2, 4):
+            subdivisions = 0 if method == 1 else s
+            variant = "improved" if method == 4 else "paper"
+            boxes = []
+            for low, high, weight, active in bragg.piecewise_constant_boxes(geometry, subdivisions, variant=variant):
+                nm_low, nm_high = float(bragg.wavelength_of(high)[0]), float(bragg.wavelength_of(low)[0])
+                if active[0] and nm_high > nm_low and _in_visible(nm_low, nm_high):
+                    boxes.append((max(nm_low, bragg.WAVELENGTH_LOW), min(nm_high, bragg.WAVELENGTH_HIGH), float(weight[0])))
+            result.boxes[polarisation] = boxes
+    result.landmarks = np.unique(np.round(np.array(landmarks), 2))
+    return result
+
+
+def boxes_polyline(boxes: list[tuple[float, float, float]]) -> tuple[np.ndarray, np.ndarray]:
+    """A step line through boxes (nm low, nm high, weight), for plotting."""
+    xs, ys = [], []
+    for low, high, weight in sorted(boxes):
+        xs += [low, high]
+        ys += [weight, weight]
+    return np.array(xs, dtype=np.float64), np.array(ys, dtype=np.float64)
+
+
+def polar_curve(scatter_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The BRDF in the plane of incidence from a ``(1, W, 3)`` scatter view rendered at height 1.
+
+    At height 1 the scatter view's only row lies at y = 0: pixel x in (-1, 1) is the outgoing direction
+    at ``theta_o = 90 |x|`` degrees in the plane of incidence (phi = 0 for x > 0, 180 for x < 0), and it
+    shows ``BRDF cos theta_o``. Returns the signed ``theta_o`` (degrees, negative toward phi = 180) and
+    the BRDF ``(W, 3)`` (``cos theta_o`` divided out).
+    """
+    row = np.asarray(scatter_row, dtype=np.float64).reshape(-1, 3)
+    width = row.shape[0]
+    x = 2.0 * (np.arange(width) + 0.5) / width - 1.0
+    theta = 90.0 * x
+    cos_theta = np.cos(np.radians(theta))
+    return theta, row / np.maximum(cos_theta, 1e-3)[:, None]
+
+
+def disc_mask(width: int, height: int) -> np.ndarray:
+    """The pixels of the sphere views' disc (as the shaders test ``r^2 < 1``)."""
+    from .render import view_cos_theta
+
+    return view_cos_theta("sphere", width, height)[1]
+
+
+def delta_e_map(a: np.ndarray, b: np.ndarray, mask: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """ΔE2000 per pixel between two linear RGB images (0 outside ``mask``) and its mean over ``mask``."""
+    mask = np.ones(a.shape[:2], dtype=bool) if mask is None else mask
+    result = np.zeros(a.shape[:2])
+    if mask.any():
+        result[mask] = colorimetry.delta_E_2000(np.asarray(a, np.float64)[mask], np.asarray(b, np.float64)[mask])
+    return result, float(result[mask].mean()) if mask.any() else 0.0
+
+
+def heat_map_rgba(delta_e: np.ndarray, top: float = 10.0) -> np.ndarray:
+    """An 8-bit RGBA image of ΔE2000 (matplotlib's viridis over [0, ``top``])."""
+    from matplotlib import colormaps
+
+    rgba = colormaps["viridis"](np.clip(delta_e / top, 0.0, 1.0))
+    return np.round(rgba * 255.0).astype(np.uint8)

@@ -1,0 +1,196 @@
+"""
+The explorer app's parameter sets, without any GUI: widget kinds, reset, and saving and loading a
+material's values as JSON or as Disney BRDF Explorer's ``.bparam`` files.
+
+A ``.bparam`` file is what BRDF Explorer's "Save Params" writes (``BRDFBase::saveParamsFile``)::
+
+    bparam /path/to/material.brdf
+
+    ::begin parameters
+    float n 1 1000 250.000000
+    bool divide_by_NdotL 1
+    color albedo 0.820000 0.670000 0.160000
+    ::end parameters
+
+floats (``name min max value``), then bools, then colours. Loading one sets the parameters whose names
+the current material has (BRDF Explorer's ``syncParametersIntoBRDF``); the others are reported.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping
+
+from .brd import Material, Parameter
+from .errors import LocatedError
+
+
+class ParameterFileError(LocatedError):
+    """A parameter-set file (JSON or ``.bparam``) cannot be read, written or applied."""
+
+
+def widget_kind(parameter: Parameter) -> str:
+    """
+    The widget of a parameter: ``'int'`` (an integer slider: counts, switches such as ``N``, ``s``,
+    ``method``, the floats whose range and default are integers), ``'float'``, ``'bool'`` or ``'color'``.
+    """
+    if parameter.type == "float":
+        return "int" if parameter.is_integer() else "float"
+    return parameter.type
+
+
+def slider_format(parameter: Parameter) -> str:
+    """A printf format showing enough digits for the parameter's range."""
+    span = abs((parameter.max or 1.0) - (parameter.min or 0.0))
+    return "%.4f" if span <= 1.0 else "%.3f" if span <= 10.0 else "%.2f"
+
+
+@dataclass
+class LoadedValues:
+    """Values read from a file: those that apply to the material, and what was skipped (one line each)."""
+
+    values: dict[str, object]
+    material: str | None = None
+    skipped: list[str] = field(default_factory=list)
+
+
+def _display(path: os.PathLike[str] | str) -> str:
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)
+
+
+def _json_value(value):
+    return list(value) if isinstance(value, tuple) else value
+
+
+def save_json(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
+    """Write ``{"material": path, "values": {...}}`` (colours as lists)."""
+    document = {
+        "format": "bragg-explorer parameters",
+        "material": str(Path(material.path).resolve()),
+        "values": {p.name: _json_value(values[p.name]) for p in material.parameters},
+    }
+    _write_text(path, json.dumps(document, indent=2) + "\n")
+
+
+def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
+    """Write BRDF Explorer's ``.bparam`` (``%f`` numbers, floats then bools then colours, as it does)."""
+    lines = [f"bparam {Path(material.path).resolve()}", "", "::begin parameters"]
+    for p in material.parameters:
+        if p.type == "float":
+            lines.append(f"float {p.name} {p.min:f} {p.max:f} {float(values[p.name]):f}")
+    for p in material.parameters:
+        if p.type == "bool":
+            lines.append(f"bool {p.name} {1 if values[p.name] else 0}")
+    for p in material.parameters:
+        if p.type == "color":
+            r, g, b = values[p.name]
+            lines.append(f"color {p.name} {r:f} {g:f} {b:f}")
+    lines.append("::end parameters")
+    _write_text(path, "\n".join(lines) + "\n")
+
+
+def _write_text(path: os.PathLike[str] | str, text: str) -> None:
+    try:
+        Path(path).write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise ParameterFileError(_display(path), None, f"cannot write ({error.strerror})") from None
+
+
+def _apply(material: Material, raw: Mapping[str, object], where: str, lines: Mapping[str, int]) -> LoadedValues:
+    """Coerce ``raw`` into ``material``'s parameters; unknown names are skipped, bad values are errors."""
+    known = {p.name: p for p in material.parameters}
+    result = LoadedValues({})
+    for name, value in raw.items():
+        if name not in known:
+            result.skipped.append(f"{name} (not a parameter of {_display(material.path)})")
+            continue
+        try:
+            result.values[name] = known[name].coerce(value)
+        except ValueError as error:
+            raise ParameterFileError(where, lines.get(name), f"parameter {name!r}: {error}") from None
+    return result
+
+
+def load_json(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
+    """Read values saved by :func:`save_json` and check them against ``material``."""
+    where = _display(path)
+    try:
+        document = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as error:
+        raise ParameterFileError(where, None, f"cannot read ({error.strerror})") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ParameterFileError(where, getattr(error, "lineno", None), f"not valid JSON ({getattr(error, 'msg', error)})") from None
+    raw = document.get("values") if isinstance(document, dict) else None
+    if not isinstance(raw, dict):
+        raise ParameterFileError(where, None, 'expected an object with "values": {NAME: VALUE, ...}')
+    result = _apply(material, raw, where, {})
+    result.material = document.get("material") if isinstance(document.get("material"), str) else None
+    return result
+
+
+def parse_bparam(text: str, where: str) -> tuple[str | None, dict[str, object], dict[str, int]]:
+    """``(material file, {name: value}, {name: line})`` of a ``.bparam`` text (values as strings/tuples)."""
+    material_file: str | None = None
+    raw: dict[str, object] = {}
+    lines: dict[str, int] = {}
+    section = None
+    first = True
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        tokens = stripped.split()
+        if first:
+            first = False
+            if tokens[0] != "bparam":
+                raise ParameterFileError(where, number, f"expected 'bparam MATERIAL' on the first line, got {tokens[0]!r}")
+            material_file = stripped[len("bparam"):].strip() or None
+            continue
+        if tokens[0] == "::begin":
+            section = tokens[1] if len(tokens) > 1 else ""
+            continue
+        if tokens[0] == "::end":
+            section = None
+            continue
+        if section != "parameters":
+            continue
+        kind, name, numbers = tokens[0], tokens[1] if len(tokens) > 1 else "", tokens[2:]
+        expected = {"float": 3, "bool": 1, "color": 3}.get(kind)
+        if expected is None or len(numbers) != expected:
+            raise ParameterFileError(where, number, f"expected 'float NAME MIN MAX VALUE', 'bool NAME 0|1' or 'color NAME R G B', got {stripped!r}")
+        raw[name] = numbers[2] if kind == "float" else numbers[0] if kind == "bool" else ",".join(numbers)
+        lines[name] = number
+    if first:
+        raise ParameterFileError(where, None, "empty file (expected 'bparam MATERIAL')")
+    return material_file, raw, lines
+
+
+def load_bparam(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
+    """Read a BRDF Explorer ``.bparam`` file and apply the parameters ``material`` has."""
+    where = _display(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise ParameterFileError(where, None, f"cannot read ({error.strerror})") from None
+    except UnicodeDecodeError:
+        raise ParameterFileError(where, None, "not a text file") from None
+    material_file, raw, lines = parse_bparam(text, where)
+    result = _apply(material, raw, where, lines)
+    result.material = material_file
+    return result
+
+
+def save_values(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
+    """Save as ``.bparam`` when the name ends so, as JSON otherwise."""
+    (save_bparam if str(path).lower().endswith(".bparam") else save_json)(path, material, values)
+
+
+def load_values(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
+    """Load a ``.bparam`` or a JSON parameter set for ``material``."""
+    return (load_bparam if str(path).lower().endswith(".bparam") else load_json)(path, material)
