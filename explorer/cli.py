@@ -128,12 +128,15 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None)
 
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
-    light: tuple[float, float] | None = None, thickness=None,
+    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
-    :class:`explorer.thickness.ThicknessTexture`) for the ``textured`` view.
+    :class:`explorer.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
+    :class:`explorer.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
     """
+    if view == "env":
+        return _render_env(material, values, width, height, engine, environment, spp)
     if view == "textured":
         from .thickness import ThicknessTexture, check_prefilter
 
@@ -159,6 +162,35 @@ def render_material(
             uniforms={"prefilter": thickness.prefilter},
         )
     return Renderer().render(material, values, view, width, height, light=light)
+
+
+def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
+    """The env view (:func:`explorer.env.render_env`), its progress on stderr every few seconds."""
+    import time
+
+    from .env import render_env
+
+    if engine == "numpy":
+        from .models import model_for
+
+        model = model_for(material, values)
+        if model is None or not callable(getattr(model, "brdf", None)):
+            raise MaterialError(material.path, None, "its numpy twin has no brdf(): no env view with --engine numpy")
+    start = last = time.perf_counter()
+    unit = "samples per pixel" if engine == "gl" else "pixels"
+
+    def progress(done: int, total: int) -> None:
+        nonlocal last
+        now = time.perf_counter()
+        if now - last >= 2.0 or (done == total and now - start >= 2.0):
+            last = now
+            click.echo(f"{PROG}: env: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
+
+    def warn(message: str) -> None:
+        click.echo(f"{PROG}: warning: {message}", err=True)
+
+    return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
+                      progress=progress, warn=warn)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -239,7 +271,7 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured"]), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured", "env"]), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
@@ -249,14 +281,18 @@ def _errors(function):
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
+@click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
+@click.option("--spp", type=click.IntRange(min=1), help="env view: Monte Carlo samples per pixel (default 64).")
 @_errors
-def render(material, view, assignments, size, out, engine, light, preset, texture, dinc_range, prefilter):
+def render(material, view, assignments, size, out, engine, light, preset, texture, dinc_range, prefilter, env_file, spp):
     """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
     (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y);
-    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range.
+    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range;
+    env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
+    (--engine numpy: the exact integral, slow; use a small --size).
     """
     from .render import scatter_circles
 
@@ -279,7 +315,14 @@ def render(material, view, assignments, size, out, engine, light, preset, textur
         )
     elif texture is not None or dinc_range is not None or prefilter == "on":
         raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
-    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness)
+    environment = None
+    if view == "env":
+        from .env import DEFAULT_ENVIRONMENT, EnvironmentMap
+
+        environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+    elif env_file is not None or spp is not None:
+        raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
+    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
     write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None)
     bad = int((~np.isfinite(image)).sum())
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))

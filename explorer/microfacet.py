@@ -21,6 +21,7 @@ Fourneau, Pacanowski, Barla (2024). Interactive Exploration of Vivid Material Ir
 Mirrors. Computer Graphics Forum 43(2). Sections 4.1-4.2, Eqs. 17-19 and 24-30, Figures 5-7, Appendix C.
 Walter, Marschner, Li, Torrance (2007). Microfacet Models for Refraction through Rough Surfaces. EGSR.
 Heitz (2014). Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs. JCGT 3(2).
+Heitz (2018). Sampling the GGX Distribution of Visible Normals. JCGT 7(4) (the env view's sampling).
 """
 
 from __future__ import annotations
@@ -286,6 +287,103 @@ def rough_bragg_brdf(i, o, mirror: bragg.BraggMirror, alpha, wavelength=None) ->
     return microfacet_brdf(
         i, o, alpha, lambda cos_theta_d: bragg.bragg_reflectance(np.maximum(cos_theta_d, COS_THETA_MIN), wavelength, mirror)
     )
+
+
+# --------------------------------------------------------------------------------------------------
+# Sampling the visible normals (Heitz 2018), for the env view's Monte Carlo estimator
+
+
+def sample_ggx_visible_normal(v, alpha, u1, u2) -> np.ndarray:
+    """
+    Sample a microfacet normal from GGX's distribution of normals visible from ``v`` (Heitz 2018).
+
+    The twin of ``sample_ggx_visible_normal`` in ``shaders/lib/sampling.glsl``: the view direction is
+    stretched to the hemisphere configuration, a point is picked uniformly on the projected disc of
+    the half-sphere (the half facing away from ``v`` scaled by ``(1 + v_h.z) / 2``), lifted onto the
+    hemisphere and unstretched. The density of ``m`` is :func:`ggx_visible_normal_pdf`.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Unit view direction in the local frame (``n = +z``), ``v.z > 0``.
+    alpha : float
+        GGX roughness in [0, 1] (0 is :data:`ALPHA_MIN`).
+    u1, u2 : array_like
+        Uniform numbers in [0, 1) (broadcast with ``v[..., 0]``).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Unit microfacet normals, ``m.z >= 0``.
+
+    References
+    ----------
+    Heitz (2018). Sampling the GGX Distribution of Visible Normals. JCGT 7(4), Listing 1.
+    """
+    a = float(check_alpha(alpha))
+    v = np.asarray(v, dtype=np.float64)
+    u1, u2 = np.asarray(u1, dtype=np.float64), np.asarray(u2, dtype=np.float64)
+    vh = np.stack([a * v[..., 0], a * v[..., 1], v[..., 2]], axis=-1)
+    vh = vh / np.linalg.norm(vh, axis=-1, keepdims=True)
+    lensq = vh[..., 0] ** 2 + vh[..., 1] ** 2
+    safe = np.sqrt(np.where(lensq > 0.0, lensq, 1.0))
+    t1_axis = np.where(
+        (lensq > 0.0)[..., None],
+        np.stack([-vh[..., 1], vh[..., 0], np.zeros_like(lensq)], axis=-1) / safe[..., None],
+        np.array([1.0, 0.0, 0.0]),
+    )
+    t2_axis = np.cross(vh, t1_axis)
+    r, phi = np.sqrt(u1), 2.0 * np.pi * u2
+    t1, t2 = r * np.cos(phi), r * np.sin(phi)
+    s = 0.5 * (1.0 + vh[..., 2])
+    t2 = (1.0 - s) * np.sqrt(np.maximum(1.0 - t1 * t1, 0.0)) + s * t2
+    lift = np.sqrt(np.maximum(0.0, 1.0 - t1 * t1 - t2 * t2))
+    nh = t1[..., None] * t1_axis + t2[..., None] * t2_axis + lift[..., None] * vh
+    m = np.stack([a * nh[..., 0], a * nh[..., 1], np.maximum(nh[..., 2], 0.0)], axis=-1)
+    return m / np.linalg.norm(m, axis=-1, keepdims=True)
+
+
+def ggx_visible_normal_pdf(v, m, alpha) -> np.ndarray:
+    """
+    The density (1/sr) of :func:`sample_ggx_visible_normal`: Heitz's distribution of visible normals
+    ``D_v(m) = G1(v) max(0, v.m) D(m) / v.n`` (Eqs. 18-19 of Fourneau et al. 2024 for ``D`` and ``G1``),
+    which integrates to 1 over the hemisphere of ``m`` because ``G1`` is Smith's (Heitz 2014, Eq. 14).
+
+    Parameters
+    ----------
+    v, m : array_like, shape (..., 3)
+        Unit view direction and microfacet normal in the local frame (``n = +z``).
+    alpha : float
+        GGX roughness in [0, 1].
+
+    References
+    ----------
+    Heitz (2018), Eq. 1; Heitz (2014), Eq. 14.
+    """
+    v, m = np.asarray(v, dtype=np.float64), np.asarray(m, dtype=np.float64)
+    cos_v = v[..., 2]
+    v_dot_m = np.maximum(np.sum(v * m, axis=-1), 0.0)
+    return smith_G1_over_cos(cos_v, alpha) * v_dot_m * ggx_D(m[..., 2], alpha)
+
+
+def ggx_reflection_pdf(l, v, alpha) -> np.ndarray:
+    """
+    The density (1/sr) of ``l = reflect(-v, m)`` for ``m`` drawn by :func:`sample_ggx_visible_normal`:
+    ``D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.n)`` with ``h = (l + v) / |l + v|`` (the Jacobian of the
+    reflection, Walter et al. 2007, Eq. 14). The twin of ``ggx_reflection_pdf`` in
+    ``shaders/lib/sampling.glsl``; it integrates to 1 over the whole sphere of ``l`` (reflected
+    directions may point below the surface).
+
+    Parameters
+    ----------
+    l, v : array_like, shape (..., 3)
+        Unit directions in the local frame (``n = +z``), ``v.z > 0``.
+    alpha : float
+        GGX roughness in [0, 1].
+    """
+    h = half_vector(l, v)
+    v = np.asarray(v, dtype=np.float64)
+    return np.where(v[..., 2] > 0.0, 0.25 * smith_G1_over_cos(v[..., 2], alpha) * ggx_D(h[..., 2], alpha), 0.0)
 
 
 # --------------------------------------------------------------------------------------------------

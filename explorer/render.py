@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-VIEWS = ("gradient", "sphere", "lit", "slice", "scatter", "textured")
+VIEWS = ("gradient", "sphere", "lit", "slice", "scatter", "textured", "env")
 DEFAULT_SIZES = {
     "gradient": (256, 32), "sphere": (256, 256), "lit": (256, 256), "slice": (256, 256), "scatter": (256, 256),
-    "textured": (256, 256),
+    "textured": (256, 256), "env": (256, 256),
 }
 #: Views that evaluate the material's BRDF(L, V, N, X, Y); those that take a light direction.
 BRDF_VIEWS = ("lit", "slice", "scatter")
@@ -55,7 +55,7 @@ def view_cos_theta(view: str, width: int, height: int) -> tuple[np.ndarray, np.n
 
 def rim_distance(view: str, width: int, height: int) -> np.ndarray:
     """|r^2 - 1| per pixel for the disc views (inf elsewhere): tests skip the float32 rim."""
-    if view not in ("sphere", "lit", "scatter", "textured"):
+    if view not in ("sphere", "lit", "scatter", "textured", "env"):
         return np.full((height, width), np.inf)
     x = 2.0 * (np.arange(width) + 0.5) / width - 1.0
     y = 1.0 - 2.0 * (np.arange(height) + 0.5) / height
@@ -159,7 +159,8 @@ def scatter_circles(width: int, height: int) -> np.ndarray:
 
 
 def render_numpy(
-    model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None
+    model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
+    environment=None,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -167,7 +168,15 @@ def render_numpy(
     ``light`` (``lit``, ``scatter``, ``textured``): ``(theta, phi)`` in degrees, default :data:`DEFAULT_LIGHT`.
     ``thickness`` (``textured``): an :class:`explorer.thickness.ThicknessTexture` (default: the default
     texture over the default D_inc range, without prefiltering).
+    ``environment`` (``env``): an :class:`explorer.env.EnvironmentMap` (default: the shipped one); the
+    image is the exact integral :func:`explorer.env.env_integral_numpy` (slow: use small sizes).
     """
+    if view == "env":
+        from .env import EnvironmentMap, env_integral_numpy
+
+        if not callable(getattr(model, "brdf", None)):
+            raise ValueError(f"the env view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
+        return env_integral_numpy(model, EnvironmentMap.default() if environment is None else environment, width, height)
     if view == "textured":
         from .thickness import ThicknessTexture
 

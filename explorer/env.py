@@ -1,0 +1,586 @@
+"""
+The ``env`` view: the lit view's sphere under an environment map, by progressive Monte Carlo on the GPU
+(``shaders/views/env.glsl``), and its numpy twin, the exact integral by quadrature.
+
+Each pixel shows ``L_o = int f(L, V) cos theta_L L_e(L) d omega_L`` over the hemisphere of its normal
+``N``, with ``V = (0, 0, 1)`` and the lit view's geometry and frame (:func:`explorer.render.brdf_view_geometry`).
+
+The environment is an equirectangular image of linear RGB radiance (:class:`EnvironmentMap`), read
+from Radiance ``.hdr`` or OpenEXR ``.exr`` files by OpenCV. Its direction convention, shared with the
+shader: the image's top row is the zenith ``+y`` (the sphere's screen up), ``v = theta / pi`` with
+``theta`` the angle from ``+y``; the centre column ``u = 0.5`` looks away from the viewer (``-z``) and
+``u = 0.75`` is ``+x``, so ``u = 0.5 + atan2(x, -z) / (2 pi)``. Lookups are bilinear between texel
+centres, wrapping in ``u`` and clamped in ``v`` (GL's ``LINEAR`` with ``REPEAT`` / ``CLAMP_TO_EDGE``).
+
+The GPU estimator is unbiased for any material: cosine sampling, or with a material's optional
+``sampling_lobes`` hook one-sample MIS over GGX visible-normal lobes (Heitz 2018) and a cosine lobe,
+the mixture density in the denominator (balance heuristic). The layered material's hook chooses
+lobes by the layer probabilities of Eq. 35 (Fourneau et al. 2024); ``shaders/bragg_layer.brd`` uses
+Eq. 31 for its one layer over the base.
+
+References
+----------
+Fourneau, Pacanowski, Barla (2024), Section 4.2.3 and 4.3.2, Eqs. 31 and 35.
+Heitz (2018). Sampling the GGX Distribution of Visible Normals. JCGT 7(4).
+Veach (1997), PhD thesis, Section 9.2 (one-sample MIS, balance heuristic).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from pathlib import Path
+from typing import Callable, Mapping
+
+import numpy as np
+
+from .errors import LocatedError
+
+DEFAULT_ENVIRONMENT = Path(__file__).resolve().parent.parent / "shaders" / "environments" / "default.hdr"
+#: The file formats read (through OpenCV): Radiance RGBE and OpenEXR.
+SUFFIXES = (".hdr", ".pic", ".exr")
+#: The default environment: 256 x 128 texels (1.4 degrees each), a sky, a sun and a ground.
+DEFAULT_SIZE = (256, 128)
+#: The default sun: elevation and azimuth (degrees; azimuth from -z toward +x, so 180 is behind the
+#: viewer), angular radius of its Gaussian profile (standard deviation, degrees), peak radiance.
+SUN_ELEVATION, SUN_AZIMUTH, SUN_SIGMA, SUN_PEAK = 40.0, 145.0, 2.5, 40.0
+#: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
+PASS_BUDGET_MS = 50.0
+#: Samples per pixel in one pass at most (the shader's loop).
+MAX_SAMPLES_PER_PASS = 256
+#: Texture unit of the environment: above those Renderer.bind assigns (library, model and input tables).
+ENVIRONMENT_UNIT = 15
+#: Directions per block in the numpy quadrature (memory: a few arrays of this many 3-vectors).
+QUADRATURE_BLOCK = 1 << 18
+#: Quadrature cells per texel side at most (:func:`quadrature_subdivisions`).
+MAX_SUBDIVISIONS = 16
+
+
+class EnvironmentFileError(LocatedError):
+    """An environment file is missing or not an HDR image (one line naming it)."""
+
+
+def _cv2():
+    """OpenCV with OpenEXR enabled (it is off by default) and its own logging silenced (errors are ours)."""
+    os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
+    import cv2
+
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+    return cv2
+
+
+# --------------------------------------------------------------------------------------------------
+# Directions
+
+
+def direction_to_uv(d) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Texture coordinates of unit directions ``d`` (``(..., 3)``): ``u = 0.5 + atan2(x, -z) / 2 pi``,
+    ``v = atan2(|(x, z)|, y) / pi`` (the shader's ``environment_radiance``; ``v = 0`` at ``+y``).
+    """
+    d = np.asarray(d, dtype=np.float64)
+    u = 0.5 + np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * np.pi)
+    v = np.arctan2(np.hypot(d[..., 0], d[..., 2]), d[..., 1]) / np.pi
+    return u, v
+
+
+def uv_to_direction(u, v) -> np.ndarray:
+    """The unit direction at texture coordinates ``(u, v)`` (inverse of :func:`direction_to_uv`)."""
+    phi = 2.0 * np.pi * (np.asarray(u, dtype=np.float64) - 0.5)
+    theta = np.pi * np.asarray(v, dtype=np.float64)
+    phi, theta = np.broadcast_arrays(phi, theta)
+    return np.stack([np.sin(theta) * np.sin(phi), np.cos(theta), -np.sin(theta) * np.cos(phi)], axis=-1)
+
+
+def _bilinear_weights(coordinate: np.ndarray, size: int, wrap: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """GL's LINEAR filter along one axis: texel indices ``i0, i1`` and the weight of ``i1``."""
+    x = np.asarray(coordinate, dtype=np.float64) * size - 0.5
+    i0 = np.floor(x)
+    f = x - i0
+    i0 = i0.astype(np.int64)
+    i1 = i0 + 1
+    if wrap:
+        return np.mod(i0, size), np.mod(i1, size), f
+    return np.clip(i0, 0, size - 1), np.clip(i1, 0, size - 1), f
+
+
+# --------------------------------------------------------------------------------------------------
+# The environment map
+
+
+class EnvironmentMap:
+    """
+    An equirectangular environment: linear RGB radiance, ``(height, width, 3)`` float32, rows from the
+    top (the zenith ``+y``); see the module's docstring for the direction convention.
+
+    Parameters
+    ----------
+    pixels : array_like, shape (height, width, 3)
+        Finite radiance values.
+    name : str
+        Where it comes from (a path), for messages.
+    """
+
+    def __init__(self, pixels, name: str = "<array>"):
+        data = np.ascontiguousarray(pixels, dtype=np.float32)
+        if data.ndim != 3 or data.shape[2] != 3 or data.shape[0] < 1 or data.shape[1] < 1:
+            raise EnvironmentFileError(name, None, f"environment must be an RGB image (height, width, 3), got shape {data.shape}")
+        if not np.isfinite(data).all():
+            raise EnvironmentFileError(name, None, "environment has non-finite (NaN or infinite) texels")
+        data.setflags(write=False)
+        self.pixels = data
+        self.name = name
+
+    @property
+    def width(self) -> int:
+        return self.pixels.shape[1]
+
+    @property
+    def height(self) -> int:
+        return self.pixels.shape[0]
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> "EnvironmentMap":
+        """
+        Read a Radiance ``.hdr`` (``.pic``) or OpenEXR ``.exr`` file (through OpenCV; an EXR's alpha is
+        dropped, a grey one becomes RGB). Raises :class:`EnvironmentFileError`, one line naming the file,
+        when it is missing, a directory, of another format, or not readable as an image.
+        """
+        path = Path(path)
+        name = os.fspath(path)
+        if path.suffix.lower() not in SUFFIXES:
+            raise EnvironmentFileError(name, None, "environment must be a Radiance .hdr or an OpenEXR .exr file")
+        if not path.exists():
+            raise EnvironmentFileError(name, None, "environment file not found")
+        if path.is_dir():
+            raise EnvironmentFileError(name, None, "environment file is a directory, not an image")
+        if not os.access(path, os.R_OK):
+            raise EnvironmentFileError(name, None, "environment file is not readable")
+        cv2 = _cv2()
+        try:
+            image = cv2.imread(name, cv2.IMREAD_UNCHANGED)
+        except cv2.error as error:
+            image, reason = None, " ".join(str(error).split())
+        else:
+            reason = None
+        if image is None:
+            what = "HDR" if path.suffix.lower() != ".exr" else "OpenEXR"
+            raise EnvironmentFileError(name, None, f"environment file is not an {what} image OpenCV can read" + (f" ({reason})" if reason else ""))
+        image = np.asarray(image)
+        if image.ndim == 2:
+            image = np.repeat(image[:, :, None], 3, axis=2)
+        elif image.shape[2] == 4:
+            image = image[:, :, :3]
+        elif image.shape[2] == 1:
+            image = np.repeat(image, 3, axis=2)
+        if image.dtype.kind != "f":
+            raise EnvironmentFileError(name, None, f"environment file holds {image.dtype} values, not floating-point radiance")
+        return cls(image[:, :, ::-1], name)  # OpenCV's BGR to RGB
+
+    @classmethod
+    def default(cls) -> "EnvironmentMap":
+        """The environment shipped in the repository (:data:`DEFAULT_ENVIRONMENT`, :func:`generate_default_environment`)."""
+        return cls.load(DEFAULT_ENVIRONMENT)
+
+    def radiance(self, d) -> np.ndarray:
+        """Bilinear radiance ``(..., 3)`` (float64) toward unit directions ``d``: the shader's lookup."""
+        u, v = direction_to_uv(d)
+        return self.radiance_uv(u, v)
+
+    def radiance_uv(self, u, v) -> np.ndarray:
+        """Bilinear radiance at texture coordinates (GL's ``LINEAR``, ``REPEAT`` in u, ``CLAMP_TO_EDGE`` in v)."""
+        j0, j1, fu = _bilinear_weights(u, self.width, wrap=True)
+        i0, i1, fv = _bilinear_weights(v, self.height, wrap=False)
+        p = self.pixels.astype(np.float64)
+        top = p[i0, j0] * (1.0 - fu)[..., None] + p[i0, j1] * fu[..., None]
+        bottom = p[i1, j0] * (1.0 - fu)[..., None] + p[i1, j1] * fu[..., None]
+        return top * (1.0 - fv)[..., None] + bottom * fv[..., None]
+
+    def quadrature(self, subdivisions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        A midpoint rule over the sphere: each texel split into ``subdivisions``\\ ² cells of equal
+        ``(u, v)`` extent.
+
+        Returns
+        -------
+        directions : ndarray, shape (M, 3)
+            The cells' centre directions.
+        solid_angle : ndarray, shape (M,)
+            Each cell's exact solid angle, ``dphi (cos theta_0 - cos theta_1)`` (they sum to 4 pi).
+        radiance : ndarray, shape (M, 3)
+            The bilinear radiance at the centres. With an even ``subdivisions`` every cell lies within
+            one bilinear patch (patch edges pass through texel centres).
+        """
+        s = int(subdivisions)
+        rows, columns = self.height * s, self.width * s
+        v_edges = np.arange(rows + 1) / rows
+        v = 0.5 * (v_edges[1:] + v_edges[:-1])
+        u = (np.arange(columns) + 0.5) / columns
+        band = (np.cos(np.pi * v_edges[:-1]) - np.cos(np.pi * v_edges[1:])) * (2.0 * np.pi / columns)
+        directions = uv_to_direction(u[None, :], v[:, None]).reshape(-1, 3)
+        solid_angle = np.broadcast_to(band[:, None], (rows, columns)).reshape(-1)
+        radiance = self.radiance_uv(u[None, :], v[:, None]).reshape(-1, 3)
+        return directions, solid_angle, radiance
+
+    def gl_texture(self, ctx):
+        """The environment as a float RGB texture of ``ctx``: LINEAR, repeat in u, clamp in v, row 0 at v = 0."""
+        import moderngl
+
+        texture = ctx.texture((self.width, self.height), 3, self.pixels.tobytes(), dtype="f4")
+        texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        texture.repeat_x = True
+        texture.repeat_y = False
+        return texture
+
+
+def generate_default_environment(width: int = DEFAULT_SIZE[0], height: int = DEFAULT_SIZE[1]) -> np.ndarray:
+    """
+    The default environment (``shaders/environments/default.hdr``): a procedural sky, deterministic.
+
+    Above the horizon a sky from a pale horizon (radiance 1.1, 1.1, 1.05) to a blue zenith
+    (0.25, 0.45, 0.95) as ``sqrt(sin elevation)``; below it a warm grey ground (0.32, 0.27, 0.22),
+    darker straight down; a smooth transition over +-2 degrees; a sun of Gaussian profile
+    (:data:`SUN_SIGMA` degrees, peak :data:`SUN_PEAK` times (1, 0.92, 0.8)) at :data:`SUN_ELEVATION`,
+    :data:`SUN_AZIMUTH` (behind the viewer's right shoulder, so it lights the visible face). Evaluated at
+    texel centres; ``(height, width, 3)`` float32.
+    """
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    d = uv_to_direction(u[None, :], v[:, None])
+    up = d[..., 1]
+    horizon, zenith = np.array([1.1, 1.1, 1.05]), np.array([0.25, 0.45, 0.95])
+    t = np.sqrt(np.clip(up, 0.0, 1.0))[..., None]
+    sky = horizon * (1.0 - t) + zenith * t
+    ground = np.array([0.32, 0.27, 0.22]) * (0.55 + 0.45 * (1.0 + np.clip(up, -1.0, 0.0)))[..., None]
+    edge = np.sin(np.radians(2.0))
+    w = np.clip((up + edge) / (2.0 * edge), 0.0, 1.0)
+    w = (w * w * (3.0 - 2.0 * w))[..., None]
+    image = ground * (1.0 - w) + sky * w
+    elevation, azimuth = np.radians(SUN_ELEVATION), np.radians(SUN_AZIMUTH)
+    sun = np.array([np.cos(elevation) * np.sin(azimuth), np.sin(elevation), -np.cos(elevation) * np.cos(azimuth)])
+    angle = np.arccos(np.clip(d @ sun, -1.0, 1.0))
+    image += SUN_PEAK * np.array([1.0, 0.92, 0.8]) * np.exp(-0.5 * (angle / np.radians(SUN_SIGMA)) ** 2)[..., None]
+    return image.astype(np.float32)
+
+
+def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
+    """Write :func:`generate_default_environment` as Radiance RGBE (``python -m explorer.env``)."""
+    cv2 = _cv2()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(os.fspath(path), generate_default_environment()[:, :, ::-1]):
+        raise OSError(f"{path}: OpenCV could not write it")
+    return path
+
+
+# --------------------------------------------------------------------------------------------------
+# Twins of the shader's random numbers and cosine sampling (shaders/lib/sampling.glsl)
+
+
+def pcg4d(v) -> np.ndarray:
+    """The shader's PCG4D hash (Jarzynski & Olano 2020) on ``uint32 (..., 4)``: bit for bit the same."""
+    v = np.array(v, dtype=np.uint32)
+    with np.errstate(over="ignore"):
+        v = v * np.uint32(1664525) + np.uint32(1013904223)
+        x, y, z, w = (v[..., k].copy() for k in range(4))
+        for _ in range(2):
+            x += y * w
+            y += z * x
+            z += x * y
+            w += y * z
+            if _ == 0:
+                x ^= x >> np.uint32(16)
+                y ^= y >> np.uint32(16)
+                z ^= z >> np.uint32(16)
+                w ^= w >> np.uint32(16)
+    return np.stack([x, y, z, w], axis=-1)
+
+
+def uniform_floats(h) -> np.ndarray:
+    """The top 24 bits of each word as floats in [0, 1) (the shader's ``uniform_floats``)."""
+    return (np.asarray(h, dtype=np.uint32) >> np.uint32(8)).astype(np.float64) / 16777216.0
+
+
+def sample_cosine_hemisphere(u1, u2) -> np.ndarray:
+    """Malley's method about ``+z``: density ``cos theta / pi`` (the shader's ``sample_cosine_hemisphere``)."""
+    r, phi = np.sqrt(u1), 2.0 * np.pi * np.asarray(u2, dtype=np.float64)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - np.asarray(u1)))], axis=-1)
+
+
+# --------------------------------------------------------------------------------------------------
+# The numpy twin: the exact integral by quadrature
+
+
+def quadrature_subdivisions(model, environment: EnvironmentMap) -> int:
+    """
+    Cells per texel side for :func:`env_integral_numpy`: even, at least 2, and fine enough that a cell
+    spans at most a quarter of the model's GGX roughness (``model.alpha`` in radians, where it has
+    one), at most :data:`MAX_SUBDIVISIONS`.
+    """
+    texel = np.pi / environment.height
+    s = 2
+    alpha = getattr(model, "alpha", None)
+    if alpha is not None and float(alpha) > 0.0:
+        s = max(s, math.ceil(texel / (0.25 * float(alpha))))
+    s += s % 2
+    return int(min(s, MAX_SUBDIVISIONS))
+
+
+def env_integral_numpy(
+    model, environment: EnvironmentMap, width: int, height: int, pixels=None, subdivisions: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> np.ndarray:
+    """
+    The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, by a midpoint
+    rule over the environment's texels (:meth:`EnvironmentMap.quadrature`, each cell's exact solid
+    angle, the bilinear radiance the shader reads).
+
+    Parameters
+    ----------
+    model
+        A numpy twin from :mod:`explorer.models` (``model.brdf(L, V, N, X, Y) -> (..., 3)``).
+    environment : EnvironmentMap
+    width, height : int
+        The image size (the lit view's sphere: :func:`explorer.render.brdf_view_geometry`).
+    pixels : array_like of (row, column), optional
+        Only these pixels (rows from the top): the integral costs one BRDF evaluation per cell (about
+        ``4 pi`` / 2 of ``(W_env H_env s^2)`` directions) per pixel.
+    subdivisions : int, optional
+        Cells per texel side (default :func:`quadrature_subdivisions`).
+    progress : callable, optional
+        ``progress(done, total)`` after each pixel.
+
+    Returns
+    -------
+    ndarray
+        ``(P, 3)`` float64 for ``pixels`` (0 outside the disc), else the ``(height, width, 3)`` float32 image.
+    """
+    from .render import brdf_view_geometry
+
+    _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
+    if pixels is None:
+        rows, columns = np.nonzero(inside)
+    else:
+        index = np.asarray(pixels, dtype=np.int64).reshape(-1, 2)
+        rows, columns = index[:, 0], index[:, 1]
+        if ((rows < 0) | (rows >= height) | (columns < 0) | (columns >= width)).any():
+            raise ValueError(f"pixels must lie in the {width}x{height} image")
+    s = quadrature_subdivisions(model, environment) if subdivisions is None else int(subdivisions)
+    directions, solid_angle, radiance = environment.quadrature(s)
+    weighted = radiance * solid_angle[:, None]
+    values = np.zeros((rows.size, 3))
+    for k, (r, c) in enumerate(zip(rows, columns)):
+        if inside[r, c]:
+            n = N[r, c].astype(np.float64)
+            frame = [a[r, c].astype(np.float64) for a in (V, N, X, Y)]
+            for start in range(0, directions.shape[0], QUADRATURE_BLOCK):
+                block = directions[start:start + QUADRATURE_BLOCK]
+                cos_l = block @ n
+                above = cos_l > 0.0
+                if not above.any():
+                    continue
+                L = block[above]
+                f = np.asarray(model.brdf(L, *(np.broadcast_to(a, L.shape) for a in frame)), dtype=np.float64)
+                values[k] += np.sum(f * (cos_l[above, None] * weighted[start:start + QUADRATURE_BLOCK][above]), axis=0)
+        if progress is not None:
+            progress(k + 1, rows.size)
+    if pixels is not None:
+        return values
+    image = np.zeros((height, width, 3), dtype=np.float32)
+    image[rows, columns] = values
+    return image
+
+
+# --------------------------------------------------------------------------------------------------
+# The GPU estimator
+
+
+class ProgressiveEnvRender:
+    """
+    Progressive Monte Carlo rendering of the env view on the GPU (``shaders/views/env.glsl``).
+
+    Samples accumulate in two float32 RGBA textures by additive blending: the sum of the samples (and
+    their count, alpha) and the sum of their squares (and the non-finite samples dropped, alpha);
+    :meth:`image` divides by :attr:`samples`, :meth:`standard_error` is the per-pixel standard error
+    of that mean. Random numbers hash (pixel, sample index, seed): a render is reproducible, the same
+    however its samples are split into passes.
+
+    Parameters
+    ----------
+    renderer : explorer.gl.Renderer
+        Its programs, uniforms and tables are reused (:meth:`~explorer.gl.Renderer.program`,
+        :meth:`~explorer.gl.Renderer.bind`).
+    material : explorer.brd.Material
+    values : mapping
+        The material's resolved parameter values.
+    environment : EnvironmentMap
+    width, height : int
+    seed : int, optional
+        Selects an independent sequence of random numbers (0 to 2^32 - 1).
+    pass_budget_ms : float, optional
+        Target duration of one pass; the samples per pass adapt to it (at least 1, at most
+        :data:`MAX_SAMPLES_PER_PASS`).
+
+    Notes
+    -----
+    Each :meth:`step` runs its passes with blending enabled and leaves ``BLEND`` disabled, as the
+    other views expect. Float32 sums limit the relative precision of the variance to about
+    ``1e-7 n / (SE/mean)^2``, far below the statistical error for any realistic sample count.
+    """
+
+    def __init__(
+        self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
+    ):
+        if not 0 <= int(seed) < 1 << 32:
+            raise ValueError(f"seed must be in [0, 2^32), got {seed}")
+        self.renderer = renderer
+        self.ctx = renderer.ctx
+        self.material = material
+        self.environment = environment
+        self.width, self.height = int(width), int(height)
+        self.seed = int(seed)
+        self.pass_budget_ms = float(pass_budget_ms)
+        #: Samples per pixel of the next pass (adapted after each pass to :attr:`pass_budget_ms`).
+        self.samples_per_pass = 1
+        #: Duration of the last pass in milliseconds (bounded by glFinish), None before the first.
+        self.last_pass_ms: float | None = None
+        self._texture = environment.gl_texture(self.ctx)
+        self._targets = [self.ctx.texture((self.width, self.height), 4, dtype="f4") for _ in range(2)]
+        self._framebuffer = self.ctx.framebuffer(color_attachments=self._targets)
+        self._vertex_arrays: dict[int, object] = {}
+        self.values = dict(values)
+        self.reset()
+
+    def reset(self, values: Mapping[str, object] | None = None) -> None:
+        """Drop every sample; with ``values``, render the material with those parameters from now on."""
+        if values is not None:
+            self.values = dict(values)
+        self.program = self.renderer.program(self.material, "env", self.values)
+        self._framebuffer.use()
+        self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
+        #: Samples per pixel so far.
+        self.samples = 0
+        self.passes = 0
+
+    def step(self, spp: int = 1) -> None:
+        """Add ``spp`` samples per pixel, in passes of about :attr:`pass_budget_ms` each."""
+        import moderngl
+
+        spp = int(spp)
+        if spp < 1:
+            raise ValueError(f"spp must be at least 1, got {spp}")
+        program = self.program
+        self.renderer.bind(program, self.material, self.values)
+        self._texture.use(location=ENVIRONMENT_UNIT)
+        for name, value in (("environment", ENVIRONMENT_UNIT), ("resolution", (float(self.width), float(self.height))),
+                            ("seed", self.seed)):
+            if name in program:
+                program[name].value = value
+        vertex_array = self._vertex_arrays.get(id(program))
+        if vertex_array is None:
+            vertex_array = self._vertex_arrays[id(program)] = self.ctx.vertex_array(program, [])
+        self._framebuffer.use()
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+        self.ctx.blend_equation = moderngl.FUNC_ADD
+        try:
+            remaining = spp
+            while remaining > 0:
+                count = min(remaining, self.samples_per_pass)
+                program["samples_per_pass"].value = count
+                program["first_sample"].value = self.samples
+                self.ctx.finish()
+                start = time.perf_counter()
+                vertex_array.render(vertices=3)
+                self.ctx.finish()
+                self.last_pass_ms = (time.perf_counter() - start) * 1e3
+                self.passes += 1
+                self.samples += count
+                remaining -= count
+                per_sample = max(self.last_pass_ms / count, 1e-3)
+                self.samples_per_pass = int(min(MAX_SAMPLES_PER_PASS, max(1, self.pass_budget_ms // per_sample)))
+        finally:
+            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
+            self.ctx.disable(moderngl.BLEND)
+
+    def _read(self, attachment: int) -> np.ndarray:
+        data = self._framebuffer.read(components=4, attachment=attachment, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 4)[::-1]
+
+    def image(self) -> np.ndarray:
+        """The mean so far, ``(height, width, 3)`` float32 linear RGB, rows from the top (0 before any sample)."""
+        if self.samples == 0:
+            return np.zeros((self.height, self.width, 3), dtype=np.float32)
+        return np.ascontiguousarray(self._read(0)[:, :, :3] / np.float32(self.samples))
+
+    def sums(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(sum, sum of squares, count, dropped)`` per pixel as accumulated (float64, rows from the top)."""
+        first, second = self._read(0).astype(np.float64), self._read(1).astype(np.float64)
+        return first[:, :, :3], second[:, :, :3], first[:, :, 3], second[:, :, 3]
+
+    def standard_error(self) -> np.ndarray:
+        """
+        The standard error of :meth:`image` per pixel and channel, ``sqrt(s^2 / n)`` with the unbiased
+        sample variance ``s^2``; ``(height, width, 3)`` float32, infinite before two samples.
+        """
+        n = self.samples
+        if n < 2:
+            return np.full((self.height, self.width, 3), np.inf, dtype=np.float32)
+        total, squares, _, _ = self.sums()
+        mean = total / n
+        variance = np.maximum(squares / n - mean * mean, 0.0) * (n / (n - 1))
+        return np.sqrt(variance / n).astype(np.float32)
+
+    def dropped_samples(self) -> int:
+        """Samples dropped because the material's BRDF returned NaN or infinity (0 for a sound material)."""
+        return int(round(float(self.sums()[3].sum())))
+
+    def release(self) -> None:
+        """Free the GL objects (textures, framebuffer, vertex arrays)."""
+        for vertex_array in self._vertex_arrays.values():
+            vertex_array.release()
+        self._vertex_arrays = {}
+        self._framebuffer.release()
+        for target in self._targets:
+            target.release()
+        self._texture.release()
+
+
+def render_env(
+    material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
+    environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
+    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
+) -> np.ndarray:
+    """
+    The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
+    (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
+    tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
+    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
+    """
+    environment = EnvironmentMap.default() if environment is None else environment
+    if engine == "numpy":
+        from .models import model_for
+
+        model = model_for(material, values)
+        return env_integral_numpy(model, environment, width, height, progress=progress)
+    from .gl import Renderer
+
+    renderer = Renderer() if renderer is None else renderer
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    try:
+        while render.samples < spp:
+            render.step(min(spp - render.samples, max(1, render.samples_per_pass)))
+            if progress is not None:
+                progress(render.samples, spp)
+        dropped = render.dropped_samples()
+        if dropped and warn is not None:
+            warn(f"{dropped} samples dropped: the material's BRDF returned NaN or infinity there")
+        return render.image()
+    finally:
+        render.release()
+
+
+if __name__ == "__main__":
+    print(f"wrote {write_default_environment()}")

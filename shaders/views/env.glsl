@@ -1,0 +1,122 @@
+// The env view: the lit view's orthographic unit sphere (V = (0, 0, 1), N and BRDF Explorer's frame X, Y
+// from lib/views.glsl) under an environment map, by progressive Monte Carlo. Each pass adds
+// samples_per_pass samples per pixel of the estimator f(L, V) cos theta_L Le(L) / pdf(L); the host blends
+// the passes additively (explorer/env.py, ProgressiveEnvRender) and divides by the sample count.
+//
+// Random numbers: the PCG4D hash of (pixel, sample index, seed), the sample index counted from the first
+// sample of the render (first_sample + s): the same numbers however the host splits the samples into passes.
+//
+// Outputs: sum_out = (sum of the samples, count), square_out = (sum of their squares, dropped non-finite
+// samples); both float32, added over passes.
+//
+// Sampling (one-sample MIS, balance heuristic): without the material hook, cosine sampling about N. With
+//   #define HAS_SAMPLING_LOBES
+//   float sampling_lobes(vec3 V, vec3 N, out vec4 alphas, out vec4 weights);
+// (up to four GGX lobes of roughness alphas[k] and weights[k] >= 0, returning the weight of a cosine lobe,
+// unnormalised) a lobe is chosen with probability w / sum(w), sampled (GGX: Heitz 2018's visible normals
+// reflected about V; the cosine lobe: Malley's method) and the sample divided by the mixture density
+// sum_k w_k pdf_k(L) + w_c cos theta_L / pi. Unbiased for any weights; the weights only change the variance.
+//
+// Environment: equirectangular, linear RGB, texture row 0 (v = 0) at the zenith +y (the sphere's screen
+// up), v = theta / pi with theta the angle from +y; the centre column u = 0.5 faces away from the viewer
+// (-z) and u = 0.75 is +x: u = 0.5 + atan(x, -z) / 2 pi. Both angles come from atan, not acos: Mesa's
+// inverse trigonometry is a polynomial with errors near 1e-4 rad at worst, a small fraction of a texel of
+// any environment up to 8k wide, and atan(length(d.xz), d.y) stays accurate at the poles where acos(d.y)
+// loses digits. Linear filtering, repeat in u, clamp in v, level 0. Twin: explorer.env.EnvironmentMap.
+#include "lib/views.glsl"
+#include "lib/sampling.glsl"
+
+uniform vec2 resolution;
+uniform sampler2D environment;
+uniform uint first_sample;
+uniform int samples_per_pass;
+uniform uint seed;
+layout(location = 0) out vec4 sum_out;
+layout(location = 1) out vec4 square_out;
+
+vec3 environment_radiance(vec3 d) {
+    float u = 0.5 + atan(d.x, -d.z) * (0.5 / SAMPLING_PI);
+    float v = atan(length(d.xz), d.y) * (1.0 / SAMPLING_PI);
+    return textureLod(environment, vec2(u, v), 0.0).rgb;
+}
+
+// x > 0, false for NaN (GLSL's max() is undefined for NaN).
+float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }
+
+void main() {
+    vec2 p;
+    float r2;
+    if (!disc_point(resolution, p, r2)) {
+        sum_out = vec4(0.0, 0.0, 0.0, float(samples_per_pass));
+        square_out = vec4(0.0);
+        return;
+    }
+    vec3 normal, tangent, bitangent;
+    lit_sphere_frame(p, r2, normal, tangent, bitangent);
+    vec3 view = vec3(0.0, 0.0, 1.0);
+    vec3 t, b;
+    sampling_basis(normal, t, b);
+    vec3 view_local = vec3(dot(view, t), dot(view, b), dot(view, normal));
+
+    vec4 alphas = vec4(0.0), weights = vec4(0.0);
+    float cosine_weight = 1.0;
+#ifdef HAS_SAMPLING_LOBES
+    cosine_weight = positive_or_zero(sampling_lobes(view, normal, alphas, weights));
+    weights = vec4(positive_or_zero(weights.x), positive_or_zero(weights.y), positive_or_zero(weights.z),
+                   positive_or_zero(weights.w));
+    float total = cosine_weight + weights.x + weights.y + weights.z + weights.w;
+    if (total > 0.0 && !isinf(total)) {
+        weights /= total;
+        cosine_weight /= total;
+    } else {  // a hook that returns nothing usable: cosine sampling
+        weights = vec4(0.0);
+        cosine_weight = 1.0;
+    }
+#endif
+
+    uvec2 pixel = uvec2(gl_FragCoord.xy);
+    vec3 sum = vec3(0.0), square = vec3(0.0);
+    float dropped = 0.0;
+    for (int s = 0; s < samples_per_pass; ++s) {
+        vec4 u = uniform_floats(pcg4d(uvec4(pixel, first_sample + uint(s), seed)));
+        vec3 light;
+        float choice = u.x - cosine_weight;
+        if (choice < 0.0) {
+            vec3 l = sample_cosine_hemisphere(u.yz);
+            light = l.x * t + l.y * b + l.z * normal;
+        } else {
+            int k = 0;  // the lobe whose cumulative weight passes u.x (the last non-empty one on round-off)
+            for (int j = 0; j < 4; ++j) {
+                if (weights[j] > 0.0) {
+                    k = j;
+                    if (choice < weights[j]) break;
+                    choice -= weights[j];
+                }
+            }
+            vec3 m = sample_ggx_visible_normal(view_local, alphas[k], u.yz);
+            vec3 micro = m.x * t + m.y * b + m.z * normal;
+            light = 2.0 * dot(view, micro) * micro - view;
+        }
+        float cos_light = dot(normal, light);
+        vec3 value = vec3(0.0);
+        if (cos_light > 0.0) {
+            float pdf = cosine_weight * cos_light * (1.0 / SAMPLING_PI);
+            for (int j = 0; j < 4; ++j) {
+                if (weights[j] > 0.0) pdf += weights[j] * ggx_reflection_pdf(light, view, normal, alphas[j]);
+            }
+            if (pdf > 0.0) {
+                value = BRDF(light, view, normal, tangent, bitangent) * (cos_light / pdf) * environment_radiance(light);
+            }
+        }
+        // A NaN or infinite sample (a material's BRDF out of its domain) would spoil the pixel for good:
+        // it is dropped and counted, so the host can report it.
+        if (any(isnan(value)) || any(isinf(value))) {
+            value = vec3(0.0);
+            dropped += 1.0;
+        }
+        sum += value;
+        square += value * value;
+    }
+    sum_out = vec4(sum, float(samples_per_pass));
+    square_out = vec4(square, dropped);
+}
