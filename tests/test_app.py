@@ -47,7 +47,7 @@ def run_session(display, material, actions, tmp_path, *extra, timeout=240):
     """Run a scripted session; returns (completed process, report dict)."""
     script, report = tmp_path / "script.json", tmp_path / "report.json"
     script.write_text(json.dumps(actions))
-    env = {**os.environ, "DISPLAY": display, "BRAGG_EXPLORER_NO_SETUP": "1"}
+    env = {**os.environ, "DISPLAY": display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
     process = subprocess.run(
         [sys.executable, "-m", "explorer.cli", "open", str(material), "--script", str(script), "--report", str(report),
          "--window-size", WINDOW, *extra],
@@ -107,6 +107,7 @@ def test_no_display_falls_back_to_the_headless_render(tmp_path):
     """``bragg-explorer`` without a display: one line saying so, then the default renders, exit 0."""
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     env["BRAGG_EXPLORER_NO_SETUP"] = "1"
+    env["PYTHONPATH"] = str(REPO_ROOT)  # this checkout's package, whatever the venv has installed
     process = subprocess.run([sys.executable, "-m", "explorer.cli"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=240)
     assert process.returncode == 0, process.stderr
     assert process.stderr.startswith("bragg-explorer: no display") and "Traceback" not in process.stderr
