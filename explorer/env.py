@@ -43,8 +43,10 @@ SUFFIXES = (".hdr", ".pic", ".exr")
 #: The default environment: 256 x 128 texels (1.4 degrees each), a sky, a sun and a ground.
 DEFAULT_SIZE = (256, 128)
 #: The default sun: elevation and azimuth (degrees; azimuth from -z toward +x, so 180 is behind the
-#: viewer), angular radius of its Gaussian profile (standard deviation, degrees), peak radiance.
-SUN_ELEVATION, SUN_AZIMUTH, SUN_SIGMA, SUN_PEAK = 40.0, 145.0, 2.5, 40.0
+#: viewer), angular radius of its Gaussian profile (standard deviation, degrees), peak radiance. A broad,
+#: dim sun: nothing samples the environment itself, and at a given irradiance a sun's variance grows as
+#: the inverse of its solid angle.
+SUN_ELEVATION, SUN_AZIMUTH, SUN_SIGMA, SUN_PEAK = 40.0, 145.0, 5.0, 12.0
 #: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
 PASS_BUDGET_MS = 50.0
 #: Samples per pixel in one pass at most (the shader's loop).
@@ -312,17 +314,25 @@ def sample_cosine_hemisphere(u1, u2) -> np.ndarray:
 # The numpy twin: the exact integral by quadrature
 
 
+def _roughness(model) -> float | None:
+    """The smallest GGX roughness of a model: its ``alpha``, or its stack's layers' (None for neither)."""
+    alphas = [getattr(model, "alpha", None)]
+    alphas += [getattr(layer, "alpha", None) for layer in getattr(getattr(model, "stack", None), "layers", ())]
+    alphas = [float(a) for a in alphas if a is not None]
+    return min(alphas) if alphas else None
+
+
 def quadrature_subdivisions(model, environment: EnvironmentMap) -> int:
     """
     Cells per texel side for :func:`env_integral_numpy`: even, at least 2, and fine enough that a cell
-    spans at most a quarter of the model's GGX roughness (``model.alpha`` in radians, where it has
-    one), at most :data:`MAX_SUBDIVISIONS`.
+    spans at most a quarter of the model's smallest GGX roughness (``model.alpha`` or its stack's
+    layers' ``alpha``, in radians, where it has one), at most :data:`MAX_SUBDIVISIONS`.
     """
     texel = np.pi / environment.height
     s = 2
-    alpha = getattr(model, "alpha", None)
-    if alpha is not None and float(alpha) > 0.0:
-        s = max(s, math.ceil(texel / (0.25 * float(alpha))))
+    alpha = _roughness(model)
+    if alpha is not None and alpha > 0.0:
+        s = max(s, math.ceil(texel / (0.25 * alpha)))
     s += s % 2
     return int(min(s, MAX_SUBDIVISIONS))
 
