@@ -44,7 +44,9 @@ SCREENSHOT_DIR = Path("screenshots")
 MODES = ("lit", "sphere", "env")
 #: GL budgets (ms) per frame while a slider is dragged: the active view, and each of the others.
 DRAG_BUDGET_MS = 16.0
-SIDE_DRAG_BUDGET_MS = 3.0
+SIDE_DRAG_BUDGET_MS = 0.0
+#: The spectrum plot's refresh period while a slider is dragged (seconds).
+DRAG_SPECTRUM_S = 0.1
 
 
 class AppError(Exception):
@@ -133,6 +135,7 @@ class App:
         self._pending_screenshot: str | None = None
         self._spectrum = None
         self._spectrum_key = None
+        self._spectrum_time = 0.0
         self._spectrum_structure_key = None
         self._polar = None
         self._polar_generation = -1
@@ -263,16 +266,22 @@ class App:
                 glfw.swap_buffers(window)
                 self._take_screenshot()
                 now = time.perf_counter()
+                values_key = tuple(sorted((k, str(v)) for k, v in self.values.items()))
+                changed, self._last_values_key = values_key != getattr(self, "_last_values_key", None), values_key
                 self.frame_times.append({
+                    "changed": changed,
                     "ms": (now - last) * 1e3, "work_ms": (now - start) * 1e3, "gl_ms": gl_ms,
                     "ui_ms": (ui_done - start) * 1e3, "imgui_draw_ms": (drawn - ui_done) * 1e3 - gl_ms, "swap_ms": (now - drawn) * 1e3,
                     "dragging": self._dragging, "mark": self.script.mark if self.script else None,
                     "main": {"size": list(self.jobs["main"].size), "preview": list(self.jobs["main"].preview_size),
-                             "has_preview": self.jobs["main"].has_preview, "complete": self.jobs["main"].complete},
+                             "has_preview": self.jobs["main"].has_preview, "complete": self.jobs["main"].complete,
+                             "generation": self.jobs["main"].generation},
                     "table_ms": self.renderer.last_table_ms,
                 })
                 self.last_frame_ms = (now - last) * 1e3
                 last = now
+            if self._executor is not None:
+                self._executor.shutdown(wait=True)
             backend.shutdown()
             implot.destroy_context()
             imgui.destroy_context()
@@ -710,7 +719,8 @@ class App:
             self._request_env(size)
             texture = self._env_texture
         else:
-            job.request(self.material, self.values, self._main_view(), size, light=self._light_vector(), dragging=self._dragging)
+            values = self._prepared_values(self.values)
+            job.request(self.material, values, self._main_view(), size, light=self._light_vector(), dragging=self._dragging)
             texture = self.display.target("main", size)
             self._display_requests = getattr(self, "_display_requests", {})
             self._display_requests["main"] = (job, None)
@@ -719,6 +729,39 @@ class App:
         imgui.text(f"{self._main_view()} {size[0]}x{size[1]}: {state}; {self._frame_label()}")
         if job.error:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), job.error)
+
+    def _prepared_values(self, values: dict) -> dict:
+        """
+        The parameter values the sphere shows. While a slider is dragged the host's tables (the tabulated
+        method's ~10 ms, a stack's layers) are built on a worker thread as the frame draws, and the sphere
+        shows the newest values whose tables are ready: one frame behind the slider. Otherwise they are
+        built here, so a released slider always shows its own values.
+        """
+        import concurrent.futures
+
+        if self.renderer.model_ready(self.material, values):
+            self._ready_values = dict(values)
+            return values
+        if self._dragging and self._ready_values is not None:
+            if self._prefetch is not None and self._prefetch.done():
+                if self._prefetch.exception() is None:
+                    self._ready_values = self._prefetch_values  # the newest values whose tables are built
+                self._prefetch = None
+            if self._prefetch is None:
+                if self._executor is None:
+                    self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="tables")
+                self._prefetch_values = dict(values)
+                self._prefetch = self._executor.submit(self.renderer.prepare_model, self.material, self._prefetch_values)
+            return self._ready_values
+        if self._prefetch is not None:
+            concurrent.futures.wait([self._prefetch])  # its errors resurface in bind, with the current values
+        self._ready_values = dict(values)
+        return values
+
+    _ready_values: dict | None = None
+    _prefetch_values: dict | None = None
+    _prefetch = None
+    _executor = None
 
     def _image(self, texture, size, label: str, interactive: bool = False) -> None:
         """An image fitted to the window, flipped to rows-from-the-top, zoomed about its centre."""
@@ -916,7 +959,11 @@ class App:
         method = int(round(float(self.values.get("method", 0))))
         s = int(round(float(self.values.get("s", 3))))
         key = (tuple(sorted(self.values.items())), self.spectrum_theta)
-        if key != self._spectrum_key:
+        # While a slider is dragged the curves follow at most every DRAG_SPECTRUM_S (their ~3 ms of numpy
+        # would otherwise come out of every frame of the sphere's); on release they catch up at once.
+        throttled = self._dragging and time.perf_counter() - self._spectrum_time < DRAG_SPECTRUM_S
+        if key != self._spectrum_key and not (throttled and self._spectrum is not None):
+            self._spectrum_time = time.perf_counter()
             structure = not self._dragging
             self._spectrum = app_data.spectrum(self.values, self.spectrum_theta, method, s, structure=structure)
             if not structure and self._spectrum_structure is not None:

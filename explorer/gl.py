@@ -8,6 +8,7 @@ line. Headless rendering uses a moderngl standalone EGL context (Mesa's llvmpipe
 
 from __future__ import annotations
 
+import threading
 import time
 from collections import OrderedDict
 from pathlib import Path
@@ -93,6 +94,7 @@ class Renderer:
         self.last_table_ms: float | None = None
         # (material path, model, values) -> [model, its textures() or None], least recently used first.
         self._models: OrderedDict[tuple, list] = OrderedDict()
+        self._models_lock = threading.Lock()  # prepare_model may fill the cache from another thread
         self._model_texture_keys: dict[str, tuple] = {}  # which model's table each model texture holds
 
     # -- resources ---------------------------------------------------------------------------------
@@ -223,25 +225,64 @@ class Renderer:
                 texture.use(location=unit)
                 program[name].value = unit
 
-    def _model_entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
-        """``(key, [model, tables])`` of :func:`explorer.models.model_for`, from a small LRU cache (key None: uncached)."""
+    @staticmethod
+    def _model_key(material: Material, values: Mapping[str, object]) -> tuple | None:
+        """The cache key of ``material``'s model at ``values`` (None: an unhashable value, not cached)."""
         try:
             key = (str(material.path), material.model, tuple(sorted(values.items())))
             hash(key)
-        except TypeError:  # an unhashable value (a list): no caching
+        except TypeError:  # an unhashable value (a list)
+            return None
+        return key
+
+    def _model_entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
+        """``(key, [model, tables])`` of :func:`explorer.models.model_for`, from a small LRU cache (key None: uncached)."""
+        key = self._model_key(material, values)
+        if key is None:
             model = model_for(material, values)
             return None, ([model, None] if model is not None else None)
-        entry = self._models.get(key)
-        if entry is not None:
-            self._models.move_to_end(key)
-            return key, entry
+        with self._models_lock:
+            entry = self._models.get(key)
+            if entry is not None:
+                self._models.move_to_end(key)
+                return key, entry
         model = model_for(material, values)
         if model is None:
             return key, None
-        self._models[key] = entry = [model, None]
-        while len(self._models) > MODEL_CACHE_SIZE:
-            self._models.popitem(last=False)
-        return key, entry
+        return key, self._cache_model(key, [model, None])
+
+    def _cache_model(self, key: tuple, entry: list) -> list:
+        with self._models_lock:
+            self._models[key] = entry
+            self._models.move_to_end(key)
+            while len(self._models) > MODEL_CACHE_SIZE:
+                self._models.popitem(last=False)
+        return entry
+
+    def model_ready(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Whether binding ``material`` at ``values`` needs no numpy work (its tables are cached, or it has none)."""
+        from .models import MODELS
+
+        if (material.model or "") not in MODELS:
+            return True
+        key = self._model_key(material, values)
+        with self._models_lock:
+            entry = self._models.get(key) if key is not None else None
+        return entry is not None and entry[1] is not None
+
+    def prepare_model(self, material: Material, values: Mapping[str, object]) -> None:
+        """
+        Build ``material``'s numpy model at ``values`` and its tables into the cache, without touching GL:
+        safe on a worker thread, so that an interactive host can build the next tables (~10 ms) while it
+        draws. Errors are raised here as they would be by :meth:`bind`.
+        """
+        if self.model_ready(material, values):
+            return
+        key = self._model_key(material, values)
+        model = model_for(material, values)
+        if model is None or key is None:
+            return
+        self._cache_model(key, [model, model.textures()])
 
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,

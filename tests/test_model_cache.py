@@ -1,0 +1,60 @@
+"""explorer.gl.Renderer's model cache: tables built once per parameter set, and on a worker thread for the app."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from conftest import REPO_ROOT
+from explorer import gl
+from explorer.brd import load_material
+
+MIRROR = REPO_ROOT / "shaders" / "bragg_mirror.brd"
+
+
+@pytest.fixture()
+def counted_models(monkeypatch):
+    """How many numpy models Renderer builds (explorer.gl.model_for calls)."""
+    calls = []
+    original = gl.model_for
+
+    def counting(material, values):
+        calls.append(threading.current_thread().name)
+        return original(material, values)
+
+    monkeypatch.setattr(gl, "model_for", counting)
+    return calls
+
+
+@pytest.mark.gl
+def test_tables_are_built_once_per_parameter_set(gl_renderer, counted_models):
+    material = load_material(MIRROR)
+    values = material.resolve({"method": 3, "Lambda": 613})
+    first = gl_renderer.render(material, values, "sphere", 16, 16)
+    again = gl_renderer.render(material, values, "sphere", 16, 16)
+    assert len(counted_models) == 1
+    np.testing.assert_array_equal(first, again)
+    other = gl_renderer.render(material, {**values, "Lambda": 614.0}, "sphere", 16, 16)
+    assert len(counted_models) == 2 and not np.array_equal(first, other)
+
+
+@pytest.mark.gl
+def test_prepare_model_on_a_worker_thread_then_bind_uses_it(gl_renderer, counted_models):
+    material = load_material(MIRROR)
+    values = material.resolve({"method": 3, "Lambda": 777, "N": 13})
+    assert not gl_renderer.model_ready(material, values)
+    worker = threading.Thread(target=gl_renderer.prepare_model, args=(material, values), name="tables")
+    worker.start()
+    worker.join()
+    assert counted_models == ["tables"] and gl_renderer.model_ready(material, values)
+    image = gl_renderer.render(material, values, "sphere", 16, 16)
+    assert counted_models == ["tables"], "bind rebuilt a model the worker had prepared"
+    fresh = gl.Renderer(gl_renderer.ctx).render(material, values, "sphere", 16, 16)
+    np.testing.assert_array_equal(image, fresh)
+
+
+def test_a_material_without_a_model_is_always_ready(gl_renderer):
+    material = load_material(REPO_ROOT / "tests" / "data" / "brdf" / "lambert.brdf")
+    assert gl_renderer.model_ready(material, material.resolve({}))
