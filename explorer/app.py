@@ -822,10 +822,13 @@ class App:
                 self._env_render.reset(values=self.values)
             self._env_key = key
         self._env_pending = True
-        texture = getattr(self, "_env_tex", None)
-        if texture is None or texture.size != size:
-            self._env_tex = self.ctx.texture(size, 4)
-        self._env_texture = self._env_tex
+        from .app_views import AccumulatedImage
+
+        if getattr(self, "_env_source", None) is None or self._env_source.render is not self._env_render:
+            self._env_source = AccumulatedImage(self._env_render)
+        self._display_requests = getattr(self, "_display_requests", {})
+        self._display_requests["main"] = (self._env_source, None)
+        self._env_texture = self.display.target("main", size)
 
     # -- compare ---------------------------------------------------------------------------------------
 
@@ -1066,17 +1069,8 @@ class App:
         return (time.perf_counter() - start) * 1e3
 
     def _env_work(self, budget_ms: float) -> None:
-        render = self._env_render
-        start = time.perf_counter()
-        render.step(1)
-        while (time.perf_counter() - start) * 1e3 < 0.5 * budget_ms:
-            render.step(1)
-        image = render.image()
-        rgb = np.clip(self.exposure * np.nan_to_num(image), 0.0, 1.0)
-        from .colorimetry import encode_srgb8
-
-        rgba = np.concatenate([encode_srgb8(rgb), np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=-1)
-        self._env_tex.write(np.ascontiguousarray(rgba[::-1]).tobytes())
+        # Bands of rows when one sample costs more than the budget; the display pass divides by the counts.
+        self._env_render.advance(max(0.5 * budget_ms, 5.0))
 
     # -- screenshots -------------------------------------------------------------------------------------
 

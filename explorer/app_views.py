@@ -251,8 +251,13 @@ uniform bool gamut;       // mark colours outside sRGB (a negative channel or ab
 uniform vec2 resolution;
 out vec4 frag_colour;
 
-vec3 sample_image(sampler2D full, sampler2D preview, float refined, vec2 uv) {{
-    return uv.y >= refined ? texelFetch(full, ivec2(gl_FragCoord.xy), 0).rgb : texture(preview, uv).rgb;
+uniform bool accumulated_a;  // the full image holds sums of samples with their count in alpha (env)
+uniform bool accumulated_b;
+
+vec3 sample_image(sampler2D full, sampler2D preview, float refined, bool accumulated, vec2 uv) {{
+    if (uv.y < refined) return texture(preview, uv).rgb;
+    vec4 texel = texelFetch(full, ivec2(gl_FragCoord.xy), 0);
+    return accumulated ? texel.rgb / max(texel.a, 1.0) : texel.rgb;
 }}
 
 float encode(float c) {{
@@ -263,7 +268,8 @@ float encode(float c) {{
 void main() {{
     vec2 uv = gl_FragCoord.xy / resolution;
     bool b = uv.x >= split;
-    vec3 rgb = exposure * (b ? sample_image(full_b, preview_b, refined_b, uv) : sample_image(full_a, preview_a, refined_a, uv));
+    vec3 rgb = exposure * (b ? sample_image(full_b, preview_b, refined_b, accumulated_b, uv)
+                             : sample_image(full_a, preview_a, refined_a, accumulated_a, uv));
     vec3 colour = vec3(encode(rgb.r), encode(rgb.g), encode(rgb.b));
     if (gamut && (any(lessThan(rgb, vec3(-1e-6))) || any(greaterThan(rgb, vec3(1.0 + 1e-6))))) {{
         // A magenta and black hatching: visible on any colour, and the colour still shows in between.
@@ -273,6 +279,28 @@ void main() {{
     frag_colour = vec4(colour, 1.0);
 }}
 """
+
+
+class AccumulatedImage:
+    """
+    A progressive env render (:class:`explorer.env.ProgressiveEnvRender`) as a source of
+    :class:`DisplayPass`: its float texture of sample sums, divided by each pixel's count on the GPU
+    (reading it back and encoding 512² pixels in numpy would cost ~40 ms a frame).
+    """
+
+    preview = None
+    has_preview = False
+
+    def __init__(self, render):
+        self.render = render
+        self.full = render._framebuffer  # attachment 0: the sums, the count in alpha
+        self.size = (render.width, render.height)
+        self.refined_rows = render.height
+
+    @property
+    def generation(self) -> tuple[int, int, int]:
+        """Changes with every pass or band: the display redraws only then."""
+        return (id(self.render), self.render.passes, self.render._band_rows)
 
 
 class DisplayPass:
@@ -315,6 +343,8 @@ class DisplayPass:
         else:
             refined = 1.0 - view.refined_rows / view.size[1] if view.refined_rows else 0.0
         self.program[f"refined_{suffix}"].value = refined
+        if f"accumulated_{suffix}" in self.program:
+            self.program[f"accumulated_{suffix}"].value = isinstance(view, AccumulatedImage)
 
     def draw(self, key, a: ProgressiveView, b: ProgressiveView | None = None, *, split: float = 2.0,
              exposure: float = 1.0, gamut: bool = False):

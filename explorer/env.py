@@ -406,6 +406,10 @@ def env_integral_numpy(
 # The GPU estimator
 
 
+#: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
+BAND_PROBE_ROWS = 8
+
+
 class ProgressiveEnvRender:
     """
     Progressive Monte Carlo rendering of the env view on the GPU (``shaders/views/env.glsl``).
@@ -456,6 +460,8 @@ class ProgressiveEnvRender:
         self.samples_per_pass = 1
         #: Duration of the last pass in milliseconds (bounded by glFinish), None before the first.
         self.last_pass_ms: float | None = None
+        #: Measured cost of one sample over the whole image (ms), None before the first.
+        self.sample_ms: float | None = None
         self._texture = environment.gl_texture(self.ctx)
         self._targets = [self.ctx.texture((self.width, self.height), 4, dtype="f4") for _ in range(2)]
         self._framebuffer = self.ctx.framebuffer(color_attachments=self._targets)
@@ -470,17 +476,15 @@ class ProgressiveEnvRender:
         self.program = self.renderer.program(self.material, "env", self.values)
         self._framebuffer.use()
         self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
-        #: Samples per pixel so far.
+        #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
         self.samples = 0
         self.passes = 0
+        self._band_rows = 0  # rows done of the sample in progress by bands
 
-    def step(self, spp: int = 1) -> None:
-        """Add ``spp`` samples per pixel, in passes of about :attr:`pass_budget_ms` each."""
+    def _begin(self):
+        """Bind the program, its tables and the targets, with additive blending; returns the vertex array."""
         import moderngl
 
-        spp = int(spp)
-        if spp < 1:
-            raise ValueError(f"spp must be at least 1, got {spp}")
         program = self.program
         self.renderer.bind(program, self.material, self.values)
         self._texture.use(location=ENVIRONMENT_UNIT)
@@ -495,25 +499,95 @@ class ProgressiveEnvRender:
         self.ctx.enable(moderngl.BLEND)
         self.ctx.blend_func = moderngl.ONE, moderngl.ONE
         self.ctx.blend_equation = moderngl.FUNC_ADD
+        return vertex_array
+
+    def _end(self) -> None:
+        import moderngl
+
+        self.ctx.scissor = None
+        self.ctx.blend_func = moderngl.DEFAULT_BLENDING
+        self.ctx.disable(moderngl.BLEND)
+
+    def _pass(self, vertex_array, count: int, rows: tuple[int, int] | None = None) -> float:
+        """Draw ``count`` samples (numbered from :attr:`samples`) into rows ``[top, bottom)`` (all: None); ms."""
+        self.program["samples_per_pass"].value = count
+        self.program["first_sample"].value = self.samples
+        if rows is not None:
+            top, bottom = rows  # GL rows count from the bottom
+            self.ctx.scissor = (0, self.height - bottom, self.width, bottom - top)
+        self.ctx.finish()
+        start = time.perf_counter()
+        vertex_array.render(vertices=3)
+        self.ctx.finish()
+        elapsed = (time.perf_counter() - start) * 1e3
+        self.ctx.scissor = None
+        return elapsed
+
+    def step(self, spp: int = 1) -> None:
+        """Add ``spp`` samples per pixel, in passes of about :attr:`pass_budget_ms` each."""
+        spp = int(spp)
+        if spp < 1:
+            raise ValueError(f"spp must be at least 1, got {spp}")
+        self._finish_band()
+        vertex_array = self._begin()
         try:
             remaining = spp
             while remaining > 0:
                 count = min(remaining, self.samples_per_pass)
-                program["samples_per_pass"].value = count
-                program["first_sample"].value = self.samples
-                self.ctx.finish()
-                start = time.perf_counter()
-                vertex_array.render(vertices=3)
-                self.ctx.finish()
-                self.last_pass_ms = (time.perf_counter() - start) * 1e3
+                self.last_pass_ms = self._pass(vertex_array, count)
                 self.passes += 1
                 self.samples += count
                 remaining -= count
                 per_sample = max(self.last_pass_ms / count, 1e-3)
+                self.sample_ms = per_sample
                 self.samples_per_pass = int(min(MAX_SAMPLES_PER_PASS, max(1, self.pass_budget_ms // per_sample)))
         finally:
-            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
-            self.ctx.disable(moderngl.BLEND)
+            self._end()
+
+    def advance(self, budget_ms: float) -> None:
+        """
+        Add samples for about ``budget_ms``: whole passes when one sample of the whole image fits, or else
+        one sample in bands of rows, so that an interactive caller never waits much longer than its budget
+        for an expensive material (a stack's 471 wavelengths cost ~1 s per sample at 256² on llvmpipe).
+        Pixels of a band hold one sample more than :attr:`samples` until the sample is complete.
+        """
+        budget_ms = max(float(budget_ms), 1.0)
+        if self._band_rows == 0 and self.sample_ms is not None and self.sample_ms <= budget_ms:
+            self.step(max(1, min(MAX_SAMPLES_PER_PASS, int(budget_ms // self.sample_ms))))
+            return
+        vertex_array = self._begin()
+        try:
+            row_ms = (self.sample_ms / self.height) if self.sample_ms is not None else None
+            spent = 0.0
+            while spent < budget_ms:
+                rows = BAND_PROBE_ROWS if row_ms is None else max(1, int((budget_ms - spent) / max(row_ms, 1e-6)))
+                top = self._band_rows
+                bottom = min(self.height, top + rows)
+                elapsed = self._pass(vertex_array, 1, (top, bottom))
+                spent += elapsed
+                row_ms = max(elapsed / (bottom - top), 1e-6)
+                self._band_rows = bottom
+                if bottom >= self.height:
+                    self.sample_ms = row_ms * self.height
+                    self.samples += 1
+                    self.passes += 1
+                    self._band_rows = 0
+                    break
+        finally:
+            self._end()
+
+    def _finish_band(self) -> None:
+        """Complete a sample left in bands by :meth:`advance` (whole-image passes assume equal counts)."""
+        if self._band_rows == 0:
+            return
+        vertex_array = self._begin()
+        try:
+            self._pass(vertex_array, 1, (self._band_rows, self.height))
+            self.samples += 1
+            self.passes += 1
+            self._band_rows = 0
+        finally:
+            self._end()
 
     def _read(self, attachment: int) -> np.ndarray:
         data = self._framebuffer.read(components=4, attachment=attachment, dtype="f4")
@@ -521,9 +595,12 @@ class ProgressiveEnvRender:
 
     def image(self) -> np.ndarray:
         """The mean so far, ``(height, width, 3)`` float32 linear RGB, rows from the top (0 before any sample)."""
-        if self.samples == 0:
+        if self.samples == 0 and self._band_rows == 0:
             return np.zeros((self.height, self.width, 3), dtype=np.float32)
-        return np.ascontiguousarray(self._read(0)[:, :, :3] / np.float32(self.samples))
+        if self._band_rows == 0:
+            return np.ascontiguousarray(self._read(0)[:, :, :3] / np.float32(self.samples))
+        first = self._read(0)  # a sample in progress: each pixel's own count (alpha)
+        return np.ascontiguousarray(first[:, :, :3] / np.maximum(first[:, :, 3:], np.float32(1.0)))
 
     def sums(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(sum, sum of squares, count, dropped)`` per pixel as accumulated (float64, rows from the top)."""
@@ -535,10 +612,10 @@ class ProgressiveEnvRender:
         The standard error of :meth:`image` per pixel and channel, ``sqrt(s^2 / n)`` with the unbiased
         sample variance ``s^2``; ``(height, width, 3)`` float32, infinite before two samples.
         """
-        n = self.samples
-        if n < 2:
+        if self.samples < 2:
             return np.full((self.height, self.width, 3), np.inf, dtype=np.float32)
-        total, squares, _, _ = self.sums()
+        total, squares, count, _ = self.sums()
+        n = count[..., None]  # each pixel's own count: rows of a sample in progress hold one more
         mean = total / n
         variance = np.maximum(squares / n - mean * mean, 0.0) * (n / (n - 1))
         return np.sqrt(variance / n).astype(np.float32)

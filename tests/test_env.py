@@ -557,3 +557,34 @@ def test_cli_env_with_an_exr(gl_renderer, tmp_path):
     assert image.shape == (20, 20, 3) and np.isfinite(image).all()
     inside = brdf_view_geometry("lit", 20, 20)[5]
     assert (image[inside].max(axis=-1) > 0).all() and (image[~inside] == 0).all()
+
+
+@pytest.mark.gl
+def test_advance_in_bands_equals_whole_passes(gl_renderer):
+    """advance() with a budget below one sample's cost works in bands of rows: same samples, same image."""
+    from explorer.brd import load_material
+    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+
+    material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
+    values = material.resolve({"alpha": 0.3})
+    environment = EnvironmentMap.default()
+    whole = ProgressiveEnvRender(gl_renderer, material, values, environment, 24, 20, seed=3)
+    whole.step(3)
+    banded = ProgressiveEnvRender(gl_renderer, material, values, environment, 24, 20, seed=3)
+    real_pass = banded._pass
+
+    def slow_pass(vertex_array, count, rows=None):  # pretend each row costs 5 ms: a sample, 100 ms
+        real_pass(vertex_array, count, rows)
+        return 5.0 * ((rows[1] - rows[0]) if rows is not None else banded.height) * count
+
+    banded._pass = slow_pass
+    calls = 0
+    while banded.samples < 3:
+        banded.advance(10.0)
+        calls += 1
+        assert calls < 500
+    assert calls > 3, "advance did not split samples into bands"
+    np.testing.assert_allclose(banded.image(), whole.image(), rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(banded.standard_error(), whole.standard_error(), rtol=1e-4, atol=1e-6)
+    whole.release()
+    banded.release()
