@@ -423,6 +423,10 @@ class App:
             if step == 0:
                 self._pending_window_shot = str(action["window_screenshot"])
             done = step > 0 and self._pending_window_shot is None
+        elif "write" in action:  # what a user's editor does to the material file between two reloads
+            Path(action["write"]).write_text(str(action["text"]))
+            script.log.append(f"wrote {action['write']}")
+            done = True
         elif "quit" in action:
             self._quit = True
             done = True
@@ -552,7 +556,9 @@ class App:
         from imgui_bundle import imgui
 
         imgui.text_wrapped(str(self.material_path))
-        if imgui.button("Reload (F5)"):
+        reload_clicked = imgui.button("Reload (F5)")
+        self._record("reload")
+        if reload_clicked:
             self.reload()
         if self.error:
             imgui.push_text_wrap_pos(0.0)
@@ -797,16 +803,11 @@ class App:
         if hovered and io.mouse_wheel:
             self.zoom = float(np.clip(self.zoom * (1.1 ** io.mouse_wheel), 1.0, 8.0))
 
-    # -- env (explorer/env.py, when present) ------------------------------------------------------------
+    # -- env (explorer/env.py) ------------------------------------------------------------
 
     def _make_env(self) -> None:
-        try:
-            from . import env  # noqa: F401  (built by another change; the mode appears when it exists)
+        from . import env
 
-            env.EnvironmentMap, env.ProgressiveEnvRender  # noqa: B018  (the API this mode uses)
-        except Exception:  # absent, or not the expected API: no env mode rather than no app
-            self.env = None
-            return
         self.env = env
 
     def _request_env(self, size) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -137,3 +138,26 @@ def test_parameter_sets_round_trip(tmp_path, bragg_material):
     (tmp_path / "bad.bparam").write_text("bparam x\n::begin parameters\nfloat n 1 1000 5000\n::end parameters\n")
     with pytest.raises(ParameterFileError, match=r"bad.bparam:3: parameter 'n'"):
         load_values(tmp_path / "bad.bparam", material)
+
+
+def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path, gl_renderer):
+    """A GLSL error on reload shows file:line in the UI and keeps drawing the last good material."""
+    good = (BRDF_DATA / "lambert.brdf").read_text()
+    material_path = tmp_path / "edited.brdf"
+    material_path.write_text(good)
+    broken = good.replace("return vec3(reflectance * (1/PI));", "return vec3(reflectance * (1/PI))  // a missing semicolon\n;;; oops")
+    assert broken != good
+    shot = tmp_path / "kept.png"
+    actions = [
+        {"wait": 2}, {"wait_complete": True},
+        {"write": str(material_path), "text": broken}, {"click": "reload"}, {"wait": 3},
+        {"wait_complete": True}, {"screenshot": str(shot)}, {"quit": True},
+    ]
+    _, report = run_session(x_display, material_path, actions, tmp_path)
+    assert "clicked reload" in report["script_log"], report["script_log"]
+    error = report["error"]
+    assert re.match(rf"{re.escape(str(material_path))}:\d+: ", error) and len(error.splitlines()) == 1, error
+    material = load_material(BRDF_DATA / "lambert.brdf")
+    headless = gl_renderer.render(material, material.resolve({}), "lit", 512, 512)
+    png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+    assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
