@@ -423,6 +423,9 @@ class App:
             if step == 0:
                 self._pending_window_shot = str(action["window_screenshot"])
             done = step > 0 and self._pending_window_shot is None
+        elif "focus" in action:  # bring a docked window's tab to the front, as a click on its tab does
+            self._focused_request = str(action["focus"])
+            done = True
         elif "write" in action:  # what a user's editor does to the material file between two reloads
             Path(action["write"]).write_text(str(action["text"]))
             script.log.append(f"wrote {action['write']}")
@@ -442,8 +445,11 @@ class App:
         io.add_mouse_pos_event(float(point[0]), float(point[1]))
 
     def _idle(self) -> bool:
-        main = self.jobs["main"]
-        return (main.complete or main.error is not None) and not self._dragging
+        """Nothing left to draw: the sphere, and the compare pair when it is on and shown."""
+        jobs = [self.jobs["main"]]
+        if self.compare["on"] and "Compare" in getattr(self, "_visible", ()):
+            jobs += [self.jobs["compare_a"], self.jobs["compare_b"]]
+        return all(job.complete or job.error is not None for job in jobs) and not self._dragging
 
     def _record(self, label: str) -> None:
         """Remember the last item's screen rectangle under ``label`` (for scripted input)."""

@@ -161,3 +161,24 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
     headless = gl_renderer.render(material, material.resolve({}), "lit", 512, 512)
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
+
+
+def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, bragg_material):
+    """Compare: spectral reference | improved approximation; the mean ΔE2000 shown is that of the two headless renders."""
+    from explorer.colorimetry import delta_E_2000
+    from explorer.render import view_cos_theta
+
+    actions = [
+        {"wait": 2}, {"wait_complete": True}, {"focus": "Compare"}, {"wait": 2}, {"click": "compare_on"},
+        {"wait": 2}, {"wait_complete": True, "timeout": 1200}, {"wait": 3}, {"quit": True},
+    ]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert "clicked compare_on" in report["script_log"], report["script_log"]
+    values = bragg_material.resolve(report["values"])
+    size = report["view_size"] // 2
+    reference = gl_renderer.render(bragg_material, {**values, "method": 0.0}, "sphere", size, size)
+    improved = gl_renderer.render(bragg_material, {**values, "method": 4.0}, "sphere", size, size)
+    inside = view_cos_theta("sphere", size, size)[1]
+    expected = float(np.mean(delta_E_2000(reference[inside].astype(np.float64), improved[inside].astype(np.float64))))
+    assert report["mean_delta_e"] == pytest.approx(expected, rel=1e-3), (report["mean_delta_e"], expected)
+    assert report["mean_delta_e"] > 0.01  # two different methods
