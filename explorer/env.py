@@ -342,7 +342,8 @@ def env_integral_numpy(
     progress: Callable[[int, int], None] | None = None,
 ) -> np.ndarray:
     """
-    The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, by a midpoint
+    The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel (plus a model's
+    Dirac reflection, ``model.mirror_reflection(V, N) L_e(reflect(-V, N))``, when it has one), by a midpoint
     rule over the environment's texels (:meth:`EnvironmentMap.quadrature`, each cell's exact solid
     angle, the bilinear radiance the shader reads).
 
@@ -395,6 +396,12 @@ def env_integral_numpy(
                 values[k] += np.sum(f * (cos_l[above, None] * weighted[start:start + QUADRATURE_BLOCK][above]), axis=0)
         if progress is not None:
             progress(k + 1, rows.size)
+    mirror = getattr(model, "mirror_reflection", None)
+    if mirror is not None:  # a Dirac (a smooth coating): its weight times the radiance of the mirror direction
+        hit = inside[rows, columns]
+        v, n = V[rows, columns][hit].astype(np.float64), N[rows, columns][hit].astype(np.float64)
+        reflected = 2.0 * np.sum(v * n, axis=-1, keepdims=True) * n - v
+        values[hit] += mirror(v, n) * environment.radiance(reflected)
     if pixels is not None:
         return values
     image = np.zeros((height, width, 3), dtype=np.float32)

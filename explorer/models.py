@@ -192,6 +192,12 @@ class BraggStackModel:
         X, Y, N = (np.asarray(a, dtype=np.float64) for a in (X, Y, N))
         return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables)
 
+    def mirror_reflection(self, V, N) -> np.ndarray:
+        """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
+        cos_theta = np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1)
+        F = layered.coating_reflectance(cos_theta, self.stack.n1) if self.stack.coating else np.zeros_like(cos_theta)
+        return np.repeat(np.asarray(F)[..., None], 3, axis=-1)
+
     def textures(self) -> dict[str, np.ndarray]:
         """
         ``stack_reflectance`` and ``stack_transmissivity``: ``(361, 471, 3)``, rows theta = k 0.25 deg,

@@ -588,3 +588,30 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
     np.testing.assert_allclose(banded.standard_error(), whole.standard_error(), rtol=1e-4, atol=1e-6)
     whole.release()
     banded.release()
+
+
+@pytest.mark.gl
+def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
+    """A coated stack whose layer is invisible (n2 = n1 = nh) and base black shows only the coating's Dirac: F Le(R)."""
+    from explorer.brd import load_material
+    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.models import model_for
+    from explorer.render import brdf_view_geometry
+
+    material = load_material(REPO_ROOT / "shaders" / "bragg_stack.brd")
+    values = material.resolve({"nh": 1.5, "n1_1": 1.5, "n2_1": 1.5, "rho_d": 0})
+    environment = EnvironmentMap.default()
+    render = ProgressiveEnvRender(gl_renderer, material, values, environment, 16, 16)
+    render.step(2)
+    image = render.image()
+    render.release()
+    _, V, N, _, _, inside, _ = brdf_view_geometry("lit", 16, 16)
+    v, n = V[inside].astype(np.float64), N[inside].astype(np.float64)
+    expected = model_for(material, values).mirror_reflection(v, n) * environment.radiance(2.0 * np.sum(v * n, -1, keepdims=True) * n - v)
+    assert expected.max() > 0.01
+    np.testing.assert_allclose(image[inside], expected, rtol=2e-3, atol=1e-5)
+    uncoated = material.resolve({**values, "coating": False})
+    render = ProgressiveEnvRender(gl_renderer, material, uncoated, environment, 16, 16)
+    render.step(2)
+    assert np.abs(render.image()).max() < 1e-6  # no coating, an invisible layer, a black base: black
+    render.release()

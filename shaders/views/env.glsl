@@ -17,6 +17,11 @@
 // reflected about V; the cosine lobe: Malley's method) and the sample divided by the mixture density
 // sum_k w_k pdf_k(L) + w_c cos theta_L / pi. Unbiased for any weights; the weights only change the variance.
 //
+// A Dirac reflection (a smooth coating, Eq. 34's f_r,0) cannot be sampled by directions; a material declares it
+//   #define HAS_MIRROR_REFLECTION
+//   vec3 mirror_reflection(vec3 V, vec3 N);  // its weight into reflect(-V, N)
+// and every sample adds mirror_reflection(V, N) Le(reflect(-V, N)) exactly (no variance).
+//
 // Environment: equirectangular, linear RGB, texture row 0 (v = 0) at the zenith +y (the sphere's screen
 // up), v = theta / pi with theta the angle from +y; the centre column u = 0.5 faces away from the viewer
 // (-z) and u = 0.75 is +x: u = 0.5 + atan(x, -z) / 2 pi. Both angles come from atan, not acos: Mesa's
@@ -74,6 +79,10 @@ void main() {
     }
 #endif
 
+    vec3 mirror = vec3(0.0);
+#ifdef HAS_MIRROR_REFLECTION
+    mirror = mirror_reflection(view, normal) * environment_radiance(reflect(-view, normal));
+#endif
     uvec2 pixel = uvec2(gl_FragCoord.xy);
     vec3 sum = vec3(0.0), square = vec3(0.0);
     float dropped = 0.0;
@@ -108,6 +117,7 @@ void main() {
                 value = BRDF(light, view, normal, tangent, bitangent) * (cos_light / pdf) * environment_radiance(light);
             }
         }
+        value += mirror;
         // A NaN or infinite sample (a material's BRDF out of its domain) would spoil the pixel for good:
         // it is dropped and counted, so the host can report it.
         if (any(isnan(value)) || any(isinf(value))) {
