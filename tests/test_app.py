@@ -182,3 +182,20 @@ def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, brag
     expected = float(np.mean(delta_E_2000(reference[inside].astype(np.float64), improved[inside].astype(np.float64))))
     assert report["mean_delta_e"] == pytest.approx(expected, rel=1e-3), (report["mean_delta_e"], expected)
     assert report["mean_delta_e"] > 0.01  # two different methods
+
+
+def test_bench_app_measures_drag_frames(x_display, tmp_path):
+    """``bench --app``: the harness drags Lambda through the UI per method and reports the frames that changed it."""
+    env = {**os.environ, "DISPLAY": x_display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
+    process = subprocess.run([sys.executable, "-m", "explorer.cli", "bench", "--app", "--json", "--size", "128"],
+                             cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert process.returncode == 0, process.stderr
+    document = json.loads(process.stdout)
+    rows = {row["method"]: row for row in document["rows"]}
+    assert set(rows) == {0, 1, 2, 3, 4} and document["size"] == 128
+    for row in rows.values():
+        assert row["frames"] >= 20, row  # the slider moved on most of the 60 drag frames
+        assert 0.0 < row["median_ms"] <= row["p90_ms"] <= row["max_ms"]
+        assert row["fps"] == pytest.approx(1e3 / row["median_ms"])
+        assert row["sphere_updates_per_s"] > 0.0, row  # the sphere followed the slider
+    assert rows[3]["while_dragging"] == "128x128 full"
