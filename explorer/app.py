@@ -7,7 +7,8 @@ headless renderer's views (:mod:`explorer.app_views`: the same programs, binding
 drawn progressively into offscreen textures shown in docked ImGui windows:
 
 * **Sphere**: ``lit`` (one directional light; orbit camera by left-drag, light by right-drag or the
-  sliders, zoom by the wheel) or ``sphere`` (white furnace; the mirror's reflectance);
+  sliders, zoom by the wheel), ``sphere`` (white furnace; the mirror's reflectance) or ``env``
+  (progressive Monte Carlo under the default sky, :mod:`explorer.env`);
 * **Compare**: a split sphere of two methods or two parameter sets (A | B), or their ΔE2000 heat-map;
 * **Strips**: Figure 4's θ gradient, one row per method; **Spectrum**: R_λ at one angle (Figure 3);
   **Polar**: the BRDF in the plane of incidence; **Slice** and **Scatter**: BRDF Explorer's views.

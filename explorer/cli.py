@@ -421,7 +421,7 @@ def accuracy(as_json, plot, strips):
 @cli.command("default", hidden=True)
 @_errors
 def default_job():
-    """Render the default mirror (the main job until the slider app exists)."""
+    """Render the default mirror to out/*.png: the main job where no display can show the app."""
     material = _load(DEFAULT_MATERIAL)
     values = material.resolve({"method": "3"})
     out = Path("out")
