@@ -12,9 +12,6 @@ samples that hit the sun) and z is not Gaussian at these sample counts. Seeds ar
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +25,7 @@ from explorer.env import (
     uniform_floats, uv_to_direction,
 )
 from explorer.render import brdf_view_geometry, rim_distance
+from test_cli import cli
 
 GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
@@ -501,11 +499,6 @@ def test_progressive_bookkeeping(gl_renderer, smooth):
 # -- the command line --------------------------------------------------------------------------------
 
 
-def cli(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
 
 
 def test_cli_bad_environment_input(tmp_path):
