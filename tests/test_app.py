@@ -199,3 +199,38 @@ def test_bench_app_measures_drag_frames(x_display, tmp_path):
         assert row["fps"] == pytest.approx(1e3 / row["median_ms"])
         assert row["sphere_updates_per_s"] > 0.0, row  # the sphere followed the slider
     assert rows[3]["while_dragging"] == "128x128 full"
+
+
+def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):
+    """Left-drag on the sphere orbits the camera: a Lambertian sphere is then lit from the light turned into view space."""
+    shot = tmp_path / "orbit.png"
+    actions = [
+        {"wait": 2}, {"wait_complete": True},
+        {"drag": "sphere_image", "from": 0.5, "to": 0.62, "frames": 6}, {"wait": 2},
+        {"wait_complete": True}, {"screenshot": str(shot)}, {"quit": True},
+    ]
+    _, report = run_session(x_display, BRDF_DATA / "lambert.brdf", actions, tmp_path)
+    yaw, pitch = report["camera"]
+    assert abs(yaw) > 1.0, report["camera"]  # the drag turned the camera
+    # The world light (theta, phi) turned by pitch about x after yaw about y: rotations written out here.
+    theta, phi = np.radians(report["light"])
+    light = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+    a, b = np.radians(yaw), np.radians(pitch)
+    about_y = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    about_x = np.array([[1, 0, 0], [0, np.cos(b), -np.sin(b)], [0, np.sin(b), np.cos(b)]])
+    turned = about_x @ about_y @ light  # the app's convention: pitch about x after yaw about y
+    backwards = (about_x @ about_y).T @ light  # the opposite turn, which must not match
+    # Lambert in the lit view: reflectance / pi * max(0, N.L) on the orthographic sphere.
+    size = report["view_size"]
+    x = 2.0 * (np.arange(size) + 0.5) / size - 1.0
+    X, Y = np.meshgrid(x, -x)
+    inside = X**2 + Y**2 < 0.98
+    normal = np.stack([X, Y, np.sqrt(np.maximum(1.0 - X**2 - Y**2, 0.0))], axis=-1)
+    png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+
+    def lambert(direction):
+        return encode_srgb8(np.repeat((0.8 / np.pi * np.maximum(normal @ direction, 0.0))[..., None], 3, -1)).astype(int)
+
+    assert np.abs(png[inside] - lambert(turned)[inside]).max() <= 2
+    assert np.abs(png[inside] - lambert(backwards)[inside]).max() > 10
+    assert np.abs(png[inside] - lambert(light)[inside]).max() > 10  # nor the unturned light
