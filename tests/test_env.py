@@ -608,3 +608,22 @@ def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     render.step(2)
     assert np.abs(render.image()).max() < 1e-6  # no coating, an invisible layer, a black base: black
     render.release()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("declaration", ["const float PI = 3.14159265358979323846;", "#define PI 3.14159265358979323846"])
+def test_brdf_explorer_pi_does_not_clash_with_the_library(gl_renderer, tmp_path, declaration):
+    """BRDF Explorer files declare PI (a const or a macro) before the env view includes the GGX library."""
+    from conftest import BRDF_DATA
+    from explorer.env import EnvironmentMap
+
+    text = (BRDF_DATA / "lambert.brdf").read_text()
+    assert "const float PI = 3.14159265358979323846;" in text
+    path = tmp_path / "lambert_pi.brdf"
+    path.write_text(text.replace("const float PI = 3.14159265358979323846;", declaration))
+    material, values = load(path)
+    render = ProgressiveEnvRender(gl_renderer, material, values, EnvironmentMap.default(), 8, 8)
+    render.step(4)
+    image = render.image()
+    render.release()
+    assert np.isfinite(image).all() and image.max() > 0.0

@@ -1,7 +1,11 @@
 // Complex arithmetic on vec2 (x = real part, y = imaginary part).
 // Waves travel as exp(+i k z), as in explorer/fresnel.py.
 
-const float PI = 3.14159265358979;
+// A macro, not a constant: a material's code precedes the library in a program, and BRDF Explorer's files
+// declare their own PI (a const, which this later #define leaves alone, or a #define, which it keeps).
+#ifndef PI
+#define PI 3.14159265358979
+#endif
 
 vec2 cmul(vec2 a, vec2 b) { return vec2(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x); }
 vec2 cconj(vec2 a) { return vec2(a.x, -a.y); }

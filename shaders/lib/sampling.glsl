@@ -1,12 +1,8 @@
 // Monte Carlo sampling for the env view (shaders/views/env.glsl): a hash for random numbers, cosine and
 // GGX visible-normal sampling and their densities. Twins: explorer/microfacet.py (sample_ggx_visible_normal,
 // ggx_visible_normal_pdf, ggx_reflection_pdf) and explorer/env.py (pcg4d, sample_cosine_hemisphere).
-// Self-contained on purpose: the material comes first in the program and may define PI (BRDF Explorer's
-// files do) or include lib/microfacet.glsl, so every name here is new (GGX's D and G1 are repeated as
-// sampling_ggx_D and sampling_G1_over_cos, Eqs. 18-19, the same expressions as lib/microfacet.glsl).
-
-const float SAMPLING_PI = 3.14159265358979;
-const float SAMPLING_ALPHA_MIN = 1e-6;
+// GGX's D and G1 come from lib/microfacet.glsl (its PI is a macro that a material's own PI does not clash with).
+#include "lib/microfacet.glsl"
 
 // PCG4D (Jarzynski & Olano 2020, Hash Functions for GPU Rendering, JCGT 9(3)): four well-mixed 32-bit
 // words from four inputs (pixel x, pixel y, sample, seed).
@@ -33,34 +29,19 @@ void sampling_basis(vec3 n, out vec3 t, out vec3 b) {
 
 // Cosine-distributed direction about +z (Malley's method): density cos(theta) / pi.
 vec3 sample_cosine_hemisphere(vec2 u) {
-    float r = sqrt(u.x), phi = 2.0 * SAMPLING_PI * u.y;
+    float r = sqrt(u.x), phi = 2.0 * PI * u.y;
     return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
-}
-
-// Eq. 18 (as ggx_D in lib/microfacet.glsl).
-float sampling_ggx_D(float cos_theta_m, float alpha) {
-    if (cos_theta_m <= 0.0) return 0.0;
-    float a2 = max(alpha, SAMPLING_ALPHA_MIN) * max(alpha, SAMPLING_ALPHA_MIN), c = min(cos_theta_m, 1.0);
-    float denominator = a2 * c * c + (1.0 - c) * (1.0 + c);
-    return a2 / (SAMPLING_PI * denominator * denominator);
-}
-
-// Eq. 19 over cos (as smith_G1_over_cos in lib/microfacet.glsl).
-float sampling_G1_over_cos(float cos_theta, float alpha) {
-    if (cos_theta <= 0.0) return 0.0;
-    float a = max(alpha, SAMPLING_ALPHA_MIN), c = min(cos_theta, 1.0);
-    return 2.0 / (c + sqrt(c * c + a * a * (1.0 - c * c)));
 }
 
 // A GGX normal visible from v (local frame, n = +z, v.z > 0): Heitz 2018, Sampling the GGX Distribution of
 // Visible Normals, JCGT 7(4), Listing 1. Density: ggx_visible_normal_pdf.
 vec3 sample_ggx_visible_normal(vec3 v, float alpha, vec2 u) {
-    float a = max(alpha, SAMPLING_ALPHA_MIN);
+    float a = max(alpha, ALPHA_MIN);
     vec3 vh = normalize(vec3(a * v.x, a * v.y, v.z));
     float lensq = vh.x * vh.x + vh.y * vh.y;
     vec3 t1_axis = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(lensq) : vec3(1.0, 0.0, 0.0);
     vec3 t2_axis = cross(vh, t1_axis);
-    float r = sqrt(u.x), phi = 2.0 * SAMPLING_PI * u.y;
+    float r = sqrt(u.x), phi = 2.0 * PI * u.y;
     float t1 = r * cos(phi), t2 = r * sin(phi);
     float s = 0.5 * (1.0 + vh.z);
     t2 = (1.0 - s) * sqrt(max(0.0, 1.0 - t1 * t1)) + s * t2;
@@ -70,7 +51,7 @@ vec3 sample_ggx_visible_normal(vec3 v, float alpha, vec2 u) {
 
 // D_v(m) = G1(v) max(0, v.m) D(m) / v.n (Heitz 2018, Eq. 1), local frame.
 float ggx_visible_normal_pdf(vec3 v, vec3 m, float alpha) {
-    return sampling_G1_over_cos(v.z, alpha) * max(0.0, dot(v, m)) * sampling_ggx_D(m.z, alpha);
+    return smith_G1_over_cos(v.z, alpha) * max(0.0, dot(v, m)) * ggx_D(m.z, alpha);
 }
 
 // Density of l = reflect(-v, m), m ~ D_v, about the unit normal N (any frame): D_v(h) / (4 v.h) =
@@ -83,5 +64,5 @@ float ggx_reflection_pdf(vec3 l, vec3 v, vec3 N, float alpha) {
     float norm = length(s);
     if (norm <= 1e-12) return 0.0;
     vec3 h = s / norm;
-    return 0.25 * sampling_G1_over_cos(dot(v, N), alpha) * sampling_ggx_D(dot(h, N), alpha);
+    return 0.25 * smith_G1_over_cos(dot(v, N), alpha) * ggx_D(dot(h, N), alpha);
 }

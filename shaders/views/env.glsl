@@ -40,8 +40,8 @@ layout(location = 0) out vec4 sum_out;
 layout(location = 1) out vec4 square_out;
 
 vec3 environment_radiance(vec3 d) {
-    float u = 0.5 + atan(d.x, -d.z) * (0.5 / SAMPLING_PI);
-    float v = atan(length(d.xz), d.y) * (1.0 / SAMPLING_PI);
+    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI);
+    float v = atan(length(d.xz), d.y) * (1.0 / PI);
     return textureLod(environment, vec2(u, v), 0.0).rgb;
 }
 
@@ -109,7 +109,7 @@ void main() {
         float cos_light = dot(normal, light);
         vec3 value = vec3(0.0);
         if (cos_light > 0.0) {
-            float pdf = cosine_weight * cos_light * (1.0 / SAMPLING_PI);
+            float pdf = cosine_weight * cos_light * (1.0 / PI);
             for (int j = 0; j < 4; ++j) {
                 if (weights[j] > 0.0) pdf += weights[j] * ggx_reflection_pdf(light, view, normal, alphas[j]);
             }
