@@ -18,6 +18,22 @@ BRAGG_MATERIAL = REPO_ROOT / "shaders" / "bragg_mirror.brd"
 BRDF_DATA = REPO_ROOT / "tests" / "data" / "brdf"
 
 
+#: How every CLI error line begins.
+CLI_ERROR_PREFIX = "bragg-explorer: error: "
+
+
+def one_line_error(run) -> str:
+    """
+    Assert that a CLI run (anything with ``returncode``, ``stdout``, ``stderr``) failed with exactly one
+    line on stderr, prefixed :data:`CLI_ERROR_PREFIX`, and no traceback; returns that line.
+    """
+    assert run.returncode != 0, run.stderr
+    assert "Traceback" not in run.stderr + run.stdout, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(CLI_ERROR_PREFIX), run.stderr
+    return lines[0]
+
+
 def running_in_ci() -> bool:
     """True when the environment variable CI is "true" (GitHub Actions, GitLab CI and most others)."""
     return os.environ.get("CI", "").strip().lower() == "true"

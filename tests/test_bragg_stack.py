@@ -9,23 +9,19 @@ test_layered.py.
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT
+from conftest import REPO_ROOT, one_line_error
 from explorer import bragg, colorimetry, layered
 from explorer.brd import load_material
 from explorer.models import BraggStackModel, model_for
 from explorer.render import render_numpy, rim_distance
 from test_bragg_layer import directions
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
+from test_cli import cli
 
 STACK_MATERIAL = REPO_ROOT / "shaders" / "bragg_stack.brd"
-PREFIX = "bragg-explorer: error: "
 #: The slice view's last row and column reach theta_h, theta_d = 89 deg, where float32 directions lose
 #: ~5e-3 of Eq. 17's value (G1 / cos and D at grazing angles): those pixels get this tolerance.
 GRAZING_RTOL = 1e-2
@@ -158,20 +154,9 @@ def test_no_nan_or_inf_over_a_sweep(stack_material):
         assert np.isfinite(model.reflectance(np.linspace(0.0, 1.0, 9))).all(), values
 
 
-def run_cli(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
-        timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
-
-
 @pytest.mark.parametrize("assignment, named", [("layers=4", "layers"), ("alpha_2=-0.1", "alpha_2"), ("alpha_1=1.5", "alpha_1")])
 def test_bad_parameters_are_one_line(tmp_path, assignment, named):
     out = tmp_path / "x.png"
-    run = run_cli("render", "shaders/bragg_stack.brd", "--view", "lit", "--set", assignment, "--size", "8", "--out", out)
-    assert run.returncode != 0
-    assert "Traceback" not in run.stderr + run.stdout
-    lines = run.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(PREFIX), run.stderr
-    assert named in lines[0]
+    run = cli("render", "shaders/bragg_stack.brd", "--view", "lit", "--set", assignment, "--size", "8", "--out", out)
+    assert named in one_line_error(run)
     assert not out.exists()
