@@ -160,3 +160,53 @@ def test_bad_parameters_are_one_line(tmp_path, assignment, named):
     run = cli("render", "shaders/bragg_stack.brd", "--view", "lit", "--set", assignment, "--size", "8", "--out", out)
     assert named in one_line_error(run)
     assert not out.exists()
+
+
+PROBE_COLUMNS = 64
+#: The material's sampling hook at V = (sin theta, 0, cos theta), N = +z, cos theta = (i + 0.5) / width.
+HOOK_PROBE = """
+layout(location = 0) out vec4 refl_out;
+void main() {
+    float c = gl_FragCoord.x / float(PROBE_COLUMNS);
+    vec3 V = vec3(sqrt(1.0 - c * c), 0.0, c), N = vec3(0.0, 0.0, 1.0);
+    vec4 alphas, weights;
+    float base = sampling_lobes(V, N, alphas, weights);
+    refl_out = vec4(weights.xyz, base);
+}
+"""
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)"])
+def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, case):
+    """The GLSL layer choice (sampling_lobes) equals explorer.layered.layer_choice_probabilities (Eqs. 31, 35)."""
+    from explorer.gl import SHADER_DIR, VERTEX_SHADER
+    from explorer.glsl import ShaderBuilder
+
+    values = stack_material.resolve(CASES[case])
+    builder = ShaderBuilder(include_dirs=[SHADER_DIR])
+    builder.define("PROBE_COLUMNS", PROBE_COLUMNS)
+    builder.add_source(stack_material.uniform_declarations(), "parameters")
+    builder.add_source(stack_material.shader, str(stack_material.path), stack_material.shader_line)
+    builder.add_source(HOOK_PROBE, "probe")
+    ctx = gl_renderer.ctx
+    program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=builder.build().code)
+    target = ctx.renderbuffer((PROBE_COLUMNS, 1), 4, dtype="f4")
+    framebuffer = ctx.framebuffer(color_attachments=[target])
+    try:
+        gl_renderer.bind(program, stack_material, values)
+        framebuffer.use()
+        ctx.vertex_array(program, []).render(vertices=3)
+        got = np.frombuffer(framebuffer.read(components=4, dtype="f4"), np.float32).reshape(PROBE_COLUMNS, 4)
+    finally:
+        framebuffer.release()
+        target.release()
+        program.release()
+    model = model_for(stack_material, values)
+    cos_theta = (np.arange(PROBE_COLUMNS) + 0.5) / PROBE_COLUMNS
+    p_refl, p_base = layered.layer_choice_probabilities(model.stack, cos_theta, model.tables)
+    expected = np.zeros((PROBE_COLUMNS, 3))
+    expected[:, : p_refl.shape[1]] = p_refl
+    np.testing.assert_allclose(got[:, :3], expected, atol=2e-5)
+    np.testing.assert_allclose(got[:, 3], p_base * max(model.stack.rho_d), atol=2e-5)
+    assert expected[:, 0].min() > 0.0
