@@ -13,8 +13,9 @@ Set-up is idempotent and cheap the second time:
    ``stat`` calls and installed with ``apt-get`` (through ``sudo -n`` when not root)
    only when missing;
 2. a virtual environment ``.venv/`` at the repository root receives
-   ``pip install -e .`` (or ``.[test]``); a stamp file in it records a hash of
-   ``pyproject.toml``, the Python version and the extras, and pip is skipped
+   ``pip install -e .`` (or ``.[test]``) constrained to the tested versions of
+   ``explorer/constraints.txt``; a stamp file in it records a hash of
+   ``pyproject.toml``, the constraints, the Python version and the extras, and pip is skipped
    while the stamp matches;
 3. the venv's interpreter is ``exec``'d, so signals and exit codes pass
    straight through.
@@ -48,6 +49,8 @@ PYPROJECT = REPO_ROOT / "pyproject.toml"
 STAMP_NAME = ".bragg-explorer-setup.json"
 PIP_LOG_NAME = ".bragg-explorer-pip.log"
 LOCK_PATH = REPO_ROOT / ".venv.lock"
+#: The tested versions (``pip install -c``): a fresh machine gets what the tests passed with.
+CONSTRAINTS = Path(__file__).resolve().parent / "constraints.txt"
 
 MIN_PYTHON = (3, 10)  # pyproject.toml: requires-python = ">=3.10"
 
@@ -414,9 +417,9 @@ def python_tag(version_info: Sequence[int] = tuple(sys.version_info[:2]),
     return f"{implementation}-{version_info[0]}.{version_info[1]}"
 
 
-def stamp_key(pyproject_text: bytes, python: str, venv_dir: str) -> str:
+def stamp_key(pyproject_text: bytes, python: str, venv_dir: str, constraints_text: bytes = b"") -> str:
     h = hashlib.sha256()
-    for part in (pyproject_text, python.encode(), os.fsencode(venv_dir)):
+    for part in (pyproject_text, python.encode(), os.fsencode(venv_dir), constraints_text):
         h.update(len(part).to_bytes(8, "little"))
         h.update(part)
     return h.hexdigest()
@@ -483,10 +486,11 @@ def in_venv(venv_dir: Path = VENV_DIR) -> bool:
         return False
 
 
-def pip_install_command(python: str, extras: Sequence[str]) -> list[str]:
+def pip_install_command(python: str, extras: Sequence[str], constraints: Path | None = None) -> list[str]:
     target = "." if not extras else f".[{','.join(sorted(extras))}]"
+    pinned = ["-c", str(constraints)] if constraints is not None else []
     return [python, "-m", "pip", "install", "--disable-pip-version-check", "--no-input",
-            "-e", target]
+            *pinned, "-e", target]
 
 
 def venv_package_for(version_info: Sequence[int] = tuple(sys.version_info[:2])) -> str:
@@ -524,7 +528,7 @@ def create_venv(venv_dir: Path, clear: bool) -> None:
 
 
 def pip_install(python: str, extras: Sequence[str], log_path: Path) -> None:
-    cmd = pip_install_command(python, extras)
+    cmd = pip_install_command(python, extras, CONSTRAINTS if CONSTRAINTS.exists() else None)
     with open(log_path, "w") as fh:
         fh.write("$ " + " ".join(cmd) + "\n")
         fh.flush()
@@ -568,7 +572,8 @@ def current_key() -> str:
         text = PYPROJECT.read_bytes()
     except OSError as exc:
         raise SetupError(f"[setup] error: cannot read {PYPROJECT}: {exc.strerror}") from None
-    return stamp_key(text, python_tag(), str(VENV_DIR))
+    constraints = CONSTRAINTS.read_bytes() if CONSTRAINTS.exists() else b""
+    return stamp_key(text, python_tag(), str(VENV_DIR), constraints)
 
 
 def ensure_python_packages(extras: Sequence[str], inside: bool) -> bool:

@@ -59,6 +59,38 @@ def test_pip_command_with_and_without_extras():
     assert bs.pip_install_command("py", ["test", "docs"])[-1] == ".[docs,test]"
 
 
+def test_pip_command_pins_the_tested_versions():
+    command = bs.pip_install_command("py", ("test",), bs.CONSTRAINTS)
+    assert command[-4:] == ["-c", str(bs.CONSTRAINTS), "-e", ".[test]"]
+
+
+def test_constraints_pin_every_requirement_exactly():
+    """Each dependency of pyproject.toml (and the test extra) has one exact pin in the constraints."""
+    import tomllib
+
+    from packaging.requirements import Requirement
+
+    project = tomllib.loads(bs.PYPROJECT.read_text())["project"]
+    wanted = project["dependencies"] + project["optional-dependencies"]["test"]
+    pins = {}
+    for line in bs.CONSTRAINTS.read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            requirement = Requirement(line)
+            assert len(requirement.specifier) == 1 and next(iter(requirement.specifier)).operator == "=="
+            pins[requirement.name.lower()] = requirement
+    for text in wanted:
+        requirement = Requirement(text)
+        pin = pins[requirement.name.lower()]
+        version = next(iter(pin.specifier)).version
+        assert requirement.specifier.contains(version), (text, version)  # the pin satisfies pyproject
+
+
+def test_stamp_invalidated_by_constraints():
+    key = bs.stamp_key(PYPROJECT, "cpython-3.11", "/r/.venv", b"numpy==2.4.6\n")
+    stamp = bs.make_stamp(key, [])
+    assert not bs.stamp_matches(stamp, bs.stamp_key(PYPROJECT, "cpython-3.11", "/r/.venv", b"numpy==2.4.7\n"), ())
+
+
 def test_child_environment_activates_venv():
     env = bs.child_environment({"PATH": "/usr/bin:/bin", "PYTHONHOME": "/x"}, Path("/r/.venv"))
     assert env["PATH"].split(":") == ["/r/.venv/bin", "/usr/bin", "/bin"]
@@ -136,6 +168,7 @@ def _fake_repo(tmp_path, monkeypatch, stamp_extras):
     monkeypatch.setattr(bs, "VENV_DIR", venv)
     monkeypatch.setattr(bs, "PYPROJECT", tmp_path / "pyproject.toml")
     monkeypatch.setattr(bs, "LOCK_PATH", tmp_path / ".venv.lock")
+    monkeypatch.setattr(bs, "CONSTRAINTS", tmp_path / "constraints.txt")  # none: no pins
     key = bs.stamp_key(PYPROJECT, bs.python_tag(), str(venv))
     bs.write_stamp(venv / bs.STAMP_NAME, bs.make_stamp(key, stamp_extras))
     calls = []

@@ -12,6 +12,9 @@ from explorer import colorimetry, luts
 
 #: Sums of up to 471 CMF values against the cumulative table's differences.
 CUMULATIVE_ATOL = 1e-12
+#: A table regenerated on another machine (CPU, numpy, libm) against the committed one: sums of 471
+#: products differ in their last bits (~1e-15 measured); the tables hold values of order 1.
+REGENERATED_ATOL = 1e-12
 NAMES = sorted(luts.TABLES)
 
 
@@ -35,13 +38,13 @@ def test_committed_tables_are_up_to_date(name):
     manifest = json.loads((luts.LUT_DIR / luts.MANIFEST).read_text())["tables"][name]
     assert list(table.shape) == manifest["shape"] == luts.TABLES[name]["spec"]["shape"]
     assert "colour-science" in manifest["source"]
-    # And they are what the generator writes today.
-    np.testing.assert_array_equal(table, luts.TABLES[name]["generate"]())
+    # And they are what the generator writes today, to rounding: never bit for bit across machines.
+    np.testing.assert_allclose(table, luts.TABLES[name]["generate"](), rtol=0, atol=REGENERATED_ATOL)
 
 
 def test_committed_tables_content():
     cmf = committed("cmf_1nm")
-    np.testing.assert_array_equal(cmf, colorimetry.colour_matching_functions())
+    np.testing.assert_allclose(cmf, colorimetry.colour_matching_functions(), rtol=0, atol=REGENERATED_ATOL)
     cumulative = committed("cmf_cumulative")
     np.testing.assert_array_equal(cumulative[0], 0.0)
     np.testing.assert_allclose(cumulative[1:], np.cumsum(cmf, axis=0), rtol=0, atol=CUMULATIVE_ATOL)
@@ -87,10 +90,10 @@ def test_stale_table_is_reported_and_regenerated(lut_copy, name, alteration):
     messages = []
     table = luts.load(name, lut_copy, log=messages.append)
     assert len(messages) == 1 and name in messages[0] and reason in messages[0]
-    np.testing.assert_array_equal(table, committed(name))
+    np.testing.assert_allclose(table, committed(name), rtol=0, atol=REGENERATED_ATOL)
     # Regenerated on disk, with a manifest entry that makes it current again.
     assert luts.staleness(name, lut_copy) is None
-    np.testing.assert_array_equal(np.load(lut_copy / f"{name}.npy"), committed(name))
+    np.testing.assert_array_equal(np.load(lut_copy / f"{name}.npy"), table)
     # Loading again uses it silently.
     assert luts.load(name, lut_copy, log=messages.append) is table and len(messages) == 1
     assert not table.flags.writeable
@@ -101,7 +104,7 @@ def test_untouched_copy_loads_silently(lut_copy):
         messages = []
         table = luts.load(name, lut_copy, log=messages.append)
         assert messages == []
-        np.testing.assert_array_equal(table, committed(name))
+        np.testing.assert_array_equal(table, committed(name))  # the same file, read back
 
 
 def test_stale_table_in_unwritable_place_is_used_from_memory(tmp_path):
@@ -111,7 +114,7 @@ def test_stale_table_in_unwritable_place_is_used_from_memory(tmp_path):
     messages = []
     table = luts.load("cmf_cumulative", blocker / "luts", log=messages.append)
     assert len(messages) == 1 and "cmf_cumulative" in messages[0]
-    np.testing.assert_array_equal(table, committed("cmf_cumulative"))
+    np.testing.assert_allclose(table, committed("cmf_cumulative"), rtol=0, atol=REGENERATED_ATOL)
 
 
 # --------------------------------------------------------------------------------------------------
