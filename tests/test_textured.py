@@ -97,7 +97,9 @@ def test_large_variance_leaves_the_fringe_average():
 def test_default_texture_is_its_generator():
     from explorer.thickness import DEFAULT_TEXTURE, generate_default_texture, load_grey
 
-    np.testing.assert_array_equal(np.round(load_grey(DEFAULT_TEXTURE) * 255.0), generate_default_texture())
+    # To one grey level: a value that rounds on .5 may go either way on another machine's arithmetic.
+    shipped = np.round(load_grey(DEFAULT_TEXTURE) * 255.0)
+    np.testing.assert_allclose(shipped, generate_default_texture(), rtol=0, atol=1)
 
 
 def test_footprint_moments_of_a_constant_and_of_a_checkerboard():
