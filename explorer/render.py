@@ -170,9 +170,11 @@ def view_brdf(brdf, L, V, N, X, Y, *per_direction) -> np.ndarray:
     the arguments: float32, as in the shaders); elsewhere the value is 0. A channel that is NaN or
     infinite counts as 0; a finite negative channel is kept (linear sRGB is negative outside the gamut).
 
-    This is BRDF Explorer's convention made explicit. Its lit sphere evaluates the BRDF on the dark
-    side too and clamps ``max(BRDF, 0)`` before the cosine, but ``pow(N.L N.V, k - 1)`` (Minnaert) or
-    ``sqrt(N.L N.V)`` (Ward) is NaN there, NaN times 0 is NaN, and GLSL leaves ``max(NaN, 0)`` undefined.
+    BRDF Explorer's lit sphere (``brdftemplatesphere.frag``) evaluates the BRDF on the dark side too,
+    clamps ``max(BRDF, 0)`` and multiplies by the cosine; but ``pow(N.L N.V, k - 1)`` (Minnaert) or
+    ``sqrt(N.L N.V)`` (Ward) is NaN there, NaN times 0 is NaN, and GLSL leaves ``max(NaN, 0)``
+    undefined: hence the explicit domain and test. Unlike it, negative channels are not clamped: they
+    are the out-of-gamut colours of vivid spectra (and what the app's gamut overlay shows).
 
     Returns
     -------
