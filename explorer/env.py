@@ -342,7 +342,8 @@ def env_integral_numpy(
     progress: Callable[[int, int], None] | None = None,
 ) -> np.ndarray:
     """
-    The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel (plus a model's
+    The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
+    views' rule (:func:`explorer.render.view_brdf`: 0 below the surface, NaN or infinite channels 0; plus a model's
     Dirac reflection, ``model.mirror_reflection(V, N) L_e(reflect(-V, N))``, when it has one), by a midpoint
     rule over the environment's texels (:meth:`EnvironmentMap.quadrature`, each cell's exact solid
     angle, the bilinear radiance the shader reads).
@@ -367,7 +368,7 @@ def env_integral_numpy(
     ndarray
         ``(P, 3)`` float64 for ``pixels`` (0 outside the disc), else the ``(height, width, 3)`` float32 image.
     """
-    from .render import brdf_view_geometry
+    from .render import brdf_view_geometry, view_brdf
 
     _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:
@@ -392,7 +393,7 @@ def env_integral_numpy(
                 if not above.any():
                     continue
                 L = block[above]
-                f = np.asarray(model.brdf(L, *(np.broadcast_to(a, L.shape) for a in frame)), dtype=np.float64)
+                f = view_brdf(model.brdf, L, *(np.broadcast_to(a, L.shape) for a in frame))
                 values[k] += np.sum(f * (cos_l[above, None] * weighted[start:start + QUADRATURE_BLOCK][above]), axis=0)
         if progress is not None:
             progress(k + 1, rows.size)
@@ -422,7 +423,8 @@ class ProgressiveEnvRender:
     Progressive Monte Carlo rendering of the env view on the GPU (``shaders/views/env.glsl``).
 
     Samples accumulate in two float32 RGBA textures by additive blending: the sum of the samples (and
-    their count, alpha) and the sum of their squares (and the non-finite samples dropped, alpha);
+    their count, alpha) and the sum of their squares (and, alpha, the samples whose BRDF was NaN or
+    infinite, counted as 0);
     :meth:`image` divides by :attr:`samples`, :meth:`standard_error` is the per-pixel standard error
     of that mean. Random numbers hash (pixel, sample index, seed): a render is reproducible, the same
     however its samples are split into passes.
@@ -628,7 +630,7 @@ class ProgressiveEnvRender:
         return np.sqrt(variance / n).astype(np.float32)
 
     def dropped_samples(self) -> int:
-        """Samples dropped because the material's BRDF returned NaN or infinity (0 for a sound material)."""
+        """Samples where the material's BRDF returned NaN or infinity, counted as 0 (0 for a sound material)."""
         return int(round(float(self.sums()[3].sum())))
 
     def release(self) -> None:
@@ -670,7 +672,7 @@ def render_env(
                 progress(render.samples, spp)
         dropped = render.dropped_samples()
         if dropped and warn is not None:
-            warn(f"{dropped} samples dropped: the material's BRDF returned NaN or infinity there")
+            warn(f"{dropped} samples counted as 0: the material's BRDF returned NaN or infinity there")
         return render.image()
     finally:
         render.release()

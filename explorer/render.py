@@ -6,7 +6,9 @@ evaluate the material at the same angle; the physics then runs in float64.
 
 ``gradient`` and ``sphere`` show a material's ``reflectance(cos_theta)``; ``lit``, ``slice`` and
 ``scatter`` call its ``BRDF(L, V, N, X, Y)`` (any material of the format, BRDF Explorer's own files
-included), whose numpy twin is the model's ``brdf(L, V, N, X, Y) -> (..., 3)``.
+included), whose numpy twin is the model's ``brdf(L, V, N, X, Y) -> (..., 3)``, under one rule
+(:func:`view_brdf`, ``shaders/lib/views.glsl``): 0 unless ``N.L > 0`` and ``N.V > 0``, a NaN or
+infinite channel 0.
 """
 
 from __future__ import annotations
@@ -146,6 +148,49 @@ def brdf_view_geometry(view: str, width: int, height: int, light: tuple[float, f
     raise ValueError(f"{view!r} is not a BRDF view ({', '.join(BRDF_VIEWS)})")
 
 
+def above_surface(L, V, N) -> np.ndarray:
+    """``N.L > 0`` and ``N.V > 0`` for vectors ``(..., 3)``, in their own precision (the shaders': float32)."""
+    return (np.sum(N * L, axis=-1) > 0) & (np.sum(N * V, axis=-1) > 0)
+
+
+def finite_or_zero(f) -> np.ndarray:
+    """``f`` as float64 with its NaN and infinite entries set to 0 (finite negative entries kept)."""
+    f = np.array(f, dtype=np.float64)
+    f[~np.isfinite(f)] = 0.0
+    return f
+
+
+def view_brdf(brdf, L, V, N, X, Y, *per_direction) -> np.ndarray:
+    """
+    A material's BRDF as every view evaluates it (the twin of ``view_brdf`` in ``shaders/lib/views.glsl``).
+
+    ``brdf(L, V, N, X, Y, *per_direction)`` (a model's ``brdf``, or ``textured_brdf`` with the per-pixel
+    D_inc and its spread as ``per_direction``) is evaluated in float64 only where the light and the
+    view are both strictly above the surface, ``N.L > 0`` and ``N.V > 0`` (decided in the precision of
+    the arguments: float32, as in the shaders); elsewhere the value is 0. A channel that is NaN or
+    infinite counts as 0; a finite negative channel is kept (linear sRGB is negative outside the gamut).
+
+    BRDF Explorer's lit sphere (``brdftemplatesphere.frag``) evaluates the BRDF on the dark side too,
+    clamps ``max(BRDF, 0)`` and multiplies by the cosine; but ``pow(N.L N.V, k - 1)`` (Minnaert) or
+    ``sqrt(N.L N.V)`` (Ward) is NaN there, NaN times 0 is NaN, and GLSL leaves ``max(NaN, 0)``
+    undefined: hence the explicit domain and test. Unlike it, negative channels are not clamped: they
+    are the out-of-gamut colours of vivid spectra (and what the app's gamut overlay shows).
+
+    Returns
+    -------
+    ndarray
+        ``(..., 3)`` float64, finite.
+    """
+    above = above_surface(*(np.asarray(a) for a in (L, V, N)))
+    result = np.zeros(above.shape + (3,))
+    if above.any():
+        arguments = [np.broadcast_to(np.asarray(a, dtype=np.float64), above.shape + (3,))[above] for a in (L, V, N, X, Y)]
+        extra = [np.broadcast_to(np.asarray(a), above.shape)[above] for a in per_direction]
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # the material's NaN become 0 below
+            result[above] = finite_or_zero(brdf(*arguments, *extra))
+    return result
+
+
 def scatter_circles(width: int, height: int) -> np.ndarray:
     """The pixels (bool ``(height, width)``) of the scatter view's 5, 30, 60 and 90 degree circles."""
     x = 2.0 * (np.arange(width) + 0.5) / width - 1.0
@@ -187,17 +232,21 @@ def render_numpy(
         x, y, _ = _disc(width, height)
         d_inc, sigma = thickness.per_pixel(x, y, width, height)
         image = np.zeros((height, width, 3), dtype=np.float32)
-        vectors = [a[inside].astype(np.float64) for a in (L, V, N, X, Y)]
-        rgb = model.textured_brdf(*vectors, d_inc[inside], sigma[inside], thickness.prefilter)
-        image[inside] = np.asarray(rgb, dtype=np.float64) * factor[inside][:, None]
+        vectors = [a[inside] for a in (L, V, N, X, Y)]
+
+        def textured_brdf(L, V, N, X, Y, d_inc, sigma):
+            return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter)
+
+        rgb = view_brdf(textured_brdf, *vectors, d_inc[inside], sigma[inside])
+        image[inside] = rgb * factor[inside][:, None]
         return image
     if view in BRDF_VIEWS:
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the {view} view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
         L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
         image = np.zeros((height, width, 3), dtype=np.float32)
-        vectors = [a[inside].astype(np.float64) for a in (L, V, N, X, Y)]
-        image[inside] = np.asarray(model.brdf(*vectors), dtype=np.float64) * factor[inside][:, None]
+        vectors = [a[inside] for a in (L, V, N, X, Y)]
+        image[inside] = view_brdf(model.brdf, *vectors) * factor[inside][:, None]
         return image
     cos_theta, inside = view_cos_theta(view, width, height)
     image = np.zeros((height, width, 3), dtype=np.float32)

@@ -25,6 +25,16 @@ def _half_vector(L, V) -> np.ndarray:
     return H / np.linalg.norm(H, axis=-1, keepdims=True)
 
 
+def glsl_pow(x, y) -> np.ndarray:
+    """
+    GLSL's ``pow(x, y)`` as GPUs compute it, ``exp2(y log2(x))``: NaN for ``x < 0`` and for ``x = 1``,
+    ``y = NaN`` (where the GLSL specification leaves it undefined), which numpy's ``**`` is not
+    (``(-2.0) ** 2.0 = 4``, ``1.0 ** nan = 1``). Float64.
+    """
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return np.exp2(np.asarray(y, np.float64) * np.log2(np.asarray(x, np.float64)))
+
+
 def _grey(value: np.ndarray) -> np.ndarray:
     return np.repeat(np.asarray(value, np.float64)[..., None], 3, axis=-1)
 
@@ -100,7 +110,106 @@ class AshikhminShirleyTwin(_Twin):
         return _grey(value)
 
 
-TWINS = (LambertTwin, ColoredLambertTwin, BlinnPhongTwin, AshikhminShirleyTwin)
+class AppAllKindsTwin(_Twin):
+    """app_all_kinds.brdf: albedo / pi + ks (n + 2) / (8 pi) max(0, N.H)^n, divided by max(N.L, 1e-4) when the bool is set."""
+
+    name = "app_all_kinds"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        n, ks = float(self.values["n"]), float(self.values["ks"])
+        value = ks * glsl_pow(np.maximum(_dot(N, _half_vector(L, V)), 0.0), n) * (n + 2.0) / (8.0 * 3.14159265)
+        if self.values["divide_by_NdotL"]:
+            value = value / np.maximum(_dot(N, L), 1e-4)
+        return np.asarray(self.values["albedo"], np.float64) / 3.14159265 + _grey(value)
+
+
+# The failure patterns of BRDF Explorer's own files (NaN, infinities, negative values out of the BRDF's
+# domain): twins evaluate them everywhere with GLSL's arithmetic, NaN included; the views' rule
+# (explorer.render.view_brdf) decides what is shown.
+
+
+class LimbDarkeningTwin(_Twin):
+    """limb_darkening.brdf: Minnaert's albedo (k + 1) / (2 pi) (N.L N.V)^(k - 1); NaN below the horizon."""
+
+    name = "limb_darkening"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        k = float(self.values["k"])
+        darkening = glsl_pow(_dot(N, L) * _dot(N, V), k - 1.0)
+        return np.asarray(self.values["albedo"], np.float64) * ((k + 1.0) / (2.0 * np.pi) * darkening)[..., None]
+
+
+class AnisotropicWardTwin(_Twin):
+    """anisotropic_ward.brdf: rho_d / pi + rho_s exp(-(s_x^2 + s_y^2)) / (4 pi a_x a_y sqrt(N.L N.V))."""
+
+    name = "anisotropic_ward"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        a_x, a_y = float(self.values["a_x"]), float(self.values["a_y"])
+        H = _half_vector(L, V)
+        HdotN = _dot(H, N)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s_x, s_y = _dot(H, X) / (a_x * HdotN), _dot(H, Y) / (a_y * HdotN)
+            lobe = np.exp(-(s_x**2 + s_y**2)) / (4.0 * np.pi * a_x * a_y * np.sqrt(_dot(N, L) * _dot(N, V)))
+        rho_s, rho_d = (np.asarray(self.values[name], np.float64) for name in ("rho_s", "rho_d"))
+        return rho_d / np.pi + rho_s * lobe[..., None]
+
+
+class CompactLobeTwin(_Twin):
+    """compact_lobe.brdf: ks D / (4 N.L N.V) + kd / pi, D's (1 - t^2)^n NaN beyond t = 1 (GLSL's pow)."""
+
+    name = "compact_lobe"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        m, n, ks, kd = (float(self.values[name]) for name in ("m", "n", "ks", "kd"))
+        c2 = _dot(N, _half_vector(L, V)) ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t2 = (1.0 - c2) / (c2 * m * m)
+            D = (n + 1.0) / (np.pi * m * m * c2 * c2) * glsl_pow(1.0 - t2, n)
+            return _grey(ks * D / (4.0 * _dot(N, L) * _dot(N, V)) + kd / np.pi)
+
+
+class AzimuthRatioTwin(_Twin):
+    """azimuth_ratio.brdf: kd / pi + ks (n + 8) / (8 pi) (1 + a cos 2 phi_h) (N.H)^n; 0 / 0 where H = N."""
+
+    name = "azimuth_ratio"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        n, a, ks, kd = (float(self.values[name]) for name in ("n", "a", "ks", "kd"))
+        H = _half_vector(L, V)
+        hx, hy = _dot(H, X), _dot(H, Y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cos_2phi = (hx * hx - hy * hy) / (hx * hx + hy * hy)
+        lobe = (n + 8.0) / (8.0 * np.pi) * (1.0 + a * cos_2phi) * glsl_pow(np.maximum(_dot(N, H), 0.0), n)
+        return _grey(kd / np.pi + ks * lobe)
+
+
+class LommelSeeligerTwin(_Twin):
+    """lommel_seeliger.brdf: w / (4 pi (N.L + N.V)); negative, and a pole, below the horizon."""
+
+    name = "lommel_seeliger"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        with np.errstate(divide="ignore"):
+            inverse = 1.0 / (4.0 * np.pi * (_dot(N, L) + _dot(N, V)))
+        return np.asarray(self.values["w"], np.float64) * inverse[..., None]
+
+
+class NonFiniteChannelsTwin(_Twin):
+    """non_finite_channels.brdf: (sqrt(-k), exp(1000 k), -k / 4): NaN, infinite and negative channels."""
+
+    name = "non_finite_channels"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        k = np.full(np.shape(L)[:-1], float(self.values["k"]))
+        with np.errstate(invalid="ignore", over="ignore"):
+            return np.stack([np.sqrt(-k), np.exp(1000.0 * k), -0.25 * k], axis=-1)
+
+
+TWINS = (
+    LambertTwin, ColoredLambertTwin, BlinnPhongTwin, AshikhminShirleyTwin, AppAllKindsTwin, LimbDarkeningTwin,
+    AnisotropicWardTwin, CompactLobeTwin, AzimuthRatioTwin, LommelSeeligerTwin, NonFiniteChannelsTwin,
+)
 
 
 @contextlib.contextmanager

@@ -1,4 +1,5 @@
-// What the disc views share (sphere, lit, scatter, textured; twins in explorer/render.py).
+// What the views share (sphere, lit, scatter, textured, env, slice; twins in explorer/render.py). Included
+// after the material's source: view_brdf calls its BRDF.
 
 // Pixel (i, j), j from the top, at p = (2 (i + 0.5) / W - 1, 1 - 2 (j + 0.5) / H); false outside the unit disc.
 bool disc_point(vec2 resolution, out vec2 p, out float r2) {
@@ -14,4 +15,25 @@ void lit_sphere_frame(vec2 p, float r2, out vec3 normal, out vec3 tangent, out v
     normal = vec3(p, sqrt(1.0 - r2));
     tangent = normalize(cross(vec3(0.0, 1.0, 0.0), normal));
     bitangent = normalize(cross(normal, tangent));
+}
+
+// The rule of every view that evaluates a material's BRDF (lit, slice, scatter, textured, env; the numpy
+// twins in explorer/render.py have the same names): the BRDF is evaluated only where the light and the
+// view are both strictly above the surface, N.L > 0 and N.V > 0, and is 0 elsewhere (BRDF Explorer's lit
+// sphere evaluates it everywhere and relies on max(BRDF, 0) and the cosine, but Minnaert's or Ward's
+// pow(N.L N.V, e) and sqrt(N.L N.V) are NaN below the horizon and NaN * 0 stays NaN). A channel the
+// material returns as NaN or +-infinity counts as 0 (edwards06's pow(1 - |h|^2 / R^2, n) is NaN on the lit
+// side too): GLSL leaves operations on NaN undefined, max(NaN, 0) included, so the test is explicit. A
+// finite negative channel is kept: linear sRGB of a vivid spectrum is negative outside the gamut.
+
+bool above_surface(vec3 L, vec3 V, vec3 N) {
+    return dot(N, L) > 0.0 && dot(N, V) > 0.0;
+}
+
+float finite_or_zero(float x) { return isnan(x) || isinf(x) ? 0.0 : x; }
+vec3 finite_or_zero(vec3 f) { return vec3(finite_or_zero(f.x), finite_or_zero(f.y), finite_or_zero(f.z)); }
+
+// The material's BRDF(L, V, N, X, Y) under the rule above.
+vec3 view_brdf(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {
+    return above_surface(L, V, N) ? finite_or_zero(BRDF(L, V, N, X, Y)) : vec3(0.0);
 }

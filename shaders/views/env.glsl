@@ -6,8 +6,9 @@
 // Random numbers: the PCG4D hash of (pixel, sample index, seed), the sample index counted from the first
 // sample of the render (first_sample + s): the same numbers however the host splits the samples into passes.
 //
-// Outputs: sum_out = (sum of the samples, count), square_out = (sum of their squares, dropped non-finite
-// samples); both float32, added over passes.
+// Outputs: sum_out = (sum of the samples, count), square_out = (sum of their squares, samples where the
+// material's BRDF was NaN or infinite, counted as 0 by view_brdf's rule in lib/views.glsl); both float32,
+// added over passes.
 //
 // Sampling (one-sample MIS, balance heuristic): without the material hook, cosine sampling about N. With
 //   #define HAS_SAMPLING_LOBES
@@ -113,13 +114,15 @@ void main() {
             for (int j = 0; j < 4; ++j) {
                 if (weights[j] > 0.0) pdf += weights[j] * ggx_reflection_pdf(light, view, normal, alphas[j]);
             }
-            if (pdf > 0.0) {
-                value = BRDF(light, view, normal, tangent, bitangent) * (cos_light / pdf) * environment_radiance(light);
+            if (pdf > 0.0 && above_surface(light, view, normal)) {
+                // lib/views.glsl's rule (view_brdf), the non-finite channels counted so the host can report them.
+                vec3 f = BRDF(light, view, normal, tangent, bitangent);
+                if (any(isnan(f)) || any(isinf(f))) dropped += 1.0;
+                value = finite_or_zero(f) * (cos_light / pdf) * environment_radiance(light);
             }
         }
         value += mirror;
-        // A NaN or infinite sample (a material's BRDF out of its domain) would spoil the pixel for good:
-        // it is dropped and counted, so the host can report it.
+        // Any other non-finite sample would spoil the pixel for good: it is dropped and counted too.
         if (any(isnan(value)) || any(isinf(value))) {
             value = vec3(0.0);
             dropped += 1.0;

@@ -2,9 +2,11 @@
 // phi_h = 0 and phi_d = 90 deg. N = (0, 0, 1), X = (1, 0, 0), Y = (0, 1, 0); column i has
 // theta_h = 90 deg (i + 0.5) / W, row j from the top has theta_d = 90 deg (j + 0.5) / H (BRDF Explorer puts
 // theta_d = 0 at the bottom). As there, D = (theta_d, phi_d) is rotated about Y by theta_h and about N by
-// phi_h into L, and V is L reflected about H = (theta_h, phi_h); the pixel is BRDF(L, V, N, X, Y), no
-// cosine. At phi_d = 90 deg, L.z = V.z = cos(theta_h) cos(theta_d) > 0: both stay above the horizon.
+// phi_h into L, and V is L reflected about H = (theta_h, phi_h); the pixel is view_brdf(L, V, N, X, Y)
+// (lib/views.glsl: non-finite channels 0), no cosine. At phi_d = 90 deg, L.z = V.z = cos(theta_h) cos(theta_d) > 0: both stay above the horizon.
 // Twin: explorer.render.render_numpy(model, 'slice', ...).
+#include "lib/views.glsl"
+
 uniform vec2 resolution;
 out vec4 frag_colour;
 
@@ -27,5 +29,5 @@ void main() {
     vec3 difference = vec3(sin(theta_d) * cos(SLICE_PHI_D), sin(theta_d) * sin(SLICE_PHI_D), cos(theta_d));
     vec3 light = slice_rotate(slice_rotate(difference, bitangent, theta_h), normal, SLICE_PHI_H);
     vec3 view = 2.0 * dot(half_vector, light) * half_vector - light;
-    frag_colour = vec4(BRDF(light, view, normal, tangent, bitangent), 1.0);
+    frag_colour = vec4(view_brdf(light, view, normal, tangent, bitangent), 1.0);
 }

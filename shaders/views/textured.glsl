@@ -5,6 +5,7 @@
 // u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinearly between texel centres, clamped.
 // prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
 // host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
+// The rule of lib/views.glsl's view_brdf applies: 0 unless N.L > 0 and N.V > 0, non-finite channels 0.
 // Twin: explorer.render.render_numpy(model, 'textured', ..., thickness=...).
 #include "lib/views.glsl"
 
@@ -45,6 +46,9 @@ void main() {
     } else {
         D_inc_ = dinc_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y)));
     }
-    vec3 radiance = textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter) * max(0.0, dot(normal, light_direction));
+    vec3 f = above_surface(light_direction, view, normal)
+        ? finite_or_zero(textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter))
+        : vec3(0.0);
+    vec3 radiance = f * max(0.0, dot(normal, light_direction));
     frag_colour = vec4(radiance, 1.0);
 }
