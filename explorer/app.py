@@ -32,7 +32,7 @@ import numpy as np
 
 from . import app_data
 from .app_params import ParameterFileError, load_values, save_values, slider_format, widget_kind
-from .brd import Material, MaterialError, load_material
+from .brd import Material, MaterialError, load_material, round_integer
 from .errors import LocatedError
 
 DEFAULT_WINDOW = (1280, 800)
@@ -627,7 +627,7 @@ class App:
         no_ctrl_input = imgui.SliderFlags_.no_input  # Ctrl-click resets instead of typing; the field types
         if kind == "int":
             imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.55)
-            changed, v = imgui.slider_int(name, int(round(float(value))), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
+            changed, v = imgui.slider_int(name, round_integer(value), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
             if changed:
                 new = float(v)
         elif kind == "float":
@@ -967,8 +967,8 @@ class App:
             _, self.spectrum_show[key] = imgui.checkbox(key, self.spectrum_show[key])
             imgui.same_line()
         imgui.new_line()
-        method = int(round(float(self.values.get("method", 0))))
-        s = int(round(float(self.values.get("s", 3))))
+        method = round_integer(self.values.get("method", 0))
+        s = round_integer(self.values.get("s", 3))
         key = (tuple(sorted(self.values.items())), self.spectrum_theta)
         # While a slider is dragged the curves follow at most every DRAG_SPECTRUM_S (their ~3 ms of numpy
         # would otherwise come out of every frame of the sphere's); on release they catch up at once.
