@@ -214,3 +214,15 @@ def test_brdf_explorer_floats_with_whole_number_ranges_get_float_sliders(tmp_pat
                      "kappa3": "float", "n": "float", "flag": "bool"}
     for name in ("lambert.brdf", "blinn_phong.brdf", "ashikhmin_shirley.brdf", "app_all_kinds.brdf"):
         assert all(widget_kind(p) != "int" for p in load_material(BRDF_DATA / name).parameters), name
+
+
+def test_cli_reports_a_bad_int_declaration_in_one_line(tmp_path):
+    """``info`` on a .brd whose int has a fractional default: one line naming file:line, non-zero exit."""
+    from conftest import one_line_error
+    from test_cli import cli
+
+    path = tmp_path / "bad_int.brd"
+    path.write_text("analytic\n::begin parameters\nfloat k 0 1 .5\nint N 1 1000 20.5\n::end parameters\n"
+                    "::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(k); }\n::end shader\n")
+    line = one_line_error(cli("info", path))
+    assert line.endswith(f"{path}:4: int 'N': default '20.5' is not an integer"), line
