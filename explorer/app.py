@@ -32,7 +32,7 @@ import numpy as np
 
 from . import app_data
 from .app_params import ParameterFileError, load_values, save_values, slider_format, widget_kind
-from .brd import Material, MaterialError, load_material
+from .brd import Material, MaterialError, load_material, round_integer
 from .errors import LocatedError
 
 DEFAULT_WINDOW = (1280, 800)
@@ -133,6 +133,7 @@ class App:
         self.rects: dict[str, tuple[float, float, float, float]] = {}
         self.frame_times: list[dict] = []
         self.screenshots: list[str] = []
+        self.screenshot_info: dict[str, dict] = {}  # per screenshot: material, view, values, env samples per pixel
         self._pending_screenshot: str | None = None
         self._spectrum = None
         self._spectrum_key = None
@@ -195,8 +196,13 @@ class App:
             self.error = str(error)
             return False
         self.material, self.material_path, self.values = material, path, values
-        if self.mode == "sphere" and not self._has_reflectance(material):
-            self.mode = "lit"
+        # Nothing of the previous material's values may reach the new one's uniforms: the compare view's
+        # set B (its ranges may differ: thin_film's method 5 is no mirror method) and the values shown
+        # while a slider drags (see _prepared_values). The env render follows the material (_request_env).
+        self.compare["values_b"] = dict(values)
+        self._ready_values = None
+        # The mode stays as chosen: a material without reflectance() is shown lit in the sphere mode
+        # (_main_view) and the next one that has it is shown in the sphere again.
         self.error = ""
         self.status = f"loaded {path}"
         return True
@@ -317,7 +323,8 @@ class App:
         report = {
             "material": str(self.material_path), "values": {k: list(v) if isinstance(v, tuple) else v for k, v in self.values.items()},
             "preset": self.preset, "mode": self.mode, "light": self.light, "camera": self.camera, "view_size": self.view_size,
-            "exposure": self.exposure, "frames": self.frame_times, "screenshots": self.screenshots, "error": self.error,
+            "exposure": self.exposure, "frames": self.frame_times, "screenshots": self.screenshots,
+            "screenshot_info": self.screenshot_info, "error": self.error,
             "status": self.status, "script_log": self.script.log if self.script else [],
             "mean_delta_e": self.mean_delta_e,
         }
@@ -341,7 +348,9 @@ class App:
         move to F1 over N frames, release (sliders are labelled ``param:NAME``);
         ``{"click": LABEL}`` (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...);
         ``{"set": {NAME: VALUE}}`` (bench only: no UI); ``{"mark": TEXT}`` tags the following frames;
-        ``{"screenshot": PATH}`` the active view (waits until complete); ``{"quit": true}``.
+        ``{"screenshot": PATH}`` the active view (waits until complete; in ``env``, until a whole sample);
+        ``{"file_path": PATH}`` types PATH into the Files tab's path field; ``{"view_size": N}`` picks the
+        sphere's resolution (the combo's values); ``{"quit": true}``.
         """
         script = self.script
         if script.index >= len(script.actions):
@@ -424,6 +433,12 @@ class App:
             if step == 0:
                 self._pending_window_shot = str(action["window_screenshot"])
             done = step > 0 and self._pending_window_shot is None
+        elif "file_path" in action:
+            self.file_path = str(action["file_path"])
+            done = True
+        elif "view_size" in action:
+            self.view_size = int(action["view_size"])
+            done = True
         elif "focus" in action:  # bring a docked window's tab to the front, as a click on its tab does
             self._focused_request = str(action["focus"])
             done = True
@@ -627,7 +642,7 @@ class App:
         no_ctrl_input = imgui.SliderFlags_.no_input  # Ctrl-click resets instead of typing; the field types
         if kind == "int":
             imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.55)
-            changed, v = imgui.slider_int(name, int(round(float(value))), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
+            changed, v = imgui.slider_int(name, round_integer(value), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
             if changed:
                 new = float(v)
         elif kind == "float":
@@ -686,6 +701,7 @@ class App:
                 self.status = str(error)
         if imgui.button("Open material"):
             self.reload(Path(self.file_path))
+        self._record("open_material")
         imgui.same_line()
         if imgui.button("Screenshot (F12)"):
             self._pending_screenshot = self._screenshot_name()
@@ -822,7 +838,12 @@ class App:
         env = self.env
         key = (id(self.material), tuple(sorted(self.values.items())), size, tuple(self.camera), tuple(self.light))
         if getattr(self, "_env_key", None) != key or getattr(self, "_env_render", None) is None:
-            if getattr(self, "_env_render", None) is None or getattr(self, "_env_size", None) != size:
+            render = getattr(self, "_env_render", None)
+            # Another material (Files > Open, Reload) needs a render of its own: resetting the old one with
+            # the new values would bind them to the old material's uniforms.
+            if render is None or getattr(self, "_env_size", None) != size or render.material is not self.material:
+                if render is not None:
+                    render.release()
                 self._env_map = getattr(self, "_env_map", None) or env.EnvironmentMap.default()
                 self._env_render = env.ProgressiveEnvRender(self.renderer, self.material, self.values, self._env_map, *size)
                 self._env_size = size
@@ -967,8 +988,8 @@ class App:
             _, self.spectrum_show[key] = imgui.checkbox(key, self.spectrum_show[key])
             imgui.same_line()
         imgui.new_line()
-        method = int(round(float(self.values.get("method", 0))))
-        s = int(round(float(self.values.get("s", 3))))
+        method = round_integer(self.values.get("method", 0))
+        s = round_integer(self.values.get("s", 3))
         key = (tuple(sorted(self.values.items())), self.spectrum_theta)
         # While a slider is dragged the curves follow at most every DRAG_SPECTRUM_S (their ~3 ms of numpy
         # would otherwise come out of every frame of the sphere's); on release they catch up at once.
@@ -1116,8 +1137,13 @@ class App:
             return
         from .cli import OutputError, write_image
 
+        samples = None
         if self.mode == "env" and self.env is not None:
-            image = np.asarray(self._env_render.image(), dtype=np.float32)
+            render = getattr(self, "_env_render", None)
+            if render is None or render.material is not self.material or render.samples == 0 or render._band_rows:
+                return  # written at the first whole sample of the material shown (every pixel the same count)
+            image = np.asarray(render.image(), dtype=np.float32)
+            samples = render.samples
         else:
             job = self.jobs["main"]
             if job.error is not None:
@@ -1136,6 +1162,10 @@ class App:
             self.status = str(error)
             return
         self.screenshots.append(str(path.with_suffix(".png")))
+        self.screenshot_info[str(path.with_suffix(".png"))] = {
+            "material": str(self.material_path), "view": "env" if samples is not None else self._main_view(),
+            "values": {k: list(v) if isinstance(v, tuple) else v for k, v in self.values.items()}, "samples": samples,
+        }
         self.status = f"wrote {path.with_suffix('.png')} and {path.with_suffix('.npy')}"
 
 

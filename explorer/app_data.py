@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import bragg, colorimetry
+from .brd import round_integer
 
 #: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
 BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
@@ -37,7 +38,7 @@ def mirror_of(values) -> bragg.BraggMirror:
     nh = float(values.get("nh", 0.0))
     return bragg.BraggMirror(
         n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
-        N=int(np.floor(float(values["N"]) + 0.5)), nh=nh if nh >= 1.0 else None,
+        N=round_integer(values["N"]), nh=nh if nh >= 1.0 else None,
     )
 
 

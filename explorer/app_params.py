@@ -34,11 +34,11 @@ class ParameterFileError(LocatedError):
 
 def widget_kind(parameter: Parameter) -> str:
     """
-    The widget of a parameter: ``'int'`` (an integer slider: counts, switches such as ``N``, ``s``,
-    ``method``, the floats whose range and default are integers), ``'float'``, ``'bool'`` or ``'color'``.
+    The widget of a parameter: ``'int'`` (an integer slider) for the parameters a ``.brd`` file declares
+    ``int`` (counts, switches such as ``N``, ``s``, ``method``), ``'float'``, ``'bool'`` or ``'color'``.
+    A float whose range and default are whole numbers (BRDF Explorer's ``metallic 0 1 0``) keeps a float
+    slider.
     """
-    if parameter.type == "float":
-        return "int" if parameter.is_integer() else "float"
     return parameter.type
 
 
@@ -82,7 +82,7 @@ def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mappin
     """Write BRDF Explorer's ``.bparam`` (``%f`` numbers, floats then bools then colours, as it does)."""
     lines = [f"bparam {Path(material.path).resolve()}", "", "::begin parameters"]
     for p in material.parameters:
-        if p.type == "float":
+        if p.type in ("float", "int"):  # BRDF Explorer's files know no int: an int is saved as a float
             lines.append(f"float {p.name} {p.min:f} {p.max:f} {float(values[p.name]):f}")
     for p in material.parameters:
         if p.type == "bool":

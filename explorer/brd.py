@@ -12,6 +12,7 @@ load unchanged.  A file looks like this::
     float reflectance 0 1 .8
     bool  clamp_to_hemisphere 1
     color tint 1 .9 .8
+    int   N 1 1000 20
     ::end parameters
 
     ::begin shader
@@ -31,6 +32,12 @@ Rules, following BRDF Explorer's ``BRDFBase::loadBRDF`` where it has one:
   Unknown sections (including BRDF Explorer's ``isFunc``) are skipped with a
   warning.
 * ``# model: NAME`` outside the shader names the material's numpy twin.
+* ``int NAME MIN MAX DEFAULT`` (our ``.brd`` files only; BRDF Explorer's
+  ``.brdf`` files have float, bool and color) declares an integer: a count
+  or a switch such as ``N`` or ``method``.  Its bounds and default are
+  integers; a value is rounded by `round_integer` (halves up) everywhere it
+  meets the physics, and it reaches GLSL as a ``float`` uniform holding that
+  exact integer, so shader code reads it like any float.
 
 This module never imports GL: it only turns text into data and GLSL snippets.
 """
@@ -56,6 +63,7 @@ __all__ = [
     "parse_material",
     "load_material",
     "parse_assignment",
+    "round_integer",
     "GLSL_KEYWORDS",
 ]
 
@@ -114,10 +122,12 @@ GLSL_KEYWORDS: frozenset[str] = frozenset(
 
 _PARAMETER_USAGE = {
     "float": "float NAME MIN MAX DEFAULT",
+    "int": "int NAME MIN MAX DEFAULT",
     "bool": "bool NAME 0|1",
     "color": "color NAME R G B",
 }
-_GLSL_TYPES = {"float": "float", "bool": "bool", "color": "vec3"}
+# An int is uploaded as a float uniform holding an exact integer: shader code keeps its float arithmetic.
+_GLSL_TYPES = {"float": "float", "int": "float", "bool": "bool", "color": "vec3"}
 _TRUE_WORDS = frozenset({"1", "true", "yes", "on"})
 _FALSE_WORDS = frozenset({"0", "false", "no", "off"})
 
@@ -131,6 +141,33 @@ class UnknownParameterError(MaterialError, KeyError):
 
     Also a ``KeyError``, so ``Material.parameter`` behaves like a mapping.
     """
+
+
+def round_integer(value: float) -> int:
+    """The integer an ``int`` parameter's value stands for: the nearest one, halves rounded up.
+
+    The one rounding rule of the project, shared by the GL host (uniforms and ``# specialise:``
+    constants), the numpy models, the app and the CLI.  It is GLSL's ``floor(x + 0.5)``, evaluated
+    exactly: ``0.49999999999999994 + 0.5`` is 1.0 in float64, its fractional part is not.  Python's
+    ``round`` (halves to even: ``round(0.5) == 0``) is not this rule.
+
+    Parameters
+    ----------
+    value : float
+        Finite.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> [round_integer(x) for x in (0.5, 1.5, 2.4999, 2.5, 2.5001, -0.5)]
+    [1, 2, 2, 3, 3, 0]
+    """
+    x = float(value)
+    whole = math.floor(x)
+    return int(whole) + (1 if x - whole >= 0.5 else 0)  # x - floor(x) is exact for |x| < 2**52
 
 
 def _fmt(x: float) -> str:
@@ -152,10 +189,10 @@ class Parameter:
     ----------
     name : str
         The GLSL uniform name.
-    type : {'float', 'bool', 'color'}
-        The parameter kind.
+    type : {'float', 'int', 'bool', 'color'}
+        The parameter kind (``int``: declared so in a ``.brd`` file).
     min, max : float or None
-        The slider range of a float; None for bool and color.
+        The slider range of a float or an int; None for bool and color.
     default : float or bool or tuple of 3 floats
         The value used when nothing overrides it.
     line : int
@@ -175,18 +212,13 @@ class Parameter:
         return _GLSL_TYPES[self.type]
 
     def is_integer(self) -> bool:
-        """Whether a UI should show this parameter as an integer slider.
+        """Whether the parameter is a declared ``int`` (an integer slider in a UI).
 
-        Returns
-        -------
-        bool
-            True for a float whose min, max and default are all integers
-            (exponents such as ``n``, counts, method switches).
+        A float whose range and default happen to be whole numbers (BRDF
+        Explorer's ``metallic 0 1 0``, an exponent ``n 1 1000 100``) stays a
+        float: only the declaration makes an integer.
         """
-        if self.type != "float":
-            return False
-        values = (self.min, self.max, self.default)
-        return all(isinstance(v, float) and v.is_integer() for v in values)
+        return self.type == "int"
 
     def coerce(self, value: str | float | bool | Sequence[float]) -> Value:
         """Validate a value for this parameter and convert it to its type.
@@ -201,6 +233,7 @@ class Parameter:
         Returns
         -------
         float or bool or tuple of 3 floats
+            An int's value is a float holding an exact integer.
 
         Raises
         ------
@@ -210,6 +243,9 @@ class Parameter:
         """
         if self.type == "float":
             return self._coerce_float(value)
+        if self.type == "int":
+            # The range is checked before rounding; integer bounds keep the rounded value inside.
+            return float(round_integer(self._coerce_float(value)))
         if self.type == "bool":
             return self._coerce_bool(value)
         return self._coerce_color(value)
@@ -349,6 +385,29 @@ class Material:
                 raise MaterialError(self.path, p.line, f"parameter {name!r}: {exc}") from None
         return values
 
+    def physical_values(self, values: Mapping[str, object]) -> dict[str, object]:
+        """The values the physics sees: every ``int`` parameter's value rounded by `round_integer`.
+
+        Applied by the GL host before uploading uniforms and choosing ``# specialise:`` constants, and
+        by `explorer.models.model_for` before building a numpy twin, so that both evaluate the same
+        integers whatever the caller passed (``resolve`` already rounds what it coerces).
+
+        Parameters
+        ----------
+        values : mapping of str to value
+            Resolved values; names the material does not declare are kept as they are.
+
+        Returns
+        -------
+        dict
+            A copy, ints as floats holding exact integers.
+        """
+        result = dict(values)
+        for p in self.parameters:
+            if p.type == "int" and p.name in result:
+                result[p.name] = float(round_integer(result[p.name]))
+        return result
+
     def uniform_declarations(self) -> str:
         """GLSL uniform declarations for the parameters, one per line.
 
@@ -465,12 +524,12 @@ class _Parser:
             self.warn(number, f"ignoring second model {name!r}; using {self.model!r} from line {self.model_line}")
 
     def _check_specialised(self) -> tuple[str, ...]:
-        """``# specialise: NAME``: integer-valued float parameters the host compiles in as constants."""
+        """``# specialise: NAME``: int parameters the host compiles in as constants."""
         by_name = {p.name: p for p in self.parameters}
         for name, number in self.specialised:
             parameter = by_name.get(name)
-            if parameter is None or parameter.type != "float" or not parameter.is_integer():
-                raise self.error(number, f"'# specialise: {name}' needs an integer-valued float parameter of that name")
+            if parameter is None or parameter.type != "int":
+                raise self.error(number, f"'# specialise: {name}' needs an int parameter of that name")
         return tuple(dict.fromkeys(name for name, _ in self.specialised))
 
     def header(self, number: int, tokens: list[str]) -> None:
@@ -547,12 +606,15 @@ class _Parser:
         tokens = stripped.split("#", 1)[0].split()
         kind = tokens[0]
         usage = _PARAMETER_USAGE.get(kind)
-        if usage is None:
-            raise self.error(number, f"unknown parameter type {kind!r} (expected float, bool or color)")
+        brdf_explorer_file = self.path.lower().endswith(".brdf")
+        if usage is None or (kind == "int" and brdf_explorer_file):
+            expected = "float, bool or color" if brdf_explorer_file else "float, int, bool or color"
+            where = " in BRDF Explorer's .brdf files (int is for .brd files)" if kind == "int" else ""
+            raise self.error(number, f"unknown parameter type {kind!r}{where} (expected {expected})")
         expected = len(usage.split())
         if len(tokens) != expected:
             raise self.error(
-                number, f"a {kind} parameter has {expected - 1} fields ({usage}), got {len(tokens) - 1}"
+                number, f"{'an' if kind == 'int' else 'a'} {kind} parameter has {expected - 1} fields ({usage}), got {len(tokens) - 1}"
             )
         name = tokens[1]
         self.check_name(number, name)
@@ -561,22 +623,24 @@ class _Parser:
                 raise self.error(number, f"bool {name!r}: default must be 0 or 1, got {tokens[2]!r}")
             param = Parameter(name, "bool", None, None, tokens[2] == "1", number)
         else:
-            fields = ("min", "max", "default") if kind == "float" else ("red", "green", "blue")
+            fields = ("red", "green", "blue") if kind == "color" else ("min", "max", "default")
             values: list[float] = []
             for label, token in zip(fields, tokens[2:]):
                 value = _parse_number(token)
                 if value is None or not math.isfinite(value):
                     raise self.error(number, f"{kind} {name!r}: {label} {token!r} is not a number")
+                if kind == "int" and not (value.is_integer() and abs(value) < 2**53):
+                    raise self.error(number, f"int {name!r}: {label} {token!r} is not an integer")
                 values.append(value)
-            if kind == "float":
+            if kind != "color":
                 lo, hi, default = values
                 if lo > hi:
-                    raise self.error(number, f"float {name!r}: min {_fmt(lo)} is greater than max {_fmt(hi)}")
+                    raise self.error(number, f"{kind} {name!r}: min {_fmt(lo)} is greater than max {_fmt(hi)}")
                 if not lo <= default <= hi:
                     raise self.error(
-                        number, f"float {name!r}: default {_fmt(default)} is outside [{_fmt(lo)}, {_fmt(hi)}]"
+                        number, f"{kind} {name!r}: default {_fmt(default)} is outside [{_fmt(lo)}, {_fmt(hi)}]"
                     )
-                param = Parameter(name, "float", lo, hi, default, number)
+                param = Parameter(name, kind, lo, hi, default, number)
             else:
                 param = Parameter(name, "color", None, None, (values[0], values[1], values[2]), number)
         self.names[name] = number
@@ -614,7 +678,8 @@ def parse_material(text: str, path: str | os.PathLike[str] = "<string>") -> Mate
     MaterialError
         With the offending line, for: a missing or non-``analytic`` header,
         an unterminated, unmatched or nested section, a malformed parameter
-        (unknown type, wrong number of fields, non-numeric value, min > max,
+        (unknown type, ``int`` in a ``.brdf`` file, wrong number of fields,
+        non-numeric value, an int's non-integer bound or default, min > max,
         default outside [min, max], bool default not 0/1, duplicate or invalid
         name), or no shader section.
     """

@@ -17,7 +17,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .brd import Material, MaterialError, load_material, parse_assignment
+from .brd import Material, MaterialError, load_material, parse_assignment, round_integer
 from .errors import LocatedError
 
 DEFAULT_MATERIAL = Path(__file__).resolve().parent.parent / "shaders" / "bragg_mirror.brd"
@@ -143,7 +143,7 @@ def render_material(
         if material.model != "thin_film":
             raise MaterialError(material.path, None, "the textured view needs a thin-film material (# model: thin_film)")
         thickness = ThicknessTexture.from_file() if thickness is None else thickness
-        check_prefilter(int(np.floor(float(values.get("method", 0)) + 0.5)), thickness.prefilter)
+        check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":
         from .models import model_for
         from .render import BRDF_VIEWS, render_numpy

@@ -17,7 +17,7 @@ from typing import Mapping
 import numpy as np
 
 from . import colorimetry, luts
-from .brd import Material
+from .brd import Material, round_integer
 from .glsl import ShaderBuilder, ShaderError
 from .models import model_for
 
@@ -58,8 +58,11 @@ def create_context():
 
 
 def specialisation(material: Material, values: Mapping[str, object]) -> tuple[tuple[str, int], ...]:
-    """The constants compiled into ``material``'s program: its ``# specialise:`` parameters' values."""
-    return tuple((name, int(round(float(values[name])))) for name in material.specialised)
+    """
+    The constants compiled into ``material``'s program: its ``# specialise:`` parameters' values, rounded
+    as the uniforms and the numpy models round them (:func:`explorer.brd.round_integer`).
+    """
+    return tuple((name, round_integer(values[name])) for name in material.specialised)
 
 
 def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = ()):
@@ -179,7 +182,9 @@ class Renderer:
         """
         Set the material's uniforms and bind the library and model textures; ``inputs`` (a view's
         textures, e.g. the textured view's D_inc) and ``uniforms`` (a view's flags) where the program has them.
+        ``int`` parameters are uploaded as :meth:`explorer.brd.Material.physical_values` has them (exact integers).
         """
+        values = material.physical_values(values)
         for parameter in material.parameters:
             if parameter.name not in program:
                 continue  # unused by the shader: optimised away
@@ -237,6 +242,7 @@ class Renderer:
 
     def _model_entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
         """``(key, [model, tables])`` of :func:`explorer.models.model_for`, from a small LRU cache (key None: uncached)."""
+        values = material.physical_values(values)
         key = self._model_key(material, values)
         if key is None:
             model = model_for(material, values)
@@ -265,7 +271,7 @@ class Renderer:
 
         if (material.model or "") not in MODELS:
             return True
-        key = self._model_key(material, values)
+        key = self._model_key(material, material.physical_values(values))
         with self._models_lock:
             entry = self._models.get(key) if key is not None else None
         return entry is not None and entry[1] is not None
@@ -278,6 +284,7 @@ class Renderer:
         """
         if self.model_ready(material, values):
             return
+        values = material.physical_values(values)
         key = self._model_key(material, values)
         model = model_for(material, values)
         if model is None or key is None:

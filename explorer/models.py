@@ -14,6 +14,7 @@ import functools
 import numpy as np
 
 from . import bragg, colorimetry, layered, microfacet
+from .brd import round_integer
 from .fresnel import fresnel_schlick
 from .thinfilm_model import ThinFilmModel
 
@@ -41,11 +42,11 @@ class BraggMirrorModel:
             n2=float(values["n2"]),
             Lambda=float(values["Lambda"]),
             delta=float(values["delta"]),
-            N=int(np.floor(float(values["N"]) + 0.5)),
+            N=round_integer(values["N"]),
             nh=nh if nh >= 1.0 else None,  # below 1 the host is n1
         )
-        self.method = int(np.floor(float(values.get("method", 0)) + 0.5))
-        self.s = int(np.floor(float(values.get("s", 3)) + 0.5))
+        self.method = round_integer(values.get("method", 0))
+        self.s = round_integer(values.get("s", 3))
         self._table: np.ndarray | None = None
 
     @property
@@ -162,7 +163,7 @@ class BraggStackModel:
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
-        count = int(np.floor(_number(values, "layers") + 0.5))
+        count = round_integer(values["layers"])
         if not 1 <= count <= layered.MAX_LAYERS:
             raise ValueError(f"layers must be 1 to {layered.MAX_LAYERS}, got {values['layers']}")
         nh = _number(values, "nh")
@@ -171,7 +172,7 @@ class BraggStackModel:
             n1_k = _number(values, f"n1_{k}")
             layers.append(layered.RoughBraggLayer(
                 n2=_number(values, f"n2_{k}"), Lambda=_number(values, f"Lambda_{k}"),
-                delta=_number(values, f"delta_{k}"), N=int(np.floor(_number(values, f"N_{k}") + 0.5)),
+                delta=_number(values, f"delta_{k}"), N=round_integer(values[f"N_{k}"]),
                 alpha=_number(values, f"alpha_{k}"), n1=None if n1_k == nh else n1_k,
             ))
         self.stack = layered.LayeredBragg(
@@ -275,6 +276,9 @@ MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
 
 
 def model_for(material, values: Mapping[str, object]):
-    """The numpy twin of ``material`` with parameter ``values`` (None when it names no known model)."""
+    """
+    The numpy twin of ``material`` with parameter ``values`` (None when it names no known model), its
+    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.brd.Material.physical_values`).
+    """
     factory = MODELS.get(material.model or "")
-    return factory(values) if factory else None
+    return factory(material.physical_values(values)) if factory else None

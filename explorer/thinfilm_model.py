@@ -22,6 +22,7 @@ from typing import Mapping
 import numpy as np
 
 from . import microfacet, thinfilm
+from .brd import round_integer
 
 METHODS = {0: "reference", 1: "fourier m=1", 2: "fourier m=2", 3: "fourier m=3", 4: "gaussian m=3", 5: "naive rgb"}
 
@@ -39,7 +40,7 @@ class ThinFilmModel:
         self.eta_3 = float(values["eta3"])
         self.kappa_3 = float(values["kappa3"])
         self.alpha = float(values.get("alpha", 0.0))
-        self.method = int(np.floor(float(values.get("method", 0)) + 0.5))
+        self.method = round_integer(values.get("method", 0))
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(map(str, METHODS))}, got {self.method}")
         # One-line ValueErrors on a negative thickness, kappa3 < 0, non-positive or non-finite indices.

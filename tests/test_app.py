@@ -234,3 +234,57 @@ def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):
     assert np.abs(png[inside] - lambert(turned)[inside]).max() <= 2
     assert np.abs(png[inside] - lambert(backwards)[inside]).max() > 10
     assert np.abs(png[inside] - lambert(light)[inside]).max() > 10  # nor the unturned light
+
+
+#: Files > Open material, in this order: a Bragg mirror, a layered stack, a thin film, BRDF Explorer's own file.
+SWITCHED_MATERIALS = [
+    REPO_ROOT / "shaders" / "bragg_stack.brd", REPO_ROOT / "shaders" / "thin_film.brd",
+    BRDF_DATA / "blinn_phong.brdf", BRAGG_MATERIAL,
+]
+#: The app's sphere at this resolution (the combo's smallest), so that a stack's env sample takes ~0.2 s.
+SWITCH_VIEW_SIZE = 128
+
+
+@pytest.mark.parametrize("mode", ["lit", "sphere", "env"])
+def test_switching_materials_keeps_the_app_alive(x_display, tmp_path, gl_renderer, mode):
+    """
+    Files > Open material from the mirror to a stack, a thin film, a .brdf and back, in each sphere mode: the
+    app stays alive (the env mode used to reset its render with the new values on the old material: a
+    KeyError 'method' / 'layers' closed the window) and each screenshot is the headless render of the
+    material just opened (env: the same number of samples, same seed).
+    """
+    from explorer.env import render_env
+
+    actions = [{"wait": 2}, {"view_size": SWITCH_VIEW_SIZE}, {"click": f"mode:{mode}"}, {"wait": 2},
+               {"focus": "Files"}, {"wait": 2}]
+    shots = []
+    for index, material_path in enumerate(SWITCHED_MATERIALS):
+        shot = tmp_path / f"shot{index}_{material_path.stem}.png"
+        shots.append(shot)
+        actions += [{"file_path": str(material_path)}, {"click": "open_material"}, {"wait": 3},
+                    {"wait_complete": True}, {"screenshot": str(shot)}]
+    actions.append({"quit": True})
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert report["script_log"].count("clicked open_material") == len(SWITCHED_MATERIALS), report["script_log"]
+    assert report["error"] == "" and report["material"] == str(BRAGG_MATERIAL)
+    assert report["screenshots"] == [str(s) for s in shots], report["script_log"]
+    for shot, material_path in zip(shots, SWITCHED_MATERIALS):
+        info = report["screenshot_info"][str(shot)]
+        assert info["material"] == str(material_path)
+        material = load_material(material_path)
+        values = material.resolve(info["values"])
+        has_reflectance = "reflectance(" in material.shader
+        expected_view = "env" if mode == "env" else "sphere" if mode == "sphere" and has_reflectance else "lit"
+        assert info["view"] == expected_view, (material_path.name, info)
+        size = SWITCH_VIEW_SIZE
+        if expected_view == "env":
+            assert info["samples"] >= 1
+            headless = render_env(material, values, size, size, spp=info["samples"], renderer=gl_renderer)
+        else:
+            headless = gl_renderer.render(material, values, expected_view, size, size)
+        linear = np.load(shot.with_suffix(".npy"))
+        assert linear.shape == (size, size, 3)
+        np.testing.assert_allclose(linear, headless, rtol=1e-3, atol=2e-3, err_msg=f"{mode}: {material_path.name}")
+        png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+        assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2, (mode, material_path.name)
+        assert np.abs(headless).max() > 0.05, "an empty image"

@@ -17,6 +17,7 @@ from explorer.brd import (
     load_material,
     parse_assignment,
     parse_material,
+    round_integer,
 )
 
 DATA = Path(__file__).parent / "data" / "brdf"
@@ -72,7 +73,7 @@ def test_blinn_phong() -> None:
     m = load_material(DATA / "blinn_phong.brdf")
     n, divide = m.parameters
     assert (n.name, n.type, n.min, n.max, n.default) == ("n", "float", 1.0, 1000.0, 100.0)
-    assert n.is_integer()
+    assert not n.is_integer()  # whole-number range and default, but declared float
     assert (divide.name, divide.type, divide.min, divide.max, divide.default) == (
         "divide_by_NdotL",
         "bool",
@@ -303,7 +304,7 @@ def test_brdf_explorer_stock_style() -> None:
     )
     m = parse_material(text, "disney.brdf")
     assert [p.type for p in m.parameters] == ["color", "float", "float", "bool", "bool", "float"]
-    assert m.parameter("sigma").is_integer() and not m.parameter("roughness").is_integer()
+    assert not any(p.is_integer() for p in m.parameters)  # metallic 0 1 0 and sigma 0 90 30 stay floats
     assert m.warnings == []
 
 
@@ -430,10 +431,72 @@ def test_parse_assignment() -> None:
 
 def test_is_integer() -> None:
     m = material(
-        "analytic\n::begin parameters\nfloat a 1 1000 100\nfloat b 0 1 .5\nfloat c 0 10 2.5\n"
-        "float d -3 3 0\nbool e 1\ncolor f 1 1 1\n::end parameters\n"
+        "analytic\n::begin parameters\nfloat a 1 1000 100\nfloat b 0 1 .5\nint c 0 10 2\n"
+        "int d -3 3 0\nbool e 1\ncolor f 1 1 1\n::end parameters\n"
     )
-    assert [p.is_integer() for p in m.parameters] == [True, False, False, True, False, False]
+    assert [p.is_integer() for p in m.parameters] == [False, False, True, True, False, False]
+    assert [p.type for p in m.parameters] == ["float", "float", "int", "int", "bool", "color"]
+
+
+def test_int_parameter_is_a_float_uniform_holding_an_integer() -> None:
+    m = material("analytic\n::begin parameters\nint N 1 1000 20\nint method 0 4 0\n::end parameters\n")
+    N = m.parameter("N")
+    assert (N.type, N.min, N.max, N.default, N.line) == ("int", 1.0, 1000.0, 20.0, 3)
+    assert N.glsl_type == "float"
+    assert m.uniform_declarations() == "uniform float N;\nuniform float method;\n"
+    assert N.info() == {"name": "N", "type": "int", "min": 1.0, "max": 1000.0, "default": 20.0}
+
+
+@pytest.mark.parametrize(
+    "value, expected",
+    [(0.5, 1), (1.5, 2), (2.4999, 2), (2.5, 3), (2.5001, 3), (0.49999999999999994, 0), (3, 3), ("2.5", 3), ("7", 7)],
+)
+def test_int_values_round_halves_up(value, expected) -> None:
+    """One rule, floor(x + 0.5) as GLSL computes it, not Python's round() (halves to even)."""
+    m = material("analytic\n::begin parameters\nint method 0 8 0\n::end parameters\n")
+    resolved = m.resolve({"method": value})["method"]
+    assert resolved == float(expected) and isinstance(resolved, float)
+    assert round_integer(float(value)) == expected
+    assert m.physical_values({"method": float(value), "other": 0.5}) == {"method": float(expected), "other": 0.5}
+
+
+def test_round_integer_is_not_bankers_rounding() -> None:
+    halves = np.arange(-3, 1001) + 0.5
+    assert [round_integer(x) for x in halves] == list(np.floor(halves + 0.5).astype(int))
+    assert round_integer(0.5) == 1 and round(0.5) == 0  # the rule the GL host used to apply
+
+
+@pytest.mark.parametrize(
+    "line, fragment",
+    [
+        ("int N 1 1000 20.5", "int 'N': default '20.5' is not an integer"),
+        ("int N 1.5 1000 20", "int 'N': min '1.5' is not an integer"),
+        ("int N 1 1e3 20", None),  # 1e3 is an integer
+        ("int N 1 1000 2000", "int 'N': default 2000 is outside [1, 1000]"),
+        ("int N 10 1 5", "int 'N': min 10 is greater than max 1"),
+        ("int N 1 1000", "an int parameter has 4 fields (int NAME MIN MAX DEFAULT), got 3"),
+        ("int N 1 many 20", "int 'N': max 'many' is not a number"),
+        ("int 2N 1 10 2", "'2N' is not a valid GLSL identifier"),
+    ],
+)
+def test_bad_int_declarations_are_one_line_with_file_and_line(line: str, fragment: str | None) -> None:
+    text = f"analytic\n::begin parameters\nfloat k 0 1 .5\n{line}\n::end parameters\n" + SHADER
+    if fragment is None:
+        assert parse_material(text, "m.brd").parameter("N").max == 1000.0
+        return
+    with pytest.raises(MaterialError) as info:
+        parse_material(text, "m.brd")
+    assert str(info.value) == f"m.brd:4: {info.value.message}" and "\n" not in str(info.value)
+    assert fragment in info.value.message, info.value.message
+
+
+def test_int_is_refused_in_brdf_explorer_files() -> None:
+    """BRDF Explorer's own .brdf format has float, bool and color only: an int there is an error (file:line)."""
+    text = "analytic\n::begin parameters\nint N 1 1000 20\n::end parameters\n" + SHADER
+    assert parse_material(text, "ours.brd").parameter("N").type == "int"
+    with pytest.raises(MaterialError) as info:
+        parse_material(text, "theirs.BRDF")
+    assert str(info.value).startswith("theirs.BRDF:3: unknown parameter type 'int' in BRDF Explorer's .brdf files")
 
 
 def test_info_is_json_ready() -> None:
@@ -458,8 +521,9 @@ def test_uniform_declarations_order_and_empty() -> None:
 SPECIALISED = """analytic
 # specialise: method
 ::begin parameters
-float method 0 4 0
+int method 0 4 0
 float alpha 0 1 0.5
+float count 0 4 0
 ::end parameters
 ::begin shader
 vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(alpha); }
@@ -472,7 +536,7 @@ def test_specialise_directive_lists_integer_parameters() -> None:
     assert parse_material(SPECIALISED.replace("# specialise: method\n", ""), "s.brd").specialised == ()
 
 
-@pytest.mark.parametrize("name", ["alpha", "missing"])
+@pytest.mark.parametrize("name", ["alpha", "count", "missing"])  # count: whole numbers, but a float
 def test_specialise_directive_rejects_non_integer_or_unknown_parameters(name: str) -> None:
     with pytest.raises(MaterialError) as info:
         parse_material(SPECIALISED.replace("specialise: method", f"specialise: {name}"), "s.brd")

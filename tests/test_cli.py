@@ -54,7 +54,7 @@ def declaration_line(path: Path, name: str) -> int:
     """1-based line of the parameter declaration of ``name`` in a material file."""
     for number, line in enumerate(path.read_text().splitlines(), start=1):
         tokens = line.split()
-        if len(tokens) >= 2 and tokens[0] in ("float", "bool", "color") and tokens[1] == name:
+        if len(tokens) >= 2 and tokens[0] in ("float", "int", "bool", "color") and tokens[1] == name:
             return number
     raise AssertionError(f"{name} is not declared in {path}")
 
@@ -236,11 +236,13 @@ def test_info_json_schema(cli_runs, name):
     for parameter, row in zip(info["parameters"], rows):
         assert set(parameter) == {"name", "type", "min", "max", "default"}
         assert parameter["type"] == row[0]
-        if row[0] == "float":
+        if row[0] in ("float", "int"):
             assert [parameter["min"], parameter["max"], parameter["default"]] == [float(t) for t in row[2:5]]
             assert all(isinstance(parameter[k], (int, float)) and not isinstance(parameter[k], bool)
                        for k in ("min", "max", "default"))
             assert parameter["min"] <= parameter["default"] <= parameter["max"]
+            if row[0] == "int":
+                assert all(float(parameter[k]).is_integer() for k in ("min", "max", "default"))
         elif row[0] == "bool":
             assert parameter["min"] is None and parameter["max"] is None
             assert parameter["default"] is bool(int(row[2]))
@@ -252,9 +254,9 @@ def test_info_json_schema(cli_runs, name):
             assert default == [float(t) for t in row[2:5]]
 
 
-def test_info_json_covers_the_three_kinds(cli_runs):
+def test_info_json_covers_the_four_kinds(cli_runs):
     kinds = {p["type"] for run in cli_runs[1].values() for p in json.loads(run.stdout)["parameters"]}
-    assert kinds == {"float", "bool", "color"}
+    assert kinds == {"float", "int", "bool", "color"}
 
 
 # --------------------------------------------------------------------------------------------------

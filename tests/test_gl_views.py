@@ -99,10 +99,10 @@ def test_tabulated_gl_equals_spectral_reference_on_a_smooth_mirror(gl_renderer, 
 
 
 def random_parameters(material, rng) -> dict:
-    """Uniform values inside each float parameter's declared range."""
+    """Uniform values inside each float or int parameter's declared range (ints: any float, rounded by resolve)."""
     values = {}
     for parameter in material.parameters:
-        if parameter.type == "float" and parameter.name != "method":
+        if parameter.type in ("float", "int") and parameter.name != "method":
             values[parameter.name] = float(rng.uniform(parameter.min, parameter.max))
     return values
 
