@@ -20,7 +20,7 @@ import numpy as np
 from . import bragg, colorimetry
 from .brd import load_material
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+from .resources import SHADER_DIR
 BENCH_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_DELTAS = (0.25, 0.5, 0.75)

@@ -37,7 +37,7 @@ import numpy as np
 
 from .errors import LocatedError
 
-DEFAULT_ENVIRONMENT = Path(__file__).resolve().parent.parent / "shaders" / "environments" / "default.hdr"
+from .resources import DEFAULT_ENVIRONMENT
 #: The file formats read (through OpenCV): Radiance RGBE and OpenEXR.
 SUFFIXES = (".hdr", ".pic", ".exr")
 #: The default environment: 256 x 128 texels (1.4 degrees each), a sky, a sun and a ground.

@@ -11,7 +11,6 @@ from __future__ import annotations
 import threading
 import time
 from collections import OrderedDict
-from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -21,7 +20,7 @@ from .brd import Material
 from .glsl import ShaderBuilder, ShaderError
 from .models import model_for
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+from .resources import SHADER_DIR
 GLSL_VERSION = "330 core"
 
 EGL_PACKAGES = "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri"
