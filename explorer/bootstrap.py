@@ -624,14 +624,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"[setup] error: Python {'.'.join(map(str, MIN_PYTHON))} or newer is needed "
               f"(this is {platform.python_version()} at {sys.executable})", file=sys.stderr)
         return 1
-    if os.environ.get(ENV_NO_SETUP, "") not in ("", "0"):
-        run_in_process(mode, args)
     if not PYPROJECT.is_file():
         # An installed package (pip install): pip brought its dependencies; no checkout, no .venv to set up.
         if mode == MODE_TEST:
             print("[setup] error: the tests run from a source checkout (git clone), not an installed package",
                   file=sys.stderr)
             return 1
+        run_in_process(mode, args)
+    if os.environ.get(ENV_NO_SETUP, "") not in ("", "0"):
         run_in_process(mode, args)
     try:
         ensure_system_packages(mode)

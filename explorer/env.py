@@ -677,4 +677,7 @@ def render_env(
 
 
 if __name__ == "__main__":
+    from .resources import require_checkout
+
+    require_checkout("python -m explorer.env")
     print(f"wrote {write_default_environment()}")

@@ -238,10 +238,7 @@ def cmf_cumulative_at(wavelength) -> np.ndarray:
 
 
 def main() -> int:
-    if resources.CHECKOUT_ROOT is None:
-        print(f"python -m explorer.luts regenerates a source checkout's luts/; this is an installed package "
-              f"(a stale table is regenerated into {cache_lut_dir()} when used)", file=sys.stderr)
-        return 1
+    resources.require_checkout("python -m explorer.luts")  # an installation regenerates into cache_lut_dir()
     for name in TABLES:
         table = generate(name)
         print(f"luts/{name}.npy  shape {table.shape}  {_sha256(LUT_DIR / f'{name}.npy')[:16]}…")

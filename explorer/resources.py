@@ -49,6 +49,16 @@ DEFAULT_TEXTURE = SHADER_DIR / "textures" / "thickness_noise.png"
 DEFAULT_ENVIRONMENT = SHADER_DIR / "environments" / "default.hdr"
 
 
+def require_checkout(command: str) -> None:
+    """
+    Exit with one line unless running from a source checkout: ``command`` rewrites shipped files, which in
+    an installed package would mean writing into the installation.
+    """
+    if CHECKOUT_ROOT is None:
+        raise SystemExit(f"{command} rewrites the files a source checkout ships; this is an installed package "
+                         f"({SOURCE_ROOT}), which is never written")
+
+
 def cache_dir() -> Path:
     """
     The user cache, ``$XDG_CACHE_HOME/bragg-explorer`` (``~/.cache/bragg-explorer`` when unset or not

@@ -171,4 +171,7 @@ def check_prefilter(method: int, prefilter: bool) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover
+    from .resources import require_checkout
+
+    require_checkout("python -m explorer.thickness")
     print(write_default_texture())

@@ -112,7 +112,7 @@ def test_params_names_another_material_has_are_skipped_with_a_warning(tmp_path):
 BAD_CASES = [
     "missing params", "unreadable params", "malformed json", "bparam out of range", "exposure zero", "exposure negative",
     "exposure nan", "exposure text", "exposure of npy", "exposure of exr", "unknown extension", "unknown bare name",
-    "unknown bare name info", "unknown bare name presets",
+    "unknown bare name info", "unknown bare name presets", "unknown bare name open",
 ]
 
 
@@ -137,6 +137,7 @@ def bad_inputs(tmp_path) -> dict[str, tuple[list, str]]:
         "unknown bare name": (["render", "no_such_material", *GRADIENT, *out], "bragg_stack"),
         "unknown bare name info": (["info", "bragg_mirror.brdf"], "thin_film"),
         "unknown bare name presets": (["presets", "no_such_material"], "ggx_schlick"),
+        "unknown bare name open": (["open", "no_such_material"], "bragg_layer"),
     }
 
 

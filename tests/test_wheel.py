@@ -92,7 +92,8 @@ def installed(tmp_path_factory) -> Installed:
     _check([*pip, "--python", str(venv / "bin" / "python"), "install", "--no-deps", "--no-index", "-q", str(wheel)])
     cwd, cache = root / "work", root / "cache"
     cwd.mkdir()
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "PYTHONSTARTUP")}
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "PYTHONSTARTUP", "BRAGG_EXPLORER_NO_SETUP")}
     # A cache of its own, but Mesa's compiled shaders from the usual one (llvmpipe compiles slowly).
     mesa_cache = os.environ.get("MESA_SHADER_CACHE_DIR") or str(
         Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "mesa_shader_cache")
@@ -192,3 +193,15 @@ def test_stale_shipped_table_regenerates_into_the_user_cache(installed):
         np.testing.assert_array_equal(np.load(installed.cwd / "stale0.npy"), np.load(installed.cwd / "stale1.npy"))
     finally:
         table.write_bytes(original)
+
+
+def test_installed_package_never_rewrites_its_shipped_files(installed):
+    """The developer commands that regenerate shipped files refuse in an installation, in one line."""
+    before = snapshot(installed.venv)
+    for module in ("explorer.luts", "explorer.env"):
+        run = installed.run("-m", module, script="python")
+        assert run.returncode != 0 and "Traceback" not in run.stderr, run.stderr
+        assert len(run.stderr.strip().splitlines()) == 1 and "installed package" in run.stderr, run.stderr
+    run = installed.run("-m", "explorer", "test", script="python")
+    assert run.returncode != 0 and "source checkout" in run.stderr and "Traceback" not in run.stderr, run.stderr
+    assert snapshot(installed.venv) == before
