@@ -1144,7 +1144,7 @@ class App:
         path = Path(self._pending_screenshot)
         self._pending_screenshot = None
         try:
-            write_image(image * np.float32(self.exposure), path.with_suffix(".png"))
+            write_image(image, path.with_suffix(".png"), exposure=self.exposure)
             write_image(image, path.with_suffix(".npy"))
         except OutputError as error:
             self.status = str(error)
