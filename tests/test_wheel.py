@@ -89,7 +89,10 @@ def installed(tmp_path_factory) -> Installed:
     # runs nothing in them); never the checkout itself.
     ours = dict.fromkeys(p for p in sys.path if Path(p).name in ("site-packages", "dist-packages") and Path(p).is_dir())
     (site_packages / "zz_test_dependencies.pth").write_text("".join(f"{path}\n" for path in ours))
-    _check([*pip, "--python", str(venv / "bin" / "python"), "install", "--no-deps", "--no-index", "-q", str(wheel)])
+    # This environment's pip, run by the fresh interpreter (any pip version; no --python option needed). The
+    # checkout's own install is visible to it through the .pth: --force-reinstall installs the wheel anyway.
+    _check([str(venv / "bin" / "python"), *pip[1:], "install", "--no-deps", "--no-index", "--force-reinstall", "-q",
+            str(wheel)])
     cwd, cache = root / "work", root / "cache"
     cwd.mkdir()
     env = {k: v for k, v in os.environ.items()
