@@ -36,8 +36,8 @@ from typing import Callable, Mapping
 import numpy as np
 
 from .errors import LocatedError
-
 from .resources import DEFAULT_ENVIRONMENT
+
 #: The file formats read (through OpenCV): Radiance RGBE and OpenEXR.
 SUFFIXES = (".hdr", ".pic", ".exr")
 #: The default environment: 256 x 128 texels (1.4 degrees each), a sky, a sun and a ground.

@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 import time
 from collections import OrderedDict
+from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -19,8 +20,8 @@ from . import colorimetry, luts
 from .brd import Material
 from .glsl import ShaderBuilder, ShaderError
 from .models import model_for
-
 from .resources import SHADER_DIR
+
 GLSL_VERSION = "330 core"
 
 EGL_PACKAGES = "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri"

@@ -26,8 +26,8 @@ from pathlib import Path
 
 from .brd import Material, MaterialError, load_material
 from .errors import LocatedError
-
 from .resources import PRESET_DIR, SHADER_DIR
+
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")
 _TOML_LINE = re.compile(r"\(at line (\d+), column \d+\)")

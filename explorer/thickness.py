@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from .errors import LocatedError
-
 from .resources import DEFAULT_TEXTURE
+
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
 #: Methods the prefiltering applies to: the tabulated Fourier ones (Eq. 10 with the pre-filtered table).
