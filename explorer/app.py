@@ -350,7 +350,8 @@ class App:
         ``{"set": {NAME: VALUE}}`` (bench only: no UI); ``{"mark": TEXT}`` tags the following frames;
         ``{"screenshot": PATH}`` the active view (waits until complete; in ``env``, until a whole sample);
         ``{"file_path": PATH}`` types PATH into the Files tab's path field; ``{"view_size": N}`` picks the
-        sphere's resolution (the combo's values); ``{"quit": true}``.
+        sphere's resolution (the combo's values); ``{"key": "F12"}`` presses and releases a key (ImGui's
+        name), then waits for a screenshot it asked for; ``{"quit": true}``.
         """
         script = self.script
         if script.index >= len(script.actions):
@@ -429,6 +430,18 @@ class App:
             if step > int(action.get("timeout", 3000)):
                 script.log.append("screenshot: timed out")
                 done = True
+        elif "key" in action:
+            from imgui_bundle import imgui
+
+            if step <= 1:
+                io.add_key_event(getattr(imgui.Key, str(action["key"]).lower()), step == 0)
+            else:
+                done = self._pending_screenshot is None
+                if step > int(action.get("timeout", 3000)):
+                    script.log.append(f"key {action['key']}: timed out")
+                    done = True
+                if done:
+                    script.log.append(f"pressed {action['key']}")
         elif "window_screenshot" in action:
             if step == 0:
                 self._pending_window_shot = str(action["window_screenshot"])
@@ -622,6 +635,7 @@ class App:
             self.camera, self.zoom = [0.0, 0.0], 1.0
         imgui.separator()
         changed, exposure = imgui.slider_float("exposure", self.exposure, 0.05, 20.0, "%.2f", imgui.SliderFlags_.logarithmic)
+        self._record("exposure")
         if changed:
             self.exposure = exposure
         _, self.gamut = imgui.checkbox("gamut overlay (outside sRGB)", self.gamut)
@@ -1156,7 +1170,7 @@ class App:
         path = Path(self._pending_screenshot)
         self._pending_screenshot = None
         try:
-            write_image(image * np.float32(self.exposure), path.with_suffix(".png"))
+            write_image(image, path.with_suffix(".png"), exposure=self.exposure)
             write_image(image, path.with_suffix(".npy"))
         except OutputError as error:
             self.status = str(error)

@@ -19,8 +19,8 @@ import numpy as np
 
 from . import bragg, colorimetry
 from .brd import load_material
+from .resources import SHADER_DIR
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 BENCH_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_DELTAS = (0.25, 0.5, 0.75)

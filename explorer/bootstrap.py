@@ -41,9 +41,12 @@ import time
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, NoReturn, Sequence
 
+from .resources import SOURCE_ROOT
+
 ENV_NO_SETUP = "BRAGG_EXPLORER_NO_SETUP"
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
+#: The checkout that ``python3 -m explorer`` sets up (in an installed package there is none: see main).
+REPO_ROOT = SOURCE_ROOT
 VENV_DIR = REPO_ROOT / ".venv"
 PYPROJECT = REPO_ROOT / "pyproject.toml"
 STAMP_NAME = ".bragg-explorer-setup.json"
@@ -621,6 +624,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"[setup] error: Python {'.'.join(map(str, MIN_PYTHON))} or newer is needed "
               f"(this is {platform.python_version()} at {sys.executable})", file=sys.stderr)
         return 1
+    if not PYPROJECT.is_file():
+        # An installed package (pip install): pip brought its dependencies; no checkout, no .venv to set up.
+        if mode == MODE_TEST:
+            print("[setup] error: the tests run from a source checkout (git clone), not an installed package",
+                  file=sys.stderr)
+            return 1
+        run_in_process(mode, args)
     if os.environ.get(ENV_NO_SETUP, "") not in ("", "0"):
         run_in_process(mode, args)
     try:

@@ -1,9 +1,10 @@
 """
 ``bragg-explorer``: render materials headless, inspect material files, benchmark the methods.
 
-Bad input (a malformed material file, an unknown or out-of-range ``--set``, a GLSL error, an
-unwritable ``--out``, no GL) ends with one line on stderr naming the file and line where there is
-one, and a non-zero exit; an output file is either complete or not written at all.
+A material argument is a file, or the name of a built-in material (``bragg_mirror``; see
+:mod:`explorer.resources`). Bad input (a malformed material file, an unknown or out-of-range ``--set``,
+a GLSL error, an unwritable ``--out``, no GL) ends with one line on stderr naming the file and line where
+there is one, and a non-zero exit; an output file is either complete or not written at all.
 """
 
 from __future__ import annotations
@@ -19,9 +20,11 @@ import numpy as np
 
 from .brd import Material, MaterialError, load_material, parse_assignment, round_integer
 from .errors import LocatedError
+from .resources import DEFAULT_MATERIAL, display_path, material_path
 
-DEFAULT_MATERIAL = Path(__file__).resolve().parent.parent / "shaders" / "bragg_mirror.brd"
 PROG = "bragg-explorer"
+#: What ``render --out`` writes, by suffix.
+OUTPUT_SUFFIXES = (".png", ".npy", ".exr")
 #: 8-bit colour of the scatter view's circles in PNG output (red, as in the paper's Figure 9).
 OVERLAY_RGB = (255, 0, 0)
 
@@ -36,7 +39,8 @@ def _fail(message: str) -> None:
 
 
 def _load(path: str | Path) -> Material:
-    material = load_material(path)
+    """A material file, or a built-in material by name (:func:`explorer.resources.material_path`)."""
+    material = load_material(material_path(path))
     for warning in material.warnings:
         click.echo(f"{PROG}: warning: {warning}", err=True)
     return material
@@ -80,8 +84,8 @@ def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
 
 def check_output(out: Path) -> Path:
     """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
-    if out.suffix.lower() not in (".png", ".npy"):
-        raise OutputError(f"{out}: the output must end in .png or .npy")
+    if out.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise OutputError(f"{out}: the output must end in .png, .npy or .exr")
     if out.is_dir():
         raise OutputError(f"{out}: is a directory")
     directory = out.parent if str(out.parent) else Path(".")
@@ -92,11 +96,21 @@ def check_output(out: Path) -> Path:
     return directory
 
 
-def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None) -> None:
+def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
     """
-    ``.npy``: float32 HxWx3 linear RGB; ``.png``: 8-bit sRGB, clamped. Written atomically.
+    Write a linear RGB image atomically (a temporary file, renamed): never a partial file.
 
-    ``overlay``: a bool HxW mask of pixels painted red in the PNG only (the scatter view's circles).
+    Parameters
+    ----------
+    image : ndarray, HxWx3
+        Linear RGB.
+    out : Path
+        ``.npy``: float32 linear RGB; ``.exr``: OpenEXR, float32 linear RGB (through OpenCV); ``.png``:
+        8-bit sRGB of ``exposure * image``, clamped.
+    overlay : ndarray of bool, HxW, optional
+        Pixels painted red in the PNG only (the scatter view's circles).
+    exposure : float
+        The PNG's multiplier before the sRGB encode, as the app's exposure (linear outputs keep the values).
     """
     from PIL import Image
 
@@ -112,11 +126,13 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None)
         with os.fdopen(handle, "wb") as stream:
             if suffix == ".npy":
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
-            else:
-                pixels = encode_srgb8(image)
+            elif suffix == ".png":
+                pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
                 if overlay is not None:
                     pixels[overlay] = OVERLAY_RGB
                 Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
+        if suffix == ".exr":
+            _write_exr(image, temporary, out)
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
@@ -124,6 +140,36 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None)
     except OSError as error:
         Path(temporary).unlink(missing_ok=True)
         raise OutputError(f"{out}: cannot write ({error.strerror})") from None
+
+
+def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
+    """OpenEXR, 32-bit float RGB, through OpenCV (BGR order) with OpenEXR enabled as for environments."""
+    from .env import _cv2
+
+    cv2 = _cv2()
+    bgr = np.ascontiguousarray(np.asarray(image, dtype=np.float32)[..., ::-1])
+    try:
+        written = cv2.imwrite(temporary, bgr, [cv2.IMWRITE_EXR_TYPE, cv2.IMWRITE_EXR_TYPE_FLOAT])
+    except cv2.error as error:
+        raise OSError(0, f"OpenCV: {' '.join(str(error).split())[:200]}") from None
+    if not written:
+        raise OSError(0, "OpenCV could not write OpenEXR")
+
+
+def parse_exposure(text: str | None, out: Path) -> float:
+    """``--exposure``: a positive multiplier of the linear values before the PNG's sRGB encode."""
+    if text is None:
+        return 1.0
+    try:
+        exposure = float(text)
+    except ValueError:
+        exposure = float("nan")
+    if not (np.isfinite(exposure) and exposure > 0.0):
+        raise click.BadParameter(f"{text!r} is not a positive multiplier (e.g. 2 for one stop brighter)", param_hint="--exposure")
+    if out.suffix.lower() != ".png":
+        raise click.BadParameter(f"scales the 8-bit .png encode; {out.suffix or 'this output'} keeps the linear values",
+                                 param_hint="--exposure")
+    return exposure
 
 
 def render_material(
@@ -218,7 +264,7 @@ def cli(ctx: click.Context) -> None:
 @click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
 @click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
 def open_material(material, preset, script, report, window_size):
-    """Open the interactive explorer on MATERIAL (.brd, or BRDF Explorer's .brdf)."""
+    """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
     from .app import DEFAULT_WINDOW, AppError, display_available, run_app
     from .gl import GLUnavailable
 
@@ -227,7 +273,7 @@ def open_material(material, preset, script, report, window_size):
         if preset is not None:
             from .presets import presets_for
 
-            presets_for(material).get(preset)
+            presets_for(loaded.path).get(preset)
         actions = None
         if script is not None:
             try:
@@ -245,7 +291,7 @@ def open_material(material, preset, script, report, window_size):
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
                            "for images without a window use: bragg-explorer render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
-                         is_default=Path(material).resolve() == DEFAULT_MATERIAL)
+                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve())
     except ImportError as error:
         _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
     except (LocatedError, GLUnavailable, OutputError, AppError) as error:
@@ -274,18 +320,22 @@ def _errors(function):
 @click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured", "env"]), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
-@click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB) or FILE.npy (linear float32).")
+@click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
 @click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
+@click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
+@click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter).")
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view: Monte Carlo samples per pixel (default 64).")
 @_errors
-def render(material, view, assignments, size, out, engine, light, preset, texture, dinc_range, prefilter, env_file, spp):
-    """Render MATERIAL (.brd or BRDF Explorer .brdf) headless to a PNG or .npy.
+def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
+           prefilter, env_file, spp):
+    """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
+    to a PNG, .npy or .exr.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
@@ -297,13 +347,21 @@ def render(material, view, assignments, size, out, engine, light, preset, textur
     from .render import scatter_circles
 
     check_output(Path(out))
+    exposure_factor = parse_exposure(exposure, Path(out))
     light_angles = parse_light(light, view)
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    if params_file is not None:
+        from .app_params import load_values
+
+        loaded_values = load_values(params_file, loaded)
+        for skipped in loaded_values.skipped:
+            click.echo(f"{PROG}: warning: {params_file}: skipped {skipped}", err=True)
+        overrides = {**loaded_values.values, **overrides}
     if preset is not None:
         from .presets import presets_for
 
-        overrides = {**presets_for(material).get(preset).values, **overrides}
+        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
     values = loaded.resolve(overrides)
     width, height = parse_size(size, view)
     thickness = None
@@ -323,7 +381,7 @@ def render(material, view, assignments, size, out, engine, light, preset, textur
     elif env_file is not None or spp is not None:
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
     image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
-    write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None)
+    write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
 
@@ -333,12 +391,12 @@ def render(material, view, assignments, size, out, engine, light, preset, textur
 @click.option("--json", "as_json", is_flag=True, help="Print the parameters as JSON.")
 @_errors
 def info(material, as_json):
-    """Print a material file's parameters."""
+    """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film)."""
     loaded = _load(material)
     if as_json:
         click.echo(json.dumps(loaded.info(), indent=2))
         return
-    click.echo(f"{loaded.path}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
+    click.echo(f"{display_path(loaded.path)}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
     for p in loaded.parameters:
         bounds = "" if p.min is None else f" in [{p.min:g}, {p.max:g}]"
         click.echo(f"  {p.type:5} {p.name:12} default {p.default}{bounds}")
@@ -349,18 +407,28 @@ def info(material, as_json):
 @click.option("--json", "as_json", is_flag=True, help="Print the presets as JSON.")
 @_errors
 def presets(material, as_json):
-    """List the presets (name, material, description) of MATERIAL (a .brd file or a name such as
-    thin_film), or of every material that has some."""
-    from .presets import all_preset_files, find_preset_file
+    """List the presets (name, material, description) of MATERIAL (a file, or a built-in's name such as
+    thin_film), or of every built-in material that has some."""
+    from .presets import all_preset_files, load_presets, presets_path
 
-    files = [find_preset_file(material)] if material else all_preset_files()
+    if material:
+        loaded = _load(material)
+        path = presets_path(loaded.path)
+        files = [load_presets(path)] if path.is_file() else []
+        none = f"{display_path(loaded.path)}: no presets (they would be in {display_path(path)})"
+    else:
+        files = all_preset_files()
+        none = "no presets installed"
     rows = [
-        {"name": p.name, "material": os.path.relpath(p.material.path), "figure": p.figure,
+        {"name": p.name, "material": display_path(p.material.path), "figure": p.figure,
          "description": p.description, "values": p.values}
         for f in files for p in f.presets.values()
     ]
     if as_json:
         click.echo(json.dumps(rows, indent=2))
+        return
+    if not rows:
+        click.echo(none)
         return
     width = max((len(r["name"]) for r in rows), default=4)
     material_width = max((len(r["material"]) for r in rows), default=8)

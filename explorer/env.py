@@ -36,8 +36,8 @@ from typing import Callable, Mapping
 import numpy as np
 
 from .errors import LocatedError
+from .resources import DEFAULT_ENVIRONMENT
 
-DEFAULT_ENVIRONMENT = Path(__file__).resolve().parent.parent / "shaders" / "environments" / "default.hdr"
 #: The file formats read (through OpenCV): Radiance RGBE and OpenEXR.
 SUFFIXES = (".hdr", ".pic", ".exr")
 #: The default environment: 256 x 128 texels (1.4 degrees each), a sky, a sun and a ground.
@@ -679,4 +679,7 @@ def render_env(
 
 
 if __name__ == "__main__":
+    from .resources import require_checkout
+
+    require_checkout("python -m explorer.env")
     print(f"wrote {write_default_environment()}")

@@ -20,8 +20,8 @@ from . import colorimetry, luts
 from .brd import Material, round_integer
 from .glsl import ShaderBuilder, ShaderError
 from .models import model_for
+from .resources import SHADER_DIR
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 GLSL_VERSION = "330 core"
 
 EGL_PACKAGES = "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri"

@@ -4,8 +4,10 @@ Precomputed tables in ``luts/``, generated from colour-science, with a manifest.
 Each table is a ``.npy`` file listed in ``luts/manifest.json`` with its source, range, resolution,
 the parameters that generated it and a SHA-256 checksum. :func:`load` regenerates a table that is
 missing, altered, or generated with other parameters than the code's: a stale table is never used.
+The shipped tables (:data:`LUT_DIR`, see :mod:`explorer.resources`) are read-only: a stale one is
+regenerated into the user cache (``~/.cache/bragg-explorer/luts``) and read from there afterwards.
 
-Run ``python -m explorer.luts`` to regenerate every table.
+Run ``python -m explorer.luts`` in a source checkout to regenerate the committed tables.
 
 Tables
 ------
@@ -39,9 +41,10 @@ from typing import Callable
 
 import numpy as np
 
-from . import colorimetry
+from . import colorimetry, resources
 
-LUT_DIR = Path(__file__).resolve().parent.parent / "luts"
+#: The shipped tables (read-only: see :func:`load`).
+LUT_DIR = resources.LUT_DIR
 MANIFEST = "manifest.json"
 #: Bump when a generator changes what it writes.
 GENERATOR_VERSION = 1
@@ -170,22 +173,46 @@ def generate(name: str, directory: Path = LUT_DIR) -> np.ndarray:
 _cache: dict[tuple[str, Path], np.ndarray] = {}
 
 
-def load(name: str, directory: Path = LUT_DIR, log: Callable[[str], None] | None = None) -> np.ndarray:
+def cache_lut_dir() -> Path:
+    """Where stale shipped tables are regenerated: ``luts`` in :func:`explorer.resources.cache_dir`."""
+    return resources.cache_dir() / "luts"
+
+
+def load(name: str, directory: Path | None = None, log: Callable[[str], None] | None = None) -> np.ndarray:
     """
     Table ``name``, regenerated first when missing or stale (never silently used stale).
 
-    When ``directory`` cannot be written, the regenerated table is used from memory.
+    Parameters
+    ----------
+    name : str
+        A key of :data:`TABLES`.
+    directory : Path, optional
+        A table folder of one's own, where a stale table is regenerated. By default the shipped tables
+        (:data:`LUT_DIR`), never written: a stale one is replaced by the user cache's copy
+        (:func:`cache_lut_dir`), regenerated there first unless that copy is current.
+    log : callable, optional
+        Receives the one-line message of a regeneration (default: stderr).
+
+    Notes
+    -----
+    When the target folder cannot be written, the regenerated table is used from memory.
     """
-    key = (name, Path(directory))
+    shipped = directory is None
+    directory = Path(LUT_DIR if shipped else directory)
+    key = (name, directory)
     if key in _cache:
         return _cache[key]
     reason = staleness(name, directory)
     if reason is None:
         table = np.load(directory / f"{name}.npy")
+    elif shipped and staleness(name, cache_lut_dir()) is None:
+        table = np.load(cache_lut_dir() / f"{name}.npy")
     else:
-        (log or (lambda m: print(m, file=sys.stderr)))(f"luts: regenerating {name} ({reason})")
+        target = cache_lut_dir() if shipped else directory
+        where = f" into {target}" if shipped else ""
+        (log or (lambda m: print(m, file=sys.stderr)))(f"luts: regenerating {name} ({reason}){where}")
         try:
-            table = generate(name, directory)
+            table = generate(name, target)
         except OSError:
             table = np.ascontiguousarray(TABLES[name]["generate"]())
     table.setflags(write=False)
@@ -211,6 +238,7 @@ def cmf_cumulative_at(wavelength) -> np.ndarray:
 
 
 def main() -> int:
+    resources.require_checkout("python -m explorer.luts")  # an installation regenerates into cache_lut_dir()
     for name in TABLES:
         table = generate(name)
         print(f"luts/{name}.npy  shape {table.shape}  {_sha256(LUT_DIR / f'{name}.npy')[:16]}…")

@@ -26,9 +26,8 @@ from pathlib import Path
 
 from .brd import Material, MaterialError, load_material
 from .errors import LocatedError
+from .resources import PRESET_DIR, SHADER_DIR
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
-PRESET_DIR = SHADER_DIR / "presets"
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")
 _TOML_LINE = re.compile(r"\(at line (\d+), column \d+\)")

@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from .errors import LocatedError
+from .resources import DEFAULT_TEXTURE
 
-DEFAULT_TEXTURE = Path(__file__).resolve().parent.parent / "shaders" / "textures" / "thickness_noise.png"
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
 #: Methods the prefiltering applies to: the tabulated Fourier ones (Eq. 10 with the pre-filtered table).
@@ -171,4 +171,7 @@ def check_prefilter(method: int, prefilter: bool) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover
+    from .resources import require_checkout
+
+    require_checkout("python -m explorer.thickness")
     print(write_default_texture())

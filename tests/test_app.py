@@ -86,6 +86,31 @@ def test_scripted_session_slider_preset_screenshot(x_display, tmp_path, gl_rende
     assert window.shape[:2] == (720, 1000) and window.std() > 10  # the UI was drawn
 
 
+def test_f12_saves_the_active_view_with_the_exposure(x_display, tmp_path, gl_renderer, bragg_material):
+    """F12 writes screenshots/<material>_<view>_1.png (8-bit sRGB with the exposure) and its linear .npy."""
+    actions = [
+        {"wait": 2}, {"wait_complete": True},
+        {"drag": "exposure", "from": 0.5, "to": 0.75, "frames": 4}, {"wait": 2},
+        {"wait_complete": True}, {"key": "F12"}, {"quit": True},
+    ]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert "dragged exposure" in report["script_log"] and "pressed F12" in report["script_log"], report["script_log"]
+    exposure = report["exposure"]
+    assert exposure > 1.5  # the drag moved it up from 1
+    shots = sorted(p.name for p in (tmp_path / "screenshots").iterdir())
+    view = "sphere" if report["mode"] == "sphere" else "lit"
+    assert shots == [f"bragg_mirror_{view}_1.npy", f"bragg_mirror_{view}_1.png"], shots
+    assert report["screenshots"] == [f"screenshots/bragg_mirror_{view}_1.png"]
+    linear = np.load(tmp_path / "screenshots" / shots[0])
+    png = np.asarray(Image.open(tmp_path / "screenshots" / shots[1]).convert("RGB")).astype(int)
+    # The PNG is the linear image times the exposure, encoded; the .npy holds the values without it.
+    assert np.abs(png - encode_srgb8(linear * np.float32(exposure)).astype(int)).max() <= 1
+    assert np.abs(png - encode_srgb8(linear).astype(int)).max() > 10
+    if view == "sphere":
+        headless = gl_renderer.render(bragg_material, bragg_material.resolve(report["values"]), "sphere", *linear.shape[1::-1])
+        np.testing.assert_allclose(linear, headless, atol=2e-3)
+
+
 def test_open_brdf_explorer_file(x_display, tmp_path, gl_renderer):
     """A BRDF Explorer file with float, bool and colour parameters opens in the lit view; a bool toggles by a click."""
     material_path = BRDF_DATA / "app_all_kinds.brdf"

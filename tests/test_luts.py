@@ -161,3 +161,40 @@ def test_box_spectrum_anywhere_is_the_overlap_sum():
         a, b = np.sort(rng.uniform(340.0, 850.0, size=2))
         span = luts.cmf_cumulative_at(b) - luts.cmf_cumulative_at(a)
         np.testing.assert_allclose(span, box_integral(a, b), rtol=0, atol=CUMULATIVE_ATOL)
+
+
+def test_stale_shipped_table_is_regenerated_into_the_user_cache(tmp_path, monkeypatch):
+    """The shipped tables are never written: a stale one is regenerated into the cache, then read from there."""
+    shipped = tmp_path / "site-packages" / "luts"
+    shutil.copytree(luts.LUT_DIR, shipped)
+    expected = committed("cmf_1nm")
+    monkeypatch.setattr(luts, "LUT_DIR", shipped)
+    monkeypatch.setattr(luts, "_cache", {})
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    cache = tmp_path / "cache" / "bragg-explorer" / "luts"
+    assert luts.cache_lut_dir() == cache
+    _alter_npy(shipped / "cmf_1nm.npy")
+    before = {p.name: p.read_bytes() for p in shipped.iterdir()}
+    messages = []
+    table = luts.load("cmf_1nm", log=messages.append)
+    assert len(messages) == 1 and "checksum mismatch" in messages[0] and str(cache) in messages[0], messages
+    np.testing.assert_allclose(table, expected, rtol=0, atol=REGENERATED_ATOL)
+    assert {p.name: p.read_bytes() for p in shipped.iterdir()} == before  # untouched
+    assert luts.staleness("cmf_1nm", cache) is None
+    # A current shipped table is read from the installation, whatever the cache holds.
+    assert luts.load("cmf_cumulative", log=messages.append) is not None and len(messages) == 1
+    assert not (cache / "cmf_cumulative.npy").exists()
+    # A later process (an empty memory cache) uses the cached table silently.
+    monkeypatch.setattr(luts, "_cache", {})
+    np.testing.assert_array_equal(luts.load("cmf_1nm", log=messages.append), table)
+    assert len(messages) == 1
+
+
+def test_xdg_cache_home_must_be_absolute(monkeypatch, tmp_path):
+    from explorer import resources
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert resources.cache_dir() == tmp_path / "bragg-explorer"
+    monkeypatch.setenv("XDG_CACHE_HOME", "relative/cache")  # the XDG specification: ignored
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert resources.cache_dir() == tmp_path / "home" / ".cache" / "bragg-explorer"
