@@ -15,6 +15,7 @@ import numpy as np
 
 from . import bragg, colorimetry, layered, microfacet
 from .fresnel import fresnel_schlick
+from .lobes_model import LayeredLobesModel
 from .thinfilm_model import ThinFilmModel
 
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
@@ -271,6 +272,7 @@ MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     SchlickFresnelModel.name: SchlickFresnelModel,
     ThinFilmModel.name: ThinFilmModel,
     GGXSchlickModel.name: GGXSchlickModel,
+    LayeredLobesModel.name: LayeredLobesModel,
 }
 
 

@@ -1,0 +1,59 @@
+"""
+The numpy twin of ``shaders/layered_lobes.brd`` (physics in :mod:`explorer.lobes`): Belcour's (2018)
+layered BRDF as a sum of GGX lobes (Bati et al. 2021, Eq. 3) and the FGD tables its shader reads.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from . import lobes, luts
+
+
+def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
+    """The :class:`explorer.lobes.Stack` of the material's parameter values (checked)."""
+    count = int(np.clip(np.floor(float(values["layers"]) + 0.5), 1, lobes.MAX_INTERFACES))
+    conductor = bool(values.get("conductor", False))
+    eta = [float(values[f"eta_{i}"]) for i in range(1, count + 1)]
+    if conductor:
+        eta[-1] = np.asarray(values["eta_base"], dtype=np.float64)
+    return lobes.make_stack(
+        eta,
+        [float(values[f"alpha_{i}"]) for i in range(1, count + 1)],
+        tau=[values[f"tau_{i}"] for i in range(1, count)],
+        base_kappa=values["kappa_base"] if conductor else None,
+    )
+
+
+def fgd_texture() -> np.ndarray:
+    """``luts/lobes_fgd_correction`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, channels s, p, 0."""
+    table = luts.load("lobes_fgd_correction")
+    rows = table.reshape(2, -1, table.shape[-1])
+    return np.stack([rows[0], rows[1], np.zeros_like(rows[0])], axis=-1).astype(np.float32)
+
+
+def moments_texture() -> np.ndarray:
+    """``luts/lobes_ggx_moments`` as a ``(16, 32, 3)`` texture: channels E, cbar_d, 0."""
+    table = luts.load("lobes_ggx_moments")
+    return np.stack([table[0], table[1], np.zeros_like(table[0])], axis=-1).astype(np.float32)
+
+
+class LayeredLobesModel:
+    """Twin of ``shaders/layered_lobes.brd``: ``reflectance(cos_theta)`` (sum of the lobes' energies) and Eq. 3."""
+
+    name = "layered_lobes"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.values = dict(values)
+        self.stack = stack_from_values(values)
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        return lobes.reflectance(self.stack, cos_theta)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        return lobes.brdf(self.stack, L, V, N)
+
+    def textures(self) -> dict[str, np.ndarray]:
+        return {"lobes_fgd": fgd_texture(), "lobes_ggx_moments": moments_texture()}
