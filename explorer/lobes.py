@@ -153,18 +153,21 @@ def _reflection_quadrature(cos_theta, alpha):
 
 def generate_fgd_correction() -> np.ndarray:
     """
-    ``FGD_{s,p}(cos theta, alpha, eta) - F_{s,p}(cos theta, eta)`` for a rough dielectric interface of
+    ``FGD(cos theta, alpha, eta) - F(cos theta, eta)``, unpolarised, for a rough dielectric interface of
     relative index ``eta`` (both sides of 1: light from below included), shape
-    ``(2, FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT)``. ``FGD`` is the directional albedo of the
-    GGX reflection (separable Smith G, Eq. 19 of Fourneau et al.), Belcour's (2018) tabulated term.
+    ``(FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT)``. ``FGD`` is the directional albedo of the GGX
+    reflection (separable Smith G, Eq. 19 of Fourneau et al.), Belcour's (2018) tabulated term.
+
+    One correction for both polarisations: a microfacet's s and p are not the surface's, so the rough
+    part is not split; at normal incidence FGD_s = FGD_p then, as the inverse method assumes.
     """
     cos_nodes, alphas = fgd_cos_nodes(), fgd_alpha_nodes()
     weight, i_dot_h = _reflection_quadrature(cos_nodes, alphas)
-    table = np.empty((2, FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT))
+    table = np.empty((FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT))
     smooth_c = np.maximum(cos_nodes, FGD_COS_FLOOR)
     for j, eta in enumerate(fgd_eta_nodes()):
-        F = fresnel_sp(i_dot_h, eta)  # (2, A, C, M*M)
-        table[:, j] = (weight[None] * F).sum(axis=-1) - fresnel_sp(smooth_c, eta)[:, None, :]
+        F = fresnel_sp(i_dot_h, eta).mean(axis=0)  # (A, C, M*M)
+        table[j] = (weight * F).sum(axis=-1) - fresnel_sp(smooth_c, eta).mean(axis=0)[None, :]
     return table
 
 
@@ -191,7 +194,8 @@ def _axis(value, count: int, lo: float, hi: float):
 def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
     """
     ``FGD_{s,p}`` of a rough dielectric interface of relative index ``eta`` (achromatic or per channel):
-    the exact Fresnel term plus the trilinearly interpolated tabulated correction. Leading axis 2.
+    the exact Fresnel term plus the trilinearly interpolated (unpolarised) tabulated correction, split
+    between s and p in proportion to their Fresnel terms. Leading axis 2.
     """
     from . import luts
 
@@ -205,8 +209,14 @@ def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
     for de, we in ((0, 1.0 - fe), (1, fe)):
         for da, wa in ((0, 1.0 - fa), (1, fa)):
             for dc, wc in ((0, 1.0 - fc), (1, fc)):
-                correction = correction + (we * wa * wc) * table[:, ie + de, ia + da, ic + dc]
-    return np.clip(fresnel_sp(cos_theta, eta) + correction, 0.0, 1.0)
+                correction = correction + (we * wa * wc) * table[ie + de, ia + da, ic + dc]
+    # The unpolarised FGD = F + correction, shared by s and p in proportion to their Fresnel terms (both
+    # stay >= 0 where one alone would go negative, near Brewster's angle).
+    F = fresnel_sp(cos_theta, eta)
+    mean = F.mean(axis=0)
+    target = np.clip(mean + correction, 0.0, 1.0)
+    scale = np.where(mean > 1e-9, target / np.maximum(mean, 1e-9), 1.0)
+    return np.clip(np.where(mean > 1e-9, F * scale, target), 0.0, 1.0)
 
 
 def fgd_conductor(cos_theta, alpha, eta, kappa) -> np.ndarray:

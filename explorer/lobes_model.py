@@ -28,10 +28,10 @@ def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
 
 
 def fgd_texture() -> np.ndarray:
-    """``luts/lobes_fgd_correction`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, channels s, p, 0."""
+    """``luts/lobes_fgd_correction`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, the correction in red."""
     table = luts.load("lobes_fgd_correction")
-    rows = table.reshape(2, -1, table.shape[-1])
-    return np.stack([rows[0], rows[1], np.zeros_like(rows[0])], axis=-1).astype(np.float32)
+    rows = table.reshape(-1, table.shape[-1])
+    return np.stack([rows, np.zeros_like(rows), np.zeros_like(rows)], axis=-1).astype(np.float32)
 
 
 def moments_texture() -> np.ndarray:

@@ -29,7 +29,7 @@ sensitivity_fourier
     imaginary parts (the paper's N x 2 three-channel texture, Section 5); zero beyond the last node.
 lobes_fgd_correction, lobes_ggx_moments
     Belcour's (2018) FGD term for :mod:`explorer.lobes`: a rough dielectric interface's directional
-    albedo minus the Fresnel term, per polarisation, over (eta, alpha, cos theta); and the GGX reflection
+    albedo minus the Fresnel term (unpolarised), over (eta, alpha, cos theta); and the GGX reflection
     lobe's albedo and mean half-angle cosine over (alpha, cos theta), for rough conductors.
 """
 
@@ -125,11 +125,11 @@ TABLES: dict[str, dict] = {
     "lobes_fgd_correction": {
         "generate": _generate_lobes_fgd_correction,
         "spec": {
-            "quantity": "FGD - Fresnel of a rough GGX dielectric interface, [s, p] x eta x alpha x cos theta "
+            "quantity": "FGD - Fresnel (unpolarised) of a rough GGX dielectric interface, eta x alpha x cos theta "
             "(explorer.lobes; Belcour 2018's FGD term)",
             "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 32)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
-            "shape": [2, 33, 16, 32],
+            "shape": [33, 16, 32],
         },
     },
     "lobes_ggx_moments": {

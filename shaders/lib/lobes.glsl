@@ -1,7 +1,7 @@
 // Belcour's (2018) atomic decomposition of layered materials: twin of explorer/lobes.py (Bati, Barla &
 // Pacanowski 2021, Section 4: Eqs. 2-6, BRDF Eq. 3). Energies per polarisation (s, p) and RGB channel,
 // variances per channel; the host binds luts/lobes_fgd_correction.npy as lobes_fgd (rows eta-major,
-// alpha-minor; columns cos theta; channels s, p) and luts/lobes_ggx_moments.npy as lobes_ggx_moments
+// alpha-minor; columns cos theta; the unpolarised FGD - F in red) and luts/lobes_ggx_moments.npy as lobes_ggx_moments
 // (rows alpha; columns cos theta; channels E, cbar_d). All lookups are texelFetch + explicit trilinear
 // weights, the numpy twin's arithmetic.
 #include "lib/complex.glsl"
@@ -66,22 +66,26 @@ void lobes_axis(float value, int count, float lo, float hi, out int i, out float
     f = x - float(i);
 }
 
-// FGD of a rough dielectric interface: exact Fresnel plus the tabulated correction.
+// FGD of a rough dielectric interface: exact Fresnel per polarisation plus the tabulated (unpolarised) correction.
 vec2 fgd_dielectric(sampler2D table, float cos_theta, float alpha, float eta) {
     int ic, ia, ie;
     float fc, fa, fe;
     lobes_axis(cos_theta, FGD_COS_COUNT, 0.0, 1.0, ic, fc);
     lobes_axis(alpha, FGD_ALPHA_COUNT, 0.0, 1.0, ia, fa);
     lobes_axis(log(max(eta, 1e-12)) / log(ETA_TABLE_MAX), FGD_ETA_COUNT, -1.0, 1.0, ie, fe);
-    vec2 correction = vec2(0.0);
+    float correction = 0.0;
     for (int de = 0; de < 2; ++de) {
         for (int da = 0; da < 2; ++da) {
             int row = (ie + de) * FGD_ALPHA_COUNT + ia + da;
             float w = (de == 0 ? 1.0 - fe : fe) * (da == 0 ? 1.0 - fa : fa);
-            correction += w * ((1.0 - fc) * texelFetch(table, ivec2(ic, row), 0).rg + fc * texelFetch(table, ivec2(ic + 1, row), 0).rg);
+            correction += w * ((1.0 - fc) * texelFetch(table, ivec2(ic, row), 0).r + fc * texelFetch(table, ivec2(ic + 1, row), 0).r);
         }
     }
-    return clamp(fresnel_sp(cos_theta, eta) + correction, 0.0, 1.0);
+    // Shared by s and p in proportion to their Fresnel terms (explorer.lobes.fgd_dielectric).
+    vec2 F = fresnel_sp(cos_theta, eta);
+    float mean = 0.5 * (F.x + F.y);
+    float target = clamp(mean + correction, 0.0, 1.0);
+    return clamp(mean > 1e-9 ? F * (target / max(mean, 1e-9)) : vec2(target), 0.0, 1.0);
 }
 
 // FGD of a rough conductor: the lobe's albedo E times Fresnel at its mean half-angle cosine.
