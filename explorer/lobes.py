@@ -47,7 +47,7 @@ from . import microfacet
 #: Upper bound on dielectric indices (Bati et al. use eta_max = 4 "for illustration").
 ETA_MAX = 4.0
 #: Interfaces of the material file and its shader.
-MAX_INTERFACES = 3
+MAX_INTERFACES = 4
 
 #: The FGD tables: cos theta nodes k / (N_COS - 1), alpha nodes k / (N_ALPHA - 1), eta nodes
 #: ETA_TABLE_MAX ** (2 k / (N_ETA - 1) - 1) (log-spaced from 1 / 4 to 4), and the quadrature per entry.
@@ -373,7 +373,8 @@ def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
     """
     The adding equations (Bati et al., Eqs. 2, 4-6; Belcour 2018) down to interface ``count``
     (default: all): the lobes' energies ``R_k`` and variances ``sigma_k``, ``(..., count, 3)`` each, and
-    the :class:`StackStatistics` of the top ``count`` interfaces.
+    the :class:`StackStatistics` of the top ``count`` interfaces (seen from medium ``count``, below them,
+    when ``count`` is not the base).
 
     Lobe ``k`` gathers the paths that reach interface ``k`` and no deeper (Eq. 3):
     ``R_k = T_0n R'_{n,n+1} T_n0 / (1 - R'_{n,n+1} R_n0)`` (Eq. 17, n = k - 1, ``R'`` attenuated by
@@ -419,7 +420,7 @@ def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
         R_new = R_0n + E
         s_r0n = _safe_divide(R_0n.mean(axis=0) * s_r0n + E_mean * sigma, R_new.mean(axis=0))
         R_0n = R_new
-        if i == count:
+        if conductor:
             break
         # Below interface i (the next iteration's medium i): only transmitted light goes on.
         m_ri0 = T21 * a2 * R_n0 * T12 / D
@@ -436,6 +437,8 @@ def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
         R_n0 = R_n0_new
         j_0n = j_0n * j12
         c = np.where(transmits, c_t, c)
+        if i == count:
+            break
     statistics = StackStatistics(
         R_0n.mean(axis=0), R_n0.mean(axis=0), T_0n.mean(axis=0), T_n0.mean(axis=0),
         s_r0n, s_rn0, s_t0n, s_tn0, j_0n, c,

@@ -7,7 +7,7 @@
 #include "lib/complex.glsl"
 #include "lib/microfacet.glsl"
 
-const int LOBES_MAX = 3;             // explorer.lobes.MAX_INTERFACES
+const int LOBES_MAX = 4;             // explorer.lobes.MAX_INTERFACES
 const int FGD_COS_COUNT = 32;
 const int FGD_ALPHA_COUNT = 16;
 const int FGD_ETA_COUNT = 33;
@@ -162,7 +162,7 @@ void lobes(LobeStack s, sampler2D fgd_table, sampler2D moments, float cos_theta,
 vec3 lobes_reflectance(LobeStack s, sampler2D fgd_table, sampler2D moments, float cos_theta) {
     vec3 energy[LOBES_MAX], variance[LOBES_MAX];
     lobes(s, fgd_table, moments, cos_theta, energy, variance);
-    return energy[0] + energy[1] + energy[2];
+    return energy[0] + energy[1] + energy[2] + energy[3];
 }
 
 // GGX lobe without Fresnel, per channel: D(h) G1(i) G1(o) / (4 cos_i cos_o).
