@@ -49,9 +49,10 @@ ETA_MAX = 4.0
 #: Interfaces of the material file and its shader.
 MAX_INTERFACES = 4
 
-#: The FGD tables: cos theta nodes k / (N_COS - 1), alpha nodes k / (N_ALPHA - 1), eta nodes
+#: The FGD tables: nodes t = k / (N_COS - 1) of the warped cosine (:func:`fgd_cos_coordinate`: the
+#: critical angle of eta < 1 on the middle node), alpha nodes k / (N_ALPHA - 1), eta nodes
 #: ETA_TABLE_MAX ** (2 k / (N_ETA - 1) - 1) (log-spaced from 1 / 4 to 4), and the quadrature per entry.
-FGD_COS_COUNT = 32
+FGD_COS_COUNT = 33
 FGD_ALPHA_COUNT = 16
 FGD_ETA_COUNT = 33
 ETA_TABLE_MAX = 4.0
@@ -115,7 +116,36 @@ def normal_reflectance(eta_0, eta_1, kappa_1=0.0) -> np.ndarray:
 
 
 def fgd_cos_nodes() -> np.ndarray:
+    """The table's nodes in the warped coordinate ``t`` (and in ``cos theta`` for ``eta >= 1``)."""
     return np.linspace(0.0, 1.0, FGD_COS_COUNT)
+
+
+def _critical_cos(eta):
+    eta = np.asarray(eta, dtype=np.float64)
+    return np.sqrt(np.maximum(1.0 - eta * eta, 0.0))
+
+
+def fgd_cos_coordinate(cos_theta, eta) -> np.ndarray:
+    """
+    The FGD table's coordinate ``t`` of ``cos theta``: ``cos theta`` itself for ``eta >= 1``; below 1,
+    piecewise linear with the critical angle (``cos theta_c = sqrt(1 - eta^2)``) at ``t = 1/2``, so that the
+    Fresnel term's kink there falls on a node line of every row and interpolating between rows keeps it
+    at the queried index's own critical angle (interpolated in ``cos theta``, the correction near the
+    critical angle is off by up to 0.35).
+    """
+    c = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    c_c = _critical_cos(eta)
+    below = 0.5 * c / np.maximum(c_c, 1e-12)
+    above = 0.5 + 0.5 * (c - c_c) / np.maximum(1.0 - c_c, 1e-12)
+    return np.where(c_c > 0.0, np.where(c <= c_c, below, above), c)
+
+
+def fgd_cos_from_coordinate(t, eta) -> np.ndarray:
+    """The inverse of :func:`fgd_cos_coordinate`."""
+    t = np.asarray(t, dtype=np.float64)
+    c_c = _critical_cos(eta)
+    warped = np.where(t <= 0.5, 2.0 * t * c_c, c_c + (2.0 * t - 1.0) * (1.0 - c_c))
+    return np.where(c_c > 0.0, warped, t)
 
 
 def fgd_alpha_nodes() -> np.ndarray:
@@ -161,11 +191,12 @@ def generate_fgd_correction() -> np.ndarray:
     One correction for both polarisations: a microfacet's s and p are not the surface's, so the rough
     part is not split; at normal incidence FGD_s = FGD_p then, as the inverse method assumes.
     """
-    cos_nodes, alphas = fgd_cos_nodes(), fgd_alpha_nodes()
-    weight, i_dot_h = _reflection_quadrature(cos_nodes, alphas)
+    alphas = fgd_alpha_nodes()
     table = np.empty((FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT))
-    smooth_c = np.maximum(cos_nodes, FGD_COS_FLOOR)
     for j, eta in enumerate(fgd_eta_nodes()):
+        cos_nodes = fgd_cos_from_coordinate(fgd_cos_nodes(), eta)
+        weight, i_dot_h = _reflection_quadrature(cos_nodes, alphas)
+        smooth_c = np.maximum(cos_nodes, FGD_COS_FLOOR)
         F = fresnel_sp(i_dot_h, eta).mean(axis=0)  # (A, C, M*M)
         table[j] = (weight * F).sum(axis=-1) - fresnel_sp(smooth_c, eta).mean(axis=0)[None, :]
     return table
@@ -194,14 +225,15 @@ def _axis(value, count: int, lo: float, hi: float):
 def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
     """
     ``FGD_{s,p}`` of a rough dielectric interface of relative index ``eta`` (achromatic or per channel):
-    the exact Fresnel term plus the trilinearly interpolated (unpolarised) tabulated correction, split
+    the exact Fresnel term plus the (unpolarised) tabulated correction, interpolated trilinearly in
+    (:func:`fgd_cos_coordinate`, alpha, log eta), split
     between s and p in proportion to their Fresnel terms. Leading axis 2.
     """
     from . import luts
 
     table = luts.load("lobes_fgd_correction")
     cos_theta, alpha, eta = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (cos_theta, alpha, eta)))
-    ic, fc = _axis(cos_theta, FGD_COS_COUNT, 0.0, 1.0)
+    ic, fc = _axis(fgd_cos_coordinate(cos_theta, eta), FGD_COS_COUNT, 0.0, 1.0)
     ia, fa = _axis(alpha, FGD_ALPHA_COUNT, 0.0, 1.0)
     log_eta = np.log(np.maximum(eta, 1e-12)) / np.log(ETA_TABLE_MAX)
     ie, fe = _axis(log_eta, FGD_ETA_COUNT, -1.0, 1.0)

@@ -127,9 +127,10 @@ TABLES: dict[str, dict] = {
         "spec": {
             "quantity": "FGD - Fresnel (unpolarised) of a rough GGX dielectric interface, eta x alpha x cos theta "
             "(explorer.lobes; Belcour 2018's FGD term)",
-            "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 32)",
+            "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)",
+            "cos_theta": "t = linspace(0, 1, 33) of explorer.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
-            "shape": [33, 16, 32],
+            "shape": [33, 16, 33],
         },
     },
     "lobes_ggx_moments": {
@@ -137,9 +138,9 @@ TABLES: dict[str, dict] = {
         "spec": {
             "quantity": "GGX reflection lobe albedo (F = 1) and mean half-angle cosine, [E, cbar_d] x alpha x cos theta "
             "(explorer.lobes: conductors' FGD ~ E F(cbar_d))",
-            "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 32)",
+            "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 33)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
-            "shape": [2, 16, 32],
+            "shape": [2, 16, 33],
         },
     },
     "sensitivity_fourier": {

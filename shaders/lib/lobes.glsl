@@ -8,7 +8,7 @@
 #include "lib/microfacet.glsl"
 
 const int LOBES_MAX = 4;             // explorer.lobes.MAX_INTERFACES
-const int FGD_COS_COUNT = 32;
+const int FGD_COS_COUNT = 33;
 const int FGD_ALPHA_COUNT = 16;
 const int FGD_ETA_COUNT = 33;
 const float ETA_TABLE_MAX = 4.0;
@@ -66,11 +66,18 @@ void lobes_axis(float value, int count, float lo, float hi, out int i, out float
     f = x - float(i);
 }
 
+// The table's warped cosine (explorer.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2.
+float fgd_cos_coordinate(float cos_theta, float eta) {
+    float c = clamp(cos_theta, 0.0, 1.0), c_c = sqrt(max(1.0 - eta * eta, 0.0));
+    if (c_c <= 0.0) return c;
+    return c <= c_c ? 0.5 * c / max(c_c, 1e-12) : 0.5 + 0.5 * (c - c_c) / max(1.0 - c_c, 1e-12);
+}
+
 // FGD of a rough dielectric interface: exact Fresnel per polarisation plus the tabulated (unpolarised) correction.
 vec2 fgd_dielectric(sampler2D table, float cos_theta, float alpha, float eta) {
     int ic, ia, ie;
     float fc, fa, fe;
-    lobes_axis(cos_theta, FGD_COS_COUNT, 0.0, 1.0, ic, fc);
+    lobes_axis(fgd_cos_coordinate(cos_theta, eta), FGD_COS_COUNT, 0.0, 1.0, ic, fc);
     lobes_axis(alpha, FGD_ALPHA_COUNT, 0.0, 1.0, ia, fa);
     lobes_axis(log(max(eta, 1e-12)) / log(ETA_TABLE_MAX), FGD_ETA_COUNT, -1.0, 1.0, ie, fe);
     float correction = 0.0;
