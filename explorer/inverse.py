@@ -275,7 +275,7 @@ def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: st
         eta_min, eta_top = conductor_bounds(np.minimum(R_target / E, 1.0 - 1e-12), eta_m)  # Eqs. 9-10
         if np.any(~np.isfinite(eta_top)) or np.any(R_target >= E):
             raise InverseError(
-                f"lobe {k}: energy {_fmt(R_prime if m == 0 else R_prime)} needs a conductor reflectance {_fmt(R_target)} under the layers; "
+                f"lobe {k}: its energy needs a conductor reflectance {_fmt(R_target)}{' below the layers above' if m else ''}; "
                 f"conductors with kappa >= eta reach [{CONDUCTOR_R_MIN * E:.4f}, {E:.4f}) at this roughness (Sec. 5.1.2)")
         if "eta" in choice:
             eta = np.broadcast_to(np.asarray(choice["eta"], float), (3,)).copy()

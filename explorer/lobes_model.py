@@ -57,3 +57,20 @@ class LayeredLobesModel:
 
     def textures(self) -> dict[str, np.ndarray]:
         return {"lobes_fgd": fgd_texture(), "lobes_ggx_moments": moments_texture()}
+
+
+def values_from_stack(stack: lobes.Stack) -> dict:
+    """The parameter values of ``shaders/layered_lobes.brd`` for ``stack`` (numbers and RGB lists)."""
+    if stack.count > lobes.MAX_INTERFACES:
+        raise lobes.StackError(f"the material holds at most {lobes.MAX_INTERFACES} interfaces, the stack has {stack.count}")
+    values: dict = {"layers": stack.count, "conductor": int(stack.conductor)}
+    for i in range(1, stack.count + 1):
+        values[f"alpha_{i}"] = float(stack.alpha[i])
+        if i == stack.count and stack.conductor:
+            values["eta_base"] = [float(v) for v in stack.eta[i]]
+            values["kappa_base"] = [float(v) for v in stack.kappa[i]]
+        else:
+            values[f"eta_{i}"] = float(stack.eta[i].mean())
+        if i < stack.count:
+            values[f"tau_{i}"] = [float(v) for v in stack.tau[i]]
+    return values
