@@ -190,3 +190,20 @@ def test_cli_figure_writes_png(tmp_path):
     run = run_cli("figure", "--lobe", "R=0.09,0.09,0.15 sigma=0 layers=2", "--out", str(out), "--samples", "24")
     assert run.returncode == 0, run.stderr
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_presets_reproduce_their_figures_lobes():
+    """Every preset's stack (shaders/presets/layered_lobes.toml, as written) gives its figure's lobes back."""
+    from explorer.lobes_model import stack_from_values
+    from explorer.lobes_presets import FIGURES, PRESET_FILE
+    from explorer.presets import load_presets
+
+    presets = load_presets(PRESET_FILE).presets
+    assert len(presets) >= 25
+    for name, preset in presets.items():
+        _, _, lobe_list, _ = FIGURES[name]
+        stack = stack_from_values(preset.resolve())
+        energies, _ = inverse.forward_lobes(stack, [lobe.layers for lobe in lobe_list])
+        for k, lobe in enumerate(lobe_list):
+            # The TOML keeps 6 significant digits.
+            np.testing.assert_allclose(energies[k], lobe.energy, atol=2e-5, err_msg=f"{name}: lobe {k + 1}")

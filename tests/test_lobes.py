@@ -16,7 +16,6 @@ from explorer import lobes, microfacet
 from explorer.brd import load_material
 from explorer.env import EnvironmentMap, ProgressiveEnvRender, env_integral_numpy
 from explorer.models import model_for
-from explorer.presets import load_presets
 from explorer.render import brdf_view_geometry, render_numpy, rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 
@@ -235,11 +234,3 @@ def test_env_view_matches_its_exact_integral(gl_renderer, material):
     for k, p in enumerate(pixels):
         assert np.isfinite(image[p]).all()
         assert np.all(np.abs(image[p] - exact[k]) <= 4 * error[p] + 1e-3 * np.abs(exact[k]).max()), (p, image[p], exact[k], error[p])
-
-
-def test_presets_load_and_resolve(material):
-    presets = load_presets(REPO_ROOT / "shaders" / "presets" / "layered_lobes.toml")
-    assert len(presets.presets) >= 6
-    for preset in presets.presets.values():
-        model = model_for(material, preset.resolve())
-        assert np.isfinite(model.reflectance(np.linspace(0, 1, 9))).all()
