@@ -105,6 +105,18 @@ def fresnel_sp(cos_theta, eta, kappa=0.0) -> np.ndarray:
     return np.stack([np.abs(rs) ** 2, np.abs(rp) ** 2])
 
 
+def _fresnel_dielectric_mean(cos_theta, eta) -> np.ndarray:
+    """``(R_s + R_p) / 2`` of a real relative index in real arithmetic (the tables' inner loop); 1 under TIR."""
+    c = np.clip(cos_theta, 0.0, 1.0)
+    q2 = eta * eta - 1.0 + c * c
+    q = np.sqrt(np.maximum(q2, 0.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rs = (c - q) / (c + q)
+        rp = (eta * eta * c - q) / (eta * eta * c + q)
+    value = 0.5 * (rs * rs + rp * rp)
+    return np.where((q2 <= 0.0) | ~np.isfinite(value), 1.0, value)
+
+
 def normal_reflectance(eta_0, eta_1, kappa_1=0.0) -> np.ndarray:
     """Eq. 1: ``R_01 = ((eta_0 - eta_1)^2 + kappa_1^2) / ((eta_0 + eta_1)^2 + kappa_1^2)``."""
     eta_0, eta_1, kappa_1 = (np.asarray(v, dtype=np.float64) for v in (eta_0, eta_1, kappa_1))
@@ -193,11 +205,12 @@ def generate_fgd_correction() -> np.ndarray:
     """
     alphas = fgd_alpha_nodes()
     table = np.empty((FGD_ETA_COUNT, FGD_ALPHA_COUNT, FGD_COS_COUNT))
+    plain = _reflection_quadrature(fgd_cos_nodes(), alphas)  # the rows eta >= 1 share their nodes
     for j, eta in enumerate(fgd_eta_nodes()):
         cos_nodes = fgd_cos_from_coordinate(fgd_cos_nodes(), eta)
-        weight, i_dot_h = _reflection_quadrature(cos_nodes, alphas)
+        weight, i_dot_h = plain if eta >= 1.0 else _reflection_quadrature(cos_nodes, alphas)
         smooth_c = np.maximum(cos_nodes, FGD_COS_FLOOR)
-        F = fresnel_sp(i_dot_h, eta).mean(axis=0)  # (A, C, M*M)
+        F = _fresnel_dielectric_mean(i_dot_h, eta)  # (A, C, M*M)
         table[j] = (weight * F).sum(axis=-1) - fresnel_sp(smooth_c, eta).mean(axis=0)[None, :]
     return table
 

@@ -130,6 +130,7 @@ TABLES: dict[str, dict] = {
             "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)",
             "cos_theta": "t = linspace(0, 1, 33) of explorer.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+            "resolution_nm": None,  # no wavelength axis
             "shape": [33, 16, 33],
         },
     },
@@ -140,6 +141,7 @@ TABLES: dict[str, dict] = {
             "(explorer.lobes: conductors' FGD ~ E F(cbar_d))",
             "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 33)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+            "resolution_nm": None,  # no wavelength axis
             "shape": [2, 16, 33],
         },
     },
