@@ -67,17 +67,20 @@ COS_MIN = 1e-4
 # Roughness and variance
 
 
+#: The variance of alpha = 1 (f diverges there): finite, so that 0 x it stays 0, in float32 too.
+VARIANCE_MAX = 1e6
+
+
 def variance_from_roughness(alpha) -> np.ndarray:
-    """Belcour's roughness-to-variance mapping ``f(alpha) = alpha^1.1 / (1 - alpha^1.1)`` (Bati et al., Sec. 4)."""
+    """Belcour's roughness-to-variance mapping ``f(alpha) = alpha^1.1 / (1 - alpha^1.1)`` (Bati et al., Sec. 4), at most :data:`VARIANCE_MAX`."""
     a = np.clip(np.asarray(alpha, dtype=np.float64), 0.0, 1.0) ** 1.1
-    with np.errstate(divide="ignore"):
-        return np.where(a < 1.0, a / np.maximum(1.0 - a, 1e-300), np.inf)
+    return np.minimum(a / np.maximum(1.0 - a, 1.0 / VARIANCE_MAX), VARIANCE_MAX)
 
 
 def roughness_from_variance(sigma) -> np.ndarray:
-    """``f^{-1}(sigma) = (sigma / (1 + sigma))^(1 / 1.1)``; 0 for ``sigma <= 0``."""
-    s = np.maximum(np.asarray(sigma, dtype=np.float64), 0.0)
-    return np.where(np.isinf(s), 1.0, (s / (1.0 + np.where(np.isinf(s), 0.0, s))) ** (1.0 / 1.1))
+    """``f^{-1}(sigma) = (sigma / (1 + sigma))^(1 / 1.1)``; 0 for ``sigma <= 0``, 1 from :data:`VARIANCE_MAX` on."""
+    s = np.clip(np.asarray(sigma, dtype=np.float64), 0.0, VARIANCE_MAX)
+    return np.where(s >= VARIANCE_MAX, 1.0, (s / (1.0 + s)) ** (1.0 / 1.1))
 
 
 # --------------------------------------------------------------------------------------------------

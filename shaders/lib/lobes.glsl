@@ -27,13 +27,14 @@ struct LobeStack {
     vec3 kappa_base;
 };
 
+const float VARIANCE_MAX = 1e6;  // explorer.lobes.VARIANCE_MAX: f(1) diverges; 0 x it must stay 0
 float variance_from_roughness(float alpha) {
     float a = pow(clamp(alpha, 0.0, 1.0), 1.1);
-    return a < 1.0 ? a / (1.0 - a) : 1e30;
+    return min(a / max(1.0 - a, 1.0 / VARIANCE_MAX), VARIANCE_MAX);
 }
 vec3 roughness_from_variance(vec3 sigma) {
-    vec3 s = clamp(sigma, 0.0, 1e30);
-    return pow(s / (1.0 + s), vec3(1.0 / 1.1));
+    vec3 s = clamp(sigma, 0.0, VARIANCE_MAX);
+    return mix(pow(s / (1.0 + s), vec3(1.0 / 1.1)), vec3(1.0), greaterThanEqual(s, vec3(VARIANCE_MAX)));
 }
 
 // [R_s, R_p] of a smooth dielectric interface of relative index eta; 1 beyond the critical angle.
