@@ -177,6 +177,13 @@ class TwoLayerClass:
         return self.eta_2[self.valid[i]]
 
 
+def two_layer_point_stack(cls: TwoLayerClass, i: int, j: int) -> lobes.Stack:
+    """The stack at grid point ``(eta_1[i], eta_2[j])`` of a 2-layer class (raises where it is not valid)."""
+    if not cls.valid[i, j]:
+        raise InverseError(f"(eta_1, eta_2) = ({cls.eta_1[i]:.4g}, {cls.eta_2[j]:.4g}) is outside the constrained class (tau_1 >= 0, sigma_12 >= 0)")
+    return lobes.make_stack([cls.eta_1[i], cls.eta_2[j]], [cls.alpha_1, cls.alpha_2[i]], tau=[cls.tau_1[i, j]], eta_0=cls.eta_0)
+
+
 def _lobe_terms(statistics, energy, variance, eta_0, eta_n):
     """Eqs. 18-19: ``R'_{n,n+l}`` (RGB) and ``sigma^R_{n,n+l}`` (RGB) under the statistics of the stack above."""
     s = statistics

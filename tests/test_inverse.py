@@ -124,11 +124,14 @@ def test_two_layer_class_points_are_stacks_with_the_lobe():
     points = np.argwhere(cls.valid)
     assert len(points) > 5
     for i, j in points[:: max(1, len(points) // 5)]:
-        stack = lobes.make_stack([cls.eta_1[i], cls.eta_2[j]], [cls.alpha_1, cls.alpha_2[i]], tau=[cls.tau_1[i, j]])
+        stack = inverse.two_layer_point_stack(cls, i, j)
         energies, variances = inverse.forward_lobes(stack, [2])
         np.testing.assert_allclose(energies[0], energy, atol=ROUND_TRIP_TOLERANCE)
         assert abs(variances[0][2] - variance) <= ROUND_TRIP_TOLERANCE
     assert np.all(cls.tau_1[cls.valid] >= 0.0)
+    i, j = np.argwhere(~cls.valid)[0]
+    with pytest.raises(InverseError, match="outside the constrained class"):
+        inverse.two_layer_point_stack(cls, i, j)
 
 
 def test_choices_pick_other_points_of_the_class():
