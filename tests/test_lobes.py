@@ -136,6 +136,7 @@ def hemisphere(count=96):
     {"layers": 3, "eta_1": 1.5, "eta_2": 4.0, "eta_3": 1.0, "alpha_1": 0.3, "alpha_2": 0.6, "alpha_3": 0.9},
     {"layers": 2, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 0.4, "alpha_2": 0.8},
     {"layers": 2, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 1.0, "alpha_2": 1.0},
+    {"layers": 1, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 0.2},  # the brightest: 0.89
 ])
 def test_white_furnace_at_most_one(overrides):
     material = load_material(MATERIAL)
