@@ -177,6 +177,36 @@ class TwoLayerClass:
         return self.eta_2[self.valid[i]]
 
 
+def two_layer_energy_bounds(variance, eta_0=1.0, samples=48, eta_max=ETA_MAX) -> tuple[float, float]:
+    """
+    ``[R_min, R_max]``: the achromatic energies a 2-layer lobe of ``variance`` reaches under ``eta_0``
+    with ``eta_1, eta_2`` in ``[1, eta_max]`` and no absorption (Sec. 5.2.1: the adding equation on the
+    bounds of N_1), scanned on a grid; 0.53 at most in air for ``eta_max = 4`` (smooth).
+    """
+    alpha = float(roughness_from_variance(variance))
+    eta_1, eta_2 = np.meshgrid(*(np.linspace(1.0, eta_max, samples),) * 2, indexing="ij")
+    R_01 = fgd_normal(alpha, eta_1 / eta_0)
+    # The forward model at normal incidence, both interfaces of roughness alpha (Eqs. 2 and 6).
+    sigma_T_01 = variance_from_roughness(0.5 * np.abs(1.0 - eta_0 / eta_1) * alpha)
+    R_12 = fgd_normal(roughness_from_variance(sigma_T_01 + variance_from_roughness(alpha)), eta_2 / eta_1)
+    R_02 = R_01 + (1.0 - R_01) ** 2 * R_12 / (1.0 - R_12 * R_01)
+    return float(R_02.min()), float(R_02.max())
+
+
+def tau_0_range(energy, variance, eta_0=1.0, eta_max=ETA_MAX) -> tuple[float, float]:
+    """
+    Eq. 16: ``T_0 = 1/2 log([R_min, R_max] / R_02)`` intersected with ``tau_0 >= 0``: the optical depths of
+    the medium above a 2-layer lobe (a lobe under others) that leave its energy achievable. Coloured
+    energies: the brightest channel. Empty (NaN, NaN) when ``R_02 > R_max``.
+    """
+    R = float(np.max(energy))
+    R_min, R_max = two_layer_energy_bounds(variance, eta_0, eta_max=eta_max)
+    if R > R_max:
+        return (np.nan, np.nan)
+    low = 0.5 * np.log(R_min / R) if R_min > 0.0 else -np.inf
+    return (max(0.0, low), 0.5 * np.log(R_max / R))
+
+
 def two_layer_point_stack(cls: TwoLayerClass, i: int, j: int) -> lobes.Stack:
     """The stack at grid point ``(eta_1[i], eta_2[j])`` of a 2-layer class (raises where it is not valid)."""
     if not cls.valid[i, j]:

@@ -210,3 +210,16 @@ def test_presets_reproduce_their_figures_lobes():
         for k, lobe in enumerate(lobe_list):
             # The TOML keeps 6 significant digits.
             np.testing.assert_allclose(energies[k], lobe.energy, atol=2e-5, err_msg=f"{name}: lobe {k + 1}")
+
+
+def test_tau_0_range_is_eq16():
+    """T_0 = 1/2 log([R_min, R_max] / R_02) with R_max the 2-layer maximum (0.53 smooth in air, Sec. 5.2.1)."""
+    R_min, R_max = inverse.two_layer_energy_bounds(0.0, samples=16)
+    assert R_min == pytest.approx(0.0, abs=1e-12) and R_max == pytest.approx(2 * 0.36 / 1.36, rel=1e-9)  # the 1|4|1 slab
+    low, high = inverse.tau_0_range(0.2, 0.0)
+    assert low == 0.0 and high == pytest.approx(0.5 * np.log(R_max / 0.2), rel=1e-6)
+    assert np.isnan(inverse.tau_0_range(0.6, 0.0)[0])
+    # Rough: the bounds are the forward model's (the slab 1 | 4 | 1 at alpha = f^-1(0.02) on both interfaces).
+    alpha = float(lobes.roughness_from_variance(0.02))
+    slab = lobes.make_stack([4.0, 1.0], [alpha, alpha])
+    assert inverse.two_layer_energy_bounds(0.02, samples=16)[1] == pytest.approx(float(lobes.reflectance(slab, 1.0)[0]), rel=1e-9)
