@@ -261,10 +261,11 @@ class _Partial:
     alpha: list = field(default_factory=list)
     tau: list = field(default_factory=list)
     base_kappa: np.ndarray | None = None
+    tir: bool = False
 
     def stack(self) -> lobes.Stack:
         taus = self.tau + [0.0] * max(0, len(self.eta) - 1 - len(self.tau))
-        return lobes.make_stack(self.eta, self.alpha, tau=taus[: max(0, len(self.eta) - 1)], base_kappa=self.base_kappa)
+        return lobes.make_stack(self.eta, self.alpha, tau=taus[: max(0, len(self.eta) - 1)], base_kappa=self.base_kappa, tir=self.tir)
 
     def eta_below(self) -> float:
         return float(np.mean(self.eta[-1])) if self.eta else 1.0
@@ -277,7 +278,7 @@ def _fmt(values) -> str:
 
 def _base_statistics(partial: _Partial):
     if not partial.eta:
-        return lobes.stack_statistics(lobes.make_stack([1.0], [0.0]), 0)
+        return lobes.stack_statistics(lobes.make_stack([1.0], [0.0]), 0)  # nothing above: T = 1, R = 0
     return lobes.stack_statistics(partial.stack(), len(partial.eta))
 
 
@@ -361,7 +362,7 @@ def _default_eta_top(partial: _Partial, k, energy_target, variance, statistics_a
     """The middle of N_1 (Eq. 12) for a 2-layer lobe's top interface, scanned on a grid."""
     valid = []
     for eta in np.linspace(1.0, ETA_MAX, 49):
-        trial = _Partial(list(partial.eta), list(partial.alpha), list(partial.tau), None)
+        trial = _Partial(list(partial.eta), list(partial.alpha), list(partial.tau), None, partial.tir)
         try:
             _two_layer(trial, k, energy_target, variance, statistics_above, {**choice, "eta_top": eta}, probe=True)
             valid.append(eta)
@@ -399,7 +400,7 @@ def _two_layer(partial: _Partial, k, lobe_energy, variance, statistics_above, ch
     _one_layer(partial, k, R_prime_2, sigma_R_2, statistics, base, {} if probe else {key: v for key, v in choice.items() if key in ("eta", "t", "tau")})
 
 
-def invert_lobes(lobe_list, choices=None) -> lobes.Stack:
+def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
     """
     Algorithm 2: the stack whose lobes at normal incidence are ``lobe_list`` (top first; :class:`Lobe`),
     each 1- or 2-layer, the last one possibly on a conductor base.
@@ -409,10 +410,13 @@ def invert_lobes(lobe_list, choices=None) -> lobes.Stack:
     for lobes under others), ``eta_top`` and ``tau_top`` (a 2-layer lobe's top interface and the medium
     above it), ``t`` in [0, 1] (a conductor's place between Eqs. 10 and 9). Unset, the defaults above.
 
+    ``tir``: the stack's TIR term (:class:`explorer.lobes.Stack`); the statistics of the layers above
+    then come with it, so the lobes are still reproduced exactly.
+
     Raises :class:`InverseError` (one line) naming the constraint that fails and the achievable range.
     """
     choices = list(choices or [{}] * len(lobe_list))
-    partial = _Partial()
+    partial = _Partial(tir=tir)
     total = np.zeros(3)
     for k, (lobe, choice) in enumerate(zip(lobe_list, choices), start=1):
         if lobe.variance < 0.0:

@@ -67,7 +67,7 @@ def parse_lobe(spec: str):
     return lobe, choices
 
 
-def _solve(lobe_specs):
+def _solve(lobe_specs, tir=False):
     from .inverse import InverseError, forward_lobes, invert_lobes
 
     if not lobe_specs:
@@ -75,7 +75,7 @@ def _solve(lobe_specs):
     parsed = [parse_lobe(spec) for spec in lobe_specs]
     lobe_list = [lobe for lobe, _ in parsed]
     try:
-        stack = invert_lobes(lobe_list, [choice for _, choice in parsed])
+        stack = invert_lobes(lobe_list, [choice for _, choice in parsed], tir=tir)
     except InverseError as error:
         _fail(str(error))
     energies, variances = forward_lobes(stack, [lobe.layers for lobe in lobe_list])
@@ -86,7 +86,8 @@ def _solve(lobe_specs):
 @click.option("--lobe", "lobe_specs", multiple=True, metavar='"R=.. sigma=.. [layers=1|2] [base=..] [choices]"',
               help="A lobe at normal incidence, top first (repeatable).")
 @click.option("--json", "as_json", is_flag=True, help="Print the stack, its material values and the check as JSON.")
-def inverse_command(lobe_specs, as_json):
+@click.option("--tir", is_flag=True, help="Use the stack's TIR term (shaders/layered_lobes.brd's tir; off in Bati et al.).")
+def inverse_command(lobe_specs, as_json, tir):
     """Layer stacks from BRDF lobes (Bati, Barla & Pacanowski 2021, Algorithms 1-5).
 
     Prints the stack (top first: eta, alpha, tau of the medium below), the --set values of
@@ -94,7 +95,7 @@ def inverse_command(lobe_specs, as_json):
     """
     from .lobes_model import values_from_stack
 
-    lobe_list, stack, energies, variances = _solve(lobe_specs)
+    lobe_list, stack, energies, variances = _solve(lobe_specs, tir)
     values = values_from_stack(stack)
     check = [
         {"requested": {"R": lobe.energy.tolist(), "sigma": lobe.variance},

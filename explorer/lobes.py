@@ -304,12 +304,18 @@ class Stack:
     tau : ``(n + 1, 3)``
         ``tau_i``, optical depth at normal incidence of medium ``i``; ``tau_0`` (the ambient) and
         ``tau_n`` (below the base) are unused.
+    tir : bool
+        Our TIR term: light going up through a rough interface is reflected by the FGD of its own (denser
+        or not) side, ``FGD(cos theta_i, alpha, eta_{i-1} / eta_i)``, which holds the part of the lobe beyond
+        the critical angle; off, Belcour's symmetric ``R_21 = R_12`` (Bati et al. do not use a TIR term).
+        Smooth interfaces are the same either way (Stokes).
     """
 
     eta: np.ndarray
     kappa: np.ndarray
     alpha: np.ndarray
     tau: np.ndarray
+    tir: bool = False
 
     @property
     def count(self) -> int:
@@ -333,18 +339,19 @@ class Stack:
             if i < self.count:
                 layer["tau"] = [float(v) for v in self.tau[i]]
             layers.append(layer)
-        return {"eta_0": float(self.eta[0].mean()), "interfaces": layers}
+        return {"eta_0": float(self.eta[0].mean()), "tir": self.tir, "interfaces": layers}
 
 
 def _rgb(value) -> np.ndarray:
     return np.broadcast_to(np.asarray(value, dtype=np.float64), (3,)).copy()
 
 
-def make_stack(eta, alpha, tau=None, base_kappa=None, eta_0=1.0) -> Stack:
+def make_stack(eta, alpha, tau=None, base_kappa=None, eta_0=1.0, tir=False) -> Stack:
     """
     A stack from its interfaces, top first: ``eta[i - 1]`` (a number, or RGB for a conducting base),
     ``alpha[i - 1]``, ``tau[i - 1]`` the optical depth below interface ``i`` (RGB; ``n - 1`` entries, or
-    ``n`` with the last ignored) and ``base_kappa`` (RGB) for a conducting base. Checks the constraints.
+    ``n`` with the last ignored), ``base_kappa`` (RGB) for a conducting base, ``tir`` (:class:`Stack`).
+    Checks the constraints.
     """
     count = len(eta)
     if count < 1 or len(alpha) != count:
@@ -358,7 +365,7 @@ def make_stack(eta, alpha, tau=None, base_kappa=None, eta_0=1.0) -> Stack:
     for i, t in enumerate(tau or ()):
         if i + 1 < count:
             taus[i + 1] = _rgb(t)
-    stack = Stack(etas, kappas, alphas, taus)
+    stack = Stack(etas, kappas, alphas, taus, bool(tir))
     check_stack(stack)
     return stack
 
@@ -455,7 +462,11 @@ def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
         alpha_eff = roughness_from_variance(s_t0n + s_r12)  # the light arrives blurred (Belcour; Alg. 1's alpha'_2)
         R12 = interface_fgd(stack, i, c, alpha_eff)
         T12 = np.zeros_like(R12) if conductor else 1.0 - R12
-        R21, T21 = R12, T12  # Belcour's symmetric interface; exact for smooth ones
+        if stack.tir and not conductor:
+            R21 = np.where(transmits, fgd_dielectric(c_t, alpha_eff, 1.0 / n12), R12)  # seen from below
+            T21 = 1.0 - R21
+        else:
+            R21, T21 = R12, T12  # Belcour's symmetric interface; exact for smooth ones
         j12 = np.where(transmits, c_t * n12 / c, 1.0)
         x = a2 * R12 * R_n0
         D = 1.0 - x

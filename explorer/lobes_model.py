@@ -24,6 +24,7 @@ def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
         [float(values[f"alpha_{i}"]) for i in range(1, count + 1)],
         tau=[values[f"tau_{i}"] for i in range(1, count)],
         base_kappa=values["kappa_base"] if conductor else None,
+        tir=bool(values.get("tir", False)),
     )
 
 
@@ -63,7 +64,7 @@ def values_from_stack(stack: lobes.Stack) -> dict:
     """The parameter values of ``shaders/layered_lobes.brd`` for ``stack`` (numbers and RGB lists)."""
     if stack.count > lobes.MAX_INTERFACES:
         raise lobes.StackError(f"the material holds at most {lobes.MAX_INTERFACES} interfaces, the stack has {stack.count}")
-    values: dict = {"layers": stack.count, "conductor": int(stack.conductor)}
+    values: dict = {"layers": stack.count, "conductor": int(stack.conductor), "tir": int(stack.tir)}
     for i in range(1, stack.count + 1):
         values[f"alpha_{i}"] = float(stack.alpha[i])
         if i == stack.count and stack.conductor:

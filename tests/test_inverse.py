@@ -79,6 +79,17 @@ def test_forward_of_inverse_reproduces_the_lobes(case):
     assert np.all(stack.tau >= 0.0)
 
 
+def test_round_trip_with_the_tir_term():
+    lobe_list = CASES["fig20_haze_colour"]
+    stack = inverse.invert_lobes(lobe_list, tir=True)
+    assert stack.tir
+    energies, variances = inverse.forward_lobes(stack, [2, 1])
+    for k, lobe in enumerate(lobe_list):
+        np.testing.assert_allclose(energies[k], lobe.energy, atol=ROUND_TRIP_TOLERANCE)
+        assert abs(variances[k][brightest_channel_below(stack, lobe_list, k)] - lobe.variance) <= ROUND_TRIP_TOLERANCE
+    assert not np.allclose(stack.eta, inverse.invert_lobes(lobe_list).eta), "the TIR term changes the stack"
+
+
 def test_achromatic_round_trip_is_exact_on_every_channel():
     lobe_list = CASES["fig10c_two_layer_rough"]
     energies, variances = inverse.forward_lobes(inverse.invert_lobes(lobe_list), [2])

@@ -51,8 +51,9 @@ THETAS = np.radians(np.linspace(0.0, 89.0, 46))
     ([1.0, 2.5, 1.0, 1.5], [0.0, 0.7]),  # an air gap
     ([1.0, 1.33], []),
 ])
-def test_smooth_dielectric_stack_equals_incoherent_tmm(etas, taus):
-    stack = lobes.make_stack(etas[1:], [0.0] * (len(etas) - 1), tau=taus)
+@pytest.mark.parametrize("tir", [False, True])
+def test_smooth_dielectric_stack_equals_incoherent_tmm(etas, taus, tir):
+    stack = lobes.make_stack(etas[1:], [0.0] * (len(etas) - 1), tau=taus, tir=tir)
     ours = lobes.reflectance(stack, np.cos(THETAS))
     reference = np.array([tmm_reflectance(etas, taus, t) for t in THETAS])
     error = np.abs(ours - reference[:, None]).max()
@@ -177,7 +178,7 @@ def test_bad_stack_is_one_line():
 CASES = {
     "two_dielectric": {},
     "coated_conductor": {"conductor": 1, "tau_1": "0.2,0.5,1.0", "alpha_1": 0.02, "alpha_2": 0.25},
-    "three_tir": {"layers": 3, "eta_1": 2.5, "eta_2": 1.0, "eta_3": 1.5, "tau_2": "0.3,0.1,0", "alpha_3": 0.6},
+    "three_tir": {"layers": 3, "eta_1": 2.5, "eta_2": 1.0, "eta_3": 1.5, "tau_2": "0.3,0.1,0", "alpha_3": 0.6, "tir": 1},
 }
 
 
@@ -209,6 +210,7 @@ def test_float32_sweep_is_finite(gl_renderer, material):
         {"layers": 2, "conductor": 1, "eta_base": "0.01", "kappa_base": "10", "alpha_1": 1, "alpha_2": 0},
         {"layers": 1, "conductor": 1, "eta_base": "4", "kappa_base": "0", "alpha_1": 0.001},
         {"layers": 2, "eta_1": 1, "eta_2": 1, "alpha_1": 0.5},
+        {"layers": 4, "eta_1": 4, "eta_2": 1, "eta_3": 4, "eta_4": 1, "alpha_1": 0.05, "alpha_2": 0.9, "alpha_3": 0.02, "tir": 1},
     ]
     for overrides in sweeps:
         values = material.resolve(overrides)
@@ -236,3 +238,14 @@ def test_env_view_matches_its_exact_integral(gl_renderer, material):
     for k, p in enumerate(pixels):
         assert np.isfinite(image[p]).all()
         assert np.all(np.abs(image[p] - exact[k]) <= 4 * error[p] + 1e-3 * np.abs(exact[k]).max()), (p, image[p], exact[k], error[p])
+
+
+def test_tir_term_keeps_the_lobe_beyond_the_critical_angle_inside():
+    """With tir, light going up a rough interface into a rarer medium is reflected by that side's FGD, which
+    holds the lobe's part beyond the critical angle: at normal incidence more is reflected back down and less
+    leaves (Fig. 6: FGD for eta < 1 exceeds Fresnel once alpha > 0.1). At grazing incidence Belcour's
+    symmetric R_21 = R_12 is the larger one instead, so the two differ both ways there."""
+    plain = lobes.make_stack([2.0, 1.0], [0.5, 0.0])
+    with_tir = lobes.make_stack([2.0, 1.0], [0.5, 0.0], tir=True)
+    assert np.all(lobes.stack_statistics(with_tir, 1).R_n0 > lobes.stack_statistics(plain, 1).R_n0 + 0.05)
+    assert np.all(lobes.reflectance(with_tir, 1.0) < lobes.reflectance(plain, 1.0) - 1e-3)

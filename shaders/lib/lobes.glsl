@@ -23,6 +23,7 @@ struct LobeStack {
     float alpha[LOBES_MAX + 1];
     vec3 tau[LOBES_MAX + 1];
     bool conductor;
+    bool tir;            // explorer.lobes.Stack.tir: light going up sees the FGD of its own side
     vec3 eta_base;
     vec3 kappa_base;
 };
@@ -139,6 +140,15 @@ void lobes(LobeStack s, sampler2D fgd_table, sampler2D moments, float cos_theta,
             R12_p[ch] = F.y;
         }
         vec3 T12_s = conductor ? vec3(0.0) : 1.0 - R12_s, T12_p = conductor ? vec3(0.0) : 1.0 - R12_p;
+        vec3 R21_s = R12_s, R21_p = R12_p;
+        if (s.tir && transmits) {
+            for (int ch = 0; ch < 3; ++ch) {
+                vec2 F = fgd_dielectric(fgd_table, c_t, alpha_eff[ch], 1.0 / n12);
+                R21_s[ch] = F.x;
+                R21_p[ch] = F.y;
+            }
+        }
+        vec3 T21_s = conductor ? vec3(0.0) : 1.0 - R21_s, T21_p = conductor ? vec3(0.0) : 1.0 - R21_p;
         float j12 = transmits ? c_t * n12 / c : 1.0;
         vec3 x_s = a2 * R12_s * Rn0_s, x_p = a2 * R12_p * Rn0_p;
         vec3 D_s = 1.0 - x_s, D_p = 1.0 - x_p;
@@ -147,18 +157,18 @@ void lobes(LobeStack s, sampler2D fgd_table, sampler2D moments, float cos_theta,
         energy[i - 1] = 0.5 * (E_s + E_p);
         variance[i - 1] = s_tn0 + j_0n * (s_t0n + s_r12 + m_rr * (s_r12 + s_rn0));  // Eqs. 4-5
         if (!transmits || i == s.count) break;
-        vec3 m_ri0_s = T12_s * a2 * Rn0_s * T12_s / D_s, m_ri0_p = T12_p * a2 * Rn0_p * T12_p / D_p;
-        vec3 Rn0_new_s = R12_s + m_ri0_s, Rn0_new_p = R12_p + m_ri0_p;
+        vec3 m_ri0_s = T21_s * a2 * Rn0_s * T12_s / D_s, m_ri0_p = T21_p * a2 * Rn0_p * T12_p / D_p;
+        vec3 Rn0_new_s = R21_s + m_ri0_s, Rn0_new_p = R21_p + m_ri0_p;
         vec3 Rn0_mean = 0.5 * (Rn0_new_s + Rn0_new_p);
         vec3 s_t0n_new = (s_t0n + m_rr * (s_r12 + s_rn0)) / j12 + s_t12;
         s_tn0 = s_tn0 + j_0n * (s_t21 + m_rr * (s_r12 + s_rn0));
-        vec3 numerator = 0.5 * (R12_s + R12_p) * s_r12 + 0.5 * (m_ri0_s + m_ri0_p) * (s_t12 + (s_t21 + s_rn0 + m_rr * (s_r12 + s_rn0)) / j12);
+        vec3 numerator = 0.5 * (R21_s + R21_p) * s_r12 + 0.5 * (m_ri0_s + m_ri0_p) * (s_t12 + (s_t21 + s_rn0 + m_rr * (s_r12 + s_rn0)) / j12);
         s_rn0 = mix(vec3(0.0), numerator / max(Rn0_mean, vec3(1e-30)), greaterThan(Rn0_mean, vec3(0.0)));
         s_t0n = s_t0n_new;
         T0n_s = T0n_s * attenuation * T12_s / D_s;
         T0n_p = T0n_p * attenuation * T12_p / D_p;
-        Tn0_s = T12_s * attenuation * Tn0_s / D_s;
-        Tn0_p = T12_p * attenuation * Tn0_p / D_p;
+        Tn0_s = T21_s * attenuation * Tn0_s / D_s;
+        Tn0_p = T21_p * attenuation * Tn0_p / D_p;
         Rn0_s = Rn0_new_s;
         Rn0_p = Rn0_new_p;
         j_0n *= j12;
