@@ -372,6 +372,8 @@ def make_stack(eta, alpha, tau=None, base_kappa=None, eta_0=1.0, tir=False) -> S
 
 def check_stack(stack: Stack) -> Stack:
     """Raise :class:`StackError` (one line) where a parameter is outside its physical range."""
+    if np.any(stack.kappa[-1] < 0.0):
+        raise StackError(f"kappa_{stack.count} = {stack.kappa[-1].tolist()} must be >= 0")
     for i in range(1, stack.count + 1):
         a = stack.alpha[i]
         if not (np.isfinite(a) and 0.0 <= a <= 1.0):
@@ -381,7 +383,7 @@ def check_stack(stack: Stack) -> Stack:
         if not np.all(np.isfinite(stack.eta[i])) or np.any(stack.eta[i] <= 0.0):
             raise StackError(f"eta_{i} = {stack.eta[i].tolist()} must be positive")
         if (i < stack.count or not stack.conductor) and np.ptp(stack.eta[i]) > 0.0:
-            raise StackError(f"eta_{i} = {stack.eta[i].tolist()} must be achromatic for a dielectric")
+            raise StackError(f"eta_{i} = {stack.eta[i].tolist()} must be achromatic for a dielectric (a coloured index needs kappa > 0: a conductor base)")
         if i < stack.count and (np.any(stack.tau[i] < 0.0) or not np.all(np.isfinite(stack.tau[i]))):
             raise StackError(f"tau_{i} = {stack.tau[i].tolist()} must be >= 0")
     if np.any(stack.kappa[-1] < 0.0):

@@ -10,6 +10,13 @@ from typing import Mapping
 import numpy as np
 
 from . import lobes, luts
+from .errors import LocatedError
+
+MATERIAL_NAME = "layered_lobes.brd"
+
+
+class LobesParameterError(LocatedError, ValueError):
+    """A parameter set outside the physical constraints (one line, naming which): the CLI's and the app's bad input."""
 
 
 def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
@@ -48,7 +55,10 @@ class LayeredLobesModel:
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
-        self.stack = stack_from_values(values)
+        try:
+            self.stack = stack_from_values(values)
+        except lobes.StackError as error:
+            raise LobesParameterError(MATERIAL_NAME, None, str(error)) from None
 
     def reflectance(self, cos_theta) -> np.ndarray:
         return lobes.reflectance(self.stack, cos_theta)

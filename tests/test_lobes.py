@@ -249,3 +249,18 @@ def test_tir_term_keeps_the_lobe_beyond_the_critical_angle_inside():
     with_tir = lobes.make_stack([2.0, 1.0], [0.5, 0.0], tir=True)
     assert np.all(lobes.stack_statistics(with_tir, 1).R_n0 > lobes.stack_statistics(plain, 1).R_n0 + 0.05)
     assert np.all(lobes.reflectance(with_tir, 1.0) < lobes.reflectance(plain, 1.0) - 1e-3)
+
+
+def test_cli_negative_optical_depth_is_one_line():
+    import os
+    import subprocess
+    import sys
+
+    from conftest import one_line_error
+
+    run = subprocess.run(
+        [sys.executable, "-m", "explorer", "render", str(MATERIAL), "--set", "tau_1=0,-1,0", "--view", "lit",
+         "--size", "8", "--engine", "numpy", "--out", "unused.png"],
+        cwd=REPO_ROOT, capture_output=True, text=True, timeout=120, env={**os.environ, "BRAGG_EXPLORER_NO_SETUP": "1"},
+    )
+    assert "tau_1 = [0.0, -1.0, 0.0] must be >= 0" in one_line_error(run)
