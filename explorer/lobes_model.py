@@ -26,6 +26,9 @@ def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
     eta = [float(values[f"eta_{i}"]) for i in range(1, count + 1)]
     if conductor:
         eta[-1] = np.asarray(values["eta_base"], dtype=np.float64)
+        if not np.any(np.asarray(values["kappa_base"], dtype=np.float64) > 0.0):
+            # The shader would take the conductor path, the adding equations a dielectric one: refuse.
+            raise lobes.StackError(f"kappa_base = {list(values['kappa_base'])} must be > 0 on some channel for a conductor base (or set conductor off)")
     return lobes.make_stack(
         eta,
         [float(values[f"alpha_{i}"]) for i in range(1, count + 1)],
