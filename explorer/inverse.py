@@ -292,7 +292,7 @@ def conductor_albedo(alpha) -> float:
     return float(_mean(lobes.fgd_conductor(1.0, alpha, 1.0, 1e9)))
 
 
-def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: str, choice: dict):
+def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: str, choice: dict, probe: bool = False):
     """Algorithm 4: the interface below medium m = len(partial.eta), from ``R'_{m,m+1}`` and ``sigma^R_{m,m+1}``."""
     m = len(partial.eta)
     eta_m = partial.eta_below()
@@ -315,6 +315,8 @@ def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: st
             raise InverseError(
                 f"lobe {k}: its energy needs a conductor reflectance {_fmt(R_target)}{' below the layers above' if m else ''}; "
                 f"conductors with kappa >= eta reach [{CONDUCTOR_R_MIN * E:.4f}, {E:.4f}) at this roughness (Sec. 5.1.2)")
+        if probe:
+            return  # some eta in [eta_min^c, eta_max^c] reaches it
         if "eta" in choice:
             eta = np.broadcast_to(np.asarray(choice["eta"], float), (3,)).copy()
         else:
@@ -338,6 +340,8 @@ def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: st
         raise InverseError(
             f"lobe {k}: energy {energy:.4g} is not achievable by a 1-layer dielectric lobe (eta in [1, {ETA_MAX:g}]): "
             f"achievable energy in [0, {reach:.4g}]")
+    if probe:
+        return  # R'_c <= R_max: a root in [1, eta_max] exists (FGD is continuous), tau >= 0 on the other channels
     if "eta" in choice:
         eta = float(choice["eta"])
     else:
@@ -397,7 +401,7 @@ def _two_layer(partial: _Partial, k, lobe_energy, variance, statistics_above, ch
     if np.any(R_prime_2 > 1.0):
         raise InverseError(f"lobe {k}: energy {_fmt(lobe_energy)} needs R' > 1 below eta = {eta_top:.4g}")
     base = choice.get("base", "dielectric")
-    _one_layer(partial, k, R_prime_2, sigma_R_2, statistics, base, {} if probe else {key: v for key, v in choice.items() if key in ("eta", "t", "tau")})
+    _one_layer(partial, k, R_prime_2, sigma_R_2, statistics, base, {} if probe else {key: v for key, v in choice.items() if key in ("eta", "t", "tau")}, probe)
 
 
 def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
