@@ -458,3 +458,101 @@ def forward_lobes(stack: lobes.Stack, layers) -> tuple[np.ndarray, np.ndarray]:
         out_v.append((energies[i:i + l] * variances[i:i + l]).sum(axis=0) / np.maximum(energies[i:i + l].sum(axis=0), 1e-300))
         i += l
     return np.array(out_e), np.array(out_v)
+
+
+@dataclass
+class LobeClass:
+    """
+    Lobe ``k``'s equivalence class under the stack the lobes above it give (Sec. 6; the app panel's view
+    of a stacked lobe), sampled with validity masks:
+
+    - ``"dielectric"`` (1-layer): over ``eta`` (the index below the lobe's interface), ``tau`` ``(B, 3)``
+      the optical depth above it (Algorithm 4's ``tau_m``; in air only the roots of Eq. 7 are valid).
+    - ``"conductor"`` (1-layer): over ``eta`` ``(B, 3)``, ``kappa`` ``(B, 3)``, valid between Eqs. 10 and 9.
+    - ``"two_layer"``: over ``(eta_top, eta)``, ``tau`` ``(A, B, 3)`` between the two interfaces (Eq. 13),
+      ``alpha`` ``(A,)`` the bottom roughness (Eq. 19); ``eta_top``'s valid rows are N_1, a row's valid
+      ``eta`` N_2 (Eqs. 12, 14).
+    - ``"two_layer_conductor"``: ``valid`` ``(A,)`` over ``eta_top`` (N_1); the conductor's own class then
+      follows Sec. 5.2.4.
+
+    A valid point is a stack through :func:`invert_lobes` with the choices ``{"eta": ...}`` (1-layer) or
+    ``{"eta_top": ..., "eta": ...}`` (2-layer) for lobe ``k``.
+    """
+
+    kind: str
+    eta_top: np.ndarray | None
+    eta: np.ndarray
+    kappa: np.ndarray | None
+    tau: np.ndarray | None
+    alpha: np.ndarray
+    valid: np.ndarray
+
+
+def lobe_class(lobe_list, k: int, choices=None, samples: int = 48, tir: bool = False) -> LobeClass:
+    """The class of lobe ``k`` (1-based) of ``lobe_list`` once lobes ``1..k-1`` are set (by ``choices``)."""
+    choices = list(choices or [{}] * len(lobe_list))
+    above = invert_lobes(lobe_list[: k - 1], choices[: k - 1], tir=tir) if k > 1 else None
+    partial = _Partial(tir=tir)
+    if above is not None:
+        for i in range(1, above.count + 1):
+            partial.eta.append(float(above.eta[i].mean()))
+            partial.alpha.append(float(above.alpha[i]))
+            if i < above.count:
+                partial.tau.append(above.tau[i])
+        partial.tau.append(np.asarray(choices[k - 1].get("tau_top", 0.0), float) * np.ones(3))  # the medium above lobe k
+    lobe = lobe_list[k - 1]
+    statistics = _base_statistics(partial)
+    eta_n = partial.eta_below()
+    grid = np.linspace(1.0, ETA_MAX, samples)
+    R_prime, sigma_R = _lobe_terms(statistics, lobe.energy, lobe.variance, 1.0, eta_n)
+    c = int(np.argmax(R_prime))
+    sigma = max(float(sigma_R[c]), 0.0)
+    if lobe.layers == 1:
+        alpha_eff = float(roughness_from_variance(sigma + statistics.sigma_T_0n[c]))
+        alpha = np.array(roughness_from_variance(sigma))
+        if lobe.base == "conductor":
+            E = conductor_albedo(alpha_eff)
+            R_target = R_prime
+            eta_min, eta_top = conductor_bounds(np.minimum(R_target / E, 1.0 - 1e-12), eta_n)
+            eta = np.linspace(0.0, 1.0, samples)[:, None] * np.nan_to_num(eta_top, nan=eta_min) * 1.2 + 1e-3
+            kappa = conductor_kappa(R_target[None, :], alpha_eff, eta, eta_n)
+            valid = np.isfinite(kappa) & (eta >= eta_min) & (kappa >= eta) & (sigma_R[c] >= 0.0)
+            return LobeClass("conductor", None, eta, kappa, None, alpha, valid)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = 0.5 * np.log(fgd_normal(alpha_eff, grid / eta_n)[:, None] / R_prime[None, :])
+        if not partial.eta:  # in air, no medium above: tau must vanish (Eq. 7's roots)
+            roots = [r for r in dielectric_roots(R_prime[c], alpha_eff, 1.0) if np.isfinite(r) and 1.0 <= r <= ETA_MAX]
+            return LobeClass("dielectric", None, np.array(roots), None, np.zeros((len(roots), 3)), alpha,
+                             np.full(len(roots), np.ptp(R_prime) < 1e-9 and sigma_R[c] >= 0.0))
+        valid = np.all(tau >= 0.0, axis=-1) & (sigma_R[c] >= 0.0)
+        return LobeClass("dielectric", None, grid, None, tau, alpha, valid)
+    alpha_bottom = np.full(samples, np.nan)
+    tau = np.full((samples, samples, 3), np.nan)
+    valid_rows = np.zeros(samples, bool)
+    for i, eta_top in enumerate(grid):
+        trial = _Partial(list(partial.eta), list(partial.alpha), list(partial.tau), None, tir)
+        trial.eta.append(float(eta_top))
+        trial.alpha.append(float(roughness_from_variance(sigma)))
+        try:
+            statistics_2 = _base_statistics(trial)
+        except lobes.StackError:
+            continue
+        R_bar = statistics.R_0n + lobe.energy - statistics_2.R_0n  # Eq. 20
+        if np.any(R_bar <= 0.0) or sigma_R[c] < 0.0:
+            continue
+        R_prime_2, sigma_R_2 = _lobe_terms(statistics_2, R_bar, lobe.variance, 1.0, float(eta_top))
+        c2 = int(np.argmax(R_prime_2))
+        if sigma_R_2[c2] < 0.0 or np.any(R_prime_2 > 1.0):
+            continue
+        alpha_bottom[i] = roughness_from_variance(sigma_R_2[c2])
+        alpha_eff = float(roughness_from_variance(sigma_R_2[c2] + statistics_2.sigma_T_0n[c2]))
+        if lobe.base == "conductor":
+            E = conductor_albedo(alpha_eff)
+            valid_rows[i] = bool(np.all(R_prime_2 < E) and np.all(np.isfinite(conductor_bounds(np.minimum(R_prime_2 / E, 1 - 1e-12), eta_top)[1])))
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau[i] = 0.5 * np.log(fgd_normal(alpha_eff, grid / eta_top)[:, None] / R_prime_2[None, :])
+    if lobe.base == "conductor":
+        return LobeClass("two_layer_conductor", grid, grid, None, None, alpha_bottom, valid_rows)
+    valid = np.isfinite(tau).all(axis=-1) & np.all(np.nan_to_num(tau, nan=-1.0) >= 0.0, axis=-1)
+    return LobeClass("two_layer", grid, grid, None, tau, alpha_bottom, valid)

@@ -234,3 +234,35 @@ def test_tau_0_range_is_eq16():
     alpha = float(lobes.roughness_from_variance(0.02))
     slab = lobes.make_stack([4.0, 1.0], [alpha, alpha])
     assert inverse.two_layer_energy_bounds(0.02, samples=16)[1] == pytest.approx(float(lobes.reflectance(slab, 1.0)[0]), rel=1e-9)
+
+
+@pytest.mark.parametrize("lobe_list, k", [
+    (CASES["fig14b_coated"], 2),
+    (CASES["fig19b_haze"], 2),
+    (CASES["three_lobes"], 3),
+])
+def test_stacked_lobe_class_points_reproduce_the_lobes(lobe_list, k):
+    """A few valid points of lobe k's class under the lobes above, as choices of invert_lobes, give the lobes back."""
+    cls = inverse.lobe_class(lobe_list, k, samples=16)
+    points = np.argwhere(cls.valid)
+    assert len(points) > 0, cls.kind
+    for point in points[:: max(1, len(points) // 3)]:
+        if cls.kind == "two_layer":
+            choice = {"eta_top": cls.eta_top[point[0]], "eta": cls.eta[point[1]]}
+        elif cls.kind == "conductor":
+            choice = {"eta": cls.eta[point[0]]} if cls.valid[point[0]].all() else None
+        else:
+            choice = {"eta": cls.eta[point[0]]}
+        if choice is None:
+            continue
+        choices = [{}] * len(lobe_list)
+        choices[k - 1] = choice
+        stack = inverse.invert_lobes(lobe_list, choices)
+        energies, _ = inverse.forward_lobes(stack, [lobe.layers for lobe in lobe_list])
+        np.testing.assert_allclose(energies[k - 1], lobe_list[k - 1].energy, atol=ROUND_TRIP_TOLERANCE)
+    # Outside the class, the same choice is refused.
+    if cls.kind == "dielectric" and (~cls.valid).any():
+        choices = [{}] * len(lobe_list)
+        choices[k - 1] = {"eta": cls.eta[np.argwhere(~cls.valid)[0][0]]}
+        with pytest.raises(InverseError, match="tau >= 0"):
+            inverse.invert_lobes(lobe_list, choices)
