@@ -287,6 +287,13 @@ def _achievable_energy(statistics, R_max) -> np.ndarray:
     return statistics.T_0n * R_max * statistics.T_n0 / (1.0 - R_max * statistics.R_n0)
 
 
+def _least_variance(statistics, R_prime, c: int, eta_n: float) -> float:
+    """The smallest lobe variance the layers above allow on channel ``c``: Eq. 19 with ``sigma^R = 0``."""
+    s = statistics
+    x = s.R_n0[c] * R_prime[c]
+    return float(s.sigma_T_n0[c] + eta_n * (s.sigma_T_0n[c] + x * s.sigma_R_n0[c] / (1.0 - x)))
+
+
 def conductor_albedo(alpha) -> float:
     """``E(0, alpha)``: the forward model's rough conductor FGD at normal incidence is ``E F(cbar_d)``."""
     return float(_mean(lobes.fgd_conductor(1.0, alpha, 1.0, 1e9)))
@@ -299,10 +306,8 @@ def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: st
     c = int(np.argmax(R_prime))  # Sec. 5.2.3: the brightest channel sets the roughness
     sigma = float(sigma_R[c])
     if sigma < -1e-12:
-        s = statistics  # the smallest variance the layers above allow: Eq. 19 with sigma^R = 0
-        x = s.R_n0[c] * R_prime[c]
-        least = s.sigma_T_n0[c] + eta_m * (s.sigma_T_0n[c] + x * s.sigma_R_n0[c] / (1.0 - x))
-        raise InverseError(f"lobe {k}: variance is below what the layers above give (constraint sigma^R >= 0, Eq. 19): achievable sigma >= {least:.4g}")
+        raise InverseError(f"lobe {k}: variance is below what the layers above give (constraint sigma^R >= 0, Eq. 19): "
+                           f"achievable sigma >= {_least_variance(statistics, R_prime, c, eta_m):.4g}")
     sigma = max(sigma, 0.0)
     alpha = float(roughness_from_variance(sigma))
     alpha_eff = float(roughness_from_variance(sigma + statistics.sigma_T_0n[c]))  # Algorithm 4's FGD roughness
@@ -342,6 +347,10 @@ def _one_layer(partial: _Partial, k: int, R_prime, sigma_R, statistics, base: st
             f"achievable energy in [0, {reach:.4g}]")
     if probe:
         return  # R'_c <= R_max: a root in [1, eta_max] exists (FGD is continuous), tau >= 0 on the other channels
+    if "eta" in choice and m == 0:
+        roots = [r for r in dielectric_roots(R_prime[c], alpha_eff, eta_m) if np.isfinite(r) and 1.0 <= r <= ETA_MAX]
+        if not any(abs(float(choice["eta"]) - r) < 1e-6 for r in roots):
+            raise InverseError(f"lobe {k}: in air the energy fixes eta (Eq. 7, no absorbing medium above): eta in {{{', '.join(f'{r:.6g}' for r in roots)}}}, not {float(choice['eta']):.6g}")
     if "eta" in choice:
         eta = float(choice["eta"])
     else:
@@ -384,7 +393,8 @@ def _two_layer(partial: _Partial, k, lobe_energy, variance, statistics_above, ch
     R_prime, sigma_R = _lobe_terms(statistics_above, lobe_energy, variance, 1.0, eta_n)
     c = int(np.argmax(R_prime))
     if sigma_R[c] < -1e-12:
-        raise InverseError(f"lobe {k}: variance {variance:.4g} is below what the layers above give (constraint sigma^R >= 0, Eq. 19)")
+        raise InverseError(f"lobe {k}: variance {variance:.4g} is below what the layers above give (constraint sigma^R >= 0, Eq. 19): "
+                           f"achievable sigma >= {_least_variance(statistics_above, R_prime, c, eta_n):.4g}")
     eta_top = choice.get("eta_top")
     if eta_top is None:
         eta_top = _default_eta_top(partial, k, lobe_energy, variance, statistics_above, choice)

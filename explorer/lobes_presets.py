@@ -76,8 +76,9 @@ FIGURES: dict[str, tuple] = {
                       [Lobe(0.04, 0.07), Lobe([0.6, 0.25, 0.25], 0.03, base="conductor")], None),
     "figure21_right": ("Figure 21 (right)", "the variances swapped: sigma1 = 0.03, sigma2 = 0.07",
                        [Lobe(0.04, 0.03), Lobe([0.6, 0.25, 0.25], 0.07, base="conductor")], None),
-    "figure17_blue_on_red": ("Figure 17 (left)", "2-layer blue lobe R = [0.025, 0.045, 0.05], sigma = 0.028 over a 2-layer red one R = [0.052, 0.025, 0.025], sigma = 0.014",
-                             [Lobe([0.025, 0.045, 0.05], 0.028, layers=2), Lobe([0.052, 0.025, 0.025], 0.014, layers=2)], None),
+    "figure17_blue_on_red": ("Figure 17 (left)", "the blue lobe's top interface at eta = 1 (ours: the only eta_top whose transmitted variance leaves the red lobe's 0.014 reachable); 2-layer blue lobe R = [0.025, 0.045, 0.05], sigma = 0.028 over a 2-layer red one R = [0.052, 0.025, 0.025], sigma = 0.014",
+                             [Lobe([0.025, 0.045, 0.05], 0.028, layers=2), Lobe([0.052, 0.025, 0.025], 0.014, layers=2)],
+                             [{"eta_top": 1.0}, {}]),
     "figure17_red_on_blue": ("Figure 17 (right)", "the order swapped",
                              [Lobe([0.052, 0.025, 0.025], 0.014, layers=2), Lobe([0.025, 0.045, 0.05], 0.028, layers=2)], None),
 }

@@ -162,11 +162,15 @@ def test_choices_pick_other_points_of_the_class():
     ([Lobe(0.1, 0.0, base="conductor")], r"conductors with kappa >= eta reach \[0.1716"),
     ([Lobe([0.1, 0.2, 0.1], 0.0)], r"1-layer dielectric lobe in air is achromatic"),
     ([Lobe(0.04, 0.07), Lobe([0.6, 0.25, 0.25], 0.03, base="conductor")], r"^lobe 2: variance is below what the layers above give \(constraint sigma\^R >= 0, Eq. 19\): achievable sigma >= 0.03"),
+    ([Lobe(0.04, 0.0)], None),
     ([Lobe(0.3, 0.0), Lobe(0.75, 0.02, base="conductor")], r"^lobe 2: energies sum to 1.05: the lobes' energies must sum below 1$"),
 ])
 def test_bad_lobes_say_which_constraint_fails(lobe_list, message):
+    choices = None
+    if message is None:  # a chosen eta in air that is not a root of Eq. 7
+        choices, message = [{"eta": 1.3}], r"^lobe 1: in air the energy fixes eta \(Eq. 7, no absorbing medium above\): eta in \{1.5\}, not 1.3$"
     with pytest.raises(InverseError, match=message) as error:
-        inverse.invert_lobes(lobe_list)
+        inverse.invert_lobes(lobe_list, choices)
     assert "\n" not in str(error.value)
 
 

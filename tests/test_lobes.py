@@ -208,7 +208,7 @@ def test_float32_sweep_is_finite(gl_renderer, material):
         {"layers": 3, "alpha_1": 0, "alpha_2": 0, "alpha_3": 0, "eta_1": 4, "eta_2": 1, "eta_3": 4},
         {"layers": 3, "alpha_1": 1, "alpha_2": 1, "alpha_3": 1, "tau_1": "20", "tau_2": "0,5,50"},
         {"layers": 2, "conductor": 1, "eta_base": "0.01", "kappa_base": "10", "alpha_1": 1, "alpha_2": 0},
-        {"layers": 1, "conductor": 1, "eta_base": "4", "kappa_base": "0", "alpha_1": 0.001},
+        {"layers": 1, "conductor": 1, "eta_base": "4", "kappa_base": "0,0,1e-4", "alpha_1": 0.001},
         {"layers": 2, "eta_1": 1, "eta_2": 1, "alpha_1": 0.5},
         {"layers": 4, "eta_1": 4, "eta_2": 1, "eta_3": 4, "eta_4": 1, "alpha_1": 0.05, "alpha_2": 0.9, "alpha_3": 0.02, "tir": 1},
     ]
