@@ -13,9 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
-from . import lobes
+
 from .inverse import InverseError, Lobe, invert_lobes
 from .lobes_model import values_from_stack
 
