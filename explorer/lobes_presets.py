@@ -13,8 +13,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
-
 from .inverse import InverseError, Lobe, invert_lobes
 from .lobes_model import values_from_stack
 
