@@ -503,6 +503,12 @@ def default_job():
         click.echo(f"wrote out/bragg_mirror_{view}.png ({size[0]}x{size[1]}, exact spectral colours, tabulated)")
 
 
+from .inverse_cli import figure_command, inverse_command  # noqa: E402  (issue 11: layered lobes)
+
+cli.add_command(inverse_command)
+cli.add_command(figure_command)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: click's usage errors too end as one line (not click's usage block)."""
     try:

@@ -29,6 +29,10 @@ sensitivity_fourier
     its centroid in ``nu``: the envelope ``E_j`` is smooth, so linear interpolation between nodes is
     within 6e-5 of the transform (2.5e-3 without demodulation). Shape ``(2, 4096, 3)``: real parts,
     imaginary parts (the paper's N x 2 three-channel texture, Section 5); zero beyond the last node.
+lobes_fgd_correction, lobes_ggx_moments
+    Belcour's (2018) FGD term for :mod:`explorer.lobes`: a rough dielectric interface's directional
+    albedo minus the Fresnel term (unpolarised), over (eta, alpha, cos theta); and the GGX reflection
+    lobe's albedo and mean half-angle cosine over (alpha, cos theta), for rough conductors.
 """
 
 from __future__ import annotations
@@ -84,6 +88,18 @@ def _generate_sensitivity_fourier() -> np.ndarray:
     return np.stack([envelope.real, envelope.imag]).astype(np.float64)
 
 
+def _generate_lobes_fgd_correction() -> np.ndarray:
+    from .lobes import generate_fgd_correction  # the physics lives in explorer.lobes
+
+    return generate_fgd_correction()
+
+
+def _generate_lobes_ggx_moments() -> np.ndarray:
+    from .lobes import generate_ggx_moments
+
+    return generate_ggx_moments()
+
+
 def _source() -> str:
     import colour
 
@@ -107,6 +123,29 @@ TABLES: dict[str, dict] = {
             "range_nm": [CUMULATIVE_START, colorimetry.WAVELENGTH_MAX + 0.5],
             "resolution_nm": CUMULATIVE_STEP,
             "shape": [472, 3],
+        },
+    },
+    "lobes_fgd_correction": {
+        "generate": _generate_lobes_fgd_correction,
+        "spec": {
+            "quantity": "FGD - Fresnel (unpolarised) of a rough GGX dielectric interface, eta x alpha x cos theta "
+            "(explorer.lobes; Belcour 2018's FGD term)",
+            "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)",
+            "cos_theta": "t = linspace(0, 1, 33) of explorer.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
+            "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+            "resolution_nm": None,  # no wavelength axis
+            "shape": [33, 16, 33],
+        },
+    },
+    "lobes_ggx_moments": {
+        "generate": _generate_lobes_ggx_moments,
+        "spec": {
+            "quantity": "GGX reflection lobe albedo (F = 1) and mean half-angle cosine, [E, cbar_d] x alpha x cos theta "
+            "(explorer.lobes: conductors' FGD ~ E F(cbar_d))",
+            "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 33)",
+            "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+            "resolution_nm": None,  # no wavelength axis
+            "shape": [2, 16, 33],
         },
     },
     "sensitivity_fourier": {

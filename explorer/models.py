@@ -16,6 +16,7 @@ import numpy as np
 from . import bragg, colorimetry, layered, microfacet
 from .brd import round_integer
 from .fresnel import fresnel_schlick
+from .lobes_model import LayeredLobesModel
 from .thinfilm_model import ThinFilmModel
 
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
@@ -272,6 +273,7 @@ MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
     SchlickFresnelModel.name: SchlickFresnelModel,
     ThinFilmModel.name: ThinFilmModel,
     GGXSchlickModel.name: GGXSchlickModel,
+    LayeredLobesModel.name: LayeredLobesModel,
 }
 
 

@@ -1,0 +1,90 @@
+"""
+The numpy twin of ``shaders/layered_lobes.brd`` (physics in :mod:`explorer.lobes`): Belcour's (2018)
+layered BRDF as a sum of GGX lobes (Bati et al. 2021, Eq. 3) and the FGD tables its shader reads.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from . import lobes, luts
+from .errors import LocatedError
+
+MATERIAL_NAME = "layered_lobes.brd"
+
+
+class LobesParameterError(LocatedError, ValueError):
+    """A parameter set outside the physical constraints (one line, naming which): the CLI's and the app's bad input."""
+
+
+def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
+    """The :class:`explorer.lobes.Stack` of the material's parameter values (checked)."""
+    count = int(np.clip(np.floor(float(values["layers"]) + 0.5), 1, lobes.MAX_INTERFACES))
+    conductor = bool(values.get("conductor", False))
+    eta = [float(values[f"eta_{i}"]) for i in range(1, count + 1)]
+    if conductor:
+        eta[-1] = np.asarray(values["eta_base"], dtype=np.float64)
+        if not np.any(np.asarray(values["kappa_base"], dtype=np.float64) > 0.0):
+            # The shader would take the conductor path, the adding equations a dielectric one: refuse.
+            raise lobes.StackError(f"kappa_base = {list(values['kappa_base'])} must be > 0 on some channel for a conductor base (or set conductor off)")
+    return lobes.make_stack(
+        eta,
+        [float(values[f"alpha_{i}"]) for i in range(1, count + 1)],
+        tau=[values[f"tau_{i}"] for i in range(1, count)],
+        base_kappa=values["kappa_base"] if conductor else None,
+        tir=bool(values.get("tir", False)),
+    )
+
+
+def fgd_texture() -> np.ndarray:
+    """``luts/lobes_fgd_correction`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, the correction in red."""
+    table = luts.load("lobes_fgd_correction")
+    rows = table.reshape(-1, table.shape[-1])
+    return np.stack([rows, np.zeros_like(rows), np.zeros_like(rows)], axis=-1).astype(np.float32)
+
+
+def moments_texture() -> np.ndarray:
+    """``luts/lobes_ggx_moments`` as a ``(16, 32, 3)`` texture: channels E, cbar_d, 0."""
+    table = luts.load("lobes_ggx_moments")
+    return np.stack([table[0], table[1], np.zeros_like(table[0])], axis=-1).astype(np.float32)
+
+
+class LayeredLobesModel:
+    """Twin of ``shaders/layered_lobes.brd``: ``reflectance(cos_theta)`` (sum of the lobes' energies) and Eq. 3."""
+
+    name = "layered_lobes"
+
+    def __init__(self, values: Mapping[str, object]):
+        self.values = dict(values)
+        try:
+            self.stack = stack_from_values(values)
+        except lobes.StackError as error:
+            raise LobesParameterError(MATERIAL_NAME, None, str(error)) from None
+
+    def reflectance(self, cos_theta) -> np.ndarray:
+        return lobes.reflectance(self.stack, cos_theta)
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        return lobes.brdf(self.stack, L, V, N)
+
+    def textures(self) -> dict[str, np.ndarray]:
+        return {"lobes_fgd": fgd_texture(), "lobes_ggx_moments": moments_texture()}
+
+
+def values_from_stack(stack: lobes.Stack) -> dict:
+    """The parameter values of ``shaders/layered_lobes.brd`` for ``stack`` (numbers and RGB lists)."""
+    if stack.count > lobes.MAX_INTERFACES:
+        raise lobes.StackError(f"the material holds at most {lobes.MAX_INTERFACES} interfaces, the stack has {stack.count}")
+    values: dict = {"layers": stack.count, "conductor": int(stack.conductor), "tir": int(stack.tir)}
+    for i in range(1, stack.count + 1):
+        values[f"alpha_{i}"] = float(stack.alpha[i])
+        if i == stack.count and stack.conductor:
+            values["eta_base"] = [float(v) for v in stack.eta[i]]
+            values["kappa_base"] = [float(v) for v in stack.kappa[i]]
+        else:
+            values[f"eta_{i}"] = float(stack.eta[i].mean())
+        if i < stack.count:
+            values[f"tau_{i}"] = [float(v) for v in stack.tau[i]]
+    return values
