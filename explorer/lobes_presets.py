@@ -15,8 +15,9 @@ from pathlib import Path
 
 from .inverse import InverseError, Lobe, invert_lobes
 from .lobes_model import values_from_stack
+from .resources import PRESET_DIR
 
-PRESET_FILE = Path(__file__).resolve().parent.parent / "shaders" / "presets" / "layered_lobes.toml"
+PRESET_FILE = PRESET_DIR / "layered_lobes.toml"
 
 #: name -> (figure, what it shows, lobes top first, choices per lobe).
 FIGURES: dict[str, tuple] = {
@@ -126,6 +127,9 @@ def write(path: Path = PRESET_FILE) -> dict:
 
 
 def main() -> int:
+    from .resources import require_checkout
+
+    require_checkout("python -m explorer.lobes_presets")
     failures = write()
     print(f"wrote {PRESET_FILE}")
     for name, message in failures.items():
