@@ -118,7 +118,7 @@ class App:
         self.window_size = tuple(window_size)
         self.view_size = int(view_size)
         self.mode = "sphere" if self._has_reflectance(self.material) else "lit"
-        self.light = [45.0, 0.0]  # theta, phi in degrees (explorer.render.DEFAULT_LIGHT)
+        self.light = [45.0, 0.0]  # theta, phi in degrees (explorer.views.geometry.DEFAULT_LIGHT)
         self.camera = [0.0, 0.0]  # yaw, pitch in degrees: rotates the light relative to the view
         self.zoom = 1.0
         self.exposure = 1.0
@@ -728,7 +728,7 @@ class App:
         """The light in view space: the world light turned by the inverse of the orbit camera (pyrr)."""
         from pyrr import Matrix33
 
-        from .render import light_direction
+        from .views.geometry import light_direction
 
         direction = light_direction(tuple(self.light)).astype(np.float64)
         yaw, pitch = np.radians(self.camera)
@@ -1149,7 +1149,7 @@ class App:
         """Write the active view (PNG, 8-bit sRGB with the exposure; and its linear ``.npy``) once complete."""
         if self._pending_screenshot is None:
             return
-        from .cli import OutputError, write_image
+        from .images import OutputError, write_image
 
         samples = None
         if self.mode == "env" and self.env is not None:

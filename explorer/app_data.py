@@ -131,7 +131,7 @@ def polar_curve(scatter_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def disc_mask(width: int, height: int) -> np.ndarray:
     """The pixels of the sphere views' disc (as the shaders test ``r^2 < 1``)."""
-    from .render import view_cos_theta
+    from .views.geometry import view_cos_theta
 
     return view_cos_theta("sphere", width, height)[1]
 

@@ -552,7 +552,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     import tempfile
 
     from .app import App
-    from .cli import DEFAULT_MATERIAL
+    from .resources import DEFAULT_MATERIAL
     from .xvfb import display_environment
 
     with display_environment() as display, tempfile.TemporaryDirectory() as directory:

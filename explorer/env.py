@@ -3,7 +3,7 @@ The ``env`` view: the lit view's sphere under an environment map, by progressive
 (``shaders/views/env.glsl``), and its numpy twin, the exact integral by quadrature.
 
 Each pixel shows ``L_o = int f(L, V) cos theta_L L_e(L) d omega_L`` over the hemisphere of its normal
-``N``, with ``V = (0, 0, 1)`` and the lit view's geometry and frame (:func:`explorer.render.brdf_view_geometry`).
+``N``, with ``V = (0, 0, 1)`` and the lit view's geometry and frame (:func:`explorer.views.geometry.brdf_view_geometry`).
 
 The environment is an equirectangular image of linear RGB radiance (:class:`EnvironmentMap`), read
 from Radiance ``.hdr`` or OpenEXR ``.exr`` files by OpenCV. Its direction convention, shared with the
@@ -343,7 +343,7 @@ def env_integral_numpy(
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
-    views' rule (:func:`explorer.render.view_brdf`: 0 below the surface, NaN or infinite channels 0; plus a model's
+    views' rule (:func:`explorer.views.geometry.view_brdf`: 0 below the surface, NaN or infinite channels 0; plus a model's
     Dirac reflection, ``model.mirror_reflection(V, N) L_e(reflect(-V, N))``, when it has one), by a midpoint
     rule over the environment's texels (:meth:`EnvironmentMap.quadrature`, each cell's exact solid
     angle, the bilinear radiance the shader reads).
@@ -354,7 +354,7 @@ def env_integral_numpy(
         A numpy twin from :mod:`explorer.models` (``model.brdf(L, V, N, X, Y) -> (..., 3)``).
     environment : EnvironmentMap
     width, height : int
-        The image size (the lit view's sphere: :func:`explorer.render.brdf_view_geometry`).
+        The image size (the lit view's sphere: :func:`explorer.views.geometry.brdf_view_geometry`).
     pixels : array_like of (row, column), optional
         Only these pixels (rows from the top): the integral costs one BRDF evaluation per cell (about
         ``4 pi`` / 2 of ``(W_env H_env s^2)`` directions) per pixel.
@@ -368,7 +368,7 @@ def env_integral_numpy(
     ndarray
         ``(P, 3)`` float64 for ``pixels`` (0 outside the disc), else the ``(height, width, 3)`` float32 image.
     """
-    from .render import brdf_view_geometry, view_brdf
+    from .views.geometry import brdf_view_geometry, view_brdf
 
     _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:

@@ -300,11 +300,11 @@ class Renderer:
         ``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped.
 
         ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
-        (default :data:`explorer.render.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
+        (default :data:`explorer.views.geometry.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
         ``uniforms``: a view's own textures and flags (the ``textured`` view's, from
         :meth:`explorer.thickness.ThicknessTexture.gl_inputs`).
         """
-        from .render import light_direction
+        from .views.geometry import light_direction
 
         direction = light_direction(light)
         program = self.program(material, view, values)
@@ -338,7 +338,7 @@ class Renderer:
         software rasteriser such as llvmpipe this is the rendering time. Timer queries are avoided:
         their 32-bit nanosecond results wrap at 4.29 s. ``light``: as in :meth:`render`.
         """
-        from .render import light_direction
+        from .views.geometry import light_direction
 
         program = self.program(material, view, values)
         self.bind(program, material, values, inputs, uniforms)

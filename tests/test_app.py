@@ -191,7 +191,7 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
 def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, bragg_material):
     """Compare: spectral reference | improved approximation; the mean ΔE2000 shown is that of the two headless renders."""
     from explorer.colorimetry import delta_E_2000
-    from explorer.render import view_cos_theta
+    from explorer.views.geometry import view_cos_theta
 
     actions = [
         {"wait": 2}, {"wait_complete": True}, {"focus": "Compare"}, {"wait": 2}, {"click": "compare_on"},

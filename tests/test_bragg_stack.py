@@ -16,7 +16,8 @@ from conftest import REPO_ROOT, one_line_error
 from explorer import bragg, colorimetry, layered
 from explorer.brd import load_material
 from explorer.models import BraggStackModel, model_for
-from explorer.render import render_numpy, rim_distance
+from explorer.views.geometry import rim_distance
+from explorer.render import render_numpy
 from test_bragg_layer import directions
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 from test_cli import cli

@@ -1,6 +1,6 @@
 """Materials out of their domain: every view that evaluates a BRDF follows one rule, in GLSL and numpy.
 
-The rule (``view_brdf`` in shaders/lib/views.glsl, :func:`explorer.render.view_brdf`): the BRDF is
+The rule (``view_brdf`` in shaders/lib/views.glsl, :func:`explorer.views.geometry.view_brdf`): the BRDF is
 evaluated only where N.L > 0 and N.V > 0 (0 elsewhere), and a NaN or infinite channel counts as 0; a
 finite negative channel is kept. Five of BRDF Explorer's own 40 files (Minnaert's, Ward's, Edwards',
 Kurt's and Ward's G) returned NaN in the lit view: the failure patterns of those files are reproduced by
@@ -20,7 +20,8 @@ import brdf_twins
 from conftest import BRDF_DATA, REPO_ROOT
 from explorer.brd import load_material
 from explorer.models import model_for
-from explorer.render import brdf_view_geometry, finite_or_zero, render_numpy, rim_distance, view_brdf
+from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
+from explorer.render import render_numpy
 from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
 
 #: Odd sides: the disc views have a centre pixel (x = y = 0), where H = N under a light straight above.

@@ -24,7 +24,7 @@ from explorer.env import (
     env_integral_numpy, generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere,
     uniform_floats, uv_to_direction,
 )
-from explorer.render import brdf_view_geometry, rim_distance
+from explorer.views.geometry import brdf_view_geometry, rim_distance
 from test_cli import cli
 
 GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
@@ -584,7 +584,7 @@ def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     from explorer.brd import load_material
     from explorer.env import EnvironmentMap, ProgressiveEnvRender
     from explorer.models import model_for
-    from explorer.render import brdf_view_geometry
+    from explorer.views.geometry import brdf_view_geometry
 
     material = load_material(REPO_ROOT / "shaders" / "bragg_stack.brd")
     values = material.resolve({"nh": 1.5, "n1_1": 1.5, "n2_1": 1.5, "rho_d": 0})

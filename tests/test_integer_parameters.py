@@ -18,7 +18,8 @@ from explorer.app_params import widget_kind
 from explorer.brd import load_material, round_integer
 from explorer.gl import specialisation
 from explorer.models import model_for
-from explorer.render import render_numpy, rim_distance
+from explorer.views.geometry import rim_distance
+from explorer.render import render_numpy
 from test_brdf_views import LIGHTS, assert_twin_equal
 from test_gl_views import GL_ATOL, RIM_EXCLUSION, SWEEP_SIZES
 
