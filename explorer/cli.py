@@ -118,7 +118,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
-    from .gl import Renderer
+    from .gpu import Renderer
 
     if view == "textured":
         return Renderer().render(
@@ -132,7 +132,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
     """The env view (:func:`explorer.env.render_env`), its progress on stderr every few seconds."""
     import time
 
-    from .env import render_env
+    from .gpu.env import render_env
 
     if engine == "numpy":
         from .models import model_for
@@ -184,7 +184,7 @@ def cli(ctx: click.Context) -> None:
 def open_material(material, preset, script, report, window_size):
     """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
     from .app import DEFAULT_WINDOW, AppError, display_available, run_app
-    from .gl import GLUnavailable
+    from .gpu import GLUnavailable
 
     try:
         loaded = _load(material)
@@ -221,7 +221,7 @@ def _errors(function):
     """Turn the expected failures of bad input into one line and exit status 1."""
     import functools
 
-    from .gl import GLUnavailable
+    from .gpu import GLUnavailable
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
@@ -270,7 +270,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     if params_file is not None:
-        from .app_params import load_values
+        from .app.parameter_files import load_values
 
         loaded_values = load_values(params_file, loaded)
         for skipped in loaded_values.skipped:
@@ -412,7 +412,7 @@ def default_job():
     values = material.resolve({"method": "3"})
     out = Path("out")
     out.mkdir(exist_ok=True)
-    from .gl import Renderer
+    from .gpu import Renderer
 
     renderer = Renderer()
     for view, size in (("sphere", (512, 512)), ("gradient", (512, 48))):

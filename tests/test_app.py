@@ -21,7 +21,7 @@ from PIL import Image
 
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, running_in_ci
 
-from explorer.app_params import load_values, parse_bparam, save_values
+from explorer.app.parameter_files import load_values, parse_bparam, save_values
 from explorer.brd import load_material
 from explorer.colorimetry import encode_srgb8
 
@@ -146,7 +146,7 @@ def test_no_display_falls_back_to_the_headless_render(tmp_path):
 
 def test_parameter_sets_round_trip(tmp_path, bragg_material):
     """JSON and BRDF Explorer .bparam files keep the values; unknown names are skipped, bad values are errors."""
-    from explorer.app_params import ParameterFileError
+    from explorer.app.parameter_files import ParameterFileError
 
     values = bragg_material.resolve({"Lambda": 612.25, "N": 33, "method": 4})
     for name in ("set.json", "set.bparam"):
@@ -278,7 +278,7 @@ def test_switching_materials_keeps_the_app_alive(x_display, tmp_path, gl_rendere
     KeyError 'method' / 'layers' closed the window) and each screenshot is the headless render of the
     material just opened (env: the same number of samples, same seed).
     """
-    from explorer.env import render_env
+    from explorer.gpu.env import render_env
 
     actions = [{"wait": 2}, {"view_size": SWITCH_VIEW_SIZE}, {"click": f"mode:{mode}"}, {"wait": 2},
                {"focus": "Files"}, {"wait": 2}]

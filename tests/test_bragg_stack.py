@@ -181,7 +181,8 @@ void main() {
 @pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)"])
 def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, case):
     """The GLSL layer choice (sampling_lobes) equals explorer.layered.layer_choice_probabilities (Eqs. 31, 35)."""
-    from explorer.gl import SHADER_DIR, VERTEX_SHADER
+    from explorer.gpu.context import VERTEX_SHADER
+    from explorer.resources import SHADER_DIR
     from explorer.glsl import ShaderBuilder
 
     values = stack_material.resolve(CASES[case])
@@ -195,9 +196,8 @@ def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, ca
     target = ctx.renderbuffer((PROBE_COLUMNS, 1), 4, dtype="f4")
     framebuffer = ctx.framebuffer(color_attachments=[target])
     try:
-        gl_renderer.bind(program, stack_material, values)
-        framebuffer.use()
-        ctx.vertex_array(program, []).render(vertices=3)
+        uniforms, textures = gl_renderer.bindings(program, stack_material, values)
+        gl_renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures)
         got = np.frombuffer(framebuffer.read(components=4, dtype="f4"), np.float32).reshape(PROBE_COLUMNS, 4)
     finally:
         framebuffer.release()

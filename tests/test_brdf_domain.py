@@ -173,7 +173,8 @@ ENV_SIZE, ENV_SPP = 12, 4
 @pytest.mark.gl
 @pytest.mark.parametrize("path", PATHS, ids=[p.name for p in PATHS])
 def test_env_view_is_finite(gl_renderer, path):
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
 
     m = material(path)
     render = ProgressiveEnvRender(gl_renderer, m, m.resolve(), EnvironmentMap.default(), ENV_SIZE, ENV_SIZE, seed=3)
@@ -198,7 +199,8 @@ def test_env_converges_to_the_ruled_integral(gl_renderer):
     compact_lobe (NaN wherever theta_h > atan(m), on the lit side) under the smooth test sky: the Monte
     Carlo mean converges to the numpy integral of the BRDF under the same rule (test_env's criteria).
     """
-    from explorer.env import ProgressiveEnvRender, env_integral_numpy
+    from explorer.env import env_integral_numpy
+    from explorer.gpu.env import ProgressiveEnvRender
     from test_env import CONVERGENCE_SIZE, CONVERGENCE_SPP, MAX_Z, QUADRATURE_RTOL, WITHIN_3SE, smooth_environment
 
     environment = smooth_environment()

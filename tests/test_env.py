@@ -20,10 +20,11 @@ import pytest
 from conftest import REPO_ROOT, one_line_error
 from explorer import microfacet
 from explorer.env import (
-    DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, ProgressiveEnvRender, direction_to_uv,
-    env_integral_numpy, generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere,
-    uniform_floats, uv_to_direction,
+    DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, direction_to_uv, env_integral_numpy,
+    generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere, uniform_floats,
+    uv_to_direction,
 )
+from explorer.gpu.env import ProgressiveEnvRender
 from explorer.views.geometry import brdf_view_geometry, rim_distance
 from test_cli import cli
 
@@ -294,7 +295,8 @@ void main() {
 
 
 def run_probe(ctx, view, alpha):
-    from explorer.gl import SHADER_DIR, VERTEX_SHADER
+    from explorer.gpu.context import VERTEX_SHADER
+    from explorer.resources import SHADER_DIR
     from explorer.glsl import ShaderBuilder
 
     builder = ShaderBuilder(include_dirs=[SHADER_DIR])
@@ -551,7 +553,8 @@ def test_cli_env_with_an_exr(gl_renderer, tmp_path):
 def test_advance_in_bands_equals_whole_passes(gl_renderer):
     """advance() with a budget below one sample's cost works in bands of rows: same samples, same image."""
     from explorer.brd import load_material
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
     values = material.resolve({"alpha": 0.3})
@@ -561,8 +564,8 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
     banded = ProgressiveEnvRender(gl_renderer, material, values, environment, 24, 20, seed=3)
     real_pass = banded._pass
 
-    def slow_pass(vertex_array, count, rows=None):  # pretend each row costs 5 ms: a sample, 100 ms
-        real_pass(vertex_array, count, rows)
+    def slow_pass(bindings, count, rows=None):  # pretend each row costs 5 ms: a sample, 100 ms
+        real_pass(bindings, count, rows)
         return 5.0 * ((rows[1] - rows[0]) if rows is not None else banded.height) * count
 
     banded._pass = slow_pass
@@ -582,7 +585,8 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
 def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     """A coated stack whose layer is invisible (n2 = n1 = nh) and base black shows only the coating's Dirac: F Le(R)."""
     from explorer.brd import load_material
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
     from explorer.models import model_for
     from explorer.views.geometry import brdf_view_geometry
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from explorer import microfacet
-from explorer.gl import SHADER_DIR, VERTEX_SHADER
+from explorer.gpu.context import VERTEX_SHADER
+from explorer.resources import SHADER_DIR
 from explorer.glsl import ShaderBuilder
 
 #: float32 against float64, relative where values exceed 1e-3 (the lobe of a sharp alpha is steep).

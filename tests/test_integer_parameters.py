@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT
-from explorer.app_params import widget_kind
+from explorer.app.parameter_files import widget_kind
 from explorer.brd import load_material, round_integer
-from explorer.gl import specialisation
+from explorer.gpu.programs import specialisation
 from explorer.models import model_for
 from explorer.views.geometry import rim_distance
 from explorer.render import render_numpy
