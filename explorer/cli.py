@@ -129,7 +129,7 @@ def render_material(
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
-    """The env view (:func:`explorer.env.render_env`), its progress on stderr every few seconds."""
+    """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
     from .gpu.env import render_env

@@ -18,8 +18,8 @@ from explorer import bragg, colorimetry, microfacet
 from explorer.brd import load_material
 from explorer.models import BraggLayerModel, model_for
 from explorer.presets import PRESET_DIR, load_presets
-from explorer.views.geometry import rim_distance
 from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, SMALL, assert_twin_equal
 
 LAYER_MATERIAL = REPO_ROOT / "shaders" / "bragg_layer.brd"

@@ -20,8 +20,8 @@ import brdf_twins
 from conftest import BRDF_DATA, REPO_ROOT
 from explorer.brd import load_material
 from explorer.models import model_for
-from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
 from explorer.render import render_numpy
+from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
 from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
 
 #: Odd sides: the disc views have a centre pixel (x = y = 0), where H = N under a light straight above.

@@ -294,10 +294,12 @@ void main() {
 """
 
 
-def run_probe(ctx, view, alpha):
+def run_probe(renderer, view, alpha):
+    from explorer.glsl import ShaderBuilder
     from explorer.gpu.context import VERTEX_SHADER
     from explorer.resources import SHADER_DIR
-    from explorer.glsl import ShaderBuilder
+
+    ctx = renderer.ctx
 
     builder = ShaderBuilder(include_dirs=[SHADER_DIR])
     builder.define("SIZE", f"{PROBE_SIZE:.1f}")
@@ -306,10 +308,7 @@ def run_probe(ctx, view, alpha):
     targets = [ctx.renderbuffer((PROBE_SIZE, PROBE_SIZE), 4, dtype="f4") for _ in range(3)]
     framebuffer = ctx.framebuffer(color_attachments=targets)
     try:
-        framebuffer.use()
-        program["view"].value = tuple(float(c) for c in view)
-        program["alpha"].value = alpha
-        ctx.vertex_array(program, []).render(vertices=3)
+        renderer.draw(program, framebuffer, uniforms={"view": tuple(float(c) for c in view), "alpha": alpha})
         return [np.frombuffer(framebuffer.read(components=4, attachment=k, dtype="f4"), np.float32)
                 .reshape(PROBE_SIZE, PROBE_SIZE, 4).astype(np.float64) for k in range(3)]
     finally:
@@ -324,7 +323,7 @@ def run_probe(ctx, view, alpha):
 @pytest.mark.parametrize("theta_v", [0.0, 0.7, 1.5])
 def test_sampling_glsl_equals_numpy(gl_renderer, alpha, theta_v):
     view = np.array([np.sin(theta_v) * np.cos(1.1), np.sin(theta_v) * np.sin(1.1), np.cos(theta_v)], np.float32)
-    samples, pdfs, hashes = run_probe(gl_renderer.ctx, view, alpha)
+    samples, pdfs, hashes = run_probe(gl_renderer, view, alpha)
     centre = (np.arange(PROBE_SIZE) + 0.5) / PROBE_SIZE
     u1, u2 = np.meshgrid(centre, centre)  # row = gl_FragCoord.y
     v = view.astype(np.float64)

@@ -18,8 +18,8 @@ from explorer.app.parameter_files import widget_kind
 from explorer.brd import load_material, round_integer
 from explorer.gpu.programs import specialisation
 from explorer.models import model_for
-from explorer.views.geometry import rim_distance
 from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, assert_twin_equal
 from test_gl_views import GL_ATOL, RIM_EXCLUSION, SWEEP_SIZES
 
