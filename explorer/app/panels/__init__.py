@@ -1,7 +1,7 @@
 """
 The app's windows, one module each. A panel is a :class:`~.base.Panel` subclass (its title, where it
-docks, what it draws, the GL views it wants advanced); adding one is a new module here and its line in
-:data:`PANELS`.
+docks, what it draws, the GL views it wants advanced); adding one is a new module here,
+imported below and listed in :data:`PANELS`.
 """
 
 from .base import Panel
