@@ -76,7 +76,7 @@ def table_rebuild_ms(mirror: bragg.BraggMirror, repeats: int = 15) -> float:
 
 def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
     """Measure and print Table 1 (see the module docstring). Returns the JSON document."""
-    from .gl import Renderer
+    from .gpu import Renderer
 
     renderer = Renderer()
     mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
@@ -232,7 +232,7 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
     from PIL import Image
 
     from .colorimetry import encode_srgb8
-    from .gl import Renderer
+    from .gpu import Renderer
 
     renderer = Renderer()
     material = load_material(SHADER_DIR / "bragg_mirror.brd")
@@ -281,7 +281,7 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
     thin-film preset; the frame time of every method of ``thin_film.brd`` (Figure 7 film) on a lit
     sphere relative to ``ggx_schlick.brd`` (plain GGX with Schlick's Fresnel), interleaved repeats, medians.
     """
-    from .gl import Renderer
+    from .gpu import Renderer
     from .presets import presets_for
 
     film_material = load_material(SHADER_DIR / "thin_film.brd")
@@ -423,7 +423,7 @@ def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> lis
     over :data:`STACK_PAIRS` random direction pairs where the exact BRDF's luminance exceeds 0.01.
     """
     from . import layered
-    from .gl import Renderer
+    from .gpu import Renderer
     from .models import BraggStackModel, _layer_tables
     from .presets import load_presets
 
@@ -552,7 +552,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     import tempfile
 
     from .app import App
-    from .cli import DEFAULT_MATERIAL
+    from .resources import DEFAULT_MATERIAL
     from .xvfb import display_environment
 
     with display_environment() as display, tempfile.TemporaryDirectory() as directory:

@@ -10,9 +10,7 @@ there is one, and a non-zero exit; an output file is either complete or not writ
 from __future__ import annotations
 
 import json
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 import click
@@ -20,17 +18,10 @@ import numpy as np
 
 from .brd import Material, MaterialError, load_material, parse_assignment, round_integer
 from .errors import LocatedError
+from .images import OutputError, check_output, write_image
 from .resources import DEFAULT_MATERIAL, display_path, material_path
 
 PROG = "bragg-explorer"
-#: What ``render --out`` writes, by suffix.
-OUTPUT_SUFFIXES = (".png", ".npy", ".exr")
-#: 8-bit colour of the scatter view's circles in PNG output (red, as in the paper's Figure 9).
-OVERLAY_RGB = (255, 0, 0)
-
-
-class OutputError(Exception):
-    """An output file cannot be written."""
 
 
 def _fail(message: str) -> None:
@@ -48,7 +39,7 @@ def _load(path: str | Path) -> Material:
 
 def parse_size(text: str | None, view: str) -> tuple[int, int]:
     """``W`` or ``WxH`` (a square for ``W`` alone, except the gradient, which keeps its height)."""
-    from .render import DEFAULT_SIZES
+    from .views.geometry import DEFAULT_SIZES
 
     if text is None:
         return DEFAULT_SIZES[view]
@@ -66,7 +57,7 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
 
 def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     """``THETA,PHI`` in degrees (theta in [0, 180] from +z, phi from +x; theta <= 90 for ``scatter``)."""
-    from .render import LIGHT_VIEWS
+    from .views.geometry import LIGHT_VIEWS
 
     if text is None:
         return None
@@ -80,80 +71,6 @@ def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     if not (np.isfinite(theta) and np.isfinite(phi)) or not 0.0 <= theta <= top:
         raise click.BadParameter(f"{text!r}: THETA must be in [0, {top:g}] and PHI finite", param_hint="--light")
     return theta, phi
-
-
-def check_output(out: Path) -> Path:
-    """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
-    if out.suffix.lower() not in OUTPUT_SUFFIXES:
-        raise OutputError(f"{out}: the output must end in .png, .npy or .exr")
-    if out.is_dir():
-        raise OutputError(f"{out}: is a directory")
-    directory = out.parent if str(out.parent) else Path(".")
-    if not directory.is_dir():
-        raise OutputError(f"{out}: directory {directory} does not exist")
-    if not os.access(directory, os.W_OK):
-        raise OutputError(f"{out}: directory {directory} is not writable")
-    return directory
-
-
-def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
-    """
-    Write a linear RGB image atomically (a temporary file, renamed): never a partial file.
-
-    Parameters
-    ----------
-    image : ndarray, HxWx3
-        Linear RGB.
-    out : Path
-        ``.npy``: float32 linear RGB; ``.exr``: OpenEXR, float32 linear RGB (through OpenCV); ``.png``:
-        8-bit sRGB of ``exposure * image``, clamped.
-    overlay : ndarray of bool, HxW, optional
-        Pixels painted red in the PNG only (the scatter view's circles).
-    exposure : float
-        The PNG's multiplier before the sRGB encode, as the app's exposure (linear outputs keep the values).
-    """
-    from PIL import Image
-
-    from .colorimetry import encode_srgb8
-
-    suffix = out.suffix.lower()
-    directory = check_output(out)
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix, dir=directory)
-    except OSError as error:
-        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            if suffix == ".npy":
-                np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
-            elif suffix == ".png":
-                pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
-                if overlay is not None:
-                    pixels[overlay] = OVERLAY_RGB
-                Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
-        if suffix == ".exr":
-            _write_exr(image, temporary, out)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
-        os.replace(temporary, out)
-    except OSError as error:
-        Path(temporary).unlink(missing_ok=True)
-        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
-
-
-def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
-    """OpenEXR, 32-bit float RGB, through OpenCV (BGR order) with OpenEXR enabled as for environments."""
-    from .env import _cv2
-
-    cv2 = _cv2()
-    bgr = np.ascontiguousarray(np.asarray(image, dtype=np.float32)[..., ::-1])
-    try:
-        written = cv2.imwrite(temporary, bgr, [cv2.IMWRITE_EXR_TYPE, cv2.IMWRITE_EXR_TYPE_FLOAT])
-    except cv2.error as error:
-        raise OSError(0, f"OpenCV: {' '.join(str(error).split())[:200]}") from None
-    if not written:
-        raise OSError(0, "OpenCV could not write OpenEXR")
 
 
 def parse_exposure(text: str | None, out: Path) -> float:
@@ -192,7 +109,8 @@ def render_material(
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":
         from .models import model_for
-        from .render import BRDF_VIEWS, render_numpy
+        from .views.geometry import BRDF_VIEWS
+        from .render import render_numpy
 
         model = model_for(material, values)
         if model is None:
@@ -200,7 +118,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
-    from .gl import Renderer
+    from .gpu import Renderer
 
     if view == "textured":
         return Renderer().render(
@@ -211,10 +129,10 @@ def render_material(
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
-    """The env view (:func:`explorer.env.render_env`), its progress on stderr every few seconds."""
+    """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
-    from .env import render_env
+    from .gpu.env import render_env
 
     if engine == "numpy":
         from .models import model_for
@@ -266,7 +184,7 @@ def cli(ctx: click.Context) -> None:
 def open_material(material, preset, script, report, window_size):
     """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
     from .app import DEFAULT_WINDOW, AppError, display_available, run_app
-    from .gl import GLUnavailable
+    from .gpu import GLUnavailable
 
     try:
         loaded = _load(material)
@@ -303,7 +221,7 @@ def _errors(function):
     """Turn the expected failures of bad input into one line and exit status 1."""
     import functools
 
-    from .gl import GLUnavailable
+    from .gpu import GLUnavailable
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
@@ -344,7 +262,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
     (--engine numpy: the exact integral, slow; use a small --size).
     """
-    from .render import scatter_circles
+    from .views.geometry import scatter_circles
 
     check_output(Path(out))
     exposure_factor = parse_exposure(exposure, Path(out))
@@ -352,7 +270,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     if params_file is not None:
-        from .app_params import load_values
+        from .app.parameter_files import load_values
 
         loaded_values = load_values(params_file, loaded)
         for skipped in loaded_values.skipped:
@@ -494,7 +412,7 @@ def default_job():
     values = material.resolve({"method": "3"})
     out = Path("out")
     out.mkdir(exist_ok=True)
-    from .gl import Renderer
+    from .gpu import Renderer
 
     renderer = Renderer()
     for view, size in (("sphere", (512, 512)), ("gradient", (512, 48))):

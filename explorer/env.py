@@ -1,9 +1,9 @@
 """
-The ``env`` view: the lit view's sphere under an environment map, by progressive Monte Carlo on the GPU
-(``shaders/views/env.glsl``), and its numpy twin, the exact integral by quadrature.
+The ``env`` view in numpy: environment maps, the twins of the shader's random numbers and sampling, and
+the exact integral by quadrature (the twin of the GPU's progressive Monte Carlo, :mod:`explorer.gpu.env`).
 
 Each pixel shows ``L_o = int f(L, V) cos theta_L L_e(L) d omega_L`` over the hemisphere of its normal
-``N``, with ``V = (0, 0, 1)`` and the lit view's geometry and frame (:func:`explorer.render.brdf_view_geometry`).
+``N``, with ``V = (0, 0, 1)`` and the lit view's geometry and frame (:func:`explorer.views.geometry.brdf_view_geometry`).
 
 The environment is an equirectangular image of linear RGB radiance (:class:`EnvironmentMap`), read
 from Radiance ``.hdr`` or OpenEXR ``.exr`` files by OpenCV. Its direction convention, shared with the
@@ -29,9 +29,8 @@ from __future__ import annotations
 
 import math
 import os
-import time
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import Callable
 
 import numpy as np
 
@@ -47,12 +46,6 @@ DEFAULT_SIZE = (256, 128)
 #: dim sun: nothing samples the environment itself, and at a given irradiance a sun's variance grows as
 #: the inverse of its solid angle.
 SUN_ELEVATION, SUN_AZIMUTH, SUN_SIGMA, SUN_PEAK = 40.0, 145.0, 5.0, 12.0
-#: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
-PASS_BUDGET_MS = 50.0
-#: Samples per pixel in one pass at most (the shader's loop).
-MAX_SAMPLES_PER_PASS = 256
-#: Texture unit of the environment: above those Renderer.bind assigns (library, model and input tables).
-ENVIRONMENT_UNIT = 15
 #: Directions per block in the numpy quadrature (memory: a few arrays of this many 3-vectors).
 QUADRATURE_BLOCK = 1 << 18
 #: Quadrature cells per texel side at most (:func:`quadrature_subdivisions`).
@@ -225,16 +218,6 @@ class EnvironmentMap:
         radiance = self.radiance_uv(u[None, :], v[:, None]).reshape(-1, 3)
         return directions, solid_angle, radiance
 
-    def gl_texture(self, ctx):
-        """The environment as a float RGB texture of ``ctx``: LINEAR, repeat in u, clamp in v, row 0 at v = 0."""
-        import moderngl
-
-        texture = ctx.texture((self.width, self.height), 3, self.pixels.tobytes(), dtype="f4")
-        texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        texture.repeat_x = True
-        texture.repeat_y = False
-        return texture
-
 
 def generate_default_environment(width: int = DEFAULT_SIZE[0], height: int = DEFAULT_SIZE[1]) -> np.ndarray:
     """
@@ -343,7 +326,7 @@ def env_integral_numpy(
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
-    views' rule (:func:`explorer.render.view_brdf`: 0 below the surface, NaN or infinite channels 0; plus a model's
+    views' rule (:func:`explorer.views.geometry.view_brdf`: 0 below the surface, NaN or infinite channels 0; plus a model's
     Dirac reflection, ``model.mirror_reflection(V, N) L_e(reflect(-V, N))``, when it has one), by a midpoint
     rule over the environment's texels (:meth:`EnvironmentMap.quadrature`, each cell's exact solid
     angle, the bilinear radiance the shader reads).
@@ -354,7 +337,7 @@ def env_integral_numpy(
         A numpy twin from :mod:`explorer.models` (``model.brdf(L, V, N, X, Y) -> (..., 3)``).
     environment : EnvironmentMap
     width, height : int
-        The image size (the lit view's sphere: :func:`explorer.render.brdf_view_geometry`).
+        The image size (the lit view's sphere: :func:`explorer.views.geometry.brdf_view_geometry`).
     pixels : array_like of (row, column), optional
         Only these pixels (rows from the top): the integral costs one BRDF evaluation per cell (about
         ``4 pi`` / 2 of ``(W_env H_env s^2)`` directions) per pixel.
@@ -368,7 +351,7 @@ def env_integral_numpy(
     ndarray
         ``(P, 3)`` float64 for ``pixels`` (0 outside the disc), else the ``(height, width, 3)`` float32 image.
     """
-    from .render import brdf_view_geometry, view_brdf
+    from .views.geometry import brdf_view_geometry, view_brdf
 
     _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:
@@ -408,274 +391,6 @@ def env_integral_numpy(
     image = np.zeros((height, width, 3), dtype=np.float32)
     image[rows, columns] = values
     return image
-
-
-# --------------------------------------------------------------------------------------------------
-# The GPU estimator
-
-
-#: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
-BAND_PROBE_ROWS = 8
-
-
-class ProgressiveEnvRender:
-    """
-    Progressive Monte Carlo rendering of the env view on the GPU (``shaders/views/env.glsl``).
-
-    Samples accumulate in two float32 RGBA textures by additive blending: the sum of the samples (and
-    their count, alpha) and the sum of their squares (and, alpha, the samples whose BRDF was NaN or
-    infinite, counted as 0);
-    :meth:`image` divides by :attr:`samples`, :meth:`standard_error` is the per-pixel standard error
-    of that mean. Random numbers hash (pixel, sample index, seed): a render is reproducible, the same
-    however its samples are split into passes.
-
-    Parameters
-    ----------
-    renderer : explorer.gl.Renderer
-        Its programs, uniforms and tables are reused (:meth:`~explorer.gl.Renderer.program`,
-        :meth:`~explorer.gl.Renderer.bind`).
-    material : explorer.brd.Material
-    values : mapping
-        The material's resolved parameter values.
-    environment : EnvironmentMap
-    width, height : int
-    seed : int, optional
-        Selects an independent sequence of random numbers (0 to 2^32 - 1).
-    pass_budget_ms : float, optional
-        Target duration of one pass; the samples per pass adapt to it (at least 1, at most
-        :data:`MAX_SAMPLES_PER_PASS`).
-
-    Notes
-    -----
-    Each :meth:`step` runs its passes with blending enabled and leaves ``BLEND`` disabled, as the
-    other views expect. Float32 sums limit the relative precision of the variance to about
-    ``1e-7 n / (SE/mean)^2``, far below the statistical error for any realistic sample count.
-    """
-
-    def __init__(
-        self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
-        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
-    ):
-        if not 0 <= int(seed) < 1 << 32:
-            raise ValueError(f"seed must be in [0, 2^32), got {seed}")
-        self.renderer = renderer
-        self.ctx = renderer.ctx
-        self.material = material
-        self.environment = environment
-        self.width, self.height = int(width), int(height)
-        self.seed = int(seed)
-        self.pass_budget_ms = float(pass_budget_ms)
-        #: Samples per pixel of the next pass (adapted after each pass to :attr:`pass_budget_ms`).
-        self.samples_per_pass = 1
-        #: Duration of the last pass in milliseconds (bounded by glFinish), None before the first.
-        self.last_pass_ms: float | None = None
-        #: Measured cost of one sample over the whole image (ms), None before the first.
-        self.sample_ms: float | None = None
-        self._texture = environment.gl_texture(self.ctx)
-        self._targets = [self.ctx.texture((self.width, self.height), 4, dtype="f4") for _ in range(2)]
-        self._framebuffer = self.ctx.framebuffer(color_attachments=self._targets)
-        self._vertex_arrays: dict[int, object] = {}
-        self.values = dict(values)
-        self.reset()
-
-    def reset(self, values: Mapping[str, object] | None = None) -> None:
-        """Drop every sample; with ``values``, render the material with those parameters from now on."""
-        if values is not None:
-            self.values = dict(values)
-        self.program = self.renderer.program(self.material, "env", self.values)
-        self._framebuffer.use()
-        self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
-        #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
-        self.samples = 0
-        self.passes = 0
-        self._band_rows = 0  # rows done of the sample in progress by bands
-
-    def _begin(self):
-        """Bind the program, its tables and the targets, with additive blending; returns the vertex array."""
-        import moderngl
-
-        program = self.program
-        self.renderer.bind(program, self.material, self.values)
-        self._texture.use(location=ENVIRONMENT_UNIT)
-        for name, value in (("environment", ENVIRONMENT_UNIT), ("resolution", (float(self.width), float(self.height))),
-                            ("seed", self.seed)):
-            if name in program:
-                program[name].value = value
-        vertex_array = self._vertex_arrays.get(id(program))
-        if vertex_array is None:
-            vertex_array = self._vertex_arrays[id(program)] = self.ctx.vertex_array(program, [])
-        self._framebuffer.use()
-        self.ctx.enable(moderngl.BLEND)
-        self.ctx.blend_func = moderngl.ONE, moderngl.ONE
-        self.ctx.blend_equation = moderngl.FUNC_ADD
-        return vertex_array
-
-    def _end(self) -> None:
-        import moderngl
-
-        self.ctx.scissor = None
-        self.ctx.blend_func = moderngl.DEFAULT_BLENDING
-        self.ctx.disable(moderngl.BLEND)
-
-    def _pass(self, vertex_array, count: int, rows: tuple[int, int] | None = None) -> float:
-        """Draw ``count`` samples (numbered from :attr:`samples`) into rows ``[top, bottom)`` (all: None); ms."""
-        self.program["samples_per_pass"].value = count
-        self.program["first_sample"].value = self.samples
-        if rows is not None:
-            top, bottom = rows  # GL rows count from the bottom
-            self.ctx.scissor = (0, self.height - bottom, self.width, bottom - top)
-        self.ctx.finish()
-        start = time.perf_counter()
-        vertex_array.render(vertices=3)
-        self.ctx.finish()
-        elapsed = (time.perf_counter() - start) * 1e3
-        self.ctx.scissor = None
-        return elapsed
-
-    def step(self, spp: int = 1) -> None:
-        """Add ``spp`` samples per pixel, in passes of about :attr:`pass_budget_ms` each."""
-        spp = int(spp)
-        if spp < 1:
-            raise ValueError(f"spp must be at least 1, got {spp}")
-        self._finish_band()
-        vertex_array = self._begin()
-        try:
-            remaining = spp
-            while remaining > 0:
-                count = min(remaining, self.samples_per_pass)
-                self.last_pass_ms = self._pass(vertex_array, count)
-                self.passes += 1
-                self.samples += count
-                remaining -= count
-                per_sample = max(self.last_pass_ms / count, 1e-3)
-                self.sample_ms = per_sample
-                self.samples_per_pass = int(min(MAX_SAMPLES_PER_PASS, max(1, self.pass_budget_ms // per_sample)))
-        finally:
-            self._end()
-
-    def advance(self, budget_ms: float) -> None:
-        """
-        Add samples for about ``budget_ms``: whole passes when one sample of the whole image fits, or else
-        one sample in bands of rows, so that an interactive caller never waits much longer than its budget
-        for an expensive material (a stack's 471 wavelengths cost ~1 s per sample at 256² on llvmpipe).
-        Pixels of a band hold one sample more than :attr:`samples` until the sample is complete.
-        """
-        budget_ms = max(float(budget_ms), 1.0)
-        if self._band_rows == 0 and self.sample_ms is not None and self.sample_ms <= budget_ms:
-            self.step(max(1, min(MAX_SAMPLES_PER_PASS, int(budget_ms // self.sample_ms))))
-            return
-        vertex_array = self._begin()
-        try:
-            row_ms = (self.sample_ms / self.height) if self.sample_ms is not None else None
-            spent = 0.0
-            while spent < budget_ms:
-                rows = BAND_PROBE_ROWS if row_ms is None else max(1, int((budget_ms - spent) / max(row_ms, 1e-6)))
-                top = self._band_rows
-                bottom = min(self.height, top + rows)
-                elapsed = self._pass(vertex_array, 1, (top, bottom))
-                spent += elapsed
-                row_ms = max(elapsed / (bottom - top), 1e-6)
-                self._band_rows = bottom
-                if bottom >= self.height:
-                    self.sample_ms = row_ms * self.height
-                    self.samples += 1
-                    self.passes += 1
-                    self._band_rows = 0
-                    break
-        finally:
-            self._end()
-
-    def _finish_band(self) -> None:
-        """Complete a sample left in bands by :meth:`advance` (whole-image passes assume equal counts)."""
-        if self._band_rows == 0:
-            return
-        vertex_array = self._begin()
-        try:
-            self._pass(vertex_array, 1, (self._band_rows, self.height))
-            self.samples += 1
-            self.passes += 1
-            self._band_rows = 0
-        finally:
-            self._end()
-
-    def _read(self, attachment: int) -> np.ndarray:
-        data = self._framebuffer.read(components=4, attachment=attachment, dtype="f4")
-        return np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 4)[::-1]
-
-    def image(self) -> np.ndarray:
-        """The mean so far, ``(height, width, 3)`` float32 linear RGB, rows from the top (0 before any sample)."""
-        if self.samples == 0 and self._band_rows == 0:
-            return np.zeros((self.height, self.width, 3), dtype=np.float32)
-        if self._band_rows == 0:
-            return np.ascontiguousarray(self._read(0)[:, :, :3] / np.float32(self.samples))
-        first = self._read(0)  # a sample in progress: each pixel's own count (alpha)
-        return np.ascontiguousarray(first[:, :, :3] / np.maximum(first[:, :, 3:], np.float32(1.0)))
-
-    def sums(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(sum, sum of squares, count, dropped)`` per pixel as accumulated (float64, rows from the top)."""
-        first, second = self._read(0).astype(np.float64), self._read(1).astype(np.float64)
-        return first[:, :, :3], second[:, :, :3], first[:, :, 3], second[:, :, 3]
-
-    def standard_error(self) -> np.ndarray:
-        """
-        The standard error of :meth:`image` per pixel and channel, ``sqrt(s^2 / n)`` with the unbiased
-        sample variance ``s^2``; ``(height, width, 3)`` float32, infinite before two samples.
-        """
-        if self.samples < 2:
-            return np.full((self.height, self.width, 3), np.inf, dtype=np.float32)
-        total, squares, count, _ = self.sums()
-        n = count[..., None]  # each pixel's own count: rows of a sample in progress hold one more
-        mean = total / n
-        variance = np.maximum(squares / n - mean * mean, 0.0) * (n / (n - 1))
-        return np.sqrt(variance / n).astype(np.float32)
-
-    def dropped_samples(self) -> int:
-        """Samples where the material's BRDF returned NaN or infinity, counted as 0 (0 for a sound material)."""
-        return int(round(float(self.sums()[3].sum())))
-
-    def release(self) -> None:
-        """Free the GL objects (textures, framebuffer, vertex arrays)."""
-        for vertex_array in self._vertex_arrays.values():
-            vertex_array.release()
-        self._vertex_arrays = {}
-        self._framebuffer.release()
-        for target in self._targets:
-            target.release()
-        self._texture.release()
-
-
-def render_env(
-    material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
-    environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
-    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
-) -> np.ndarray:
-    """
-    The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
-    (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
-    tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
-    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
-    """
-    environment = EnvironmentMap.default() if environment is None else environment
-    if engine == "numpy":
-        from .models import model_for
-
-        model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress)
-    from .gl import Renderer
-
-    renderer = Renderer() if renderer is None else renderer
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
-    try:
-        while render.samples < spp:
-            render.step(min(spp - render.samples, max(1, render.samples_per_pass)))
-            if progress is not None:
-                progress(render.samples, spp)
-        dropped = render.dropped_samples()
-        if dropped and warn is not None:
-            warn(f"{dropped} samples counted as 0: the material's BRDF returned NaN or infinity there")
-        return render.image()
-    finally:
-        render.release()
 
 
 if __name__ == "__main__":

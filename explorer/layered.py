@@ -152,6 +152,37 @@ class LayeredBragg:
 # Eqs. 28 and 30
 
 
+def rough_bragg_brdf(i, o, mirror: bragg.BraggMirror, alpha, wavelength=None) -> np.ndarray:
+    """
+    The BRDF of a rough Bragg layer (Eq. 17): GGX microfacets that are Bragg mirrors, reflecting with
+    Yeh's exact unpolarised reflectance ``R_lambda`` at the half-vector angle ``theta_d = acos(i.h)``
+    (Eqs. 2, 9, 10; Appendix D when the mirror's host ``nh`` differs from its ``n1``).
+
+    Parameters
+    ----------
+    i, o : array_like, shape (..., 3)
+        Unit directions in the mirror's host medium, ``n = +z``, pointing away from the surface.
+    mirror : explorer.bragg.BraggMirror
+    alpha : float
+        GGX roughness in [0, 1].
+    wavelength : array_like, optional
+        Wavelengths in nm; :data:`explorer.colorimetry.WAVELENGTHS` by default.
+
+    Returns
+    -------
+    ndarray, shape (..., n_wavelengths)
+        The spectral BRDF (1/sr).
+
+    References
+    ----------
+    Fourneau et al. (2024), Eq. 17 (with Eqs. 18-19) and Section 3.1.
+    """
+    wavelength = colorimetry.WAVELENGTHS if wavelength is None else np.asarray(wavelength, dtype=np.float64)
+    return microfacet.microfacet_brdf(
+        i, o, alpha, lambda cos_theta_d: bragg.bragg_reflectance(np.maximum(cos_theta_d, microfacet.COS_THETA_MIN), wavelength, mirror)
+    )
+
+
 def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter, transmissivity) -> np.ndarray:
     """
     The integrated transmissivity of a rough Bragg layer (Eq. 28), per wavelength:

@@ -89,13 +89,13 @@ def _generate_sensitivity_fourier() -> np.ndarray:
 
 
 def _generate_lobes_fgd_correction() -> np.ndarray:
-    from .lobes import generate_fgd_correction  # the physics lives in explorer.lobes
+    from .lobes_fgd import generate_fgd_correction  # the physics lives in explorer.lobes_fgd
 
     return generate_fgd_correction()
 
 
 def _generate_lobes_ggx_moments() -> np.ndarray:
-    from .lobes import generate_ggx_moments
+    from .lobes_fgd import generate_ggx_moments
 
     return generate_ggx_moments()
 

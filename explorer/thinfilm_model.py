@@ -108,5 +108,5 @@ class ThinFilmModel:
         return result
 
     def textures(self) -> dict[str, np.ndarray]:
-        """None of its own: the ``sensitivity_fourier`` table is a library texture (:mod:`explorer.gl`)."""
+        """None of its own: the ``sensitivity_fourier`` table is a library texture (:mod:`explorer.gpu.renderer`)."""
         return {}

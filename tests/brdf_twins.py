@@ -125,7 +125,7 @@ class AppAllKindsTwin(_Twin):
 
 # The failure patterns of BRDF Explorer's own files (NaN, infinities, negative values out of the BRDF's
 # domain): twins evaluate them everywhere with GLSL's arithmetic, NaN included; the views' rule
-# (explorer.render.view_brdf) decides what is shown.
+# (explorer.views.geometry.view_brdf) decides what is shown.
 
 
 class LimbDarkeningTwin(_Twin):

@@ -3,7 +3,7 @@
 GL tests (``@pytest.mark.gl``) take the ``gl_renderer`` fixture. Without an OpenGL 3.3 context
 through EGL they are skipped on a developer machine, but they fail when ``CI=true``: continuous
 integration must never pass by skipping the GPU half of the product. The failure message includes
-:class:`explorer.gl.GLUnavailable`'s, which names the Debian packages to install.
+:class:`explorer.gpu.GLUnavailable`'s, which names the Debian packages to install.
 """
 
 from __future__ import annotations
@@ -41,8 +41,8 @@ def running_in_ci() -> bool:
 
 @pytest.fixture(scope="session")
 def gl_renderer():
-    """One :class:`explorer.gl.Renderer` for the whole session (compiled programs are cached in it)."""
-    from explorer.gl import GLUnavailable, Renderer, create_context
+    """One :class:`explorer.gpu.Renderer` for the whole session (compiled programs are cached in it)."""
+    from explorer.gpu import GLUnavailable, Renderer, create_context
 
     try:
         ctx, reason = create_context(), None

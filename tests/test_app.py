@@ -21,7 +21,7 @@ from PIL import Image
 
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, running_in_ci
 
-from explorer.app_params import load_values, parse_bparam, save_values
+from explorer.app.parameter_files import load_values, parse_bparam, save_values
 from explorer.brd import load_material
 from explorer.colorimetry import encode_srgb8
 
@@ -146,7 +146,7 @@ def test_no_display_falls_back_to_the_headless_render(tmp_path):
 
 def test_parameter_sets_round_trip(tmp_path, bragg_material):
     """JSON and BRDF Explorer .bparam files keep the values; unknown names are skipped, bad values are errors."""
-    from explorer.app_params import ParameterFileError
+    from explorer.app.parameter_files import ParameterFileError
 
     values = bragg_material.resolve({"Lambda": 612.25, "N": 33, "method": 4})
     for name in ("set.json", "set.bparam"):
@@ -191,7 +191,7 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
 def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, bragg_material):
     """Compare: spectral reference | improved approximation; the mean ΔE2000 shown is that of the two headless renders."""
     from explorer.colorimetry import delta_E_2000
-    from explorer.render import view_cos_theta
+    from explorer.views.geometry import view_cos_theta
 
     actions = [
         {"wait": 2}, {"wait_complete": True}, {"focus": "Compare"}, {"wait": 2}, {"click": "compare_on"},
@@ -278,7 +278,7 @@ def test_switching_materials_keeps_the_app_alive(x_display, tmp_path, gl_rendere
     KeyError 'method' / 'layers' closed the window) and each screenshot is the headless render of the
     material just opened (env: the same number of samples, same seed).
     """
-    from explorer.env import render_env
+    from explorer.gpu.env import render_env
 
     actions = [{"wait": 2}, {"view_size": SWITCH_VIEW_SIZE}, {"click": f"mode:{mode}"}, {"wait": 2},
                {"focus": "Files"}, {"wait": 2}]

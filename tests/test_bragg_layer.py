@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import bragg, colorimetry, microfacet
+from explorer import bragg, colorimetry, layered, microfacet
 from explorer.brd import load_material
 from explorer.models import BraggLayerModel, model_for
 from explorer.presets import PRESET_DIR, load_presets
-from explorer.render import render_numpy, rim_distance
+from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, SMALL, assert_twin_equal
 
 LAYER_MATERIAL = REPO_ROOT / "shaders" / "bragg_layer.brd"
@@ -77,7 +78,7 @@ def test_absorbing_base_reference_is_the_rough_bragg_brdf_in_rgb(layer_material)
     model = model_for(layer_material, values)
     L, V = directions(6, 3), directions(6, 4)
     ours = model.brdf(L, V, np.array([0.0, 0.0, 1.0]), None, None)
-    spectral = microfacet.rough_bragg_brdf(L, V, model.mirror, 0.25)
+    spectral = layered.rough_bragg_brdf(L, V, model.mirror, 0.25)
     expected = colorimetry.spectrum_to_rgb(spectral)
     assert np.abs(expected).max() > 1e-2
     np.testing.assert_allclose(ours, expected, rtol=1e-7, atol=1e-12)

@@ -16,7 +16,8 @@ from conftest import REPO_ROOT, one_line_error
 from explorer import bragg, colorimetry, layered
 from explorer.brd import load_material
 from explorer.models import BraggStackModel, model_for
-from explorer.render import render_numpy, rim_distance
+from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance
 from test_bragg_layer import directions
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 from test_cli import cli
@@ -180,8 +181,9 @@ void main() {
 @pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)"])
 def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, case):
     """The GLSL layer choice (sampling_lobes) equals explorer.layered.layer_choice_probabilities (Eqs. 31, 35)."""
-    from explorer.gl import SHADER_DIR, VERTEX_SHADER
     from explorer.glsl import ShaderBuilder
+    from explorer.gpu.context import VERTEX_SHADER
+    from explorer.resources import SHADER_DIR
 
     values = stack_material.resolve(CASES[case])
     builder = ShaderBuilder(include_dirs=[SHADER_DIR])
@@ -194,9 +196,8 @@ def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, ca
     target = ctx.renderbuffer((PROBE_COLUMNS, 1), 4, dtype="f4")
     framebuffer = ctx.framebuffer(color_attachments=[target])
     try:
-        gl_renderer.bind(program, stack_material, values)
-        framebuffer.use()
-        ctx.vertex_array(program, []).render(vertices=3)
+        uniforms, textures = gl_renderer.bindings(program, stack_material, values)
+        gl_renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures)
         got = np.frombuffer(framebuffer.read(components=4, dtype="f4"), np.float32).reshape(PROBE_COLUMNS, 4)
     finally:
         framebuffer.release()

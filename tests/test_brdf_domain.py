@@ -1,6 +1,6 @@
 """Materials out of their domain: every view that evaluates a BRDF follows one rule, in GLSL and numpy.
 
-The rule (``view_brdf`` in shaders/lib/views.glsl, :func:`explorer.render.view_brdf`): the BRDF is
+The rule (``view_brdf`` in shaders/lib/views.glsl, :func:`explorer.views.geometry.view_brdf`): the BRDF is
 evaluated only where N.L > 0 and N.V > 0 (0 elsewhere), and a NaN or infinite channel counts as 0; a
 finite negative channel is kept. Five of BRDF Explorer's own 40 files (Minnaert's, Ward's, Edwards',
 Kurt's and Ward's G) returned NaN in the lit view: the failure patterns of those files are reproduced by
@@ -20,7 +20,8 @@ import brdf_twins
 from conftest import BRDF_DATA, REPO_ROOT
 from explorer.brd import load_material
 from explorer.models import model_for
-from explorer.render import brdf_view_geometry, finite_or_zero, render_numpy, rim_distance, view_brdf
+from explorer.render import render_numpy
+from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
 from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
 
 #: Odd sides: the disc views have a centre pixel (x = y = 0), where H = N under a light straight above.
@@ -172,7 +173,8 @@ ENV_SIZE, ENV_SPP = 12, 4
 @pytest.mark.gl
 @pytest.mark.parametrize("path", PATHS, ids=[p.name for p in PATHS])
 def test_env_view_is_finite(gl_renderer, path):
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
 
     m = material(path)
     render = ProgressiveEnvRender(gl_renderer, m, m.resolve(), EnvironmentMap.default(), ENV_SIZE, ENV_SIZE, seed=3)
@@ -197,7 +199,8 @@ def test_env_converges_to_the_ruled_integral(gl_renderer):
     compact_lobe (NaN wherever theta_h > atan(m), on the lit side) under the smooth test sky: the Monte
     Carlo mean converges to the numpy integral of the BRDF under the same rule (test_env's criteria).
     """
-    from explorer.env import ProgressiveEnvRender, env_integral_numpy
+    from explorer.env import env_integral_numpy
+    from explorer.gpu.env import ProgressiveEnvRender
     from test_env import CONVERGENCE_SIZE, CONVERGENCE_SPP, MAX_Z, QUADRATURE_RTOL, WITHIN_3SE, smooth_environment
 
     environment = smooth_environment()

@@ -25,15 +25,8 @@ import brdf_twins
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, one_line_error
 from explorer.brd import load_material
 from explorer.models import model_for
-from explorer.render import (
-    DEFAULT_LIGHT,
-    SCATTER_CIRCLES,
-    brdf_view_geometry,
-    light_direction,
-    render_numpy,
-    rim_distance,
-    scatter_circles,
-)
+from explorer.render import render_numpy
+from explorer.views.geometry import DEFAULT_LIGHT, SCATTER_CIRCLES, brdf_view_geometry, light_direction, rim_distance, scatter_circles
 
 RTOL = 2e-3
 #: Below this value (a pixel's largest |channel|) the tolerance is absolute: RTOL x FLOOR.

@@ -289,7 +289,8 @@ def test_render_png_and_npy(gl_renderer, tmp_path):
 @pytest.mark.gl
 def test_render_npy_equals_numpy_twin(gl_renderer, bragg_material, tmp_path):
     from explorer.models import model_for
-    from explorer.render import render_numpy, rim_distance
+    from explorer.render import render_numpy
+    from explorer.views.geometry import rim_distance
 
     out = tmp_path / "basic.npy"
     size = (40, 24)

@@ -16,7 +16,7 @@ from PIL import Image
 from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX, REPO_ROOT, one_line_error
 from test_cli import WORKERS, cli, relative
 
-from explorer.app_params import save_values
+from explorer.app.parameter_files import save_values
 from explorer.brd import load_material
 from explorer.colorimetry import encode_srgb8
 

@@ -20,11 +20,12 @@ import pytest
 from conftest import REPO_ROOT, one_line_error
 from explorer import microfacet
 from explorer.env import (
-    DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, ProgressiveEnvRender, direction_to_uv,
-    env_integral_numpy, generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere,
-    uniform_floats, uv_to_direction,
+    DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, direction_to_uv, env_integral_numpy,
+    generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere, uniform_floats,
+    uv_to_direction,
 )
-from explorer.render import brdf_view_geometry, rim_distance
+from explorer.gpu.env import ProgressiveEnvRender
+from explorer.views.geometry import brdf_view_geometry, rim_distance
 from test_cli import cli
 
 GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
@@ -293,9 +294,12 @@ void main() {
 """
 
 
-def run_probe(ctx, view, alpha):
-    from explorer.gl import SHADER_DIR, VERTEX_SHADER
+def run_probe(renderer, view, alpha):
     from explorer.glsl import ShaderBuilder
+    from explorer.gpu.context import VERTEX_SHADER
+    from explorer.resources import SHADER_DIR
+
+    ctx = renderer.ctx
 
     builder = ShaderBuilder(include_dirs=[SHADER_DIR])
     builder.define("SIZE", f"{PROBE_SIZE:.1f}")
@@ -304,10 +308,7 @@ def run_probe(ctx, view, alpha):
     targets = [ctx.renderbuffer((PROBE_SIZE, PROBE_SIZE), 4, dtype="f4") for _ in range(3)]
     framebuffer = ctx.framebuffer(color_attachments=targets)
     try:
-        framebuffer.use()
-        program["view"].value = tuple(float(c) for c in view)
-        program["alpha"].value = alpha
-        ctx.vertex_array(program, []).render(vertices=3)
+        renderer.draw(program, framebuffer, uniforms={"view": tuple(float(c) for c in view), "alpha": alpha})
         return [np.frombuffer(framebuffer.read(components=4, attachment=k, dtype="f4"), np.float32)
                 .reshape(PROBE_SIZE, PROBE_SIZE, 4).astype(np.float64) for k in range(3)]
     finally:
@@ -322,7 +323,7 @@ def run_probe(ctx, view, alpha):
 @pytest.mark.parametrize("theta_v", [0.0, 0.7, 1.5])
 def test_sampling_glsl_equals_numpy(gl_renderer, alpha, theta_v):
     view = np.array([np.sin(theta_v) * np.cos(1.1), np.sin(theta_v) * np.sin(1.1), np.cos(theta_v)], np.float32)
-    samples, pdfs, hashes = run_probe(gl_renderer.ctx, view, alpha)
+    samples, pdfs, hashes = run_probe(gl_renderer, view, alpha)
     centre = (np.arange(PROBE_SIZE) + 0.5) / PROBE_SIZE
     u1, u2 = np.meshgrid(centre, centre)  # row = gl_FragCoord.y
     v = view.astype(np.float64)
@@ -551,7 +552,8 @@ def test_cli_env_with_an_exr(gl_renderer, tmp_path):
 def test_advance_in_bands_equals_whole_passes(gl_renderer):
     """advance() with a budget below one sample's cost works in bands of rows: same samples, same image."""
     from explorer.brd import load_material
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
     values = material.resolve({"alpha": 0.3})
@@ -561,8 +563,8 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
     banded = ProgressiveEnvRender(gl_renderer, material, values, environment, 24, 20, seed=3)
     real_pass = banded._pass
 
-    def slow_pass(vertex_array, count, rows=None):  # pretend each row costs 5 ms: a sample, 100 ms
-        real_pass(vertex_array, count, rows)
+    def slow_pass(bindings, count, rows=None):  # pretend each row costs 5 ms: a sample, 100 ms
+        real_pass(bindings, count, rows)
         return 5.0 * ((rows[1] - rows[0]) if rows is not None else banded.height) * count
 
     banded._pass = slow_pass
@@ -582,9 +584,10 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
 def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     """A coated stack whose layer is invisible (n2 = n1 = nh) and base black shows only the coating's Dirac: F Le(R)."""
     from explorer.brd import load_material
-    from explorer.env import EnvironmentMap, ProgressiveEnvRender
+    from explorer.env import EnvironmentMap
+    from explorer.gpu.env import ProgressiveEnvRender
     from explorer.models import model_for
-    from explorer.render import brdf_view_geometry
+    from explorer.views.geometry import brdf_view_geometry
 
     material = load_material(REPO_ROOT / "shaders" / "bragg_stack.brd")
     values = material.resolve({"nh": 1.5, "n1_1": 1.5, "n2_1": 1.5, "rho_d": 0})

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from explorer import microfacet
-from explorer.gl import SHADER_DIR, VERTEX_SHADER
 from explorer.glsl import ShaderBuilder
+from explorer.gpu.context import VERTEX_SHADER
+from explorer.resources import SHADER_DIR
 
 #: float32 against float64, relative where values exceed 1e-3 (the lobe of a sharp alpha is steep).
 RELATIVE = 2e-3
@@ -49,9 +50,7 @@ def test_microfacet_glsl_equals_numpy(gl_renderer, alpha):
     program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=builder.build().code)
     framebuffer = ctx.framebuffer(color_attachments=[ctx.renderbuffer((SIZE, SIZE), 4, dtype="f4")])
     try:
-        framebuffer.use()
-        program["alpha"].value = alpha
-        ctx.vertex_array(program, []).render(vertices=3)
+        gl_renderer.draw(program, framebuffer, uniforms={"alpha": alpha})
         gl = np.frombuffer(framebuffer.read(components=4, dtype="f4"), dtype=np.float32).reshape(SIZE, SIZE, 4)
     finally:
         framebuffer.color_attachments[0].release()

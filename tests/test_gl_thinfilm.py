@@ -29,7 +29,8 @@ from conftest import REPO_ROOT, one_line_error
 from explorer import luts, microfacet, thinfilm
 from explorer.brd import load_material
 from explorer.models import MODELS, model_for
-from explorer.render import render_numpy, rim_distance, view_cos_theta
+from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance, view_cos_theta
 from explorer.thinfilm_model import ThinFilmModel
 
 THIN_FILM_MATERIAL = REPO_ROOT / "shaders" / "thin_film.brd"

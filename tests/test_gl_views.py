@@ -13,7 +13,8 @@ import pytest
 
 from explorer import bragg, colorimetry
 from explorer.models import model_for
-from explorer.render import render_numpy, rim_distance, view_cos_theta
+from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance, view_cos_theta
 
 #: Per linear RGB channel, absolute.
 GL_ATOL = 2e-3

@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT
-from explorer.app_params import widget_kind
+from explorer.app.parameter_files import widget_kind
 from explorer.brd import load_material, round_integer
-from explorer.gl import specialisation
+from explorer.gpu.programs import specialisation
 from explorer.models import model_for
-from explorer.render import render_numpy, rim_distance
+from explorer.render import render_numpy
+from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, assert_twin_equal
 from test_gl_views import GL_ATOL, RIM_EXCLUSION, SWEEP_SIZES
 

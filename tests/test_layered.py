@@ -3,7 +3,7 @@ the per-layer tables (Table 2's LUT version) and the single-reflection BRDF (Eq.
 
 References are independent of ``explorer.layered``: Yeh's exact reflectance and the Airy slab of
 ``explorer.bragg`` (themselves checked against ``tmm`` in the physics tests), Fresnel and Snell written
-out, Eq. 17 through ``explorer.microfacet.rough_bragg_brdf``, and hemispherical quadratures written
+out, Eq. 17 through ``explorer.layered.rough_bragg_brdf``, and hemispherical quadratures written
 here. Spectral albedos are checked per wavelength.
 """
 
@@ -181,7 +181,7 @@ def test_eq34_with_one_layer_is_eq17_under_the_coating():
     for n1 in (1.0, 1.35, 1.6):
         stack = LayeredBragg((A,), n1=n1)
         spectra = layered.single_reflection_spectra(stack, i, o, exact_reflectance=True)
-        eq17 = microfacet.rough_bragg_brdf(refract(i, n1), refract(o, n1), A.mirror(n1), A.alpha)
+        eq17 = layered.rough_bragg_brdf(refract(i, n1), refract(o, n1), A.mirror(n1), A.alpha)
         factor = (1.0 - fresnel_unpolarised(i[:, 2], n1)) * (1.0 - fresnel_unpolarised(o[:, 2], n1)) / n1**2
         np.testing.assert_allclose(spectra.layers, factor[:, None] * eq17, rtol=1e-10, atol=1e-14)
         # The tabulated reflectance (Model-LUT) stays close to the exact one (Model): linear

@@ -14,9 +14,11 @@ import tmm
 from conftest import REPO_ROOT
 from explorer import lobes, microfacet
 from explorer.brd import load_material
-from explorer.env import EnvironmentMap, ProgressiveEnvRender, env_integral_numpy
+from explorer.env import EnvironmentMap, env_integral_numpy
+from explorer.gpu.env import ProgressiveEnvRender
 from explorer.models import model_for
-from explorer.render import brdf_view_geometry, render_numpy, rim_distance
+from explorer.render import render_numpy
+from explorer.views.geometry import brdf_view_geometry, rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 
 MATERIAL = REPO_ROOT / "shaders" / "layered_lobes.brd"

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer import bragg, colorimetry, microfacet
+from explorer import bragg, colorimetry, layered, microfacet
 from explorer.bragg import BraggMirror
 
 SEED = 20240603
@@ -126,8 +126,8 @@ def test_rough_bragg_brdf_is_reciprocal(alpha):
     rng = np.random.default_rng(SEED)
     i, o = random_directions(rng, 64), random_directions(rng, 64)
     mirror = BraggMirror(n1=1.0, n2=1.5, Lambda=500.0, delta=0.5, N=10)
-    forward = microfacet.rough_bragg_brdf(i, o, mirror, alpha)
-    backward = microfacet.rough_bragg_brdf(o, i, mirror, alpha)
+    forward = layered.rough_bragg_brdf(i, o, mirror, alpha)
+    backward = layered.rough_bragg_brdf(o, i, mirror, alpha)
     assert np.all(np.isfinite(forward)) and np.max(forward) > 0.0
     np.testing.assert_allclose(forward, backward, rtol=RECIPROCITY_RTOL, atol=0.0)
 
@@ -152,7 +152,7 @@ def test_rough_layer_with_one_cell_is_a_rough_dielectric_slab(alpha):
         / (4.0 * i[:, 2] * o[:, 2])
     )
     expected = lobe[:, None] * slab
-    np.testing.assert_allclose(microfacet.rough_bragg_brdf(i, o, mirror, alpha), expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(layered.rough_bragg_brdf(i, o, mirror, alpha), expected, rtol=1e-9, atol=1e-12)
 
 
 def half_vector_albedo(brdf, theta_i, alpha, panels=64, phis=48):
@@ -291,7 +291,7 @@ def test_no_nan_or_inf_over_a_sweep():
         assert np.max(np.abs(table.row_sums() - microfacet.smith_G1(np.cos(table.theta), alpha))) < APPENDIX_C_ACHIEVED
         F = microfacet.transmission_filter(table.theta[:, None], table.theta[None, ::30], alpha)
         assert np.all(np.isfinite(F)) and np.all(F >= 0.0)
-        f = microfacet.rough_bragg_brdf(i, o, mirror, alpha)
+        f = layered.rough_bragg_brdf(i, o, mirror, alpha)
         assert np.all(np.isfinite(f)) and np.all(f >= 0.0)
 
 

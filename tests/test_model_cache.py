@@ -1,4 +1,4 @@
-"""explorer.gl.Renderer's model cache: tables built once per parameter set, and on a worker thread for the app."""
+"""explorer.gpu.Renderer's model cache: tables built once per parameter set, and on a worker thread for the app."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT
-from explorer import gl
+from explorer.gpu import Renderer, tables
 from explorer.brd import load_material
 
 MIRROR = REPO_ROOT / "shaders" / "bragg_mirror.brd"
@@ -16,15 +16,15 @@ MIRROR = REPO_ROOT / "shaders" / "bragg_mirror.brd"
 
 @pytest.fixture()
 def counted_models(monkeypatch):
-    """How many numpy models Renderer builds (explorer.gl.model_for calls)."""
+    """How many numpy models Renderer builds (explorer.gpu.tables.model_for calls)."""
     calls = []
-    original = gl.model_for
+    original = tables.model_for
 
     def counting(material, values):
         calls.append(threading.current_thread().name)
         return original(material, values)
 
-    monkeypatch.setattr(gl, "model_for", counting)
+    monkeypatch.setattr(tables, "model_for", counting)
     return calls
 
 
@@ -51,7 +51,7 @@ def test_prepare_model_on_a_worker_thread_then_bind_uses_it(gl_renderer, counted
     assert counted_models == ["tables"] and gl_renderer.model_ready(material, values)
     image = gl_renderer.render(material, values, "sphere", 16, 16)
     assert counted_models == ["tables"], "bind rebuilt a model the worker had prepared"
-    fresh = gl.Renderer(gl_renderer.ctx).render(material, values, "sphere", 16, 16)
+    fresh = Renderer(gl_renderer.ctx).render(material, values, "sphere", 16, 16)
     np.testing.assert_array_equal(image, fresh)
 
 

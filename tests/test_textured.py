@@ -122,7 +122,7 @@ def test_footprint_moments_of_a_constant_and_of_a_checkerboard():
 @pytest.mark.gl
 @pytest.mark.parametrize("method", [0, 1, 2, 3, 4, 5])
 def test_textured_gl_equals_numpy(gl_renderer, film, method):
-    from explorer.render import rim_distance
+    from explorer.views.geometry import rim_distance
     from explorer.thickness import ThicknessTexture
 
     thickness = ThicknessTexture.from_file(dinc_range=(0.0, 1125.0))
@@ -135,7 +135,7 @@ def test_textured_gl_equals_numpy(gl_renderer, film, method):
 @pytest.mark.parametrize("method", [1, 2, 3])
 @pytest.mark.parametrize("texture", ["default", "noise"])
 def test_textured_prefiltered_gl_equals_numpy(gl_renderer, film, method, texture):
-    from explorer.render import rim_distance
+    from explorer.views.geometry import rim_distance
     from explorer.thickness import ThicknessTexture
 
     if texture == "noise":
@@ -221,7 +221,7 @@ def test_cli_bad_thickness_input(tmp_path):
 
 @pytest.mark.gl
 def test_cli_textured_npy_equals_numpy(gl_renderer, tmp_path):
-    from explorer.render import rim_distance
+    from explorer.views.geometry import rim_distance
 
     texture = tmp_path / "stripes.png"
     from PIL import Image

@@ -14,8 +14,8 @@ import numpy as np
 from PIL import Image
 
 from explorer.colorimetry import encode_srgb8
-from explorer.env import render_env
-from explorer.gl import Renderer
+from explorer.gpu.env import render_env
+from explorer.gpu.renderer import Renderer
 from explorer.presets import load_presets
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bragg, colorimetry
-from .brd import round_integer
+from .. import bragg, colorimetry
+from ..brd import round_integer
 
 #: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
 BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
@@ -131,7 +131,7 @@ def polar_curve(scatter_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def disc_mask(width: int, height: int) -> np.ndarray:
     """The pixels of the sphere views' disc (as the shaders test ``r^2 < 1``)."""
-    from .render import view_cos_theta
+    from ..views.geometry import view_cos_theta
 
     return view_cos_theta("sphere", width, height)[1]
 

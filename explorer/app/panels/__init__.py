@@ -1,0 +1,38 @@
+"""
+The app's windows, one module each. A panel is a :class:`~.base.Panel` subclass (its title, where it
+docks, what it draws, the GL views it wants advanced); adding one is a new module here,
+imported below and listed in :data:`PANELS`.
+"""
+
+from .base import Panel
+from .brdf_views import ScatterPanel, SlicePanel
+from .compare import ComparePanel
+from .files import FilesPanel
+from .parameters import ParametersPanel
+from .polar import PolarPanel
+from .spectrum import SpectrumPanel
+from .sphere import SpherePanel
+from .strips import StripsPanel
+
+#: The windows, in the order they are drawn (a docked window's first tab is the first of its dock here).
+PANELS: tuple[type[Panel], ...] = (
+    ParametersPanel, FilesPanel, SpherePanel, ComparePanel, SlicePanel, ScatterPanel, SpectrumPanel, PolarPanel,
+    StripsPanel,
+)
+
+
+def dock_layout(imgui, dockspace, panels) -> None:
+    """Dock every panel's window where it says (left, centre, right_top, right_bottom)."""
+    internal = imgui.internal
+    internal.dock_builder_remove_node(dockspace)
+    internal.dock_builder_add_node(dockspace, internal.DockNodeFlagsPrivate_.dock_space)
+    internal.dock_builder_set_node_size(dockspace, imgui.get_main_viewport().size)
+    split = internal.dock_builder_split_node(dockspace, imgui.Dir.left, 0.26)
+    left, rest = split.id_at_dir, split.id_at_opposite_dir
+    split = internal.dock_builder_split_node(rest, imgui.Dir.right, 0.40)
+    right, centre = split.id_at_dir, split.id_at_opposite_dir
+    split = internal.dock_builder_split_node(right, imgui.Dir.down, 0.45)
+    docks = {"left": left, "centre": centre, "right_bottom": split.id_at_dir, "right_top": split.id_at_opposite_dir}
+    for panel in panels:
+        internal.dock_builder_dock_window(panel.title, docks[panel.dock])
+    internal.dock_builder_finish(dockspace)

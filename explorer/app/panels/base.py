@@ -1,0 +1,63 @@
+"""What every panel is: a docked window with a title, drawn each frame it is visible, and the GL views
+it wants advanced (see :mod:`explorer.app.panels`)."""
+
+from __future__ import annotations
+
+from ..camera import sphere_mouse
+
+
+class Panel:
+    """
+    A docked ImGui window of the app.
+
+    Attributes
+    ----------
+    title : str
+        The window's title (and what a script's ``{"focus": TITLE}`` names).
+    dock : str
+        Where the layout docks it: ``left``, ``centre``, ``right_top`` or ``right_bottom``.
+    gl_order : int
+        Its views' place in the frame's GL work (lower first: the sphere's is 0).
+    """
+
+    title = ""
+    dock = "centre"
+    gl_order = 100
+
+    def __init__(self, app):
+        self.app = app
+        self.state = app.state
+        self.scheduler = app.scheduler
+
+    def draw(self, imgui) -> None:
+        """The window's contents (between ImGui's ``begin`` and ``end``)."""
+        raise NotImplementedError
+
+    def gl_jobs(self) -> list:
+        """The progressive views to advance this frame, in order (when the window is visible)."""
+        return []
+
+    def after_gl(self) -> None:
+        """Work on the frame's finished views (when the window is visible)."""
+
+
+def record(state, label: str) -> None:
+    """Remember the last item's screen rectangle under ``label`` (for scripted input)."""
+    from imgui_bundle import imgui
+
+    lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    state.rects[label] = (lo.x, lo.y, hi.x, hi.y)
+
+
+def show_image(state, texture, size, label: str, interactive: bool = False) -> None:
+    """An image fitted to the window, flipped to rows-from-the-top, zoomed about its centre when ``interactive``."""
+    from imgui_bundle import imgui
+
+    avail = imgui.get_content_region_avail()
+    scale = min(1.0, max(avail.x, 16) / size[0], max(avail.y - 24, 16) / size[1]) if size[0] > 0 else 1.0
+    shown = imgui.ImVec2(size[0] * scale, size[1] * scale)
+    half = 0.5 / (state.zoom if interactive else 1.0)
+    imgui.image(imgui.ImTextureRef(texture.glo), shown, imgui.ImVec2(0.5 - half, 0.5 + half), imgui.ImVec2(0.5 + half, 0.5 - half))
+    record(state, label)
+    if interactive:
+        sphere_mouse(state, imgui, label)

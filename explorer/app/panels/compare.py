@@ -1,0 +1,82 @@
+"""The Compare window: a split sphere of two methods or two parameter sets (A | B), or their ΔE2000 heat-map."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import data
+from ..camera import light_vector
+from .base import Panel, record, show_image
+
+
+class ComparePanel(Panel):
+    title = "Compare"
+    dock = "centre"
+    gl_order = 1
+
+    def __init__(self, app):
+        super().__init__(app)
+        self._heat_texture = None
+        self._heat_generation = None  # the pair of images the heat-map was computed from
+
+    def draw(self, imgui) -> None:
+        state, c = self.state, self.state.compare
+        _, c.on = imgui.checkbox("compare", c.on)
+        record(state, "compare_on")
+        names = data.method_names(state.material)
+        if imgui.radio_button("two methods", c.kind == "methods") and names:
+            c.kind = "methods"
+        imgui.same_line()
+        if imgui.radio_button("two parameter sets (A = current | B)", c.kind == "sets"):
+            c.kind = "sets"
+        if c.kind == "methods" and names:
+            labels = [f"{m}: {n}" for m, n in names.items()]
+            keys = list(names)
+            _, ia = imgui.combo("A (left)", keys.index(c.a) if c.a in keys else 0, labels)
+            _, ib = imgui.combo("B (right)", keys.index(c.b) if c.b in keys else 0, labels)
+            c.a, c.b = keys[ia], keys[ib]
+        elif imgui.button("B := current parameters"):
+            c.values_b = dict(state.values)
+        _, c.heat = imgui.checkbox("dE2000 heat-map (viridis, 0 to 10)", c.heat)
+        if not c.on:
+            imgui.text("(off)")
+            return
+        size = (state.view_size // 2, state.view_size // 2) if state.view_size > 256 else (state.view_size, state.view_size)
+        if c.kind == "methods" and names:
+            values_a = {**state.values, "method": float(c.a)}
+            values_b = {**state.values, "method": float(c.b)}
+        else:
+            known = {p.name for p in state.material.parameters}
+            values_a, values_b = state.values, state.material.resolve({k: v for k, v in c.values_b.items() if k in known})
+        light, dragging, view = light_vector(state.light, state.camera), self.app.dragging, state.main_view()
+        a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
+        a.request(state.material, values_a, view, size, light=light, dragging=dragging)
+        b.request(state.material, values_b, view, size, light=light, dragging=dragging)
+        if c.heat and self._heat_texture is not None:
+            show_image(state, self._heat_texture, size, "compare_image")
+        else:
+            show_image(state, self.scheduler.show("compare", size, a, b), size, "compare_image")
+        if state.mean_delta_e is not None:
+            imgui.text(f"mean dE2000 over the sphere: {state.mean_delta_e:.3f}")
+        else:
+            imgui.text("mean dE2000: (rendering)")
+
+    def gl_jobs(self) -> list:
+        return [self.scheduler.job("compare_a"), self.scheduler.job("compare_b")] if self.state.compare.on else []
+
+    def after_gl(self) -> None:
+        """The heat-map and the mean ΔE2000, once both images are complete."""
+        a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
+        if not (self.state.compare.on and a.complete and b.complete):
+            return
+        generation = (a.generation, b.generation)
+        if generation == self._heat_generation:
+            return
+        mask = data.disc_mask(*a.size)
+        delta_e, self.state.mean_delta_e = data.delta_e_map(a.read(), b.read(), mask)
+        rgba = data.heat_map_rgba(delta_e)
+        rgba[~mask] = (0, 0, 0, 255)
+        if self._heat_texture is None or self._heat_texture.size != a.size:
+            self._heat_texture = self.app.ctx.texture(a.size, 4)
+        self._heat_texture.write(np.ascontiguousarray(rgba[::-1]).tobytes())
+        self._heat_generation = generation

@@ -1,0 +1,42 @@
+"""The Files window: parameter sets (JSON or BRDF Explorer's ``.bparam``), another material, a screenshot."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...errors import LocatedError
+from ..parameter_files import load_values, save_values
+from ..screenshots import screenshot_name
+from .base import Panel, record
+
+
+class FilesPanel(Panel):
+    title = "Files"
+    dock = "left"
+
+    def draw(self, imgui) -> None:
+        state = self.state
+        imgui.text_wrapped("Parameter sets: .json, or BRDF Explorer's .bparam. Materials: .brd / .brdf.")
+        _, state.file_path = imgui.input_text("path", state.file_path)
+        if imgui.button("Save parameters"):
+            try:
+                save_values(state.file_path, state.material, state.values)
+                state.status = f"saved {state.file_path}"
+            except LocatedError as error:
+                state.status = str(error)
+        imgui.same_line()
+        if imgui.button("Load parameters"):
+            try:
+                loaded = load_values(state.file_path, state.material)
+                state.values = state.material.resolve({**state.values, **loaded.values})
+                state.status = f"loaded {state.file_path}" + (f"; skipped {', '.join(loaded.skipped)}" if loaded.skipped else "")
+            except LocatedError as error:
+                state.status = str(error)
+        if imgui.button("Open material"):
+            self.app.reload(Path(state.file_path))
+        record(state, "open_material")
+        imgui.same_line()
+        if imgui.button("Screenshot (F12)"):
+            state.pending_screenshot = screenshot_name(state)
+        if state.status:
+            imgui.text_wrapped(state.status)

@@ -1,0 +1,123 @@
+"""The Parameters window: a widget per material parameter, the presets, light, camera, exposure, resolution."""
+
+from __future__ import annotations
+
+from ...brd import round_integer
+from ..parameter_files import slider_format, widget_kind
+from ..state import VIEW_SIZES
+from .base import Panel, record
+
+
+class ParametersPanel(Panel):
+    title = "Parameters"
+    dock = "left"
+
+    def draw(self, imgui) -> None:
+        state, app = self.state, self.app
+        imgui.text_wrapped(str(state.material_path))
+        reload_clicked = imgui.button("Reload (F5)")
+        record(state, "reload")
+        if reload_clicked:
+            app.reload()
+        if state.error:
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), state.error)
+            imgui.pop_text_wrap_pos()
+        presets = app.presets()
+        if presets:
+            if imgui.begin_combo("Preset", state.preset or "(none)"):
+                for name in presets:
+                    clicked, _ = imgui.selectable(name, state.preset == name)
+                    record(state, f"preset:{name}")
+                    if clicked:
+                        app.apply_preset(name)
+                imgui.end_combo()
+            record(state, "preset_combo")
+        imgui.separator()
+        io = imgui.get_io()
+        for parameter in state.material.parameters:
+            self._parameter_widget(imgui, io, parameter)
+        imgui.separator()
+        self._light_and_camera(imgui)
+        imgui.separator()
+        changed, exposure = imgui.slider_float("exposure", state.exposure, 0.05, 20.0, "%.2f", imgui.SliderFlags_.logarithmic)
+        record(state, "exposure")
+        if changed:
+            state.exposure = exposure
+        _, state.gamut = imgui.checkbox("gamut overlay (outside sRGB)", state.gamut)
+        sizes = [str(s) for s in VIEW_SIZES]
+        changed, index = imgui.combo("resolution", VIEW_SIZES.index(state.view_size) if state.view_size in VIEW_SIZES else 2, sizes)
+        if changed:
+            state.view_size = VIEW_SIZES[index]
+        imgui.text(state.frame_label())
+        if state.status:
+            imgui.text_wrapped(state.status)
+
+    def _light_and_camera(self, imgui) -> None:
+        state = self.state
+        imgui.text("Light and camera")
+        changed, theta = imgui.slider_float("light theta", state.light[0], 0.0, 180.0, "%.1f deg")
+        if changed:
+            state.light[0] = theta
+        changed, phi = imgui.slider_float("light phi", state.light[1], -180.0, 180.0, "%.1f deg")
+        if changed:
+            state.light[1] = phi
+        changed, yaw = imgui.slider_float("camera yaw", state.camera[0], -180.0, 180.0, "%.1f deg")
+        if changed:
+            state.camera[0] = yaw
+        changed, pitch = imgui.slider_float("camera pitch", state.camera[1], -89.0, 89.0, "%.1f deg")
+        if changed:
+            state.camera[1] = pitch
+        changed, zoom = imgui.slider_float("zoom", state.zoom, 1.0, 8.0, "%.2fx")
+        if changed:
+            state.zoom = zoom
+        if imgui.button("Reset camera"):
+            state.camera, state.zoom = [0.0, 0.0], 1.0
+
+    def _parameter_widget(self, imgui, io, parameter) -> None:
+        """A parameter's widget: slider (integer or float), checkbox or colour editor, plus a typed field."""
+        state = self.state
+        name, kind = parameter.name, widget_kind(parameter)
+        value = state.values[name]
+        new = value
+        imgui.push_id(name)
+        no_ctrl_input = imgui.SliderFlags_.no_input  # Ctrl-click resets instead of typing; the field types
+        if kind == "int":
+            imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.55)
+            changed, v = imgui.slider_int(name, round_integer(value), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
+            if changed:
+                new = float(v)
+        elif kind == "float":
+            imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.55)
+            changed, v = imgui.slider_float(name, float(value), float(parameter.min), float(parameter.max), slider_format(parameter), no_ctrl_input)
+            if changed:
+                new = float(v)
+        elif kind == "bool":
+            changed, v = imgui.checkbox(name, bool(value))
+            if changed:
+                new = bool(v)
+        else:
+            changed, v = imgui.color_edit3(name, list(value), imgui.ColorEditFlags_.float | imgui.ColorEditFlags_.hdr)
+            if changed:
+                new = tuple(float(c) for c in v)
+        record(state, f"param:{name}")
+        if imgui.is_item_clicked() and io.key_ctrl:
+            new = parameter.default
+        if imgui.is_item_hovered():
+            bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
+            imgui.set_tooltip(f"{name}: {parameter.type}{bounds}, default {parameter.default}; Ctrl-click resets")
+        if kind in ("int", "float"):
+            imgui.same_line()
+            imgui.set_next_item_width(-1)
+            typed, text = imgui.input_text("##typed", f"{float(new):g}", imgui.InputTextFlags_.enter_returns_true | imgui.InputTextFlags_.chars_scientific)
+            record(state, f"typed:{name}")
+            if typed:
+                try:
+                    new = parameter.coerce(text)
+                    state.status = ""
+                except ValueError as error:
+                    state.status = f"{name}: {error}"
+        imgui.pop_id()
+        if new != value:
+            state.values = {**state.values, name: new}
+            state.preset = None

@@ -1,0 +1,164 @@
+"""
+The GL work of a frame within its budget: which views advance and in what order (the sphere first),
+the host's tables built on a worker thread while a slider moves, the env mode's progressive Monte Carlo,
+and the display passes that turn the views into the textures ImGui shows.
+
+Views that cost more than a frame are drawn at reduced resolution while a slider moves and refined in
+bands afterwards (:class:`explorer.gpu.progressive.ProgressiveView`), so the window stays responsive.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import time
+
+from ..env import EnvironmentMap
+from ..gpu.display import AccumulatedImage, DisplayPass
+from ..gpu.env import ProgressiveEnvRender
+from ..gpu.progressive import CostModel, ProgressiveView
+from .state import AppState
+
+#: Per-frame budget of GL work (ms): ~30 ms of drawing plus the UI's own frame keeps >= 15 fps.
+FRAME_BUDGET_MS = 30.0
+#: GL budgets (ms) per frame while a slider is dragged: the active view, and each of the others.
+DRAG_BUDGET_MS = 16.0
+SIDE_DRAG_BUDGET_MS = 0.0
+
+
+class TablePrefetcher:
+    """
+    The parameter values the sphere shows. While a slider is dragged the host's tables (the tabulated
+    method's ~10 ms, a stack's layers) are built on a worker thread as the frame draws, and the sphere
+    shows the newest values whose tables are ready: one frame behind the slider. Otherwise they are
+    built on the spot, so a released slider always shows its own values.
+    """
+
+    def __init__(self, renderer):
+        self.renderer = renderer
+        self.ready_values: dict | None = None  # the newest values whose tables are built
+        self._future = None
+        self._future_values: dict | None = None
+        self._executor = None
+
+    def values(self, material, values: dict, dragging: bool) -> dict:
+        """The values to draw ``material`` with this frame (``values``, or the newest ready ones while dragging)."""
+        if self.renderer.model_ready(material, values):
+            self.ready_values = dict(values)
+            return values
+        if dragging and self.ready_values is not None:
+            if self._future is not None and self._future.done():
+                if self._future.exception() is None:
+                    self.ready_values = self._future_values
+                self._future = None
+            if self._future is None:
+                if self._executor is None:
+                    self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="tables")
+                self._future_values = dict(values)
+                self._future = self._executor.submit(self.renderer.prepare_model, material, self._future_values)
+            return self.ready_values
+        if self._future is not None:
+            concurrent.futures.wait([self._future])  # its errors resurface in the bindings, with the current values
+        self.ready_values = dict(values)
+        return values
+
+    def forget(self) -> None:
+        """Another material: none of the previous one's values may reach its uniforms."""
+        self.ready_values = None
+
+    def shutdown(self) -> None:
+        if self._executor is not None:
+            self._executor.shutdown(wait=True)
+
+
+class EnvSphere:
+    """The env mode: progressive Monte Carlo under the default sky (:mod:`explorer.gpu.env`), restarted on change."""
+
+    def __init__(self, renderer):
+        self.renderer = renderer
+        self.environment: EnvironmentMap | None = None
+        self.render: ProgressiveEnvRender | None = None
+        self.source: AccumulatedImage | None = None
+        self._key = None
+        self._size = None
+        self.pending = False  # requested this frame: advanced by the scheduler
+
+    def request(self, state: AppState, size) -> AccumulatedImage:
+        """The render of ``state``'s material and values at ``size``, as a display source."""
+        key = (id(state.material), tuple(sorted(state.values.items())), size, tuple(state.camera), tuple(state.light))
+        if self._key != key or self.render is None:
+            # Another material (Files > Open, Reload) needs a render of its own: resetting the old one with
+            # the new values would bind them to the old material's uniforms.
+            if self.render is None or self._size != size or self.render.material is not state.material:
+                if self.render is not None:
+                    self.render.release()
+                self.environment = self.environment or EnvironmentMap.default()
+                self.render = ProgressiveEnvRender(self.renderer, state.material, state.values, self.environment, *size)
+                self._size = size
+            else:
+                self.render.reset(values=state.values)
+            self._key = key
+        self.pending = True
+        if self.source is None or self.source.render is not self.render:
+            self.source = AccumulatedImage(self.render)
+        return self.source
+
+    def work(self, budget_ms: float) -> None:
+        # Bands of rows when one sample costs more than the budget; the display pass divides by the counts.
+        self.render.advance(max(0.5 * budget_ms, 5.0))
+
+
+class Scheduler:
+    """The app's views (progressive jobs by name), what is displayed this frame, and the frame's GL work."""
+
+    def __init__(self, renderer):
+        self.renderer = renderer
+        self.costs = CostModel()
+        self.display = DisplayPass(renderer)
+        self.prefetcher = TablePrefetcher(renderer)
+        self.env = EnvSphere(renderer)
+        self.jobs: dict[str, ProgressiveView] = {}
+        self._requests: dict = {}  # display key -> (source a, source b or None), drawn after the views advance
+
+    def job(self, name: str) -> ProgressiveView:
+        """The progressive view called ``name`` (made on first use)."""
+        if name not in self.jobs:
+            self.jobs[name] = ProgressiveView(self.renderer, self.costs)
+        return self.jobs[name]
+
+    def show(self, key: str, size, a, b=None):
+        """The texture that shows ``a`` (and ``b`` right of the middle) under ``key`` once this frame's work is done."""
+        self._requests[key] = (a, b)
+        return self.display.target(key, size)
+
+    def work(self, state: AppState, panels, dragging: bool) -> float:
+        """Advance the visible panels' views within the frame's budget (the sphere first), then display them; ms."""
+        start = time.perf_counter()
+        budget = FRAME_BUDGET_MS
+        order = [job for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
+        if state.pending_screenshot and state.mode != "env":
+            order.insert(0, self.job("main"))
+        for index, job in enumerate(order):
+            remaining = budget - (time.perf_counter() - start) * 1e3
+            if dragging:
+                # While a slider moves the sphere comes first and gets a preview that fits with the UI's
+                # own ~30 ms in a 15 fps frame; the other views get what little is left.
+                remaining = min(remaining, DRAG_BUDGET_MS) if index == 0 else min(remaining, SIDE_DRAG_BUDGET_MS)
+            if remaining <= 0:
+                break
+            job.work(remaining)
+        if self.env.pending and state.mode == "env":
+            self.env.work(budget - (time.perf_counter() - start) * 1e3)
+        self.env.pending = False
+        for panel in panels:
+            panel.after_gl()
+        for key, (a, b) in self._requests.items():
+            if a.full is not None:
+                self.display.draw(key, a, b, split=0.5 if b is not None else 2.0, exposure=state.exposure, gamut=state.gamut)
+        self._requests = {}
+        return (time.perf_counter() - start) * 1e3
+
+    def main_report(self) -> dict:
+        """The sphere's progress, for a frame's record."""
+        main = self.job("main")
+        return {"size": list(main.size), "preview": list(main.preview_size), "has_preview": main.has_preview,
+                "complete": main.complete, "generation": main.generation}

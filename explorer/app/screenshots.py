@@ -1,0 +1,81 @@
+"""
+Screenshots: the active view (PNG, 8-bit sRGB with the exposure, and its linear ``.npy``) once it is
+complete, and the whole window (the README's picture; the tests' check of what is on screen).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..images import OutputError, write_image
+from .scheduler import Scheduler
+from .state import AppState
+
+SCREENSHOT_DIR = Path("screenshots")
+
+
+def screenshot_name(state: AppState) -> str:
+    """The next free ``screenshots/MATERIAL_VIEW_N.png``."""
+    SCREENSHOT_DIR.mkdir(exist_ok=True)
+    stem = f"{Path(state.material_path).stem}_{state.main_view()}"
+    index = 1
+    while (SCREENSHOT_DIR / f"{stem}_{index}.png").exists():
+        index += 1
+    return str(SCREENSHOT_DIR / f"{stem}_{index}.png")
+
+
+def window_shot(state: AppState, ctx) -> None:
+    """The whole window as a PNG, from the back buffer before it is swapped."""
+    from PIL import Image
+
+    import OpenGL.GL as gl
+
+    # PyOpenGL, not moderngl: moderngl reads "colour attachment 0", which the window's own
+    # framebuffer does not have (GL_INVALID_OPERATION).
+    width, height = ctx.screen.size
+    gl.glBindFramebuffer(gl.GL_READ_FRAMEBUFFER, 0)
+    gl.glReadBuffer(gl.GL_BACK)
+    gl.glPixelStorei(gl.GL_PACK_ALIGNMENT, 1)
+    data = gl.glReadPixels(0, 0, width, height, gl.GL_RGB, gl.GL_UNSIGNED_BYTE)
+    pixels = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
+    Image.fromarray(np.ascontiguousarray(pixels), mode="RGB").save(state.pending_window_shot)
+    state.screenshots.append(state.pending_window_shot)
+    state.pending_window_shot = None
+
+
+def take_screenshot(state: AppState, scheduler: Scheduler) -> None:
+    """Write the active view asked for (``state.pending_screenshot``) once it is complete."""
+    if state.pending_screenshot is None:
+        return
+    samples = None
+    if state.mode == "env":
+        render = scheduler.env.render
+        if render is None or render.material is not state.material or render.samples == 0 or render._band_rows:
+            return  # written at the first whole sample of the material shown (every pixel the same count)
+        image = np.asarray(render.image(), dtype=np.float32)
+        samples = render.samples
+    else:
+        job = scheduler.job("main")
+        if job.error is not None:
+            state.status = f"no screenshot: {job.error}"
+            state.pending_screenshot = None
+            return
+        if not job.complete:
+            return  # written when the image is refined (the window stays responsive meanwhile)
+        image = job.read()
+    path = Path(state.pending_screenshot)
+    state.pending_screenshot = None
+    try:
+        write_image(image, path.with_suffix(".png"), exposure=state.exposure)
+        write_image(image, path.with_suffix(".npy"))
+    except OutputError as error:
+        state.status = str(error)
+        return
+    state.screenshots.append(str(path.with_suffix(".png")))
+    state.screenshot_info[str(path.with_suffix(".png"))] = {
+        "material": str(state.material_path), "view": "env" if samples is not None else state.main_view(),
+        "values": state.json_values(), "samples": samples,
+    }
+    state.status = f"wrote {path.with_suffix('.png')} and {path.with_suffix('.npy')}"

@@ -1,0 +1,249 @@
+"""
+The ``env`` view on the GPU: progressive Monte Carlo under an environment map (``shaders/views/env.glsl``;
+the estimator and the direction convention are described in :mod:`explorer.env`, whose exact integral
+is its numpy twin), every pass through the renderer's draw primitive.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Mapping
+
+import numpy as np
+
+from ..env import EnvironmentMap, env_integral_numpy
+from .renderer import Renderer
+
+#: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
+PASS_BUDGET_MS = 50.0
+#: Samples per pixel in one pass at most (the shader's loop).
+MAX_SAMPLES_PER_PASS = 256
+
+
+def environment_texture(ctx, environment: EnvironmentMap):
+    """``environment`` as a float RGB texture of ``ctx``: LINEAR, repeat in u, clamp in v, row 0 at v = 0."""
+    import moderngl
+
+    texture = ctx.texture((environment.width, environment.height), 3, environment.pixels.tobytes(), dtype="f4")
+    texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    texture.repeat_x = True
+    texture.repeat_y = False
+    return texture
+
+
+#: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
+BAND_PROBE_ROWS = 8
+
+
+class ProgressiveEnvRender:
+    """
+    Progressive Monte Carlo rendering of the env view on the GPU (``shaders/views/env.glsl``).
+
+    Samples accumulate in two float32 RGBA textures by additive blending: the sum of the samples (and
+    their count, alpha) and the sum of their squares (and, alpha, the samples whose BRDF was NaN or
+    infinite, counted as 0);
+    :meth:`image` divides by :attr:`samples`, :meth:`standard_error` is the per-pixel standard error
+    of that mean. Random numbers hash (pixel, sample index, seed): a render is reproducible, the same
+    however its samples are split into passes.
+
+    Parameters
+    ----------
+    renderer : explorer.gpu.Renderer
+        Its programs, bindings and draw primitive are reused (:meth:`~explorer.gpu.Renderer.program`,
+        :meth:`~explorer.gpu.Renderer.bindings`, :meth:`~explorer.gpu.Renderer.draw`).
+    material : explorer.brd.Material
+    values : mapping
+        The material's resolved parameter values.
+    environment : EnvironmentMap
+    width, height : int
+    seed : int, optional
+        Selects an independent sequence of random numbers (0 to 2^32 - 1).
+    pass_budget_ms : float, optional
+        Target duration of one pass; the samples per pass adapt to it (at least 1, at most
+        :data:`MAX_SAMPLES_PER_PASS`).
+
+    Notes
+    -----
+    Each pass is an additive draw (:meth:`explorer.gpu.Renderer.draw`), which leaves ``BLEND`` disabled
+    as the other views expect. Float32 sums limit the relative precision of the variance to about
+    ``1e-7 n / (SE/mean)^2``, far below the statistical error for any realistic sample count.
+    """
+
+    def __init__(
+        self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
+    ):
+        if not 0 <= int(seed) < 1 << 32:
+            raise ValueError(f"seed must be in [0, 2^32), got {seed}")
+        self.renderer = renderer
+        self.ctx = renderer.ctx
+        self.material = material
+        self.environment = environment
+        self.width, self.height = int(width), int(height)
+        self.seed = int(seed)
+        self.pass_budget_ms = float(pass_budget_ms)
+        #: Samples per pixel of the next pass (adapted after each pass to :attr:`pass_budget_ms`).
+        self.samples_per_pass = 1
+        #: Duration of the last pass in milliseconds (bounded by glFinish), None before the first.
+        self.last_pass_ms: float | None = None
+        #: Measured cost of one sample over the whole image (ms), None before the first.
+        self.sample_ms: float | None = None
+        self._texture = environment_texture(self.ctx, environment)
+        self._targets = [self.ctx.texture((self.width, self.height), 4, dtype="f4") for _ in range(2)]
+        self._framebuffer = self.ctx.framebuffer(color_attachments=self._targets)
+        self.values = dict(values)
+        self.reset()
+
+    def reset(self, values: Mapping[str, object] | None = None) -> None:
+        """Drop every sample; with ``values``, render the material with those parameters from now on."""
+        if values is not None:
+            self.values = dict(values)
+        self.program = self.renderer.program(self.material, "env", self.values)
+        self._framebuffer.use()
+        self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
+        #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
+        self.samples = 0
+        self.passes = 0
+        self._band_rows = 0  # rows done of the sample in progress by bands
+
+    def _bindings(self) -> dict:
+        """The program's uniforms and textures for :meth:`_pass` (the material's, the environment, the seed)."""
+        uniforms, textures = self.renderer.bindings(self.program, self.material, self.values)
+        uniforms["seed"] = self.seed
+        textures["environment"] = self._texture
+        return {"uniforms": uniforms, "textures": textures}
+
+    def _pass(self, bindings: dict, count: int, rows: tuple[int, int] | None = None) -> float:
+        """Add ``count`` samples (numbered from :attr:`samples`) to rows ``[top, bottom)`` (all: None); ms."""
+        uniforms = {**bindings["uniforms"], "samples_per_pass": count, "first_sample": self.samples}
+        return self.renderer.draw(self.program, self._framebuffer, uniforms=uniforms, textures=bindings["textures"],
+                                  rows=rows, additive=True)
+
+    def step(self, spp: int = 1) -> None:
+        """Add ``spp`` samples per pixel, in passes of about :attr:`pass_budget_ms` each."""
+        spp = int(spp)
+        if spp < 1:
+            raise ValueError(f"spp must be at least 1, got {spp}")
+        self._finish_band()
+        bindings = self._bindings()
+        remaining = spp
+        while remaining > 0:
+            count = min(remaining, self.samples_per_pass)
+            self.last_pass_ms = self._pass(bindings, count)
+            self.passes += 1
+            self.samples += count
+            remaining -= count
+            per_sample = max(self.last_pass_ms / count, 1e-3)
+            self.sample_ms = per_sample
+            self.samples_per_pass = int(min(MAX_SAMPLES_PER_PASS, max(1, self.pass_budget_ms // per_sample)))
+
+    def advance(self, budget_ms: float) -> None:
+        """
+        Add samples for about ``budget_ms``: whole passes when one sample of the whole image fits, or else
+        one sample in bands of rows, so that an interactive caller never waits much longer than its budget
+        for an expensive material (a stack's 471 wavelengths cost ~1 s per sample at 256² on llvmpipe).
+        Pixels of a band hold one sample more than :attr:`samples` until the sample is complete.
+        """
+        budget_ms = max(float(budget_ms), 1.0)
+        if self._band_rows == 0 and self.sample_ms is not None and self.sample_ms <= budget_ms:
+            self.step(max(1, min(MAX_SAMPLES_PER_PASS, int(budget_ms // self.sample_ms))))
+            return
+        bindings = self._bindings()
+        row_ms = (self.sample_ms / self.height) if self.sample_ms is not None else None
+        spent = 0.0
+        while spent < budget_ms:
+            rows = BAND_PROBE_ROWS if row_ms is None else max(1, int((budget_ms - spent) / max(row_ms, 1e-6)))
+            top = self._band_rows
+            bottom = min(self.height, top + rows)
+            elapsed = self._pass(bindings, 1, (top, bottom))
+            spent += elapsed
+            row_ms = max(elapsed / (bottom - top), 1e-6)
+            self._band_rows = bottom
+            if bottom >= self.height:
+                self.sample_ms = row_ms * self.height
+                self.samples += 1
+                self.passes += 1
+                self._band_rows = 0
+                break
+
+    def _finish_band(self) -> None:
+        """Complete a sample left in bands by :meth:`advance` (whole-image passes assume equal counts)."""
+        if self._band_rows == 0:
+            return
+        self._pass(self._bindings(), 1, (self._band_rows, self.height))
+        self.samples += 1
+        self.passes += 1
+        self._band_rows = 0
+
+    def _read(self, attachment: int) -> np.ndarray:
+        data = self._framebuffer.read(components=4, attachment=attachment, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 4)[::-1]
+
+    def image(self) -> np.ndarray:
+        """The mean so far, ``(height, width, 3)`` float32 linear RGB, rows from the top (0 before any sample)."""
+        if self.samples == 0 and self._band_rows == 0:
+            return np.zeros((self.height, self.width, 3), dtype=np.float32)
+        if self._band_rows == 0:
+            return np.ascontiguousarray(self._read(0)[:, :, :3] / np.float32(self.samples))
+        first = self._read(0)  # a sample in progress: each pixel's own count (alpha)
+        return np.ascontiguousarray(first[:, :, :3] / np.maximum(first[:, :, 3:], np.float32(1.0)))
+
+    def sums(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(sum, sum of squares, count, dropped)`` per pixel as accumulated (float64, rows from the top)."""
+        first, second = self._read(0).astype(np.float64), self._read(1).astype(np.float64)
+        return first[:, :, :3], second[:, :, :3], first[:, :, 3], second[:, :, 3]
+
+    def standard_error(self) -> np.ndarray:
+        """
+        The standard error of :meth:`image` per pixel and channel, ``sqrt(s^2 / n)`` with the unbiased
+        sample variance ``s^2``; ``(height, width, 3)`` float32, infinite before two samples.
+        """
+        if self.samples < 2:
+            return np.full((self.height, self.width, 3), np.inf, dtype=np.float32)
+        total, squares, count, _ = self.sums()
+        n = count[..., None]  # each pixel's own count: rows of a sample in progress hold one more
+        mean = total / n
+        variance = np.maximum(squares / n - mean * mean, 0.0) * (n / (n - 1))
+        return np.sqrt(variance / n).astype(np.float32)
+
+    def dropped_samples(self) -> int:
+        """Samples where the material's BRDF returned NaN or infinity, counted as 0 (0 for a sound material)."""
+        return int(round(float(self.sums()[3].sum())))
+
+    def release(self) -> None:
+        """Free the GL objects (textures, framebuffer)."""
+        self._framebuffer.release()
+        for target in self._targets:
+            target.release()
+        self._texture.release()
+
+
+def render_env(
+    material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
+    environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
+    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
+) -> np.ndarray:
+    """
+    The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
+    (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
+    tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
+    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
+    """
+    environment = EnvironmentMap.default() if environment is None else environment
+    if engine == "numpy":
+        from ..models import model_for
+
+        model = model_for(material, values)
+        return env_integral_numpy(model, environment, width, height, progress=progress)
+    renderer = Renderer() if renderer is None else renderer
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    try:
+        while render.samples < spp:
+            render.step(min(spp - render.samples, max(1, render.samples_per_pass)))
+            if progress is not None:
+                progress(render.samples, spp)
+        dropped = render.dropped_samples()
+        if dropped and warn is not None:
+            warn(f"{dropped} samples counted as 0: the material's BRDF returned NaN or infinity there")
+        return render.image()
+    finally:
+        render.release()

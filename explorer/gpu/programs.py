@@ -1,0 +1,47 @@
+"""
+A material's fragment shader for a view: the preprocessor (:mod:`explorer.glsl`) assembles the
+material's parameter uniforms, its shader section and the view template; compile errors name the
+real file and line.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+from ..brd import Material, round_integer
+from ..glsl import ShaderBuilder, ShaderError, compile_error
+from ..resources import SHADER_DIR
+from .context import GLSL_VERSION
+
+
+def specialisation(material: Material, values: Mapping[str, object]) -> tuple[tuple[str, int], ...]:
+    """
+    The constants compiled into ``material``'s program: its ``# specialise:`` parameters' values, rounded
+    as the uniforms and the numpy models round them (:func:`explorer.brd.round_integer`).
+    """
+    return tuple((name, round_integer(values[name])) for name in material.specialised)
+
+
+def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = ()):
+    """
+    The fragment shader of ``material`` in ``view`` (an :class:`explorer.glsl.Program`).
+
+    Each ``(name, value)`` of ``constants`` becomes ``#define SPECIALISED_name value``: the shader
+    can branch at compile time on a parameter such as ``method`` (one smaller program per value).
+    """
+    template = SHADER_DIR / "views" / f"{view}.glsl"
+    if not template.exists():
+        raise ShaderError(str(template), None, f"no such view {view!r}")
+    builder = ShaderBuilder(include_dirs=[SHADER_DIR], version=GLSL_VERSION)
+    for name, value in constants:
+        builder.define(f"SPECIALISED_{name}", value)
+    builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
+    builder.add_source(material.shader, str(material.path), material.shader_line)
+    builder.add_file(template)
+    return builder.build()
+
+
+def first_error(source, log: str) -> tuple[str, int | None, str]:
+    """(file, line, message) of the first error in a driver log, mapped to the real files."""
+    error = compile_error(log, source.sources, source.line_stride)
+    return error.path, error.line, error.message

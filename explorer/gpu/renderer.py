@@ -1,0 +1,297 @@
+"""
+The :class:`Renderer`: a material's programs (one per view and specialisation), its uniforms and
+tables as bindings, and the one draw primitive every image goes through (:meth:`Renderer.draw`: the
+headless renders, the app's progressive views and display passes, the environment view's passes).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Mapping
+
+import numpy as np
+
+from .. import colorimetry, luts
+from ..brd import Material
+from ..glsl import ShaderError
+from ..views.geometry import light_direction
+from .context import VERTEX_SHADER, create_context
+from .programs import build_program_source, first_error, specialisation
+from .tables import ModelCache
+
+
+class Renderer:
+    """Renders material views into float32 images; caches programs, library textures and model tables."""
+
+    def __init__(self, ctx=None):
+        self.ctx = ctx if ctx is not None else create_context()
+        self._programs: dict[tuple, object] = {}
+        self._library = self._library_textures()
+        self._model_textures: dict[str, object] = {}
+        self._model_texture_keys: dict[str, tuple] = {}  # which model's table each model texture holds
+        self._inputs: dict[str, object] = {}
+        self._vertex_arrays: dict[int, tuple[object, object]] = {}  # id(program) -> (program, its vertex array)
+        self.models = ModelCache()
+        #: Milliseconds the last :meth:`bindings` spent on the model's tables (None: no model yet).
+        self.last_table_ms: float | None = None
+
+    # -- resources ---------------------------------------------------------------------------------
+
+    def _texture(self, data: np.ndarray, linear: bool):
+        """A float RGB texture of ``(height, width, 3)`` data (row 0 = texel row 0), clamped."""
+        import moderngl
+
+        data = np.ascontiguousarray(data, dtype=np.float32)
+        texture = self.ctx.texture((data.shape[1], data.shape[0]), 3, data.tobytes(), dtype="f4")
+        texture.filter = (moderngl.LINEAR, moderngl.LINEAR) if linear else (moderngl.NEAREST, moderngl.NEAREST)
+        texture.repeat_x = texture.repeat_y = False
+        return texture
+
+    def _model_texture(self, name: str, table: np.ndarray):
+        """
+        The linearly filtered texture of a model's table, rewritten in place when its shape is unchanged:
+        ``(width, 3)`` is a row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0).
+        """
+        data = np.ascontiguousarray(table, dtype=np.float32)
+        if data.ndim == 2:
+            data = data.reshape(1, -1, 3)
+        texture = self._model_textures.get(name)
+        if texture is not None and texture.size == (data.shape[1], data.shape[0]):
+            texture.write(data.tobytes())
+            return texture
+        if texture is not None:
+            texture.release()
+        texture = self._model_textures[name] = self._texture(data, linear=True)
+        return texture
+
+    def _library_textures(self) -> dict[str, object]:
+        fourier = self.ctx.texture(
+            (luts.SENSITIVITY_FOURIER_COUNT, 2), 3, luts.load("sensitivity_fourier").astype("f4").tobytes(), dtype="f4"
+        )
+        return {
+            "cmf_1nm": self._texture(luts.load("cmf_1nm").reshape(1, -1, 3), linear=False),
+            "cmf_cumulative": self._texture(luts.load("cmf_cumulative").reshape(1, -1, 3), linear=True),
+            # (2, 4096, 3): a 4096 x 2 texture, row 0 real and row 1 imaginary parts (lib/thinfilm.glsl texelFetches).
+            "sensitivity_fourier": fourier,
+        }
+
+    def _input_textures(self, inputs: Mapping[str, np.ndarray]) -> dict[str, object]:
+        """A view's per-render inputs (``(h, w)`` or ``(h, w, c)`` float arrays, row 0 = texel row 0) as NEAREST textures."""
+        import moderngl
+
+        for texture in self._inputs.values():
+            texture.release()
+        self._inputs = {}
+        for name, array in inputs.items():
+            data = np.ascontiguousarray(array, dtype=np.float32)
+            if data.ndim == 2:
+                data = data[..., None]
+            texture = self.ctx.texture((data.shape[1], data.shape[0]), data.shape[2], data.tobytes(), dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            texture.repeat_x = texture.repeat_y = False
+            self._inputs[name] = texture
+        return self._inputs
+
+    def program(self, material: Material, view: str, values: Mapping[str, object] | None = None):
+        """The compiled program (cached), or :class:`ShaderError` naming the file and line."""
+        constants = specialisation(material, values if values is not None else material.resolve())
+        key = (str(material.path), material.shader, material.uniform_declarations(), view, constants)
+        if key not in self._programs:
+            import moderngl
+
+            source = build_program_source(material, view, constants)
+            try:
+                program = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=source.code)
+            except moderngl.Error as error:
+                raise ShaderError(*first_error(source, str(error))) from None
+            self._programs[key] = program
+        return self._programs[key]
+
+    # -- the model cache ---------------------------------------------------------------------------
+
+    def model_ready(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Whether binding ``material`` at ``values`` needs no numpy work (its tables are cached, or it has none)."""
+        return self.models.ready(material, values)
+
+    def prepare_model(self, material: Material, values: Mapping[str, object]) -> None:
+        """
+        Build ``material``'s numpy model at ``values`` and its tables into the cache, without touching GL:
+        safe on a worker thread, so that an interactive host can build the next tables (~10 ms) while it
+        draws. Errors are raised here as they would be by :meth:`bindings`.
+        """
+        self.models.prepare(material, values)
+
+    # -- bindings and the draw primitive ------------------------------------------------------------
+
+    def bindings(
+        self, program, material: Material, values: Mapping[str, object],
+        inputs: Mapping[str, np.ndarray] | None = None, uniforms: Mapping[str, object] | None = None,
+    ) -> tuple[dict[str, object], dict[str, object]]:
+        """
+        ``(uniforms, textures)`` of ``material`` at ``values`` for ``program``, as :meth:`draw` takes them:
+        the parameters (``int`` ones as :meth:`explorer.brd.Material.physical_values` has them, exact
+        integers), the colour matrix, the library and model tables; ``inputs`` (a view's textures, e.g.
+        the textured view's D_inc) and ``uniforms`` (a view's flags) added.
+        """
+        values = material.physical_values(values)
+        bound: dict[str, object] = {}
+        for parameter in material.parameters:
+            if parameter.name not in program:
+                continue  # unused by the shader: optimised away
+            value = values[parameter.name]
+            if parameter.type == "bool":
+                bound[parameter.name] = bool(value)
+            elif parameter.type == "color":
+                bound[parameter.name] = tuple(float(v) for v in value)
+            else:
+                bound[parameter.name] = float(value)
+        if "xyz_to_rgb_matrix" in program:
+            bound["xyz_to_rgb_matrix"] = tuple(float(v) for v in colorimetry.xyz_to_rgb_matrix().T.ravel())  # column-major
+        bound.update(uniforms or {})
+        textures = dict(self._library)
+        if "sensitivity_fourier_prefiltered" in program:  # Section 5's table: built on first use
+            if "sensitivity_fourier_prefiltered" not in self._library:
+                from ..thinfilm import sensitivity_fourier_prefiltered
+
+                table = sensitivity_fourier_prefiltered()
+                self._library["sensitivity_fourier_prefiltered"] = self.ctx.texture(
+                    (table.shape[1], table.shape[0]), 3, np.ascontiguousarray(table, dtype=np.float32).tobytes(), dtype="f4"
+                )
+            textures["sensitivity_fourier_prefiltered"] = self._library["sensitivity_fourier_prefiltered"]
+        if inputs:
+            textures.update(self._input_textures(inputs))
+        start = time.perf_counter()
+        key, entry = self.models.entry(material, values)
+        if entry is not None:
+            if entry[1] is None:
+                entry[1] = entry[0].textures()
+            for name, table in entry[1].items():
+                if name in program:
+                    if key is None or self._model_texture_keys.get(name) != key or name not in self._model_textures:
+                        self._model_texture(name, table)
+                        self._model_texture_keys[name] = key
+                    textures[name] = self._model_textures[name]
+            self.last_table_ms = (time.perf_counter() - start) * 1e3
+        return bound, textures
+
+    def draw(
+        self, program, framebuffer, *, uniforms: Mapping[str, object] | None = None,
+        textures: Mapping[str, object] | None = None, rows: tuple[int, int] | None = None,
+        additive: bool = False, finish: bool = True,
+    ) -> float:
+        """
+        The draw primitive: one full-screen pass of ``program`` into ``framebuffer``.
+
+        Parameters
+        ----------
+        program : moderngl.Program
+        framebuffer : moderngl.Framebuffer
+            Drawn whole, or only ``rows``; the program's ``resolution`` uniform is its size.
+        uniforms : mapping, optional
+            Values of the program's uniforms (names the program lacks are skipped: optimised away).
+        textures : mapping, optional
+            Textures by sampler name, bound to consecutive units (those the program lacks are skipped).
+        rows : (top, bottom), optional
+            Only rows ``[top, bottom)`` counted from the top of the image (a scissor).
+        additive : bool
+            Add to what the framebuffer holds (blending ``ONE, ONE``), as accumulating passes do.
+        finish : bool
+            Bound the draw by ``glFinish`` on both sides and time it; else return 0 at once.
+
+        Returns
+        -------
+        float
+            The draw's milliseconds (0 without ``finish``). Timer queries are avoided: their 32-bit
+            nanosecond results wrap at 4.29 s.
+        """
+        import moderngl
+
+        width, height = framebuffer.size
+        values = {**(uniforms or {}), "resolution": (float(width), float(height))}
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+        bound = sorted((name, texture) for name, texture in (textures or {}).items() if name in program)
+        for unit, (name, texture) in enumerate(bound):
+            texture.use(location=unit)
+            program[name].value = unit
+        cached = self._vertex_arrays.get(id(program))
+        if cached is None or cached[0] is not program:
+            cached = self._vertex_arrays[id(program)] = (program, self.ctx.vertex_array(program, []))
+        framebuffer.use()
+        if rows is not None:
+            top, bottom = rows  # GL rows count from the bottom
+            self.ctx.scissor = (0, height - bottom, width, bottom - top)
+        if additive:
+            self.ctx.enable(moderngl.BLEND)
+            self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+            self.ctx.blend_equation = moderngl.FUNC_ADD
+        try:
+            if finish:
+                self.ctx.finish()
+            start = time.perf_counter()
+            cached[1].render(vertices=3)
+            if finish:
+                self.ctx.finish()
+            return (time.perf_counter() - start) * 1e3 if finish else 0.0
+        finally:
+            self.ctx.scissor = None
+            if additive:  # the other passes expect no blending
+                self.ctx.blend_func = moderngl.DEFAULT_BLENDING
+                self.ctx.disable(moderngl.BLEND)
+
+    # -- whole images ------------------------------------------------------------------------------
+
+    def _headless(self, material, values, view, width, height, light, inputs, uniforms):
+        """The program and a float framebuffer of one headless render, bound: ``(program, framebuffer, bindings)``."""
+        direction = light_direction(light)
+        program = self.program(material, view, values)
+        bound, textures = self.bindings(program, material, values, inputs, uniforms)
+        bound["light_direction"] = tuple(float(c) for c in direction)
+        framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
+        return program, framebuffer, {"uniforms": bound, "textures": textures}
+
+    @staticmethod
+    def _release(framebuffer) -> None:
+        for attachment in framebuffer.color_attachments:
+            attachment.release()
+        framebuffer.release()
+
+    def render(
+        self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
+        *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
+        uniforms: Mapping[str, object] | None = None,
+    ) -> np.ndarray:
+        """
+        ``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped.
+
+        ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
+        (default :data:`explorer.views.geometry.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
+        ``uniforms``: a view's own textures and flags (the ``textured`` view's, from
+        :meth:`explorer.thickness.ThicknessTexture.gl_inputs`).
+        """
+        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms)
+        try:
+            framebuffer.use()
+            framebuffer.clear(0.0, 0.0, 0.0, 1.0)
+            self.draw(program, framebuffer, **bindings, finish=False)
+            data = framebuffer.read(components=4, dtype="f4")
+        finally:
+            self._release(framebuffer)
+        image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
+        return np.ascontiguousarray(image)
+
+    def time_frame(
+        self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
+        *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
+        uniforms: Mapping[str, object] | None = None,
+    ) -> float:
+        """
+        Time of one frame in ms, bounded by ``glFinish`` on both sides (tables already bound): on a
+        software rasteriser such as llvmpipe this is the rendering time. ``light``: as in :meth:`render`.
+        """
+        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms)
+        try:
+            return self.draw(program, framebuffer, **bindings)
+        finally:
+            self._release(framebuffer)

@@ -1,0 +1,85 @@
+"""
+The numpy models behind the materials' tables (:func:`explorer.models.model_for`), kept in a small
+least-recently-used cache: an interactive session goes back and forth between a few parameter sets (a
+slider and its start, compare A | B), and a table costs ~10 ms. Filling it needs no GL, so an
+interactive host can build the next tables on a worker thread while it draws.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+from typing import Mapping
+
+from ..brd import Material
+from ..models import MODELS, model_for
+
+#: Numpy models (and their tables) kept by :class:`ModelCache`.
+MODEL_CACHE_SIZE = 8
+
+
+class ModelCache:
+    """``(material path, model, values) -> [model, its textures() or None]``, least recently used first."""
+
+    def __init__(self, size: int = MODEL_CACHE_SIZE):
+        self.size = size
+        self._models: OrderedDict[tuple, list] = OrderedDict()
+        self._lock = threading.Lock()  # prepare() may fill the cache from another thread
+
+    @staticmethod
+    def key(material: Material, values: Mapping[str, object]) -> tuple | None:
+        """The cache key of ``material``'s model at physical ``values`` (None: an unhashable value, not cached)."""
+        try:
+            key = (str(material.path), material.model, tuple(sorted(values.items())))
+            hash(key)
+        except TypeError:  # an unhashable value (a list)
+            return None
+        return key
+
+    def entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
+        """
+        ``(key, [model, tables])`` of ``material`` at ``values`` (None: it has no model), from the cache
+        or built here; key None: uncached. ``tables`` is None until someone asks the model for them.
+        """
+        values = material.physical_values(values)
+        key = self.key(material, values)
+        if key is None:
+            model = model_for(material, values)
+            return None, ([model, None] if model is not None else None)
+        with self._lock:
+            entry = self._models.get(key)
+            if entry is not None:
+                self._models.move_to_end(key)
+                return key, entry
+        model = model_for(material, values)
+        if model is None:
+            return key, None
+        return key, self._store(key, [model, None])
+
+    def _store(self, key: tuple, entry: list) -> list:
+        with self._lock:
+            self._models[key] = entry
+            self._models.move_to_end(key)
+            while len(self._models) > self.size:
+                self._models.popitem(last=False)
+        return entry
+
+    def ready(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Whether ``material`` at ``values`` needs no numpy work (its tables are cached, or it has none)."""
+        if (material.model or "") not in MODELS:
+            return True
+        key = self.key(material, material.physical_values(values))
+        with self._lock:
+            entry = self._models.get(key) if key is not None else None
+        return entry is not None and entry[1] is not None
+
+    def prepare(self, material: Material, values: Mapping[str, object]) -> None:
+        """Build ``material``'s model at ``values`` and its tables into the cache; safe on a worker thread."""
+        if self.ready(material, values):
+            return
+        values = material.physical_values(values)
+        key = self.key(material, values)
+        model = model_for(material, values)
+        if model is None or key is None:
+            return
+        self._store(key, [model, model.textures()])

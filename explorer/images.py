@@ -1,0 +1,95 @@
+"""
+Image files of linear RGB renders: ``.png`` (8-bit sRGB with an exposure), ``.npy`` and ``.exr`` (float32
+linear), written atomically. Shared by the CLI, the benchmarks and the app's screenshots.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+#: What ``render --out`` writes, by suffix.
+OUTPUT_SUFFIXES = (".png", ".npy", ".exr")
+#: 8-bit colour of the scatter view's circles in PNG output (red, as in the paper's Figure 9).
+OVERLAY_RGB = (255, 0, 0)
+
+
+class OutputError(Exception):
+    """An output file cannot be written."""
+
+
+def check_output(out: Path) -> Path:
+    """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
+    if out.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise OutputError(f"{out}: the output must end in .png, .npy or .exr")
+    if out.is_dir():
+        raise OutputError(f"{out}: is a directory")
+    directory = out.parent if str(out.parent) else Path(".")
+    if not directory.is_dir():
+        raise OutputError(f"{out}: directory {directory} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise OutputError(f"{out}: directory {directory} is not writable")
+    return directory
+
+
+def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
+    """
+    Write a linear RGB image atomically (a temporary file, renamed): never a partial file.
+
+    Parameters
+    ----------
+    image : ndarray, HxWx3
+        Linear RGB.
+    out : Path
+        ``.npy``: float32 linear RGB; ``.exr``: OpenEXR, float32 linear RGB (through OpenCV); ``.png``:
+        8-bit sRGB of ``exposure * image``, clamped.
+    overlay : ndarray of bool, HxW, optional
+        Pixels painted red in the PNG only (the scatter view's circles).
+    exposure : float
+        The PNG's multiplier before the sRGB encode, as the app's exposure (linear outputs keep the values).
+    """
+    from PIL import Image
+
+    from .colorimetry import encode_srgb8
+
+    suffix = out.suffix.lower()
+    directory = check_output(out)
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix, dir=directory)
+    except OSError as error:
+        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            if suffix == ".npy":
+                np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
+            elif suffix == ".png":
+                pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
+                if overlay is not None:
+                    pixels[overlay] = OVERLAY_RGB
+                Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
+        if suffix == ".exr":
+            _write_exr(image, temporary, out)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
+        os.replace(temporary, out)
+    except OSError as error:
+        Path(temporary).unlink(missing_ok=True)
+        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
+
+
+def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
+    """OpenEXR, 32-bit float RGB, through OpenCV (BGR order) with OpenEXR enabled as for environments."""
+    from .env import _cv2
+
+    cv2 = _cv2()
+    bgr = np.ascontiguousarray(np.asarray(image, dtype=np.float32)[..., ::-1])
+    try:
+        written = cv2.imwrite(temporary, bgr, [cv2.IMWRITE_EXR_TYPE, cv2.IMWRITE_EXR_TYPE_FLOAT])
+    except cv2.error as error:
+        raise OSError(0, f"OpenCV: {' '.join(str(error).split())[:200]}") from None
+    if not written:
+        raise OSError(0, "OpenCV could not write OpenEXR")

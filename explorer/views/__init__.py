@@ -1,0 +1,1 @@
+"""The views in numpy: their geometry (:mod:`explorer.views.geometry`)."""
