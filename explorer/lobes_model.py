@@ -10,6 +10,7 @@ from typing import Mapping
 import numpy as np
 
 from . import lobes, luts
+from .brd import round_integer
 from .errors import LocatedError
 
 MATERIAL_NAME = "layered_lobes.brd"
@@ -21,7 +22,7 @@ class LobesParameterError(LocatedError, ValueError):
 
 def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
     """The :class:`explorer.lobes.Stack` of the material's parameter values (checked)."""
-    count = int(np.clip(np.floor(float(values["layers"]) + 0.5), 1, lobes.MAX_INTERFACES))
+    count = int(np.clip(round_integer(values["layers"]), 1, lobes.MAX_INTERFACES))
     conductor = bool(values.get("conductor", False))
     eta = [float(values[f"eta_{i}"]) for i in range(1, count + 1)]
     if conductor:

@@ -159,6 +159,7 @@ SHIPPED_INTEGERS = {
     "bragg_layer.brd": {"N", "method", "s"},
     "bragg_stack.brd": {"layers", "N_1", "N_2", "N_3"},
     "thin_film.brd": {"method"},
+    "layered_lobes.brd": {"layers"},
     "ggx_schlick.brd": set(),
     "schlick_fresnel.brd": set(),
 }
