@@ -9,7 +9,7 @@ and the checkout's otherwise (running from source, or an editable install).
 The shipped data is read-only: what the package regenerates at run time (a stale table) goes to the user
 cache, :func:`cache_dir`, never into the installation.
 
-Standard library only: :mod:`explorer.bootstrap` imports this before any dependency is installed.
+Standard library only: :mod:`explorer.dev.bootstrap` imports this before any dependency is installed.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import importlib.resources
 import os
 from pathlib import Path
 
-from .errors import LocatedError
+from explorer.errors import LocatedError
 
 #: The distribution's name: the console script, the cache folder.
 APP_NAME = "bragg-explorer"

@@ -1,7 +1,7 @@
 """
 Numpy twins of the BRDF Explorer-style test materials in tests/data/brdf (their ``# model:`` lines).
 
-Test support, not product models: :func:`registered` adds them to :data:`explorer.models.MODELS` for the
+Test support, not product models: :func:`registered` adds them to :data:`explorer.materials.models.MODELS` for the
 duration of a test. Each twin's ``brdf(L, V, N, X, Y)`` evaluates, in float64, what the file's GLSL
 ``BRDF`` evaluates, for unit vectors of shape ``(..., 3)``, and returns linear RGB ``(..., 3)``.
 """
@@ -13,7 +13,7 @@ from typing import Iterator, Mapping
 
 import numpy as np
 
-from explorer import models
+from explorer.materials import models
 
 
 def _dot(a, b) -> np.ndarray:
@@ -214,7 +214,7 @@ TWINS = (
 
 @contextlib.contextmanager
 def registered() -> Iterator[None]:
-    """Add the twins to explorer.models.MODELS, and take them out again afterwards."""
+    """Add the twins to explorer.materials.models.MODELS, and take them out again afterwards."""
     added = [twin for twin in TWINS if twin.name not in models.MODELS]
     for twin in added:
         models.MODELS[twin.name] = twin

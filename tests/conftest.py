@@ -60,6 +60,6 @@ def gl_renderer():
 @pytest.fixture(scope="session")
 def bragg_material():
     """``shaders/bragg_mirror.brd``, parsed."""
-    from explorer.brd import load_material
+    from explorer.materials.brd import load_material
 
     return load_material(BRAGG_MATERIAL)

@@ -22,8 +22,8 @@ from PIL import Image
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, running_in_ci
 
 from explorer.app.parameter_files import load_values, parse_bparam, save_values
-from explorer.brd import load_material
-from explorer.colorimetry import encode_srgb8
+from explorer.materials.brd import load_material
+from explorer.physics.colorimetry import encode_srgb8
 
 WINDOW = "1000x720"
 
@@ -31,7 +31,7 @@ WINDOW = "1000x720"
 @pytest.fixture(scope="session")
 def x_display():
     """A virtual X display for the session's app windows."""
-    from explorer.xvfb import XvfbUnavailable, virtual_display
+    from explorer.dev.xvfb import XvfbUnavailable, virtual_display
 
     try:
         context = virtual_display()
@@ -50,7 +50,7 @@ def run_session(display, material, actions, tmp_path, *extra, timeout=240):
     script.write_text(json.dumps(actions))
     env = {**os.environ, "DISPLAY": display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
     process = subprocess.run(
-        [sys.executable, "-m", "explorer.cli", "open", str(material), "--script", str(script), "--report", str(report),
+        [sys.executable, "-m", "explorer.cli.commands", "open", str(material), "--script", str(script), "--report", str(report),
          "--window-size", WINDOW, *extra],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=timeout,
     )
@@ -134,11 +134,11 @@ def test_no_display_falls_back_to_the_headless_render(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     env["BRAGG_EXPLORER_NO_SETUP"] = "1"
     env["PYTHONPATH"] = str(REPO_ROOT)  # this checkout's package, whatever the venv has installed
-    process = subprocess.run([sys.executable, "-m", "explorer.cli"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=240)
+    process = subprocess.run([sys.executable, "-m", "explorer.cli.commands"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=240)
     assert process.returncode == 0, process.stderr
     assert process.stderr.startswith("bragg-explorer: no display") and "Traceback" not in process.stderr
     assert (tmp_path / "out" / "bragg_mirror_sphere.png").exists()
-    opened = subprocess.run([sys.executable, "-m", "explorer.cli", "open", str(BRAGG_MATERIAL)], cwd=tmp_path, env=env,
+    opened = subprocess.run([sys.executable, "-m", "explorer.cli.commands", "open", str(BRAGG_MATERIAL)], cwd=tmp_path, env=env,
                             capture_output=True, text=True, timeout=60)
     assert opened.returncode != 0 and opened.stderr.startswith("bragg-explorer: error: no display")
     assert len(opened.stderr.strip().splitlines()) == 1
@@ -190,7 +190,7 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
 
 def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, bragg_material):
     """Compare: spectral reference | improved approximation; the mean ΔE2000 shown is that of the two headless renders."""
-    from explorer.colorimetry import delta_E_2000
+    from explorer.physics.colorimetry import delta_E_2000
     from explorer.views.geometry import view_cos_theta
 
     actions = [
@@ -212,7 +212,7 @@ def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, brag
 def test_bench_app_measures_drag_frames(x_display, tmp_path):
     """``bench --app``: the harness drags Lambda through the UI per method and reports the frames that changed it."""
     env = {**os.environ, "DISPLAY": x_display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
-    process = subprocess.run([sys.executable, "-m", "explorer.cli", "bench", "--app", "--json", "--size", "128"],
+    process = subprocess.run([sys.executable, "-m", "explorer.cli.commands", "bench", "--app", "--json", "--size", "128"],
                              cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert process.returncode == 0, process.stderr
     document = json.loads(process.stdout)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer import bootstrap as bs
+from explorer.dev import bootstrap as bs
 
 PYPROJECT = b'[project]\nname = "bragg-explorer"\ndependencies = ["numpy>=1.24"]\n'
 
@@ -381,17 +381,17 @@ def test_bootstrap_and_main_import_only_stdlib():
     code = (
         "import sys, runpy\n"
         "before = set(sys.modules)\n"
-        "import explorer.bootstrap\n"
+        "import explorer.dev.bootstrap\n"
         "new = {m.split('.')[0] for m in set(sys.modules) - before}\n"
         "std = set(sys.stdlib_module_names) | {'explorer', '_distutils_hack'}\n"
         "bad = sorted(m for m in new if m not in std and not m.startswith('_'))\n"
         "print(','.join(bad))\n"
     )
-    src = Path(bs.__file__).resolve().parent.parent
+    src = Path(bs.__file__).resolve().parents[2]  # the checkout: explorer/dev/bootstrap.py
     out = subprocess.run([sys.executable, "-S", "-c", code], cwd=src, capture_output=True,
                          text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == ""
     main_src = (src / "explorer" / "__main__.py").read_text()
     imports = [line for line in main_src.splitlines() if line.startswith(("import", "from"))]
-    assert imports == ["import sys", "from explorer.bootstrap import main"]
+    assert imports == ["import sys", "from explorer.dev.bootstrap import main"]

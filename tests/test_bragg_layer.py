@@ -1,6 +1,6 @@
 """shaders/bragg_layer.brd (issue #3, item 3): one rough Bragg layer over a diffuse base, GL against numpy.
 
-The numpy twin is :class:`explorer.models.BraggLayerModel`; the tolerance is test_brdf_views' rule (2e-3
+The numpy twin is :class:`explorer.materials.models.BraggLayerModel`; the tolerance is test_brdf_views' rule (2e-3
 relative to a pixel's largest |channel| where it exceeds 1e-3, absolute below).
 """
 
@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import bragg, colorimetry, layered, microfacet
-from explorer.brd import load_material
-from explorer.models import BraggLayerModel, model_for
-from explorer.presets import PRESET_DIR, load_presets
-from explorer.render import render_numpy
+from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.materials.brd import load_material
+from explorer.materials.models import BraggLayerModel, model_for
+from explorer.materials.presets import PRESET_DIR, load_presets
+from explorer.views.render import render_numpy
 from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, SMALL, assert_twin_equal
 
@@ -73,7 +73,7 @@ def test_numpy_brdf_is_reciprocal(layer_material, method):
 
 
 def test_absorbing_base_reference_is_the_rough_bragg_brdf_in_rgb(layer_material):
-    """rho_d = 0, method 0: Eq. 17 with Yeh's reflectance, integrated to RGB (explorer.microfacet)."""
+    """rho_d = 0, method 0: Eq. 17 with Yeh's reflectance, integrated to RGB (explorer.physics.microfacet)."""
     values = layer_material.resolve({"method": 0, "alpha": 0.25, "rho_d": 0, "N": 12, "Lambda": 420})
     model = model_for(layer_material, values)
     L, V = directions(6, 3), directions(6, 4)
@@ -104,7 +104,7 @@ def test_base_term_is_rho_d_over_pi_times_the_transmission_table(layer_material)
 def test_alpha_out_of_range_is_one_line(tmp_path):
     out = tmp_path / "x.png"
     run = subprocess.run(
-        [sys.executable, "-m", "explorer.cli", "render", "shaders/bragg_layer.brd", "--view", "lit", "--set", "alpha=2",
+        [sys.executable, "-m", "explorer.cli.commands", "render", "shaders/bragg_layer.brd", "--view", "lit", "--set", "alpha=2",
          "--size", "8", "--out", str(out)],
         cwd=REPO_ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )

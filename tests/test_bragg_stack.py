@@ -1,7 +1,7 @@
 """shaders/bragg_stack.brd (issue #3, item 3): the single-reflection BRDF of layered Bragg structures (Eq. 34)
 evaluated spectrally per pixel from the host's tables, GL against its numpy twin.
 
-The numpy twin is :class:`explorer.models.BraggStackModel` (over :func:`explorer.layered.single_reflection_brdf`);
+The numpy twin is :class:`explorer.materials.models.BraggStackModel` (over :func:`explorer.physics.layered.single_reflection_brdf`);
 the tolerance is test_brdf_views' rule (2e-3 relative to a pixel's largest |channel| where it exceeds 1e-3,
 absolute below). The physics of Eq. 34 itself (reciprocity, coating, white furnace, N = 1 slab) is tested in
 test_layered.py.
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import bragg, colorimetry, layered
-from explorer.brd import load_material
-from explorer.models import BraggStackModel, model_for
-from explorer.render import render_numpy
+from explorer.physics import bragg, colorimetry, layered
+from explorer.materials.brd import load_material
+from explorer.materials.models import BraggStackModel, model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import rim_distance
 from test_bragg_layer import directions
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
@@ -75,7 +75,7 @@ def test_specular_colour_views(gl_renderer, stack_material, view):
 
 
 def test_smooth_limit_colour_of_one_uncoated_layer_is_the_mirror_reference(stack_material):
-    """One layer in air: the specular colour is Yeh's reference RGB (explorer.bragg), up to the 0.25-degree table."""
+    """One layer in air: the specular colour is Yeh's reference RGB (explorer.physics.bragg), up to the 0.25-degree table."""
     values = stack_material.resolve({"N_1": 6, "Lambda_1": 400})
     model = model_for(stack_material, values)
     cos_theta = np.cos(np.radians(np.arange(0.0, 89.0, 7.0)))
@@ -180,8 +180,8 @@ void main() {
 @pytest.mark.gl
 @pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)"])
 def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, case):
-    """The GLSL layer choice (sampling_lobes) equals explorer.layered.layer_choice_probabilities (Eqs. 31, 35)."""
-    from explorer.glsl import ShaderBuilder
+    """The GLSL layer choice (sampling_lobes) equals explorer.physics.layered.layer_choice_probabilities (Eqs. 31, 35)."""
+    from explorer.materials.glsl import ShaderBuilder
     from explorer.gpu.context import VERTEX_SHADER
     from explorer.resources import SHADER_DIR
 

@@ -1,4 +1,4 @@
-"""Tests for explorer.brd, the parser of BRDF Explorer style material files."""
+"""Tests for explorer.materials.brd, the parser of BRDF Explorer style material files."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from explorer.brd import (
+from explorer.materials.brd import (
     Material,
     MaterialError,
     Parameter,

@@ -18,9 +18,9 @@ import pytest
 
 import brdf_twins
 from conftest import BRDF_DATA, REPO_ROOT
-from explorer.brd import load_material
-from explorer.models import model_for
-from explorer.render import render_numpy
+from explorer.materials.brd import load_material
+from explorer.materials.models import model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
 from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
 
@@ -152,7 +152,7 @@ def test_non_finite_channels_keep_the_finite_one(gl_renderer):
 @pytest.mark.gl
 def test_textured_view_follows_the_rule(gl_renderer):
     """The thin film's textured view under a light that leaves most of the sphere dark: finite, equal to numpy."""
-    from explorer.thickness import ThicknessTexture
+    from explorer.views.thickness import ThicknessTexture
 
     m = material(REPO_ROOT / "shaders" / "thin_film.brd")
     values = m.resolve({"method": 3})
@@ -173,7 +173,7 @@ ENV_SIZE, ENV_SPP = 12, 4
 @pytest.mark.gl
 @pytest.mark.parametrize("path", PATHS, ids=[p.name for p in PATHS])
 def test_env_view_is_finite(gl_renderer, path):
-    from explorer.env import EnvironmentMap
+    from explorer.views.env import EnvironmentMap
     from explorer.gpu.env import ProgressiveEnvRender
 
     m = material(path)
@@ -199,7 +199,7 @@ def test_env_converges_to_the_ruled_integral(gl_renderer):
     compact_lobe (NaN wherever theta_h > atan(m), on the lit side) under the smooth test sky: the Monte
     Carlo mean converges to the numpy integral of the BRDF under the same rule (test_env's criteria).
     """
-    from explorer.env import env_integral_numpy
+    from explorer.views.env import env_integral_numpy
     from explorer.gpu.env import ProgressiveEnvRender
     from test_env import CONVERGENCE_SIZE, CONVERGENCE_SPP, MAX_Z, QUADRATURE_RTOL, WITHIN_3SE, smooth_environment
 

@@ -1,8 +1,8 @@
 """The generic BRDF views (issue #3, item 4): ``lit``, ``slice`` and ``scatter``, GLSL against numpy.
 
 Each view calls a material's ``BRDF(L, V, N, X, Y)``: ``shaders/bragg_mirror.brd`` (whose numpy twin is
-``explorer.models.BraggMirrorModel.brdf``) and BRDF Explorer-style files of tests/data/brdf, whose twins
-live in tests/brdf_twins.py (registered into explorer.models.MODELS by this module only).
+``explorer.materials.models.BraggMirrorModel.brdf``) and BRDF Explorer-style files of tests/data/brdf, whose twins
+live in tests/brdf_twins.py (registered into explorer.materials.models.MODELS by this module only).
 
 Tolerance (the issue's rule): 2e-3 relative where values exceed 1e-3, absolute (2e-3 x 1e-3) below. A
 value is a pixel's: its largest |channel|. Linear RGB of vivid colours crosses zero in single channels,
@@ -23,9 +23,9 @@ import pytest
 
 import brdf_twins
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, one_line_error
-from explorer.brd import load_material
-from explorer.models import model_for
-from explorer.render import render_numpy
+from explorer.materials.brd import load_material
+from explorer.materials.models import model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import DEFAULT_LIGHT, SCATTER_CIRCLES, brdf_view_geometry, light_direction, rim_distance, scatter_circles
 
 RTOL = 2e-3
@@ -228,7 +228,7 @@ def test_numpy_twins_need_brdf():
 
 def cli(*args):
     completed = subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
+        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
         timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
     return completed
@@ -293,7 +293,7 @@ def test_cli_lit_npy_equals_numpy_twin(gl_renderer, tmp_path):
 def test_cli_scatter_circles_only_in_png(gl_renderer, tmp_path):
     from PIL import Image
 
-    from explorer.colorimetry import encode_srgb8
+    from explorer.physics.colorimetry import encode_srgb8
 
     path = BRDF_DATA / "colored_lambert.brdf"
     size = 96

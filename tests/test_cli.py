@@ -1,4 +1,4 @@
-"""The command line, run as users run it: ``python -m explorer.cli ...`` in a subprocess.
+"""The command line, run as users run it: ``python -m explorer.cli.commands ...`` in a subprocess.
 
 Bad input must end with exactly one line on stderr (naming the file and line where there is one),
 a non-zero exit status, no traceback, and no output file (nor a temporary one) left behind. The
@@ -40,7 +40,7 @@ class Run:
 
 def cli(*args, cwd: Path = REPO_ROOT) -> Run:
     completed = subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)],
+        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)],
         cwd=cwd, capture_output=True, text=True, timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
     return Run(completed.returncode, completed.stdout, completed.stderr)
@@ -60,7 +60,7 @@ def declaration_line(path: Path, name: str) -> int:
 
 
 def parameters_section(path: Path) -> list[list[str]]:
-    """The parameter lines of a material file, split into tokens (read here, not by explorer.brd)."""
+    """The parameter lines of a material file, split into tokens (read here, not by explorer.materials.brd)."""
     rows, inside = [], False
     for line in path.read_text().splitlines():
         stripped = line.strip()
@@ -265,7 +265,7 @@ def test_info_json_covers_the_four_kinds(cli_runs):
 
 @pytest.mark.gl
 def test_render_png_and_npy(gl_renderer, tmp_path):
-    from explorer.colorimetry import encode_srgb8
+    from explorer.physics.colorimetry import encode_srgb8
     from PIL import Image
 
     material = relative(BRAGG_MATERIAL)
@@ -288,8 +288,8 @@ def test_render_png_and_npy(gl_renderer, tmp_path):
 
 @pytest.mark.gl
 def test_render_npy_equals_numpy_twin(gl_renderer, bragg_material, tmp_path):
-    from explorer.models import model_for
-    from explorer.render import render_numpy
+    from explorer.materials.models import model_for
+    from explorer.views.render import render_numpy
     from explorer.views.geometry import rim_distance
 
     out = tmp_path / "basic.npy"

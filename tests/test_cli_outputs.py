@@ -17,8 +17,8 @@ from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX, REPO_ROOT, one
 from test_cli import WORKERS, cli, relative
 
 from explorer.app.parameter_files import save_values
-from explorer.brd import load_material
-from explorer.colorimetry import encode_srgb8
+from explorer.materials.brd import load_material
+from explorer.physics.colorimetry import encode_srgb8
 
 MATERIAL = relative(BRAGG_MATERIAL)
 BUILTINS = sorted(path.stem for path in (REPO_ROOT / "shaders").glob("*.brd"))
@@ -27,8 +27,8 @@ GRADIENT = ["--engine", "numpy", "--view", "gradient", "--size", "24x4", "--set"
 
 
 def read_exr(path) -> np.ndarray:
-    """An OpenEXR file as float32 RGB, through OpenCV with OpenEXR enabled (as explorer.env reads them)."""
-    from explorer.env import _cv2
+    """An OpenEXR file as float32 RGB, through OpenCV with OpenEXR enabled (as explorer.views.env reads them)."""
+    from explorer.views.env import _cv2
 
     cv2 = _cv2()
     image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)

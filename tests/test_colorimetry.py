@@ -1,4 +1,4 @@
-"""The colour convention (explorer.colorimetry) against colour-science and published reference data.
+"""The colour convention (explorer.physics.colorimetry) against colour-science and published reference data.
 
 Our convention: CIE 1931 2° CMFs at 1 nm from 360 to 830 nm, illuminant E, Y(flat 1) = 1; linear
 sRGB through a Bradford adaptation from E to D65, scaled per channel so that a flat reflectance of 1
@@ -16,7 +16,7 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     import colour
 
-from explorer import colorimetry
+from explorer.physics import colorimetry
 
 #: Our sums against colour-science's 'Integration' method on the same 1 nm grid (relative).
 XYZ_RTOL = 1e-9

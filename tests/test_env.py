@@ -2,7 +2,7 @@
 Monte Carlo estimate against the numpy integral, and the command line's bad input.
 
 The convergence tests compare, per pixel and channel, the GPU mean after N samples with the exact
-integral (:func:`explorer.env.env_integral_numpy`) in units of the estimate's own standard error,
+integral (:func:`explorer.views.env.env_integral_numpy`) in units of the estimate's own standard error,
 z = (mean - integral) / SE. Over an unbiased estimate with a Gaussian mean, z is standard normal: 99.73 %
 within 3, none of a few hundred beyond 5, mean 0. The environment of these tests is smooth (a sky
 gradient and a broad glow), so the mean is close to Gaussian after a few thousand samples and the
@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import microfacet
-from explorer.env import (
+from explorer.physics import microfacet
+from explorer.views.env import (
     DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, direction_to_uv, env_integral_numpy,
     generate_default_environment, pcg4d, quadrature_subdivisions, sample_cosine_hemisphere, uniform_floats,
     uv_to_direction,
@@ -71,7 +71,7 @@ def smooth():
 
 
 def load(path, overrides=None):
-    from explorer.brd import load_material
+    from explorer.materials.brd import load_material
 
     material = load_material(path)
     return material, material.resolve(overrides or {})
@@ -79,7 +79,7 @@ def load(path, overrides=None):
 
 def without_hook(path: Path, directory: Path):
     """A copy of a material whose sampling hook is off (the hook function stays, unused): cosine sampling."""
-    from explorer.brd import load_material
+    from explorer.materials.brd import load_material
 
     text = path.read_text()
     assert "#define HAS_SAMPLING_LOBES" in text
@@ -90,7 +90,7 @@ def without_hook(path: Path, directory: Path):
 
 def z_scores(renderer, material, values, environment, size, spp, seed=0, pixels=None):
     """z per (pixel, channel) inside the disc (or at ``pixels``), the within-tolerance mask, the mean and the integral."""
-    from explorer.models import model_for
+    from explorer.materials.models import model_for
 
     render = ProgressiveEnvRender(renderer, material, values, environment, size, size, seed=seed)
     try:
@@ -170,7 +170,7 @@ def test_default_environment_is_its_generator():
 
 
 def test_exr_and_hdr_load_as_written(tmp_path):
-    from explorer.env import _cv2
+    from explorer.views.env import _cv2
 
     cv2 = _cv2()
     image = smooth_environment(16, 8).pixels
@@ -295,7 +295,7 @@ void main() {
 
 
 def run_probe(renderer, view, alpha):
-    from explorer.glsl import ShaderBuilder
+    from explorer.materials.glsl import ShaderBuilder
     from explorer.gpu.context import VERTEX_SHADER
     from explorer.resources import SHADER_DIR
 
@@ -399,7 +399,7 @@ def test_env_converges_without_a_hook_for_brdf_explorer_files(gl_renderer, smoot
 
 
 def test_quadrature_is_converged(smooth):
-    from explorer.models import model_for
+    from explorer.materials.models import model_for
 
     pixels = [(8, 8), (3, 9), (12, 4), (8, 1)]
     for path, overrides in CONVERGENCE_CASES.values():
@@ -535,7 +535,7 @@ def test_cli_bad_environment_input(tmp_path):
 
 @pytest.mark.gl
 def test_cli_env_with_an_exr(gl_renderer, tmp_path):
-    from explorer.env import _cv2
+    from explorer.views.env import _cv2
 
     environment = tmp_path / "sky.exr"
     assert _cv2().imwrite(str(environment), smooth_environment(32, 16).pixels[:, :, ::-1])
@@ -551,8 +551,8 @@ def test_cli_env_with_an_exr(gl_renderer, tmp_path):
 @pytest.mark.gl
 def test_advance_in_bands_equals_whole_passes(gl_renderer):
     """advance() with a budget below one sample's cost works in bands of rows: same samples, same image."""
-    from explorer.brd import load_material
-    from explorer.env import EnvironmentMap
+    from explorer.materials.brd import load_material
+    from explorer.views.env import EnvironmentMap
     from explorer.gpu.env import ProgressiveEnvRender
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
@@ -583,10 +583,10 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
 @pytest.mark.gl
 def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     """A coated stack whose layer is invisible (n2 = n1 = nh) and base black shows only the coating's Dirac: F Le(R)."""
-    from explorer.brd import load_material
-    from explorer.env import EnvironmentMap
+    from explorer.materials.brd import load_material
+    from explorer.views.env import EnvironmentMap
     from explorer.gpu.env import ProgressiveEnvRender
-    from explorer.models import model_for
+    from explorer.materials.models import model_for
     from explorer.views.geometry import brdf_view_geometry
 
     material = load_material(REPO_ROOT / "shaders" / "bragg_stack.brd")
@@ -613,7 +613,7 @@ def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
 def test_brdf_explorer_pi_does_not_clash_with_the_library(gl_renderer, tmp_path, declaration):
     """BRDF Explorer files declare PI (a const or a macro) before the env view includes the GGX library."""
     from conftest import BRDF_DATA
-    from explorer.env import EnvironmentMap
+    from explorer.views.env import EnvironmentMap
 
     text = (BRDF_DATA / "lambert.brdf").read_text()
     assert "const float PI = 3.14159265358979323846;" in text

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer import microfacet
-from explorer.glsl import ShaderBuilder
+from explorer.physics import microfacet
+from explorer.materials.glsl import ShaderBuilder
 from explorer.gpu.context import VERTEX_SHADER
 from explorer.resources import SHADER_DIR
 

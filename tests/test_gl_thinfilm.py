@@ -1,5 +1,5 @@
 """The thin-film material (issue #5, item 2): shaders/lib/thinfilm.glsl and shaders/thin_film.brd
-against their numpy twins (explorer.thinfilm, explorer.thinfilm_model.ThinFilmModel).
+against their numpy twins (explorer.physics.thinfilm, explorer.materials.thinfilm_model.ThinFilmModel).
 
 - every method of thin_film.brd, in the ``gradient`` and ``sphere`` views, on dielectric and conducting
   bases and on a film that turns evanescent (eta1 > eta2): GL equals numpy to 2e-3 per linear channel
@@ -10,7 +10,7 @@ against their numpy twins (explorer.thinfilm, explorer.thinfilm_model.ThinFilmMo
 - the issue's cross-check: a Bragg mirror with N = 1 (nh = n1, method 0) is the thin film (n2, d2)
   between n1 and n1 (method 0), in GL;
 - no NaN or Inf over random parameters and the parameter box's corners; the BRDF's numpy twin against
-  explorer.microfacet's Eq. 17; bad input through the CLI.
+  explorer.physics.microfacet's Eq. 17; bad input through the CLI.
 """
 
 from __future__ import annotations
@@ -26,12 +26,13 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import luts, microfacet, thinfilm
-from explorer.brd import load_material
-from explorer.models import MODELS, model_for
-from explorer.render import render_numpy
+from explorer.tables import luts
+from explorer.physics import microfacet, thinfilm
+from explorer.materials.brd import load_material
+from explorer.materials.models import MODELS, model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import rim_distance, view_cos_theta
-from explorer.thinfilm_model import ThinFilmModel
+from explorer.materials.thinfilm_model import ThinFilmModel
 
 THIN_FILM_MATERIAL = REPO_ROOT / "shaders" / "thin_film.brd"
 THINFILM_GLSL = REPO_ROOT / "shaders" / "lib" / "thinfilm.glsl"
@@ -104,7 +105,7 @@ def test_model_is_registered(thin_film_material):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_model_reflectance_is_the_thinfilm_module(thin_film_material, method):
-    """The twin dispatches each method to explorer.thinfilm as the shader's reflectance() does."""
+    """The twin dispatches each method to explorer.physics.thinfilm as the shader's reflectance() does."""
     film = {"eta2": 1.33, "d": 600.0, "eta3": 1.5, "kappa3": 3.0}
     model = model_for(thin_film_material, thin_film_material.resolve({**film, "method": method}))
     cos_theta = np.linspace(0.0, 1.0, 11)
@@ -122,7 +123,7 @@ def test_model_reflectance_is_the_thinfilm_module(thin_film_material, method):
 
 
 def test_model_brdf_is_eq17_with_the_film(thin_film_material):
-    """brdf(L, V, N, X, Y) against explorer.microfacet.microfacet_brdf with the film's reflectance; reciprocal."""
+    """brdf(L, V, N, X, Y) against explorer.physics.microfacet.microfacet_brdf with the film's reflectance; reciprocal."""
     values = thin_film_material.resolve({"method": 3, "alpha": 0.3, "eta3": 1.5, "kappa3": 2.0})
     model = model_for(thin_film_material, values)
     rng = np.random.default_rng(5)
@@ -149,7 +150,7 @@ def test_model_rejects_bad_values(thin_film_material, bad):
 
 
 # --------------------------------------------------------------------------------------------------
-# The GLSL library against explorer.thinfilm: constants, names, functions
+# The GLSL library against explorer.physics.thinfilm: constants, names, functions
 
 
 def glsl_constant(name: str) -> np.ndarray:
@@ -417,7 +418,7 @@ def test_gl_sweep_and_corners_are_finite(gl_renderer, thin_film_material):
 
 def cli(*args) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
+        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
         timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
 

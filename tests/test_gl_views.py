@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer import bragg, colorimetry
-from explorer.models import model_for
-from explorer.render import render_numpy
+from explorer.physics import bragg, colorimetry
+from explorer.materials.models import model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import rim_distance, view_cos_theta
 
 #: Per linear RGB channel, absolute.

@@ -1,4 +1,4 @@
-"""Tests for explorer.glsl: #include expansion, #line mapping, compile logs.
+"""Tests for explorer.materials.glsl: #include expansion, #line mapping, compile logs.
 
 Only `test_gl_compile_error_maps_to_included_file` needs an OpenGL context.
 """
@@ -13,7 +13,7 @@ from textwrap import dedent
 
 import pytest
 
-from explorer.glsl import (
+from explorer.materials.glsl import (
     LINE_STRIDE,
     PREAMBLE,
     Program,

@@ -2,9 +2,9 @@
 
 ``method``, ``N``, ``s``, ``layers`` and ``N_k`` may arrive as any float (a typed field, a JSON or
 .bparam file, a script, a caller's dict). The GL host (uniforms and the ``# specialise:`` constant) and
-the numpy twins must turn ``2.5`` into the same integer, :func:`explorer.brd.round_integer`'s 3, where
+the numpy twins must turn ``2.5`` into the same integer, :func:`explorer.materials.brd.round_integer`'s 3, where
 they used to disagree (Python's ``round`` halves to even: 0.5 compiled method 0 while numpy ran method 1).
-Values here bypass :meth:`~explorer.brd.Material.resolve` (which rounds already), to test the host and
+Values here bypass :meth:`~explorer.materials.brd.Material.resolve` (which rounds already), to test the host and
 the twins themselves; the tolerances are the named ones of the GL-vs-numpy tests.
 """
 
@@ -15,10 +15,10 @@ import pytest
 
 from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT
 from explorer.app.parameter_files import widget_kind
-from explorer.brd import load_material, round_integer
+from explorer.materials.brd import load_material, round_integer
 from explorer.gpu.programs import specialisation
-from explorer.models import model_for
-from explorer.render import render_numpy
+from explorer.materials.models import model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import rim_distance
 from test_brdf_views import LIGHTS, assert_twin_equal
 from test_gl_views import GL_ATOL, RIM_EXCLUSION, SWEEP_SIZES
@@ -179,7 +179,7 @@ def test_shipped_integers_are_declared_int_and_get_integer_sliders(material_file
         if p.type == "int":
             assert p.glsl_type == "float" and float(p.default).is_integer()
     # Every preset's value of an integer is an integer (presets are checked against these declarations).
-    from explorer.presets import PresetError, presets_for
+    from explorer.materials.presets import PresetError, presets_for
 
     try:
         presets = presets_for(SHADERS / material_file).presets

@@ -1,4 +1,4 @@
-"""The inverse method (explorer.inverse; Bati, Barla & Pacanowski 2021, Secs. 5-6) against the forward model.
+"""The inverse method (explorer.physics.inverse; Bati, Barla & Pacanowski 2021, Secs. 5-6) against the forward model.
 
 forward(inverse(lobes)) must reproduce each requested lobe at normal incidence: its energy on every
 channel, its variance on the channel that sets the roughness (Sec. 5.2.3: the brightest R'; on every
@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer import inverse, lobes
-from explorer.inverse import InverseError, Lobe
+from explorer.physics import inverse, lobes
+from explorer.physics.inverse import InverseError, Lobe
 
 #: The issue's bound for forward(inverse(lobes)) at normal incidence.
 ROUND_TRIP_TOLERANCE = 1e-3
@@ -188,8 +188,8 @@ def test_cli_inverse_json_prints_a_stack_that_renders():
     assert len(result["stack"]["interfaces"]) == 2 and result["values"]["conductor"] == 1
     for entry in result["lobes"]:
         np.testing.assert_allclose(entry["forward"]["R"], entry["requested"]["R"], atol=ROUND_TRIP_TOLERANCE)
-    from explorer.brd import load_material
-    from explorer.models import model_for
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import model_for
 
     material = load_material(REPO_ROOT / "shaders" / "layered_lobes.brd")
     model = model_for(material, material.resolve(result["values"]))
@@ -212,9 +212,9 @@ def test_cli_figure_writes_png(tmp_path):
 
 def test_presets_reproduce_their_figures_lobes():
     """Every preset's stack (shaders/presets/layered_lobes.toml, as written) gives its figure's lobes back."""
-    from explorer.lobes_model import stack_from_values
-    from explorer.lobes_presets import FIGURES, PRESET_FILE
-    from explorer.presets import load_presets
+    from explorer.materials.lobes_model import stack_from_values
+    from explorer.materials.lobes_presets import FIGURES, PRESET_FILE
+    from explorer.materials.presets import load_presets
 
     presets = load_presets(PRESET_FILE).presets
     assert len(presets) >= 25

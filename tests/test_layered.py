@@ -1,9 +1,9 @@
 """Layered Bragg structures (numpy): the integrated transmissivity (Eq. 28), the absorption (Eq. 30),
 the per-layer tables (Table 2's LUT version) and the single-reflection BRDF (Eq. 34).
 
-References are independent of ``explorer.layered``: Yeh's exact reflectance and the Airy slab of
-``explorer.bragg`` (themselves checked against ``tmm`` in the physics tests), Fresnel and Snell written
-out, Eq. 17 through ``explorer.layered.rough_bragg_brdf``, and hemispherical quadratures written
+References are independent of ``explorer.physics.layered``: Yeh's exact reflectance and the Airy slab of
+``explorer.physics.bragg`` (themselves checked against ``tmm`` in the physics tests), Fresnel and Snell written
+out, Eq. 17 through ``explorer.physics.layered.rough_bragg_brdf``, and hemispherical quadratures written
 here. Spectral albedos are checked per wavelength.
 """
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer import bragg, colorimetry, layered, microfacet
-from explorer.layered import LayeredBragg, RoughBraggLayer
+from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.physics.layered import LayeredBragg, RoughBraggLayer
 
 SEED = 20240604
 #: The tables' float32 fast path of Yeh's reflectance against the exact float64 one (absolute).

@@ -1,4 +1,4 @@
-"""The layered lobes model (explorer.lobes, shaders/layered_lobes.brd): Belcour 2018 as in Bati et al. 2021, Sec. 4.
+"""The layered lobes model (explorer.physics.lobes, shaders/layered_lobes.brd): Belcour 2018 as in Bati et al. 2021, Sec. 4.
 
 Independent references: ``tmm.inc_tmm`` (incoherent multilayers) for smooth stacks, a brute-force
 integration of the GGX BRDF over outgoing directions for the FGD table. GL against the numpy twin with
@@ -12,12 +12,12 @@ import pytest
 import tmm
 
 from conftest import REPO_ROOT
-from explorer import lobes, microfacet
-from explorer.brd import load_material
-from explorer.env import EnvironmentMap, env_integral_numpy
+from explorer.physics import lobes, microfacet
+from explorer.materials.brd import load_material
+from explorer.views.env import EnvironmentMap, env_integral_numpy
 from explorer.gpu.env import ProgressiveEnvRender
-from explorer.models import model_for
-from explorer.render import render_numpy
+from explorer.materials.models import model_for
+from explorer.views.render import render_numpy
 from explorer.views.geometry import brdf_view_geometry, rim_distance
 from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
 

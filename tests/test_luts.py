@@ -8,7 +8,8 @@ import shutil
 import numpy as np
 import pytest
 
-from explorer import colorimetry, luts
+from explorer.physics import colorimetry
+from explorer.tables import luts
 
 #: Sums of up to 471 CMF values against the cumulative table's differences.
 CUMULATIVE_ATOL = 1e-12

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer import bragg, colorimetry, layered, microfacet
-from explorer.bragg import BraggMirror
+from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.physics.bragg import BraggMirror
 
 SEED = 20240603
 #: Appendix C: each row of the tabulated filter integrates to G1(theta_i) (the issue's tolerance).

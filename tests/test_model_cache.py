@@ -9,7 +9,7 @@ import pytest
 
 from conftest import REPO_ROOT
 from explorer.gpu import Renderer, tables
-from explorer.brd import load_material
+from explorer.materials.brd import load_material
 
 MIRROR = REPO_ROOT / "shaders" / "bragg_mirror.brd"
 

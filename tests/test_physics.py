@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from tmm import coh_tmm, interface_r, list_snell
 
-from explorer import bragg, colorimetry, fresnel
-from explorer.bragg import BraggMirror
+from explorer.physics import bragg, colorimetry, fresnel
+from explorer.physics.bragg import BraggMirror
 
 SEED = 20240522
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error
-from explorer.models import GGXSchlickModel
-from explorer.presets import PRESET_DIR, PresetError, all_preset_files, load_presets
+from explorer.materials.models import GGXSchlickModel
+from explorer.materials.presets import PRESET_DIR, PresetError, all_preset_files, load_presets
 
 PRESET_FILES = sorted(PRESET_DIR.glob("*.toml"))
 #: A fast method per material for the GL smoke test.
@@ -22,7 +22,7 @@ FAST_METHOD = {"thin_film": 1, "bragg_mirror": 1, "bragg_layer": 1}
 
 def cli(*args):
     return subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
+        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
         timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
 
@@ -100,8 +100,8 @@ def test_ggx_schlick_twin_is_microfacet_times_schlick():
     L = np.array([[np.sin(0.4), 0.0, np.cos(0.4)]])
     V = np.array([[-np.sin(0.2), 0.0, np.cos(0.2)]])
     N = np.array([[0.0, 0.0, 1.0]])
-    from explorer import microfacet
-    from explorer.fresnel import fresnel_schlick
+    from explorer.physics import microfacet
+    from explorer.physics.fresnel import fresnel_schlick
 
     H = (L + V) / np.linalg.norm(L + V)
     expected = (microfacet.ggx_D(H[0, 2], 0.3) * microfacet.smith_G1(L[0, 2], 0.3) * microfacet.smith_G1(V[0, 2], 0.3)
@@ -111,8 +111,8 @@ def test_ggx_schlick_twin_is_microfacet_times_schlick():
 
 @pytest.mark.gl
 def test_ggx_schlick_gl_equals_numpy(gl_renderer):
-    from explorer.brd import load_material
-    from explorer.render import render_numpy
+    from explorer.materials.brd import load_material
+    from explorer.views.render import render_numpy
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
     values = material.resolve({"alpha": 0.25, "F0": 0.1})
@@ -127,9 +127,9 @@ def test_preset_then_set_overrides(tmp_path):
               "--preset", "figure17_boar", "--set", "d=100", "--set", "method=3", "--out", out)
     assert run.returncode == 0, run.stderr
     got = np.load(out)
-    from explorer.brd import load_material
-    from explorer.render import render_numpy
-    from explorer.thinfilm_model import ThinFilmModel
+    from explorer.materials.brd import load_material
+    from explorer.views.render import render_numpy
+    from explorer.materials.thinfilm_model import ThinFilmModel
 
     material = load_material(REPO_ROOT / "shaders" / "thin_film.brd")
     boar = load_presets(PRESET_DIR / "thin_film.toml").presets["figure17_boar"]

@@ -25,7 +25,7 @@ ALIASING_MARGIN = 3.0
 
 @pytest.fixture(scope="module")
 def film():
-    from explorer.brd import load_material
+    from explorer.materials.brd import load_material
 
     return load_material(THIN_FILM)
 
@@ -36,8 +36,8 @@ def noise_texture(size: int = 256, low: float = 0.0, high: float = 1125.0, seed:
 
 
 def render_both(renderer, material, overrides, thickness, size=SIZE):
-    from explorer.models import model_for
-    from explorer.render import render_numpy
+    from explorer.materials.models import model_for
+    from explorer.views.render import render_numpy
 
     values = material.resolve(overrides)
     width, height = size
@@ -53,7 +53,8 @@ def render_both(renderer, material, overrides, thickness, size=SIZE):
 
 
 def test_prefiltered_table_level_zero_is_the_table():
-    from explorer import luts, thinfilm
+    from explorer.tables import luts
+    from explorer.physics import thinfilm
 
     table = thinfilm.sensitivity_fourier_prefiltered()
     plain = luts.load("sensitivity_fourier")
@@ -64,7 +65,7 @@ def test_prefiltered_table_level_zero_is_the_table():
 @pytest.mark.parametrize("sigma", [10.0, 40.0, 120.0])
 def test_prefiltered_transform_is_the_gaussian_average(sigma):
     """The table at (mu, sigma) = S^ averaged over OPDs ~ N(mu, sigma^2), by quadrature of the exact transform."""
-    from explorer import thinfilm
+    from explorer.physics import thinfilm
 
     mu = np.linspace(0.0, 4000.0, 41)
     z = np.linspace(-7.0, 7.0, 2801)
@@ -75,7 +76,7 @@ def test_prefiltered_transform_is_the_gaussian_average(sigma):
 
 
 def test_prefiltered_without_variance_is_fourier_rgb():
-    from explorer import thinfilm
+    from explorer.physics import thinfilm
 
     cos_theta = np.linspace(0.05, 1.0, 30)
     for method in (1, 2, 3):
@@ -86,7 +87,7 @@ def test_prefiltered_without_variance_is_fourier_rgb():
 
 def test_large_variance_leaves_the_fringe_average():
     """sigma -> infinity: every harmonic averages out, R -> C_0 (the colourless fringe average)."""
-    from explorer import thinfilm
+    from explorer.physics import thinfilm
 
     cos_theta = np.linspace(0.1, 1.0, 10)
     rgb = thinfilm.fourier_rgb_prefiltered(1.0, 1.5, 1.09, 0.0, cos_theta, 300.0, 1000.0, m_max=3)
@@ -95,7 +96,7 @@ def test_large_variance_leaves_the_fringe_average():
 
 
 def test_default_texture_is_its_generator():
-    from explorer.thickness import DEFAULT_TEXTURE, generate_default_texture, load_grey
+    from explorer.views.thickness import DEFAULT_TEXTURE, generate_default_texture, load_grey
 
     # To one grey level: a value that rounds on .5 may go either way on another machine's arithmetic.
     shipped = np.round(load_grey(DEFAULT_TEXTURE) * 255.0)
@@ -103,7 +104,7 @@ def test_default_texture_is_its_generator():
 
 
 def test_footprint_moments_of_a_constant_and_of_a_checkerboard():
-    from explorer.thickness import ThicknessTexture
+    from explorer.views.thickness import ThicknessTexture
 
     constant = ThicknessTexture(np.full((8, 8), 400.0, np.float32), prefilter=True).moments(4, 4)
     np.testing.assert_allclose(constant[..., 0], 400.0)
@@ -123,7 +124,7 @@ def test_footprint_moments_of_a_constant_and_of_a_checkerboard():
 @pytest.mark.parametrize("method", [0, 1, 2, 3, 4, 5])
 def test_textured_gl_equals_numpy(gl_renderer, film, method):
     from explorer.views.geometry import rim_distance
-    from explorer.thickness import ThicknessTexture
+    from explorer.views.thickness import ThicknessTexture
 
     thickness = ThicknessTexture.from_file(dinc_range=(0.0, 1125.0))
     gl, reference = render_both(gl_renderer, film, {"method": method, "alpha": 0.3}, thickness)
@@ -136,7 +137,7 @@ def test_textured_gl_equals_numpy(gl_renderer, film, method):
 @pytest.mark.parametrize("texture", ["default", "noise"])
 def test_textured_prefiltered_gl_equals_numpy(gl_renderer, film, method, texture):
     from explorer.views.geometry import rim_distance
-    from explorer.thickness import ThicknessTexture
+    from explorer.views.thickness import ThicknessTexture
 
     if texture == "noise":
         thickness = ThicknessTexture(noise_texture(), prefilter=True)
@@ -153,7 +154,7 @@ def test_prefiltering_removes_aliasing(gl_renderer, film):
     Figure 15: a texture of iid texel noise (256^2, D_inc over [0, 1125] nm) on the sphere at 32^2. With
     prefiltering, the image is much closer to the 256^2 render box-filtered to 32^2 than without.
     """
-    from explorer.thickness import ThicknessTexture
+    from explorer.views.thickness import ThicknessTexture
 
     overrides = {"method": 3, "alpha": 0.3}
     d_inc = noise_texture()
@@ -182,7 +183,7 @@ def test_prefiltering_removes_aliasing(gl_renderer, film):
 
 def cli(*args):
     return subprocess.run(
-        [sys.executable, "-m", "explorer.cli", *map(str, args)],
+        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)],
         cwd=REPO_ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
 

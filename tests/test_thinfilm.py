@@ -1,8 +1,8 @@
 """
-The thin-film model of Belcour & Barla (2017), numpy reference (explorer.thinfilm).
+The thin-film model of Belcour & Barla (2017), numpy reference (explorer.physics.thinfilm).
 
 References independent of the module: the transfer-matrix package ``tmm`` (``coh_tmm``), Yeh's Bragg
-mirror with one cell (explorer.bragg), Fresnel's single interface (explorer.fresnel), and the 1 nm
+mirror with one cell (explorer.physics.bragg), Fresnel's single interface (explorer.physics.fresnel), and the 1 nm
 spectral reference for the Fourier method.
 """
 
@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 from tmm import coh_tmm
 
-from explorer import colorimetry, luts, thinfilm
-from explorer.bragg import BraggMirror, bragg_reflectance
-from explorer.fresnel import fresnel_reflectance
+from explorer.physics import colorimetry, thinfilm
+from explorer.tables import luts
+from explorer.physics.bragg import BraggMirror, bragg_reflectance
+from explorer.physics.fresnel import fresnel_reflectance
 
 #: Airy reflectance against tmm, and against the N = 1 Bragg mirror (absolute).
 EXACT_ATOL = 1e-9

@@ -127,7 +127,7 @@ def installed(tmp_path_factory) -> Installed:
 
 def test_installed_package_is_the_wheel(installed):
     """The fresh environment imports the installed package, not the checkout, and finds its data inside it."""
-    code = ("import explorer, explorer.resources as r, explorer.luts as l; "
+    code = ("import explorer, explorer.resources as r, explorer.tables.luts as l; "
             "print(explorer.__file__); print(r.SHADER_DIR); print(r.LUT_DIR); print(r.CHECKOUT_ROOT); print(l.cache_lut_dir())")
     run = installed.run("-c", code, script="python")
     assert run.returncode == 0, run.stderr
@@ -221,7 +221,7 @@ def test_stale_shipped_table_regenerates_into_the_user_cache(installed):
 def test_installed_package_never_rewrites_its_shipped_files(installed):
     """The developer commands that regenerate shipped files refuse in an installation, in one line."""
     before = snapshot(installed.venv)
-    for module in ("explorer.luts", "explorer.env"):
+    for module in ("explorer.tables.luts", "explorer.views.env"):
         run = installed.run("-m", module, script="python")
         assert run.returncode != 0 and "Traceback" not in run.stderr, run.stderr
         assert len(run.stderr.strip().splitlines()) == 1 and "installed package" in run.stderr, run.stderr

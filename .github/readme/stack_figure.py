@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from explorer.colorimetry import encode_srgb8
+from explorer.physics.colorimetry import encode_srgb8
 from explorer.gpu.env import render_env
 from explorer.gpu import Renderer
-from explorer.presets import load_presets
+from explorer.materials.presets import load_presets
 
 ROOT = Path(__file__).resolve().parents[2]
 SIZE, SPP = 144, 96

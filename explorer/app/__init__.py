@@ -21,6 +21,6 @@ plays synthesised input through ImGui's IO and ``--report`` writes what happened
 ``bench --app`` use them), and the GUI-free :mod:`.parameter_files` and :mod:`.data`.
 """
 
-from .window import DEFAULT_WINDOW, App, AppError, display_available, run_app
+from explorer.app.window import DEFAULT_WINDOW, App, AppError, display_available, run_app
 
 __all__ = ["App", "AppError", "DEFAULT_WINDOW", "display_available", "run_app"]

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..views.geometry import light_direction
-from .state import AppState
+from explorer.views.geometry import light_direction
+from explorer.app.state import AppState
 
 
 def light_vector(light, camera) -> tuple[float, float, float]:

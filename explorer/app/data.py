@@ -2,7 +2,7 @@
 The explorer app's plots and comparisons, in numpy (no GUI): the spectrum of Figure 3 at one angle,
 the polar plot from the scatter view, the ΔE2000 heat-map of a comparison.
 
-Everything comes from the project's physics (:mod:`explorer.bragg`) and colorimetry; nothing here is a
+Everything comes from the project's physics (:mod:`explorer.physics.bragg`) and colorimetry; nothing here is a
 second implementation of a formula.
 """
 
@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import bragg, colorimetry
-from ..brd import round_integer
+from explorer.physics import bragg, colorimetry
+from explorer.materials.brd import round_integer
 
 #: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
 BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
-#: Names of the Bragg materials' methods (explorer.models.METHODS), and the gradient rows of Figure 4.
+#: Names of the Bragg materials' methods (explorer.materials.models.METHODS), and the gradient rows of Figure 4.
 BRAGG_METHOD_NAMES = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 BRAGG_STRIP_METHODS = (0, 1, 2, 4, 3)
 THIN_FILM_METHOD_NAMES = {0: "reference", 1: "Fourier m=1", 2: "Fourier m=2", 3: "Fourier m=3", 4: "Gaussian fits", 5: "naive RGB"}
@@ -131,7 +131,7 @@ def polar_curve(scatter_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def disc_mask(width: int, height: int) -> np.ndarray:
     """The pixels of the sphere views' disc (as the shaders test ``r^2 < 1``)."""
-    from ..views.geometry import view_cos_theta
+    from explorer.views.geometry import view_cos_theta
 
     return view_cos_theta("sphere", width, height)[1]
 

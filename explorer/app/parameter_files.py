@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
-from ..brd import Material, Parameter
-from ..errors import LocatedError
+from explorer.materials.brd import Material, Parameter
+from explorer.errors import LocatedError
 
 
 class ParameterFileError(LocatedError):

@@ -12,11 +12,11 @@ from __future__ import annotations
 import concurrent.futures
 import time
 
-from ..env import EnvironmentMap
-from ..gpu.display import AccumulatedImage, DisplayPass
-from ..gpu.env import ProgressiveEnvRender
-from ..gpu.progressive import CostModel, ProgressiveView
-from .state import AppState
+from explorer.views.env import EnvironmentMap
+from explorer.gpu.display import AccumulatedImage, DisplayPass
+from explorer.gpu.env import ProgressiveEnvRender
+from explorer.gpu.progressive import CostModel, ProgressiveView
+from explorer.app.state import AppState
 
 #: Per-frame budget of GL work (ms): ~30 ms of drawing plus the UI's own frame keeps >= 15 fps.
 FRAME_BUDGET_MS = 30.0

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..images import OutputError, write_image
-from .scheduler import Scheduler
-from .state import AppState
+from explorer.cli.images import OutputError, write_image
+from explorer.app.scheduler import Scheduler
+from explorer.app.state import AppState
 
 SCREENSHOT_DIR = Path("screenshots")
 

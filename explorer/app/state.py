@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..brd import Material
+from explorer.materials.brd import Material
 
 VIEW_SIZES = (128, 256, 512, 1024)
 DEFAULT_VIEW_SIZE = 512
@@ -30,7 +30,7 @@ def initial_values(material: Material, preset: str | None, is_default: bool) -> 
     if is_default and any(p.name == "method" for p in material.parameters):
         overrides["method"] = 3  # the default material opens on its fastest exact method
     if preset is not None:
-        from ..presets import presets_for
+        from explorer.materials.presets import presets_for
 
         overrides.update(presets_for(material.path).get(preset).values)
     return material.resolve(overrides)

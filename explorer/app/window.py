@@ -11,15 +11,15 @@ import os
 import time
 from pathlib import Path
 
-from ..brd import load_material
-from ..errors import LocatedError
-from .panels import PANELS, dock_layout
-from .panels.base import record
-from .panels.base import record
-from .scheduler import Scheduler
-from .screenshots import screenshot_name, take_screenshot, window_shot
-from .script import ScriptRobot
-from .state import DEFAULT_VIEW_SIZE, AppState, CompareState, has_reflectance, initial_values
+from explorer.materials.brd import load_material
+from explorer.errors import LocatedError
+from explorer.app.panels import PANELS, dock_layout
+from explorer.app.panels.base import record
+from explorer.app.panels.base import record
+from explorer.app.scheduler import Scheduler
+from explorer.app.screenshots import screenshot_name, take_screenshot, window_shot
+from explorer.app.script import ScriptRobot
+from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, has_reflectance, initial_values
 
 DEFAULT_WINDOW = (1280, 800)
 
@@ -80,7 +80,7 @@ class App:
 
     def presets(self) -> dict:
         """The presets of the open material (``{}`` when it has none)."""
-        from ..presets import PresetError, presets_for
+        from explorer.materials.presets import PresetError, presets_for
 
         material = self.state.material
         key = (str(material.path), id(material))
@@ -156,7 +156,7 @@ class App:
         from imgui_bundle import imgui, implot
         from imgui_bundle.python_backends.glfw_backend import GlfwRenderer
 
-        from ..gpu import Renderer
+        from explorer.gpu import Renderer
 
         window = self._open_window()
         try:

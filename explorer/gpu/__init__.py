@@ -5,7 +5,7 @@ numpy models' tables (:mod:`.tables`), the :class:`Renderer` and its one draw pr
 (:mod:`.progressive`, :mod:`.display`) and the environment view's Monte Carlo (:mod:`.env`).
 """
 
-from .context import GLUnavailable, create_context
-from .renderer import Renderer
+from explorer.gpu.context import GLUnavailable, create_context
+from explorer.gpu.renderer import Renderer
 
 __all__ = ["GLUnavailable", "Renderer", "create_context"]

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .context import GLSL_VERSION, VERTEX_SHADER
-from .progressive import ProgressiveView
-from .renderer import Renderer
+from explorer.gpu.context import GLSL_VERSION, VERTEX_SHADER
+from explorer.gpu.progressive import ProgressiveView
+from explorer.gpu.renderer import Renderer
 
 
 DISPLAY_SHADER = f"""#version {GLSL_VERSION}

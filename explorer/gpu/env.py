@@ -1,6 +1,6 @@
 """
 The ``env`` view on the GPU: progressive Monte Carlo under an environment map (``shaders/views/env.glsl``;
-the estimator and the direction convention are described in :mod:`explorer.env`, whose exact integral
+the estimator and the direction convention are described in :mod:`explorer.views.env`, whose exact integral
 is its numpy twin), every pass through the renderer's draw primitive.
 """
 
@@ -10,8 +10,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..env import EnvironmentMap, env_integral_numpy
-from .renderer import Renderer
+from explorer.views.env import EnvironmentMap, env_integral_numpy
+from explorer.gpu.renderer import Renderer
 
 #: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
 PASS_BUDGET_MS = 50.0
@@ -50,7 +50,7 @@ class ProgressiveEnvRender:
     renderer : explorer.gpu.Renderer
         Its programs, bindings and draw primitive are reused (:meth:`~explorer.gpu.Renderer.program`,
         :meth:`~explorer.gpu.Renderer.bindings`, :meth:`~explorer.gpu.Renderer.draw`).
-    material : explorer.brd.Material
+    material : explorer.materials.brd.Material
     values : mapping
         The material's resolved parameter values.
     environment : EnvironmentMap
@@ -230,7 +230,7 @@ def render_env(
     """
     environment = EnvironmentMap.default() if environment is None else environment
     if engine == "numpy":
-        from ..models import model_for
+        from explorer.materials.models import model_for
 
         model = model_for(material, values)
         return env_integral_numpy(model, environment, width, height, progress=progress)

@@ -1,5 +1,5 @@
 """
-A material's fragment shader for a view: the preprocessor (:mod:`explorer.glsl`) assembles the
+A material's fragment shader for a view: the preprocessor (:mod:`explorer.materials.glsl`) assembles the
 material's parameter uniforms, its shader section and the view template; compile errors name the
 real file and line.
 """
@@ -8,23 +8,23 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from ..brd import Material, round_integer
-from ..glsl import ShaderBuilder, ShaderError, compile_error
-from ..resources import SHADER_DIR
-from .context import GLSL_VERSION
+from explorer.materials.brd import Material, round_integer
+from explorer.materials.glsl import ShaderBuilder, ShaderError, compile_error
+from explorer.resources import SHADER_DIR
+from explorer.gpu.context import GLSL_VERSION
 
 
 def specialisation(material: Material, values: Mapping[str, object]) -> tuple[tuple[str, int], ...]:
     """
     The constants compiled into ``material``'s program: its ``# specialise:`` parameters' values, rounded
-    as the uniforms and the numpy models round them (:func:`explorer.brd.round_integer`).
+    as the uniforms and the numpy models round them (:func:`explorer.materials.brd.round_integer`).
     """
     return tuple((name, round_integer(values[name])) for name in material.specialised)
 
 
 def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = ()):
     """
-    The fragment shader of ``material`` in ``view`` (an :class:`explorer.glsl.Program`).
+    The fragment shader of ``material`` in ``view`` (an :class:`explorer.materials.glsl.Program`).
 
     Each ``(name, value)`` of ``constants`` becomes ``#define SPECIALISED_name value``: the shader
     can branch at compile time on a parameter such as ``method`` (one smaller program per value).

@@ -20,9 +20,9 @@ from typing import Mapping
 
 import numpy as np
 
-from ..brd import Material
-from ..glsl import ShaderError
-from .renderer import Renderer
+from explorer.materials.brd import Material
+from explorer.materials.glsl import ShaderError
+from explorer.gpu.renderer import Renderer
 
 #: Smallest preview side (pixels).
 PREVIEW_MIN = 16

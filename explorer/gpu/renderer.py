@@ -11,13 +11,14 @@ from typing import Mapping
 
 import numpy as np
 
-from .. import colorimetry, luts
-from ..brd import Material
-from ..glsl import ShaderError
-from ..views.geometry import light_direction
-from .context import VERTEX_SHADER, create_context
-from .programs import build_program_source, first_error, specialisation
-from .tables import ModelCache
+from explorer.physics import colorimetry
+from explorer.tables import luts
+from explorer.materials.brd import Material
+from explorer.materials.glsl import ShaderError
+from explorer.views.geometry import light_direction
+from explorer.gpu.context import VERTEX_SHADER, create_context
+from explorer.gpu.programs import build_program_source, first_error, specialisation
+from explorer.gpu.tables import ModelCache
 
 
 class Renderer:
@@ -129,7 +130,7 @@ class Renderer:
     ) -> tuple[dict[str, object], dict[str, object]]:
         """
         ``(uniforms, textures)`` of ``material`` at ``values`` for ``program``, as :meth:`draw` takes them:
-        the parameters (``int`` ones as :meth:`explorer.brd.Material.physical_values` has them, exact
+        the parameters (``int`` ones as :meth:`explorer.materials.brd.Material.physical_values` has them, exact
         integers), the colour matrix, the library and model tables; ``inputs`` (a view's textures, e.g.
         the textured view's D_inc) and ``uniforms`` (a view's flags) added.
         """
@@ -151,7 +152,7 @@ class Renderer:
         textures = dict(self._library)
         if "sensitivity_fourier_prefiltered" in program:  # Section 5's table: built on first use
             if "sensitivity_fourier_prefiltered" not in self._library:
-                from ..thinfilm import sensitivity_fourier_prefiltered
+                from explorer.physics.thinfilm import sensitivity_fourier_prefiltered
 
                 table = sensitivity_fourier_prefiltered()
                 self._library["sensitivity_fourier_prefiltered"] = self.ctx.texture(
@@ -268,7 +269,7 @@ class Renderer:
         ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
         (default :data:`explorer.views.geometry.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
         ``uniforms``: a view's own textures and flags (the ``textured`` view's, from
-        :meth:`explorer.thickness.ThicknessTexture.gl_inputs`).
+        :meth:`explorer.views.thickness.ThicknessTexture.gl_inputs`).
         """
         program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms)
         try:

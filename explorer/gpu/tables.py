@@ -1,5 +1,5 @@
 """
-The numpy models behind the materials' tables (:func:`explorer.models.model_for`), kept in a small
+The numpy models behind the materials' tables (:func:`explorer.materials.models.model_for`), kept in a small
 least-recently-used cache: an interactive session goes back and forth between a few parameter sets (a
 slider and its start, compare A | B), and a table costs ~10 ms. Filling it needs no GL, so an
 interactive host can build the next tables on a worker thread while it draws.
@@ -11,8 +11,8 @@ import threading
 from collections import OrderedDict
 from typing import Mapping
 
-from ..brd import Material
-from ..models import MODELS, model_for
+from explorer.materials.brd import Material
+from explorer.materials.models import MODELS, model_for
 
 #: Numpy models (and their tables) kept by :class:`ModelCache`.
 MODEL_CACHE_SIZE = 8

@@ -1,7 +1,7 @@
 """
 The views' geometry, in numpy (no GL): what each pixel of ``shaders/views/*.glsl`` shows, the views'
 names, sizes and default light, and the rule every view evaluates a BRDF under. The numpy renders
-(:mod:`explorer.render`), the environment view's twin (:mod:`explorer.env`), the GL host and the app
+(:mod:`explorer.views.render`), the environment view's twin (:mod:`explorer.views.env`), the GL host and the app
 share it.
 
 Pixel positions are computed in float32, as the fragment shader computes them, so that both sides

@@ -4,15 +4,15 @@ docks, what it draws, the GL views it wants advanced); adding one is a new modul
 imported below and listed in :data:`PANELS`.
 """
 
-from .base import Panel
-from .brdf_views import ScatterPanel, SlicePanel
-from .compare import ComparePanel
-from .files import FilesPanel
-from .parameters import ParametersPanel
-from .polar import PolarPanel
-from .spectrum import SpectrumPanel
-from .sphere import SpherePanel
-from .strips import StripsPanel
+from explorer.app.panels.base import Panel
+from explorer.app.panels.brdf_views import ScatterPanel, SlicePanel
+from explorer.app.panels.compare import ComparePanel
+from explorer.app.panels.files import FilesPanel
+from explorer.app.panels.parameters import ParametersPanel
+from explorer.app.panels.polar import PolarPanel
+from explorer.app.panels.spectrum import SpectrumPanel
+from explorer.app.panels.sphere import SpherePanel
+from explorer.app.panels.strips import StripsPanel
 
 #: The windows, in the order they are drawn (a docked window's first tab is the first of its dock here).
 PANELS: tuple[type[Panel], ...] = (

@@ -3,7 +3,7 @@ it wants advanced (see :mod:`explorer.app.panels`)."""
 
 from __future__ import annotations
 
-from ..camera import sphere_mouse
+from explorer.app.camera import sphere_mouse
 
 
 class Panel:

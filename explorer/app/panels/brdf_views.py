@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..camera import light_vector
-from .base import Panel, show_image
+from explorer.app.camera import light_vector
+from explorer.app.panels.base import Panel, show_image
 
 SIDE_VIEW_SIZE = 256
 

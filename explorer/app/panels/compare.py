@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import data
-from ..camera import light_vector
-from .base import Panel, record, show_image
+from explorer.app import data
+from explorer.app.camera import light_vector
+from explorer.app.panels.base import Panel, record, show_image
 
 
 class ComparePanel(Panel):

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...errors import LocatedError
-from ..parameter_files import load_values, save_values
-from ..screenshots import screenshot_name
-from .base import Panel, record
+from explorer.errors import LocatedError
+from explorer.app.parameter_files import load_values, save_values
+from explorer.app.screenshots import screenshot_name
+from explorer.app.panels.base import Panel, record
 
 
 class FilesPanel(Panel):

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from ...brd import round_integer
-from ..parameter_files import slider_format, widget_kind
-from ..state import VIEW_SIZES
-from .base import Panel, record
+from explorer.materials.brd import round_integer
+from explorer.app.parameter_files import slider_format, widget_kind
+from explorer.app.state import VIEW_SIZES
+from explorer.app.panels.base import Panel, record
 
 
 class ParametersPanel(Panel):

@@ -6,9 +6,9 @@ import time
 
 import numpy as np
 
-from ...brd import round_integer
-from .. import data
-from .base import Panel, record
+from explorer.materials.brd import round_integer
+from explorer.app import data
+from explorer.app.panels.base import Panel, record
 
 #: The plot's refresh period while a slider is dragged (seconds).
 DRAG_SPECTRUM_S = 0.1

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ..camera import light_vector
-from ..state import MODES, has_reflectance
-from .base import Panel, record, show_image
+from explorer.app.camera import light_vector
+from explorer.app.state import MODES, has_reflectance
+from explorer.app.panels.base import Panel, record, show_image
 
 
 class SpherePanel(Panel):

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .. import data
-from ..state import has_reflectance
-from .base import Panel
+from explorer.app import data
+from explorer.app.state import has_reflectance
+from explorer.app.panels.base import Panel
 
 STRIP_WIDTH = 512
 

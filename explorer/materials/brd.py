@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Union
 
-from .errors import LocatedError
+from explorer.errors import LocatedError
 
 __all__ = [
     "MaterialError",
@@ -324,7 +324,7 @@ class Material:
         that ``#`` comment lines (which BRDF Explorer drops) are blanked.
     shader_line : int
         1-based file line of the shader text's first line, so that GLSL
-        compile errors can be mapped back (see ``explorer.glsl``).
+        compile errors can be mapped back (see ``explorer.materials.glsl``).
     model : str or None
         The numpy twin named by a ``# model: NAME`` comment.
     warnings : list of str
@@ -389,7 +389,7 @@ class Material:
         """The values the physics sees: every ``int`` parameter's value rounded by `round_integer`.
 
         Applied by the GL host before uploading uniforms and choosing ``# specialise:`` constants, and
-        by `explorer.models.model_for` before building a numpy twin, so that both evaluate the same
+        by `explorer.materials.models.model_for` before building a numpy twin, so that both evaluate the same
         integers whatever the caller passed (``resolve`` already rounds what it coerces).
 
         Parameters

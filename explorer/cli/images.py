@@ -53,7 +53,7 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
     """
     from PIL import Image
 
-    from .colorimetry import encode_srgb8
+    from explorer.physics.colorimetry import encode_srgb8
 
     suffix = out.suffix.lower()
     directory = check_output(out)
@@ -83,7 +83,7 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
 
 def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
     """OpenEXR, 32-bit float RGB, through OpenCV (BGR order) with OpenEXR enabled as for environments."""
-    from .env import _cv2
+    from explorer.views.env import _cv2
 
     cv2 = _cv2()
     bgr = np.ascontiguousarray(np.asarray(image, dtype=np.float32)[..., ::-1])

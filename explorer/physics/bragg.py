@@ -28,9 +28,9 @@ from typing import Iterator
 
 import numpy as np
 
-from . import colorimetry
-from .fresnel import cos_theta_transmitted, fresnel_r
-from .luts import cmf_cumulative_at
+from explorer.physics import colorimetry
+from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
+from explorer.tables.luts import cmf_cumulative_at
 
 #: Bisection steps for each landmark (Airy point, band-gap edges). The GLSL twin uses the same count.
 BISECTION_STEPS = 12
@@ -632,7 +632,7 @@ ROW_BLOCK = 32
 def reflectance_spectra(cos_theta, mirror: BraggMirror) -> np.ndarray:
     """
     Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every nm of
-    :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``; the host's tables.
+    :data:`explorer.physics.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``; the host's tables.
 
     Angles where every wave propagates and ``nh == n1`` take the real fast path
     (:func:`_reflectance_real`), by blocks of rows; the others (total internal reflection, a host

@@ -6,16 +6,16 @@ A film of real index ``eta_2`` and thickness ``thickness_d`` (nm) lies on a base
 ``eta_3 + i kappa_3`` (``kappa_3 = 0``: a dielectric, ``kappa_3 > 0``: a conductor), under an
 exterior medium of real index ``eta_1``. Light arrives from the exterior; ``cos_theta_1`` is the
 cosine of its angle of incidence (the paper's ``h . omega_i``), kept at or above
-:data:`COS_THETA_MIN` as in :mod:`explorer.bragg`. Wavelengths and optical path differences are in
+:data:`COS_THETA_MIN` as in :mod:`explorer.physics.bragg`. Wavelengths and optical path differences are in
 nm. Every function broadcasts its arguments against each other (angles, wavelengths and the
 material's parameters alike).
 
-Conventions are those of :mod:`explorer.fresnel` and of ``tmm``: waves travel as ``exp(+i k_z z)``,
+Conventions are those of :mod:`explorer.physics.fresnel` and of ``tmm``: waves travel as ``exp(+i k_z z)``,
 an absorbing index is ``eta + i kappa`` with ``kappa >= 0``, and ``r_p`` has ``tmm``'s sign. They are
 also the paper's: its Eq. 3 has ``exp(+i Delta phi)`` and its base ``eta_3 + i kappa_3``, so the
 phases on reflection ``phi_ab = arg(r_ab)`` are used exactly as its Eqs. 5-10 write them.
 
-Colours follow the product's convention (:mod:`explorer.colorimetry`) and come out in linear sRGB,
+Colours follow the product's convention (:mod:`explorer.physics.colorimetry`) and come out in linear sRGB,
 unclamped:
 
 - :func:`reference_rgb`, the spectral reference: the exact Airy reflectance at every nm from 360 to
@@ -43,8 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import colorimetry, luts
-from .fresnel import cos_theta_transmitted, fresnel_r
+from explorer.physics import colorimetry
+from explorer.tables import luts
+from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
 #: Cosines are kept away from exact grazing incidence, where every interface reflects totally.
 COS_THETA_MIN = 1e-6
@@ -109,7 +110,7 @@ def _validate_wavelength(wavelength) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------------
-# Snell and Fresnel with a conducting base (explorer.fresnel is dielectric-only)
+# Snell and Fresnel with a conducting base (explorer.physics.fresnel is dielectric-only)
 
 
 def cos_theta_transmitted_conductor(cos_theta_1, eta_1, eta_3, kappa_3) -> np.ndarray:
@@ -118,7 +119,7 @@ def cos_theta_transmitted_conductor(cos_theta_1, eta_1, eta_3, kappa_3) -> np.nd
 
     Snell's law ``eta_1 sin theta_1 = (eta_3 + i kappa_3) sin theta_3`` through the normal wave number
     ``q_3 = n_3 cos theta_3 = sqrt(n_3^2 - eta_1^2 sin^2 theta_1)``, on the branch ``Im q_3 >= 0`` (the
-    wave decays into the base; with ``kappa_3 = 0`` this is :func:`explorer.fresnel.cos_theta_transmitted`,
+    wave decays into the base; with ``kappa_3 = 0`` this is :func:`explorer.physics.fresnel.cos_theta_transmitted`,
     total internal reflection included).
     """
     cos_theta_1 = np.asarray(cos_theta_1, dtype=np.float64)
@@ -133,7 +134,7 @@ def cos_theta_transmitted_conductor(cos_theta_1, eta_1, eta_3, kappa_3) -> np.nd
 
 def fresnel_t(polarisation: str, eta_i, cos_theta_i, eta_t, cos_theta_t) -> np.ndarray:
     """
-    Amplitude transmission coefficient (the ``tmm`` convention, as :func:`explorer.fresnel.fresnel_r`):
+    Amplitude transmission coefficient (the ``tmm`` convention, as :func:`explorer.physics.fresnel.fresnel_r`):
     ``t_s = 2 a / (a + b)`` with ``a = eta_i cos_i``, ``b = eta_t cos_t``; ``t_p = 2 a / (eta_t cos_i + eta_i cos_t)``.
     """
     a = eta_i * cos_theta_i
@@ -565,7 +566,7 @@ def sensitivity_fourier_transform_exact(mu) -> np.ndarray:
 
 def sensitivity_fourier_transform_table(mu) -> np.ndarray:
     """
-    ``S^_j(mu)`` from the ``sensitivity_fourier`` table (:mod:`explorer.luts`): the demodulated envelope
+    ``S^_j(mu)`` from the ``sensitivity_fourier`` table (:mod:`explorer.tables.luts`): the demodulated envelope
     ``E_j`` interpolated linearly between nodes, as a linearly filtered texture fetch does, times the
     carrier ``exp(-2 pi i mu / carrier_j)``; zero beyond the last node (``|S^| < 1e-4`` there).
 
@@ -699,7 +700,7 @@ def _with_axis(*arrays):
 def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d) -> np.ndarray:
     """
     The spectral reference: the exact Airy reflectance at every nm from 360 to 830, both polarisations
-    averaged, integrated against the CMFs (:mod:`explorer.colorimetry`), in linear sRGB.
+    averaged, integrated against the CMFs (:mod:`explorer.physics.colorimetry`), in linear sRGB.
 
     Parameters
     ----------

@@ -1,8 +1,8 @@
 """
-The tables of Belcour's (2018) FGD term for :mod:`explorer.lobes`: the Fresnel terms per polarisation,
+The tables of Belcour's (2018) FGD term for :mod:`explorer.physics.lobes`: the Fresnel terms per polarisation,
 the nodes of the tables and their generators (``luts/lobes_fgd_correction.npy``,
-``luts/lobes_ggx_moments.npy``, registered in :mod:`explorer.luts`). A module of its own so that the
-tables' generators (imported by :mod:`explorer.luts`) do not import the model that loads the tables.
+``luts/lobes_ggx_moments.npy``, registered in :mod:`explorer.tables.luts`). A module of its own so that the
+tables' generators (imported by :mod:`explorer.tables.luts`) do not import the model that loads the tables.
 
 References
 ----------
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import microfacet
+from explorer.physics import microfacet
 
 #: The FGD tables: nodes t = k / (N_COS - 1) of the warped cosine (:func:`fgd_cos_coordinate`: the
 #: critical angle of eta < 1 on the middle node), alpha nodes k / (N_ALPHA - 1), eta nodes

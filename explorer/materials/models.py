@@ -13,11 +13,11 @@ import functools
 
 import numpy as np
 
-from . import bragg, colorimetry, layered, microfacet
-from .brd import round_integer
-from .fresnel import fresnel_schlick
-from .lobes_model import LayeredLobesModel
-from .thinfilm_model import ThinFilmModel
+from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.materials.brd import round_integer
+from explorer.physics.fresnel import fresnel_schlick
+from explorer.materials.lobes_model import LayeredLobesModel
+from explorer.materials.thinfilm_model import ThinFilmModel
 
 METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 
@@ -85,8 +85,8 @@ def _transmission_rgb_table(mirror: bragg.BraggMirror, alpha: float, size: int) 
     """
     The RGB of a rough Bragg layer's integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28) at
     ``cos theta = k / (size - 1)``: ``1 - R_lambda`` of ``mirror`` at the 0.25 degree nodes, filtered by
-    the cached ``F_alpha`` (:func:`explorer.layered.transmission_filter_for`), integrated to RGB and
-    interpolated linearly in ``theta`` (:func:`explorer.layered.lookup`).
+    the cached ``F_alpha`` (:func:`explorer.physics.layered.transmission_filter_for`), integrated to RGB and
+    interpolated linearly in ``theta`` (:func:`explorer.physics.layered.lookup`).
     """
     F = layered.transmission_filter_for(alpha)
     R = layered.reflectance_table(mirror, np.cos(F.theta))
@@ -153,7 +153,7 @@ def _number(values: Mapping[str, object], name: str) -> float:
 class BraggStackModel:
     """
     Twin of ``shaders/bragg_stack.brd``: the single-reflection BRDF (Eq. 34) of 1 to 3 rough Bragg layers
-    in a host ``nh`` over a Lambertian base, under a coating (:func:`explorer.layered.single_reflection_brdf`
+    in a host ``nh`` over a Lambertian base, under a coating (:func:`explorer.physics.layered.single_reflection_brdf`
     from the per-layer tables, the "LUT version" of Table 2), and the tables its shader reads.
 
     Parameters ``layers``, ``nh``, ``coating``, ``rho_d`` and, per layer ``k`` in 1..3, ``n1_k``, ``n2_k``,
@@ -182,7 +182,7 @@ class BraggStackModel:
         self.tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
 
     def reflectance(self, cos_theta) -> np.ndarray:
-        """The smooth limit's specular colour (:func:`explorer.layered.stack_specular_rgb`)."""
+        """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
         return layered.stack_specular_rgb(self.stack, cos_theta, self.tables)
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
@@ -240,7 +240,7 @@ class SchlickFresnelModel:
 
 class GGXSchlickModel:
     """
-    Twin of ``shaders/ggx_schlick.brd``: a GGX microfacet BRDF (:mod:`explorer.microfacet`) with Schlick's
+    Twin of ``shaders/ggx_schlick.brd``: a GGX microfacet BRDF (:mod:`explorer.physics.microfacet`) with Schlick's
     Fresnel, ``D(h) G1(L) G1(V) F(theta_d) / (4 cos theta_i cos theta_o)``; the thin-film bench's baseline.
     """
 
@@ -280,7 +280,7 @@ MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
 def model_for(material, values: Mapping[str, object]):
     """
     The numpy twin of ``material`` with parameter ``values`` (None when it names no known model), its
-    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.brd.Material.physical_values`).
+    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.materials.brd.Material.physical_values`).
     """
     factory = MODELS.get(material.model or "")
     return factory(material.physical_values(values)) if factory else None

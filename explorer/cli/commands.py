@@ -16,10 +16,10 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .brd import Material, MaterialError, load_material, parse_assignment, round_integer
-from .errors import LocatedError
-from .images import OutputError, check_output, write_image
-from .resources import DEFAULT_MATERIAL, display_path, material_path
+from explorer.materials.brd import Material, MaterialError, load_material, parse_assignment, round_integer
+from explorer.errors import LocatedError
+from explorer.cli.images import OutputError, check_output, write_image
+from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
 
 PROG = "bragg-explorer"
 
@@ -39,7 +39,7 @@ def _load(path: str | Path) -> Material:
 
 def parse_size(text: str | None, view: str) -> tuple[int, int]:
     """``W`` or ``WxH`` (a square for ``W`` alone, except the gradient, which keeps its height)."""
-    from .views.geometry import DEFAULT_SIZES
+    from explorer.views.geometry import DEFAULT_SIZES
 
     if text is None:
         return DEFAULT_SIZES[view]
@@ -57,7 +57,7 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
 
 def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     """``THETA,PHI`` in degrees (theta in [0, 180] from +z, phi from +x; theta <= 90 for ``scatter``)."""
-    from .views.geometry import LIGHT_VIEWS
+    from explorer.views.geometry import LIGHT_VIEWS
 
     if text is None:
         return None
@@ -95,22 +95,22 @@ def render_material(
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
-    :class:`explorer.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
-    :class:`explorer.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
+    :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
+    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
     """
     if view == "env":
         return _render_env(material, values, width, height, engine, environment, spp)
     if view == "textured":
-        from .thickness import ThicknessTexture, check_prefilter
+        from explorer.views.thickness import ThicknessTexture, check_prefilter
 
         if material.model != "thin_film":
             raise MaterialError(material.path, None, "the textured view needs a thin-film material (# model: thin_film)")
         thickness = ThicknessTexture.from_file() if thickness is None else thickness
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":
-        from .models import model_for
-        from .views.geometry import BRDF_VIEWS
-        from .render import render_numpy
+        from explorer.materials.models import model_for
+        from explorer.views.geometry import BRDF_VIEWS
+        from explorer.views.render import render_numpy
 
         model = model_for(material, values)
         if model is None:
@@ -118,7 +118,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
-    from .gpu import Renderer
+    from explorer.gpu import Renderer
 
     if view == "textured":
         return Renderer().render(
@@ -132,10 +132,10 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
-    from .gpu.env import render_env
+    from explorer.gpu.env import render_env
 
     if engine == "numpy":
-        from .models import model_for
+        from explorer.materials.models import model_for
 
         model = model_for(material, values)
         if model is None or not callable(getattr(model, "brdf", None)):
@@ -166,7 +166,7 @@ def cli(ctx: click.Context) -> None:
     one, say so and render it (sphere and angular gradient) to out/.
     """
     if ctx.invoked_subcommand is None:
-        from .app import display_available
+        from explorer.app import display_available
 
         if display_available():
             ctx.invoke(open_material, material=str(DEFAULT_MATERIAL), preset=None, script=None, report=None, window_size=None)
@@ -183,13 +183,13 @@ def cli(ctx: click.Context) -> None:
 @click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
 def open_material(material, preset, script, report, window_size):
     """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
-    from .app import DEFAULT_WINDOW, AppError, display_available, run_app
-    from .gpu import GLUnavailable
+    from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
+    from explorer.gpu import GLUnavailable
 
     try:
         loaded = _load(material)
         if preset is not None:
-            from .presets import presets_for
+            from explorer.materials.presets import presets_for
 
             presets_for(loaded.path).get(preset)
         actions = None
@@ -221,7 +221,7 @@ def _errors(function):
     """Turn the expected failures of bad input into one line and exit status 1."""
     import functools
 
-    from .gpu import GLUnavailable
+    from explorer.gpu import GLUnavailable
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
@@ -262,7 +262,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
     (--engine numpy: the exact integral, slow; use a small --size).
     """
-    from .views.geometry import scatter_circles
+    from explorer.views.geometry import scatter_circles
 
     check_output(Path(out))
     exposure_factor = parse_exposure(exposure, Path(out))
@@ -270,21 +270,21 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     loaded = _load(material)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     if params_file is not None:
-        from .app.parameter_files import load_values
+        from explorer.app.parameter_files import load_values
 
         loaded_values = load_values(params_file, loaded)
         for skipped in loaded_values.skipped:
             click.echo(f"{PROG}: warning: {params_file}: skipped {skipped}", err=True)
         overrides = {**loaded_values.values, **overrides}
     if preset is not None:
-        from .presets import presets_for
+        from explorer.materials.presets import presets_for
 
         overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
     values = loaded.resolve(overrides)
     width, height = parse_size(size, view)
     thickness = None
     if view == "textured":
-        from .thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
+        from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
 
         thickness = ThicknessTexture.from_file(
             texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
@@ -293,7 +293,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
     environment = None
     if view == "env":
-        from .env import DEFAULT_ENVIRONMENT, EnvironmentMap
+        from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
 
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
     elif env_file is not None or spp is not None:
@@ -327,7 +327,7 @@ def info(material, as_json):
 def presets(material, as_json):
     """List the presets (name, material, description) of MATERIAL (a file, or a built-in's name such as
     thin_film), or of every built-in material that has some."""
-    from .presets import all_preset_files, load_presets, presets_path
+    from explorer.materials.presets import all_preset_files, load_presets, presets_path
 
     if material:
         loaded = _load(material)
@@ -371,10 +371,10 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
     With --layers: issue #3's host-table timings and the slice view's accuracy (64x64; --repeats, default 5 here).
     """
-    from .bench import run_bench, run_layers_bench, run_thin_film_bench
+    from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
     if app:
-        from .bench import run_app_bench
+        from explorer.cli.bench import run_app_bench
 
         run_app_bench(as_json=as_json, size=size)
         return
@@ -397,7 +397,7 @@ def bench(as_json, size, repeats, thin_film, layers, app):
 @_errors
 def accuracy(as_json, plot, strips):
     """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings)."""
-    from .bench import figure4_strips, run_accuracy
+    from explorer.cli.bench import figure4_strips, run_accuracy
 
     if strips:
         figure4_strips(Path(strips))
@@ -412,7 +412,7 @@ def default_job():
     values = material.resolve({"method": "3"})
     out = Path("out")
     out.mkdir(exist_ok=True)
-    from .gpu import Renderer
+    from explorer.gpu import Renderer
 
     renderer = Renderer()
     for view, size in (("sphere", (512, 512)), ("gradient", (512, 48))):
@@ -421,7 +421,7 @@ def default_job():
         click.echo(f"wrote out/bragg_mirror_{view}.png ({size[0]}x{size[1]}, exact spectral colours, tabulated)")
 
 
-from .inverse_cli import figure_command, inverse_command  # noqa: E402  (issue 11: layered lobes)
+from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  (issue 11: layered lobes)
 
 cli.add_command(inverse_command)
 cli.add_command(figure_command)

@@ -34,8 +34,8 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import LocatedError
-from .resources import DEFAULT_ENVIRONMENT
+from explorer.errors import LocatedError
+from explorer.resources import DEFAULT_ENVIRONMENT
 
 #: The file formats read (through OpenCV): Radiance RGBE and OpenEXR.
 SUFFIXES = (".hdr", ".pic", ".exr")
@@ -250,7 +250,7 @@ def generate_default_environment(width: int = DEFAULT_SIZE[0], height: int = DEF
 
 
 def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
-    """Write :func:`generate_default_environment` as Radiance RGBE (``python -m explorer.env``)."""
+    """Write :func:`generate_default_environment` as Radiance RGBE (``python -m explorer.views.env``)."""
     cv2 = _cv2()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -334,7 +334,7 @@ def env_integral_numpy(
     Parameters
     ----------
     model
-        A numpy twin from :mod:`explorer.models` (``model.brdf(L, V, N, X, Y) -> (..., 3)``).
+        A numpy twin from :mod:`explorer.materials.models` (``model.brdf(L, V, N, X, Y) -> (..., 3)``).
     environment : EnvironmentMap
     width, height : int
         The image size (the lit view's sphere: :func:`explorer.views.geometry.brdf_view_geometry`).
@@ -351,7 +351,7 @@ def env_integral_numpy(
     ndarray
         ``(P, 3)`` float64 for ``pixels`` (0 outside the disc), else the ``(height, width, 3)`` float32 image.
     """
-    from .views.geometry import brdf_view_geometry, view_brdf
+    from explorer.views.geometry import brdf_view_geometry, view_brdf
 
     _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:
@@ -394,7 +394,7 @@ def env_integral_numpy(
 
 
 if __name__ == "__main__":
-    from .resources import require_checkout
+    from explorer.resources import require_checkout
 
-    require_checkout("python -m explorer.env")
+    require_checkout("python -m explorer.views.env")
     print(f"wrote {write_default_environment()}")

@@ -12,7 +12,7 @@ They live next to the materials, one TOML file per material (``shaders/presets/<
     eta2 = 1.5
 
 Every value is checked against the material's declared parameters and ranges
-(:meth:`explorer.brd.Material.resolve`) when the file is loaded; a bad file is a one-line
+(:meth:`explorer.materials.brd.Material.resolve`) when the file is loaded; a bad file is a one-line
 :class:`PresetError` naming the file and, where it can be found, the line.
 """
 
@@ -24,9 +24,9 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .brd import Material, MaterialError, load_material
-from .errors import LocatedError
-from .resources import PRESET_DIR, SHADER_DIR
+from explorer.materials.brd import Material, MaterialError, load_material
+from explorer.errors import LocatedError
+from explorer.resources import PRESET_DIR, SHADER_DIR
 
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")

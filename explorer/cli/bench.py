@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import bragg, colorimetry
-from .brd import load_material
-from .resources import SHADER_DIR
+from explorer.physics import bragg, colorimetry
+from explorer.materials.brd import load_material
+from explorer.resources import SHADER_DIR
 
 BENCH_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)
@@ -76,7 +76,7 @@ def table_rebuild_ms(mirror: bragg.BraggMirror, repeats: int = 15) -> float:
 
 def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
     """Measure and print Table 1 (see the module docstring). Returns the JSON document."""
-    from .gpu import Renderer
+    from explorer.gpu import Renderer
 
     renderer = Renderer()
     mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
@@ -231,8 +231,8 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
     """
     from PIL import Image
 
-    from .colorimetry import encode_srgb8
-    from .gpu import Renderer
+    from explorer.physics.colorimetry import encode_srgb8
+    from explorer.gpu import Renderer
 
     renderer = Renderer()
     material = load_material(SHADER_DIR / "bragg_mirror.brd")
@@ -264,7 +264,7 @@ THIN_FILM_METHODS = (
 
 def thin_film_accuracy(values: dict) -> dict[str, tuple[float, float]]:
     """Median and maximum ΔE2000 of each approximate method against the 1-nm reference over θ (numpy)."""
-    from .thinfilm_model import ThinFilmModel
+    from explorer.materials.thinfilm_model import ThinFilmModel
 
     cos_theta = np.cos(np.radians(THETA_DEGREES))
     reference = ThinFilmModel({**values, "method": 0}).reflectance(cos_theta)
@@ -281,8 +281,8 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
     thin-film preset; the frame time of every method of ``thin_film.brd`` (Figure 7 film) on a lit
     sphere relative to ``ggx_schlick.brd`` (plain GGX with Schlick's Fresnel), interleaved repeats, medians.
     """
-    from .gpu import Renderer
-    from .presets import presets_for
+    from explorer.gpu import Renderer
+    from explorer.materials.presets import presets_for
 
     film_material = load_material(SHADER_DIR / "thin_film.brd")
     presets = presets_for(SHADER_DIR / "thin_film.brd").presets
@@ -361,8 +361,8 @@ def slice_accuracy(alpha: float, size: int = 64) -> dict:
     white = 1). And the tabulated method (3) against the reference: the maximum absolute linear
     difference, and the maximum relative to a pixel's largest channel (the twin tests' rule).
     """
-    from .models import model_for
-    from .render import render_numpy
+    from explorer.materials.models import model_for
+    from explorer.views.render import render_numpy
 
     material = load_material(SHADER_DIR / "bragg_layer.brd")
 
@@ -386,10 +386,10 @@ def slice_accuracy(alpha: float, size: int = 64) -> dict:
 def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64) -> dict:
     """
     ``bragg-explorer bench --layers``: the host tables' build times (F_alpha for a new alpha, one layer's
-    tables for Figure 7's A, B, A'; interleaved repeats, medians; :func:`explorer.layered.measure_timings`)
+    tables for Figure 7's A, B, A'; interleaved repeats, medians; :func:`explorer.physics.layered.measure_timings`)
     and the slice view's accuracy at each of :data:`LAYER_ALPHAS` (:func:`slice_accuracy`).
     """
-    from . import layered
+    from explorer.physics import layered
 
     _progress(f"bench --layers: host tables, {repeats} interleaved repeats")
     timings = layered.measure_timings(alphas=LAYER_ALPHAS, repeats=repeats)
@@ -422,10 +422,10 @@ def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> lis
     (Table 2's "Model-LUT", what the shader does) and computed exactly at the half-vector angle ("Model"),
     over :data:`STACK_PAIRS` random direction pairs where the exact BRDF's luminance exceeds 0.01.
     """
-    from . import layered
-    from .gpu import Renderer
-    from .models import BraggStackModel, _layer_tables
-    from .presets import load_presets
+    from explorer.physics import layered
+    from explorer.gpu import Renderer
+    from explorer.materials.models import BraggStackModel, _layer_tables
+    from explorer.materials.presets import load_presets
 
     preset_file = load_presets(SHADER_DIR / "presets" / "bragg_stack.toml")
     material = preset_file.material
@@ -551,9 +551,9 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     import os
     import tempfile
 
-    from .app import App
-    from .resources import DEFAULT_MATERIAL
-    from .xvfb import display_environment
+    from explorer.app import App
+    from explorer.resources import DEFAULT_MATERIAL
+    from explorer.dev.xvfb import display_environment
 
     with display_environment() as display, tempfile.TemporaryDirectory() as directory:
         report = Path(directory) / "report.json"

@@ -1,11 +1,11 @@
 """
 ``bragg-explorer inverse`` and ``bragg-explorer figure``: the inverse method of Bati et al. (2021) on the
-command line (:mod:`explorer.inverse`), registered by :mod:`explorer.cli`.
+command line (:mod:`explorer.physics.inverse`), registered by :mod:`explorer.cli.commands`.
 
 A lobe is ``--lobe "R=0.9,0.7,0.5 sigma=0.03 layers=1 base=conductor"`` (keys separated by spaces or
 semicolons; ``R`` one number or RGB; ``layers`` 1 or 2, default 1; ``base`` dielectric or conductor),
 top first, with optional choices of its equivalence-class point (``eta``, ``tau``, ``eta_top``,
-``tau_top``, ``t``; :func:`explorer.inverse.invert_lobes`).
+``tau_top``, ``t``; :func:`explorer.physics.inverse.invert_lobes`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def _numbers(text: str, key: str):
 
 def parse_lobe(spec: str):
     """``(Lobe, choices)`` from one ``--lobe`` string."""
-    from .inverse import Lobe
+    from explorer.physics.inverse import Lobe
 
     fields = {}
     for part in re.split(r"[;\s]+", spec.strip()):
@@ -68,7 +68,7 @@ def parse_lobe(spec: str):
 
 
 def _solve(lobe_specs, tir=False):
-    from .inverse import InverseError, forward_lobes, invert_lobes
+    from explorer.physics.inverse import InverseError, forward_lobes, invert_lobes
 
     if not lobe_specs:
         raise click.UsageError("give at least one --lobe")
@@ -93,7 +93,7 @@ def inverse_command(lobe_specs, as_json, tir):
     Prints the stack (top first: eta, alpha, tau of the medium below), the --set values of
     shaders/layered_lobes.brd, and the forward model's lobes at normal incidence against the request.
     """
-    from .lobes_model import values_from_stack
+    from explorer.materials.lobes_model import values_from_stack
 
     lobe_list, stack, energies, variances = _solve(lobe_specs, tir)
     values = values_from_stack(stack)
@@ -130,7 +130,7 @@ def figure_command(lobe_spec, out, samples):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .inverse import one_layer_class, two_layer_class
+    from explorer.physics.inverse import one_layer_class, two_layer_class
 
     lobe, _ = parse_lobe(lobe_spec)
     colours = ("tab:red", "tab:green", "tab:blue")

@@ -1,5 +1,5 @@
 """
-The numpy twin of ``shaders/thin_film.brd`` (Belcour & Barla 2017; physics in :mod:`explorer.thinfilm`).
+The numpy twin of ``shaders/thin_film.brd`` (Belcour & Barla 2017; physics in :mod:`explorer.physics.thinfilm`).
 
 The material is a GGX microfacet BRDF whose Fresnel term is a thin film's Airy reflectance at the
 half-vector angle; ``method`` picks how that reflectance becomes a colour:
@@ -11,7 +11,7 @@ method what the shader computes
 1-3    the paper's Fourier-space spectral integration (Eq. 10) truncated at m = method, with the
        tabulated transform of the convention's sensitivities (``luts/sensitivity_fourier``)
 4      the same at m = 3 with the paper's Gaussian fits of the XYZ sensitivities
-5      naive RGB: the Airy reflectance at :data:`explorer.thinfilm.NAIVE_WAVELENGTHS`
+5      naive RGB: the Airy reflectance at :data:`explorer.physics.thinfilm.NAIVE_WAVELENGTHS`
 ====== ==========================================================================================
 """
 
@@ -21,8 +21,8 @@ from typing import Mapping
 
 import numpy as np
 
-from . import microfacet, thinfilm
-from .brd import round_integer
+from explorer.physics import microfacet, thinfilm
+from explorer.materials.brd import round_integer
 
 METHODS = {0: "reference", 1: "fourier m=1", 2: "fourier m=2", 3: "fourier m=3", 4: "gaussian m=3", 5: "naive rgb"}
 
@@ -67,9 +67,9 @@ class ThinFilmModel:
     def textured_reflectance(self, cos_theta, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
         """
         The twin of the shader's ``textured_reflectance``: the film of OPD ``D_inc`` (nm, per sample) at
-        normal incidence (:func:`explorer.thinfilm.film_from_D_inc`) instead of ``d``; with ``prefiltered``
+        normal incidence (:func:`explorer.physics.thinfilm.film_from_D_inc`) instead of ``d``; with ``prefiltered``
         (methods 1-3), Eq. 10 averaged over a Gaussian of ``D_inc`` of standard deviation ``sigma_D_inc``
-        (:func:`explorer.thinfilm.fourier_rgb_prefiltered`, Section 5).
+        (:func:`explorer.physics.thinfilm.fourier_rgb_prefiltered`, Section 5).
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         eta_2, d = thinfilm.film_from_D_inc(D_inc, self.eta_1, self.eta_2)

@@ -3,7 +3,7 @@
 Two commands do everything on a fresh Debian machine that has only Python 3,
 pip and the base system:
 
-* ``python3 -m explorer [ARGS...]``            -> set up, then ``explorer.cli:main`` ARGS
+* ``python3 -m explorer [ARGS...]``            -> set up, then ``explorer.cli.commands:main`` ARGS
 * ``python3 -m explorer test [PYTEST ARGS...]`` -> set up (with test extras and Xvfb),
   then ``python -m pytest`` ARGS from the repository root
 
@@ -14,7 +14,7 @@ Set-up is idempotent and cheap the second time:
    only when missing;
 2. a virtual environment ``.venv/`` at the repository root receives
    ``pip install -e .`` (or ``.[test]``) constrained to the tested versions of
-   ``explorer/constraints.txt``; a stamp file in it records a hash of
+   ``explorer/dev/constraints.txt``; a stamp file in it records a hash of
    ``pyproject.toml``, the constraints, the Python version and the extras, and pip is skipped
    while the stamp matches;
 3. the venv's interpreter is ``exec``'d, so signals and exit codes pass
@@ -41,7 +41,7 @@ import time
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, NoReturn, Sequence
 
-from .resources import SOURCE_ROOT
+from explorer.resources import SOURCE_ROOT
 
 ENV_NO_SETUP = "BRAGG_EXPLORER_NO_SETUP"
 
@@ -65,7 +65,7 @@ MODE_TEST = "test"
 EGL_PACKAGES = ("libegl1", "libgl1", "libegl-mesa0", "libgl1-mesa-dri")
 XVFB_PACKAGES = ("xvfb", "xauth")
 
-RUN_CLI_SNIPPET = "from explorer.bootstrap import run_cli; run_cli()"
+RUN_CLI_SNIPPET = "from explorer.dev.bootstrap import run_cli; run_cli()"
 PIP_TAIL_LINES = 25
 
 
@@ -97,7 +97,7 @@ def final_command(mode: str, python: str, args: Sequence[str]) -> list[str]:
     """The command line that replaces this process once set-up is done."""
     if mode == MODE_TEST:
         return [python, "-m", "pytest", *args]
-    # Same as the `bragg-explorer` console script: import explorer.cli and call
+    # Same as the `bragg-explorer` console script: import explorer.cli.commands and call
     # main() with the arguments in sys.argv (works for click and argparse alike).
     return [python, "-c", RUN_CLI_SNIPPET, *args]
 
@@ -124,17 +124,17 @@ def child_environment(env: dict[str, str], venv_dir: Path) -> dict[str, str]:
 
 
 def run_cli(args: Sequence[str] | None = None) -> NoReturn:
-    """Call ``explorer.cli:main`` as the console script would."""
+    """Call ``explorer.cli.commands:main`` as the console script would."""
     if args is not None:
         sys.argv = ["bragg-explorer", *args]
     else:
         sys.argv[0] = "bragg-explorer"
     try:
-        from explorer.cli import main as cli_main  # noqa: PLC0415
+        from explorer.cli.commands import main as cli_main  # noqa: PLC0415
     except ModuleNotFoundError as exc:
-        if exc.name in ("explorer.cli", "explorer"):
+        if exc.name in ("explorer.cli.commands", "explorer"):
             print(
-                "[setup] error: explorer/cli.py is missing (no explorer.cli module to run)",
+                "[setup] error: explorer/cli.py is missing (no explorer.cli.commands module to run)",
                 file=sys.stderr,
             )
             raise SystemExit(1) from None

@@ -1,5 +1,5 @@
 """
-The numpy twin of ``shaders/layered_lobes.brd`` (physics in :mod:`explorer.lobes`): Belcour's (2018)
+The numpy twin of ``shaders/layered_lobes.brd`` (physics in :mod:`explorer.physics.lobes`): Belcour's (2018)
 layered BRDF as a sum of GGX lobes (Bati et al. 2021, Eq. 3) and the FGD tables its shader reads.
 """
 
@@ -9,9 +9,10 @@ from typing import Mapping
 
 import numpy as np
 
-from . import lobes, luts
-from .brd import round_integer
-from .errors import LocatedError
+from explorer.physics import lobes
+from explorer.tables import luts
+from explorer.materials.brd import round_integer
+from explorer.errors import LocatedError
 
 MATERIAL_NAME = "layered_lobes.brd"
 
@@ -21,7 +22,7 @@ class LobesParameterError(LocatedError, ValueError):
 
 
 def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
-    """The :class:`explorer.lobes.Stack` of the material's parameter values (checked)."""
+    """The :class:`explorer.physics.lobes.Stack` of the material's parameter values (checked)."""
     count = int(np.clip(round_integer(values["layers"]), 1, lobes.MAX_INTERFACES))
     conductor = bool(values.get("conductor", False))
     eta = [float(values[f"eta_{i}"]) for i in range(1, count + 1)]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .views.geometry import BRDF_VIEWS, brdf_view_geometry, disc, view_brdf, view_cos_theta
+from explorer.views.geometry import BRDF_VIEWS, brdf_view_geometry, disc, view_brdf, view_cos_theta
 
 
 def render_numpy(
@@ -23,19 +23,19 @@ def render_numpy(
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
 
     ``light`` (``lit``, ``scatter``, ``textured``): ``(theta, phi)`` in degrees, default :data:`explorer.views.geometry.DEFAULT_LIGHT`.
-    ``thickness`` (``textured``): an :class:`explorer.thickness.ThicknessTexture` (default: the default
+    ``thickness`` (``textured``): an :class:`explorer.views.thickness.ThicknessTexture` (default: the default
     texture over the default D_inc range, without prefiltering).
-    ``environment`` (``env``): an :class:`explorer.env.EnvironmentMap` (default: the shipped one); the
-    image is the exact integral :func:`explorer.env.env_integral_numpy` (slow: use small sizes).
+    ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
+    image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
     """
     if view == "env":
-        from .env import EnvironmentMap, env_integral_numpy
+        from explorer.views.env import EnvironmentMap, env_integral_numpy
 
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the env view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
         return env_integral_numpy(model, EnvironmentMap.default() if environment is None else environment, width, height)
     if view == "textured":
-        from .thickness import ThicknessTexture
+        from explorer.views.thickness import ThicknessTexture
 
         if not callable(getattr(model, "textured_brdf", None)):
             raise ValueError(f"the textured view needs the model's textured_brdf(); {type(model).__name__} has none")

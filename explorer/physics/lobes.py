@@ -42,8 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import microfacet
-from .lobes_fgd import (  # re-exported: the model's Fresnel terms and table coordinates
+from explorer.physics import microfacet
+from explorer.physics.lobes_fgd import (  # re-exported: the model's Fresnel terms and table coordinates
     ETA_TABLE_MAX, FGD_ALPHA_COUNT, FGD_COS_COUNT, FGD_COS_FLOOR, FGD_ETA_COUNT, FGD_QUADRATURE, _axis,
     _critical_cos, _fresnel_dielectric_mean, fgd_alpha_nodes, fgd_cos_coordinate, fgd_cos_from_coordinate,
     fgd_cos_nodes, fgd_eta_nodes, fresnel_sp, generate_fgd_correction, generate_ggx_moments, normal_reflectance,
@@ -85,7 +85,7 @@ def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
     (:func:`fgd_cos_coordinate`, alpha, log eta), split
     between s and p in proportion to their Fresnel terms. Leading axis 2.
     """
-    from . import luts
+    from explorer.tables import luts
 
     table = luts.load("lobes_fgd_correction")
     cos_theta, alpha, eta = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (cos_theta, alpha, eta)))
@@ -109,7 +109,7 @@ def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
 
 def fgd_conductor(cos_theta, alpha, eta, kappa) -> np.ndarray:
     """``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices)."""
-    from . import luts
+    from explorer.tables import luts
 
     table = luts.load("lobes_ggx_moments")
     cos_theta, alpha, eta, kappa = np.broadcast_arrays(

@@ -13,8 +13,8 @@ by ``F_alpha`` (Eq. 28); the single-reflection BRDF (Eq. 34) sums the paths that
 The "LUT version" of Table 2: per layer, the host tabulates Yeh's reflectance ``R_lambda(theta)`` and
 the integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28) at 0.25 degrees and every nm from 360
 to 830 (:func:`layer_tables`), from the transmission filter of the layer's ``alpha``
-(:func:`explorer.microfacet.transmission_filter_table`, cached per ``alpha``). Spectra are multiplied
-per wavelength and integrated against the CMFs (:mod:`explorer.colorimetry`) only at the end; the
+(:func:`explorer.physics.microfacet.transmission_filter_table`, cached per ``alpha``). Spectra are multiplied
+per wavelength and integrated against the CMFs (:mod:`explorer.physics.colorimetry`) only at the end; the
 base's albedo, given in RGB, multiplies the RGB of its spectral transmission factor (the only product
 taken in RGB, as ``rho_d`` has no spectrum).
 
@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bragg, colorimetry, microfacet
-from .fresnel import fresnel_reflectance
+from explorer.physics import bragg, colorimetry, microfacet
+from explorer.physics.fresnel import fresnel_reflectance
 
 #: At most this many rough Bragg layers in a stack (the issue's 1 to 3).
 MAX_LAYERS = 3
@@ -162,11 +162,11 @@ def rough_bragg_brdf(i, o, mirror: bragg.BraggMirror, alpha, wavelength=None) ->
     ----------
     i, o : array_like, shape (..., 3)
         Unit directions in the mirror's host medium, ``n = +z``, pointing away from the surface.
-    mirror : explorer.bragg.BraggMirror
+    mirror : explorer.physics.bragg.BraggMirror
     alpha : float
         GGX roughness in [0, 1].
     wavelength : array_like, optional
-        Wavelengths in nm; :data:`explorer.colorimetry.WAVELENGTHS` by default.
+        Wavelengths in nm; :data:`explorer.physics.colorimetry.WAVELENGTHS` by default.
 
     Returns
     -------
@@ -190,7 +190,7 @@ def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter
 
     Parameters
     ----------
-    transmission_filter : explorer.microfacet.TransmissionFilter
+    transmission_filter : explorer.physics.microfacet.TransmissionFilter
         ``F_alpha`` of the layer's roughness; its cell weights are the quadrature weights.
     transmissivity : array_like, shape (361, n_wavelengths)
         ``T_lambda = 1 - R_lambda`` of the layer's mirror at the nodes ``theta_d = k * 0.25 deg``.
@@ -233,9 +233,9 @@ def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
 def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
     """
     Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta`` and every
-    nm of :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``.
+    nm of :data:`explorer.physics.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``.
 
-    The core's :func:`explorer.bragg.reflectance_spectra`: its fast real path where every wave
+    The core's :func:`explorer.physics.bragg.reflectance_spectra`: its fast real path where every wave
     propagates and ``nh == n1`` (exact to ~1e-5), the exact complex one elsewhere.
     """
     return bragg.reflectance_spectra(cos_theta, mirror)
@@ -289,7 +289,7 @@ def layer_tables(layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=No
     layer : RoughBraggLayer
     n1 : float
         Index of the host medium.
-    transmission_filter : explorer.microfacet.TransmissionFilter, optional
+    transmission_filter : explorer.physics.microfacet.TransmissionFilter, optional
         ``F_alpha`` for the layer's ``alpha``; the cached one by default.
 
     Returns
@@ -464,7 +464,7 @@ def single_reflection_brdf(stack: LayeredBragg, i, o, tables=None, exact_reflect
 
     References
     ----------
-    Fourneau et al. (2024), Eq. 34; the colour convention of :mod:`explorer.colorimetry`.
+    Fourneau et al. (2024), Eq. 34; the colour convention of :mod:`explorer.physics.colorimetry`.
     """
     spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance)
     return colorimetry.spectrum_to_rgb(spectra.layers) + np.asarray(stack.rho_d) * colorimetry.spectrum_to_rgb(spectra.base)
@@ -551,7 +551,7 @@ def measure_timings(alphas=(0.025, 0.1, 0.4), layers=None, repeats: int = 5) -> 
     (``layers``: the Figure 7 configurations A, B and A' by default), over ``repeats`` interleaved
     rounds (every case once per round) after one warm-up round.
 
-    Every ``F_alpha`` is built from scratch (:func:`explorer.microfacet.transmission_filter_table`,
+    Every ``F_alpha`` is built from scratch (:func:`explorer.physics.microfacet.transmission_filter_table`,
     never the cache of :func:`transmission_filter_for`): a new ``alpha`` each time. A layer's tables
     are timed without its filter (which depends on ``alpha`` only, as in :func:`layer_tables`).
     """
@@ -574,7 +574,7 @@ def measure_timings(alphas=(0.025, 0.1, 0.4), layers=None, repeats: int = 5) -> 
     }
 
 
-if __name__ == "__main__":  # python -m explorer.layered: print the timings
+if __name__ == "__main__":  # python -m explorer.physics.layered: print the timings
     timings = measure_timings()
     for alpha, ms in timings["transmission_filter_ms"].items():
         print(f"F_alpha, {alpha}: {ms:.1f} ms (goal 100 ms; the paper: 600 ms)")

@@ -36,7 +36,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import LocatedError
+from explorer.errors import LocatedError
 
 __all__ = [
     "LINE_STRIDE",

@@ -13,7 +13,7 @@ exactly the square ``u in [i, i + 1] / W``, ``v in [j, j + 1] / H`` (the mapping
 grid). The host computes the mean and variance of ``D_inc`` over it, by the midpoint rule on an
 ``S x S`` grid of the bilinear texture with ``S = ceil(4 max(W_t, H_t) / min(W, H))`` (4 samples per texel, at most 32),
 and hands both to the shader as a per-pixel texture; the shader shades the mean film with the Fourier
-table pre-filtered by that variance (:func:`explorer.thinfilm.fourier_rgb_prefiltered`).
+table pre-filtered by that variance (:func:`explorer.physics.thinfilm.fourier_rgb_prefiltered`).
 """
 
 from __future__ import annotations
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import LocatedError
-from .resources import DEFAULT_TEXTURE
+from explorer.errors import LocatedError
+from explorer.resources import DEFAULT_TEXTURE
 
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
@@ -55,7 +55,7 @@ def generate_default_texture(size: int = 128, seed: int = 5) -> np.ndarray:
 
 
 def write_default_texture(path: Path = DEFAULT_TEXTURE) -> Path:
-    """Write :func:`generate_default_texture` as an 8-bit grey PNG (``python -m explorer.thickness``)."""
+    """Write :func:`generate_default_texture` as an 8-bit grey PNG (``python -m explorer.views.thickness``)."""
     from PIL import Image
 
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -171,7 +171,7 @@ def check_prefilter(method: int, prefilter: bool) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from .resources import require_checkout
+    from explorer.resources import require_checkout
 
-    require_checkout("python -m explorer.thickness")
+    require_checkout("python -m explorer.views.thickness")
     print(write_default_texture())

@@ -7,7 +7,7 @@ missing, altered, or generated with other parameters than the code's: a stale ta
 The shipped tables (:data:`LUT_DIR`, see :mod:`explorer.resources`) are read-only: a stale one is
 regenerated into the user cache (``~/.cache/bragg-explorer/luts``) and read from there afterwards.
 
-Run ``python -m explorer.luts`` in a source checkout to regenerate the committed tables.
+Run ``python -m explorer.tables.luts`` in a source checkout to regenerate the committed tables.
 
 Tables
 ------
@@ -30,7 +30,7 @@ sensitivity_fourier
     within 6e-5 of the transform (2.5e-3 without demodulation). Shape ``(2, 4096, 3)``: real parts,
     imaginary parts (the paper's N x 2 three-channel texture, Section 5); zero beyond the last node.
 lobes_fgd_correction, lobes_ggx_moments
-    Belcour's (2018) FGD term for :mod:`explorer.lobes`: a rough dielectric interface's directional
+    Belcour's (2018) FGD term for :mod:`explorer.physics.lobes`: a rough dielectric interface's directional
     albedo minus the Fresnel term (unpolarised), over (eta, alpha, cos theta); and the GGX reflection
     lobe's albedo and mean half-angle cosine over (alpha, cos theta), for rough conductors.
 """
@@ -45,7 +45,8 @@ from typing import Callable
 
 import numpy as np
 
-from . import colorimetry, resources
+from explorer.physics import colorimetry
+from explorer import resources
 
 #: The shipped tables (read-only: see :func:`load`).
 LUT_DIR = resources.LUT_DIR
@@ -89,13 +90,13 @@ def _generate_sensitivity_fourier() -> np.ndarray:
 
 
 def _generate_lobes_fgd_correction() -> np.ndarray:
-    from .lobes_fgd import generate_fgd_correction  # the physics lives in explorer.lobes_fgd
+    from explorer.physics.lobes_fgd import generate_fgd_correction  # the physics lives in explorer.physics.lobes_fgd
 
     return generate_fgd_correction()
 
 
 def _generate_lobes_ggx_moments() -> np.ndarray:
-    from .lobes_fgd import generate_ggx_moments
+    from explorer.physics.lobes_fgd import generate_ggx_moments
 
     return generate_ggx_moments()
 
@@ -129,9 +130,9 @@ TABLES: dict[str, dict] = {
         "generate": _generate_lobes_fgd_correction,
         "spec": {
             "quantity": "FGD - Fresnel (unpolarised) of a rough GGX dielectric interface, eta x alpha x cos theta "
-            "(explorer.lobes; Belcour 2018's FGD term)",
+            "(explorer.physics.lobes; Belcour 2018's FGD term)",
             "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)",
-            "cos_theta": "t = linspace(0, 1, 33) of explorer.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
+            "cos_theta": "t = linspace(0, 1, 33) of explorer.physics.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
             "resolution_nm": None,  # no wavelength axis
             "shape": [33, 16, 33],
@@ -141,7 +142,7 @@ TABLES: dict[str, dict] = {
         "generate": _generate_lobes_ggx_moments,
         "spec": {
             "quantity": "GGX reflection lobe albedo (F = 1) and mean half-angle cosine, [E, cbar_d] x alpha x cos theta "
-            "(explorer.lobes: conductors' FGD ~ E F(cbar_d))",
+            "(explorer.physics.lobes: conductors' FGD ~ E F(cbar_d))",
             "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 33)",
             "quadrature": "48 x 48 midpoints of the GGX normal distribution",
             "resolution_nm": None,  # no wavelength axis
@@ -277,7 +278,7 @@ def cmf_cumulative_at(wavelength) -> np.ndarray:
 
 
 def main() -> int:
-    resources.require_checkout("python -m explorer.luts")  # an installation regenerates into cache_lut_dir()
+    resources.require_checkout("python -m explorer.tables.luts")  # an installation regenerates into cache_lut_dir()
     for name in TABLES:
         table = generate(name)
         print(f"luts/{name}.npy  shape {table.shape}  {_sha256(LUT_DIR / f'{name}.npy')[:16]}…")

@@ -1,6 +1,6 @@
 """
 The inverse method of Bati, Barla & Pacanowski (2021): from BRDF lobe properties at normal incidence
-(energy ``R_k``, RGB, and variance ``sigma_k``) to layer stacks of Belcour's model (:mod:`explorer.lobes`).
+(energy ``R_k``, RGB, and variance ``sigma_k``) to layer stacks of Belcour's model (:mod:`explorer.physics.lobes`).
 
 - Single lobes (Section 5): 1-layer dielectric (Eq. 7, or the FGD term inverted numerically when
   rough) and conductor (Eqs. 8-10) lobes; 2-layer lobes with absorption and roughness (Algorithm 1,
@@ -11,7 +11,7 @@ The inverse method of Bati, Barla & Pacanowski (2021): from BRDF lobe properties
   :func:`two_layer_class`), and a point of a class to a stack (:func:`invert_lobes` with ``choices``).
 
 Everything is computed with the forward model's own terms (its FGD tables and the statistics of the
-stack above, :func:`explorer.lobes.stack_statistics`), so that ``forward(inverse(lobes))`` reproduces
+stack above, :func:`explorer.physics.lobes.stack_statistics`), so that ``forward(inverse(lobes))`` reproduces
 the requested energies exactly and the variances exactly on the channel that sets each roughness.
 
 What is ours: the default point of each class (the upper dielectric root with ``tau = 0`` on the
@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import lobes
-from .lobes import ETA_MAX, roughness_from_variance, variance_from_roughness
+from explorer.physics import lobes
+from explorer.physics.lobes import ETA_MAX, roughness_from_variance, variance_from_roughness
 
 #: Bisection steps of the numerical inversions (relative precision 2^-60).
 BISECTION_STEPS = 60
@@ -424,7 +424,7 @@ def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
     for lobes under others), ``eta_top`` and ``tau_top`` (a 2-layer lobe's top interface and the medium
     above it), ``t`` in [0, 1] (a conductor's place between Eqs. 10 and 9). Unset, the defaults above.
 
-    ``tir``: the stack's TIR term (:class:`explorer.lobes.Stack`); the statistics of the layers above
+    ``tir``: the stack's TIR term (:class:`explorer.physics.lobes.Stack`); the statistics of the layers above
     then come with it, so the lobes are still reproduced exactly.
 
     Raises :class:`InverseError` (one line) naming the constraint that fails and the achievable range.

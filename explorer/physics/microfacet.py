@@ -11,7 +11,7 @@ difference angle ``theta_d`` between ``i`` and the microfacet normal by ``F_alph
 
 Conventions. Directions ``i`` and ``o`` are unit vectors (last axis of length 3) in the local frame of
 the layer, with the geometric normal ``n = +z``, both pointing away from the surface (Walter et al.
-2007). Angles are in radians. Spectra are sampled at :data:`explorer.colorimetry.WAVELENGTHS` (last
+2007). Angles are in radians. Spectra are sampled at :data:`explorer.physics.colorimetry.WAVELENGTHS` (last
 axis). ``alpha`` lies in [0, 1] (:func:`check_alpha`); ``alpha = 0``, a smooth mirror whose ``D`` is a
 Dirac, is evaluated as :data:`ALPHA_MIN`. Every function here is numpy only.
 
