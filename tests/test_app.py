@@ -31,7 +31,7 @@ WINDOW = "1000x720"
 @pytest.fixture(scope="session")
 def x_display():
     """A virtual X display for the session's app windows."""
-    from explorer.dev.xvfb import XvfbUnavailable, virtual_display
+    from explorer.app.xvfb import XvfbUnavailable, virtual_display
 
     try:
         context = virtual_display()

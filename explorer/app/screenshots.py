@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.cli.images import OutputError, write_image
+from explorer.views.images import OutputError, write_image
 from explorer.app.scheduler import Scheduler
 from explorer.app.state import AppState
 

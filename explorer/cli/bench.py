@@ -553,7 +553,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
 
     from explorer.app import App
     from explorer.resources import DEFAULT_MATERIAL
-    from explorer.dev.xvfb import display_environment
+    from explorer.app.xvfb import display_environment
 
     with display_environment() as display, tempfile.TemporaryDirectory() as directory:
         report = Path(directory) / "report.json"

@@ -18,7 +18,7 @@ import numpy as np
 
 from explorer.materials.brd import Material, MaterialError, load_material, parse_assignment, round_integer
 from explorer.errors import LocatedError
-from explorer.cli.images import OutputError, check_output, write_image
+from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
 
 PROG = "bragg-explorer"
