@@ -298,18 +298,85 @@ def bragg_reflectance(cos_theta, wavelength, mirror: BraggMirror, polarisation: 
     return total / len(polarisations)
 
 
-def reference_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
+def substeps_for(mirror: BraggMirror, cos_theta) -> int:
     """
-    The spectral reference: exact ``R_lambda`` at every nm from 360 to 830, both polarisations
-    averaged, integrated against the CMFs (Section 3.2.2), in linear sRGB.
+    The coarsest sampling (samples per nm) that resolves the mirror's fringes: ``N`` fringes per band,
+    bands ``pi / n_+`` apart in ``omega``, so fringes as if from an optical path ``2 N n_+``
+    (:func:`explorer.colorimetry.substeps_for_fringes`), ``n_+`` the largest over the angles.
+    """
+    n_plus = optical_thickness(cell_geometry(np.asarray(cos_theta, dtype=np.float64), mirror, "s"))
+    return colorimetry.substeps_for_fringes(2.0 * mirror.N * float(np.max(n_plus, initial=0.0)))
+
+
+def converged_reflectance_spectra(
+    cos_theta, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
+    passes: int = colorimetry.CONVERGENCE_PASSES,
+):
+    """
+    The unpolarised ``R_lambda`` averaged over each nm's hat function (:func:`explorer.colorimetry.hat_average`),
+    sampled finely enough that the colour has converged (:func:`explorer.colorimetry.converged_spectra`).
+
+    Near band edges the pass band's transmission resonances (Eq. 2's zeros of ``sin N K Lambda``) are
+    narrower than a nanometre and narrow further as ``N`` grows: point samples at every nm hit or miss
+    them, hat averages integrate them. ``spectra @ colour_matching_functions()`` is the integral of
+    ``R_lambda`` against the CMFs interpolated linearly between their 1-nm nodes.
+
+    Returns
+    -------
+    spectra : ndarray, shape ``(cos_theta.size, 471)``
+    substeps : ndarray of int, shape ``(cos_theta.size,)``
+        Samples per nm each angle needed.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    return colorimetry.converged_spectra(
+        lambda wavelengths, rows: reflectance_spectra(cos_theta[rows], mirror, wavelengths),
+        cos_theta.size,
+        substeps_min=substeps_for(mirror, cos_theta),
+        tolerance=tolerance,
+        passes=passes,
+    )
+
+
+def fixed_step_spectra(cos_theta, mirror: BraggMirror, step: float) -> np.ndarray:
+    """
+    Hat-averaged spectra from samples every ``1 / round(1 / step)`` nm, without refinement: what the
+    shader's method 0 computes with its parameter ``step`` (``step = 1``: the paper's 1-nm samples).
+    """
+    K = max(1, int(round(1.0 / float(step))))
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    fine = colorimetry._evaluate(
+        lambda wavelengths, rows: reflectance_spectra(cos_theta[rows], mirror, wavelengths),
+        colorimetry.fine_wavelengths(K),
+        np.arange(cos_theta.size),
+    )
+    return colorimetry.hat_average(fine, K)
+
+
+def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
+    """
+    The spectral reference: exact ``R_lambda`` (both polarisations averaged) integrated against the CMFs
+    (Section 3.2.2), in linear sRGB.
+
+    Parameters
+    ----------
+    cos_theta : array_like
+    mirror : BraggMirror
+    step : float, optional
+        ``None``: the converged integral (:func:`converged_reflectance_spectra`), the reference every
+        accuracy figure is measured against. A number: samples every ``1 / round(1 / step)`` nm against
+        the linearly interpolated CMFs; ``step = 1`` is the paper's sum over every nm from 360 to 830,
+        which is not converged for ``N`` of a few tens and more.
 
     Returns
     -------
     ndarray, shape ``cos_theta.shape + (3,)``
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
-    spectra = bragg_reflectance(cos_theta[..., None], colorimetry.WAVELENGTHS, mirror)
-    return colorimetry.spectrum_to_rgb(spectra)
+    if step is None:
+        spectra, _ = converged_reflectance_spectra(cos_theta, mirror)
+    else:
+        spectra = fixed_step_spectra(cos_theta, mirror, step)
+    return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -629,37 +696,85 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
 ROW_BLOCK = 32
 
 
-def reflectance_spectra(cos_theta, mirror: BraggMirror) -> np.ndarray:
+def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS) -> np.ndarray:
     """
-    Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every nm of
-    :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``; the host's tables.
+    Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every wavelength (nm; by default every nm
+    of :data:`explorer.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``.
 
     Angles where every wave propagates and ``nh == n1`` take the real fast path
     (:func:`_reflectance_real`), by blocks of rows; the others (total internal reflection, a host
     ``nh != n1``) the exact complex one.
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
-    omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
+    omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
     geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
     first = geometries[0]
     # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
     real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
     spectra = np.empty((cos_theta.size, omega.size))
     real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
-    for start in range(0, real_rows.size, ROW_BLOCK):
-        rows = real_rows[start : start + ROW_BLOCK]
+    block = max(1, ROW_BLOCK * 471 // max(omega.size, 1))
+    for start in range(0, real_rows.size, block):
+        rows = real_rows[start : start + block]
         spectra[rows] = _reflectance_real(omega, geometries, rows)
-    for start in range(0, other_rows.size, ROW_BLOCK):
-        rows = other_rows[start : start + ROW_BLOCK]
+    for start in range(0, other_rows.size, block):
+        rows = other_rows[start : start + block]
         spectra[rows] = sum(
             reflectance_polarised(omega, _rows(cell_geometry(cos_theta[rows], mirror, pol))) for pol in POLARISATIONS
         ) / len(POLARISATIONS)
     return spectra
 
 
-def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
-    """The spectral reference at ``cos theta = k / (size - 1)``, for the host to upload as a 1D texture."""
-    return colorimetry.spectrum_to_rgb(reflectance_spectra(np.linspace(0.0, 1.0, size), mirror)).astype(np.float32)
+#: The table's refinement: where linear interpolation between two entries may be off by more than this
+#: fraction of the brightest channel (estimated from the entries' second differences), the midpoint is
+#: computed, and the table doubles its resolution, up to :data:`TABLE_MAX_SIZE` entries.
+TABLE_TOLERANCE = 5e-4
+#: 256 entries refined four times.
+TABLE_MAX_SIZE = 16 * (TABLE_SIZE - 1) + 1
+
+
+def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
+    spectra, _ = converged_reflectance_spectra(cos_theta, mirror)
+    return colorimetry.spectrum_to_rgb(spectra)
+
+
+def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
+    """
+    Per interval of a uniform table, the largest error of linear interpolation, ``|f''| h^2 / 8``, from
+    the second differences at its two ends, relative to the brightest channel (floor 0.05).
+    """
+    second = np.abs(table[:-2] - 2.0 * table[1:-1] + table[2:]).max(axis=-1)
+    second = np.concatenate([second[:1], second, second[-1:]])
+    estimate = np.maximum(second[:-1], second[1:]) / 8.0
+    brightest = np.maximum(np.abs(table[:-1]).max(axis=-1), np.abs(table[1:]).max(axis=-1))
+    return estimate / np.maximum(brightest, colorimetry.CONVERGENCE_FLOOR)
+
+
+def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: int = TABLE_MAX_SIZE) -> np.ndarray:
+    """
+    The converged spectral reference (:func:`reference_rgb`) over ``cos theta`` in [0, 1], entry ``k`` of
+    ``n`` at ``cos theta = k / (n - 1)``, for the host to upload as a 1D texture.
+
+    ``size`` entries first; then, while some interval's interpolation error may exceed
+    :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), every interval is halved: its
+    midpoint computed where the estimate says so, interpolated linearly elsewhere (which leaves the
+    texture's lookups unchanged there). The resolution so follows the colour, which varies fastest
+    near Brewster's and the critical angles for large ``N``.
+    """
+    cos_theta = np.linspace(0.0, 1.0, size)
+    table = _converged_rgb(cos_theta, mirror)
+    while 2 * table.shape[0] - 1 <= max_size:
+        refine = _interpolation_error_estimate(table) > TABLE_TOLERANCE
+        if not refine.any():
+            break
+        midpoints = 0.5 * (cos_theta[:-1] + cos_theta[1:])
+        values = 0.5 * (table[:-1] + table[1:])
+        values[refine] = _converged_rgb(midpoints[refine], mirror)
+        finer = np.empty((2 * table.shape[0] - 1, 3))
+        finer[0::2], finer[1::2] = table, values
+        table = finer
+        cos_theta = np.linspace(0.0, 1.0, table.shape[0])
+    return table.astype(np.float32)
 
 
 def _rows(geometry: CellGeometry) -> CellGeometry:
