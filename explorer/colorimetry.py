@@ -144,6 +144,21 @@ MAX_SUBSTEPS = 1024
 CHUNK_SAMPLES = 1 << 18
 
 
+def colour_matching_functions_at(wavelength) -> np.ndarray:
+    """
+    The CMFs (:func:`colour_matching_functions`) interpolated linearly between their 1-nm nodes, zero
+    from :data:`HAT_LOW` and :data:`HAT_HIGH` outwards: ``sum_i c_i h_i(lambda)``.
+
+    Returns
+    -------
+    ndarray, shape ``wavelength.shape + (3,)``
+    """
+    nodes = np.concatenate([[HAT_LOW], WAVELENGTHS, [HAT_HIGH]])
+    values = np.vstack([np.zeros(3), colour_matching_functions(), np.zeros(3)])
+    wavelength = np.asarray(wavelength, dtype=np.float64)
+    return np.stack([np.interp(wavelength, nodes, values[:, c], left=0.0, right=0.0) for c in range(3)], axis=-1)
+
+
 def fine_wavelengths(substeps: int) -> np.ndarray:
     """The ``472 substeps + 1`` wavelengths ``359 + j / substeps`` nm that sample the hats' support."""
     return HAT_LOW + np.arange((WAVELENGTHS.size + 1) * substeps + 1) / substeps

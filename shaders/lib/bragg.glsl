@@ -14,6 +14,7 @@ const float OMEGA_LOW = 2.0 * PI / WAVELENGTH_HIGH;
 const float OMEGA_HIGH = 2.0 * PI / WAVELENGTH_LOW;
 const float COS_THETA_MIN = 1e-6;
 const float MAX_DECAY = 40.0;
+const int CHEBYSHEV_BITS = 10;  // binary powering up to N = 1023
 
 struct BraggMirror {
     float n1, n2, Lambda, delta, N, nh;
@@ -98,9 +99,13 @@ void chebyshev_U_d(float a, float d, float N, out float U_N1, out float U_N2, ou
         // low-precision polynomials, whose error sin(N t) would multiply by N.
         a = a >= 0.0 ? 1.0 - d : d - 1.0;
         float sin_t = sqrt(d * (2.0 - d));
+        // A constant trip count (N <= 1000 < 2^10), which compilers unroll: llvmpipe ends a shader's
+        // loops after 65535 iterations in all, and a fine-step spectral reference needs every one of them.
         vec2 z = vec2(a, sin_t), power = vec2(1.0, 0.0);
-        for (int n = int(N); n > 0; n >>= 1) {
-            if ((n & 1) != 0) power = cmul(power, z);
+        int n = int(N);
+        for (int bit = 0; bit < CHEBYSHEV_BITS; ++bit) {
+            if ((n >> bit) == 0) continue;
+            if (((n >> bit) & 1) != 0) power = cmul(power, z);
             z = cmul(z, z);
         }
         U_N1 = power.y / sin_t;                                    // sin(N t) / sin t
@@ -196,13 +201,21 @@ float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
                   reflectance_polarised(omega, cell_geometry(cos_theta, mirror, 1)));
 }
 
-// The spectral reference: R_lambda at every nm from 360 to 830, both polarisations, against the CMFs.
-vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
+// The spectral reference: R_lambda, both polarisations, sampled every 1/K nm with K = round(1 / step_nm),
+// against the CMFs interpolated linearly (explorer/bragg.py, reference_rgb with a step; the samples'
+// trapezoids against the hat functions of explorer/colorimetry.py). step_nm = 1: the paper's sum over every
+// nm from 360 to 830, which misses or hits the narrow resonances beside band edges for N of a few tens
+// and more; a finer step converges towards the integral (numpy's reference_rgb without a step).
+vec3 reference_rgb(float cos_theta, BraggMirror mirror, float step_nm) {
     CellGeometry g_s = cell_geometry(cos_theta, mirror, 0), g_p = cell_geometry(cos_theta, mirror, 1);
+    int K = max(1, int(floor(1.0 / step_nm + 0.5)));
+    float inverse_K = 1.0 / float(K);
     vec3 xyz = vec3(0.0);
     bool real = is_real_path(g_s);  // both polarisations then share the phases' trig
-    for (int i = 0; i < CMF_COUNT; ++i) {
-        float omega = 2.0 * PI / (CMF_FIRST_WAVELENGTH + float(i));
+    // The hats' support is (359, 831) nm: its end samples have zero weight.
+    for (int j = 1; j < (CMF_COUNT + 1) * K; ++j) {
+        float wavelength = CMF_FIRST_WAVELENGTH - 1.0 + float(j) * inverse_K;
+        float omega = 2.0 * PI / wavelength;
         float R;
         if (real) {
             vec4 h = half_angles(omega * g_s.p1.x, omega * g_s.p2.x);
@@ -210,10 +223,13 @@ vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
         } else {
             R = 0.5 * (reflectance_polarised(omega, g_s) + reflectance_polarised(omega, g_p));
         }
-        xyz += R * colour_matching_functions(i);
+        xyz += R * colour_matching_functions_at(wavelength);
     }
-    return xyz_to_rgb(xyz);
+    return xyz_to_rgb(xyz * inverse_K);
 }
+
+// The paper's 1-nm sum.
+vec3 reference_rgb(float cos_theta, BraggMirror mirror) { return reference_rgb(cos_theta, mirror, 1.0); }
 
 // ---- Envelope and landmarks (Section 3.2.1, Appendices A, B) -------------------------------------
 
