@@ -337,21 +337,6 @@ def converged_reflectance_spectra(
     )
 
 
-def fixed_step_spectra(cos_theta, mirror: BraggMirror, step: float) -> np.ndarray:
-    """
-    Hat-averaged spectra from samples every ``1 / round(1 / step)`` nm, without refinement: what the
-    shader's method 0 computes with its parameter ``step`` (``step = 1``: the paper's 1-nm samples).
-    """
-    K = max(1, int(round(1.0 / float(step))))
-    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
-    fine = colorimetry._evaluate(
-        lambda wavelengths, rows: reflectance_spectra(cos_theta[rows], mirror, wavelengths),
-        colorimetry.fine_wavelengths(K),
-        np.arange(cos_theta.size),
-    )
-    return colorimetry.hat_average(fine, K)
-
-
 def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
     """
     The spectral reference: exact ``R_lambda`` (both polarisations averaged) integrated against the CMFs
@@ -375,7 +360,10 @@ def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> 
     if step is None:
         spectra, _ = converged_reflectance_spectra(cos_theta, mirror)
     else:
-        spectra = fixed_step_spectra(cos_theta, mirror, step)
+        flat = cos_theta.ravel()
+        spectra = colorimetry.fixed_step_spectra(
+            lambda wavelengths, rows: reflectance_spectra(flat[rows], mirror, wavelengths), flat.size, step
+        )
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
 
 

@@ -202,6 +202,15 @@ def _evaluate(spectrum, wavelengths: np.ndarray, rows: np.ndarray) -> np.ndarray
     )
 
 
+def fixed_step_spectra(spectrum, row_count: int, step: float) -> np.ndarray:
+    """
+    Hat-averaged spectra from samples every ``1 / K`` nm, ``K = round(1 / step)``, without refinement
+    (``step = 1``: the 1-nm point samples themselves). ``spectrum`` as in :func:`converged_spectra`.
+    """
+    K = max(1, int(round(1.0 / float(step))))
+    return hat_average(_evaluate(spectrum, fine_wavelengths(K), np.arange(row_count)), K)
+
+
 def converged_spectra(
     spectrum,
     row_count: int,

@@ -127,3 +127,19 @@ def test_gl_fine_step_reference_equals_converged_numpy(gl_renderer, bragg_materi
     assert np.isfinite(gl).all()
     error = relative_error(gl.astype(np.float64), reference)
     assert error.max() <= GL_RTOL, (error.max(), np.degrees(np.arccos(cos_theta[0][error.argmax()])))
+
+
+def test_thin_film_reference_equals_brute_force_integral():
+    """A thick film (fringes 1-2 nm apart in the blue) and a thin one, on a dielectric and on a metal."""
+    cos_theta = np.cos(np.radians([0.0, 60.0, 85.0]))
+    cmf = colorimetry.colour_matching_functions()
+    nodes = np.arange(359.0, 832.0)
+    padded = np.vstack([np.zeros(3), cmf, np.zeros(3)])
+    wavelengths = np.linspace(359.0, 831.0, int(round(472.0 / BRUTE_FORCE_STEP)) + 1)
+    weights = np.stack([np.interp(wavelengths, nodes, padded[:, c]) for c in range(3)], axis=-1)
+    for film in ((1.0, 1.5, 1.2, 0.0, 20000.0), (1.0, 1.33, 1.9, 1.5, 550.0)):
+        eta_1, eta_2, eta_3, kappa_3, d = film
+        R = thinfilm.airy_reflectance(eta_1, eta_2, eta_3, kappa_3, cos_theta[:, None], d, wavelengths)
+        brute = colorimetry.xyz_to_rgb(np.trapezoid(R[:, :, None] * weights[None], wavelengths, axis=1))
+        converged = thinfilm.reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta, d)
+        assert relative_error(converged, brute).max() <= CONVERGED_RTOL, film
