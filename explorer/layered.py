@@ -201,13 +201,14 @@ def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
 
 def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
     """
-    Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta`` and every
-    nm of :data:`explorer.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``.
-
-    The core's :func:`explorer.bragg.reflectance_spectra`: its fast real path where every wave
-    propagates and ``nh == n1`` (exact to ~1e-5), the exact complex one elsewhere.
+    Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta``, averaged
+    over each nm of :data:`explorer.colorimetry.WAVELENGTHS` (its hat function), sampled finely enough
+    that the colour has converged (:func:`explorer.bragg.converged_reflectance_spectra`): shape
+    ``(n_angles, 471)``. Integrated against the 1-nm CMFs, a row gives the converged reference colour;
+    so does Eq. 28's transmissivity ``1 - R``, whose integral is linear in ``R``.
     """
-    return bragg.reflectance_spectra(cos_theta, mirror)
+    spectra, _ = bragg.converged_reflectance_spectra(cos_theta, mirror)
+    return spectra
 
 
 @functools.lru_cache(maxsize=8)

@@ -250,14 +250,39 @@ float reflectance_envelope(float omega, CellGeometry g) {
     return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
+// |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = (P + Q x) / (S + T x) with x = cot(N K Lambda)
+// spanning the real line with density 1 / (pi (1 + x^2)); by residues at x = i and at the root of
+// (S + T x)(S* + T* x) in the upper half plane.
+const float FRINGE_B_MIN = 1e-12;
+float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
+    vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
+    float sin_t = sqrt(max(1.0 - a * a, 0.0));
+    vec2 A = vec2(1.0, 0.0) - a * t_cell, B = sin_t * t_cell;
+    vec2 P = r1 + cmul(g.r_h1, A), Q = cmul(g.r_h1, B), S = A + cmul(g.r_h1, r1), T = B;
+    vec2 Pc = cconj(P), Qc = cconj(Q), Sc = cconj(S), Tc = cconj(T);
+    if (cabs2(B) <= FRINGE_B_MIN) return clamp(cabs2(P) / max(cabs2(S), 1e-30), 0.0, 1.0);
+    const vec2 I = vec2(0.0, 1.0);
+    vec2 residue_i = cdiv(cmul(P + cmul(Q, I), Pc + cmul(Qc, I)), cmul(cmul(S + cmul(T, I), Sc + cmul(Tc, I)), 2.0 * I));
+    vec2 z1 = -cdiv(S, T);
+    bool upper = z1.y > 0.0;
+    vec2 z = upper ? z1 : cconj(z1);
+    vec2 one_plus_z2 = vec2(1.0, 0.0) + cmul(z, z);
+    vec2 numerator = cmul(P + cmul(Q, z), Pc + cmul(Qc, z));
+    vec2 residue_z = upper ? cdiv(numerator, cmul(cmul(T, Sc + cmul(Tc, z)), one_plus_z2))
+                           : cdiv(numerator, cmul(cmul(S + cmul(T, z), Tc), one_plus_z2));
+    return clamp(cmul(2.0 * I, residue_i + residue_z).x, 0.0, 1.0);
+}
+
 // Yeh's R averaged over its fringes: 1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda) (ours).
+// Under a host nh != n1, the coherent average above.
 float reflectance_fringe_average(float omega, CellGeometry g) {
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
+    if (!g.host_is_n1) return fringe_average_under_host(r1, t1, omega, g, a);
     float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
     float denominator = cabs2(r1) + t1_2_sin2;
-    return under_host(denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0, g);
+    return denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0;
 }
 
 // Appendix B: w~ = w~0 + (1 - w~0)(1 - cos theta_1)^5, w~0 = 0.735 R12 + 0.532.
