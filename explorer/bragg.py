@@ -23,6 +23,7 @@ Yeh (1988). Optical Waves in Layered Media, Chapter 6.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Iterator
 
@@ -298,6 +299,12 @@ def bragg_reflectance(cos_theta, wavelength, mirror: BraggMirror, polarisation: 
     return total / len(polarisations)
 
 
+def _spectra(cos_theta, mirror: BraggMirror, wavelengths, fast: bool) -> np.ndarray:
+    if fast:
+        return reflectance_spectra(cos_theta, mirror, wavelengths)
+    return bragg_reflectance(np.asarray(cos_theta)[:, None], wavelengths, mirror)
+
+
 def substeps_for(mirror: BraggMirror, cos_theta) -> int:
     """
     The coarsest sampling (samples per nm) that resolves the mirror's fringes: ``N`` fringes per band,
@@ -310,7 +317,7 @@ def substeps_for(mirror: BraggMirror, cos_theta) -> int:
 
 def converged_reflectance_spectra(
     cos_theta, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
-    passes: int = colorimetry.CONVERGENCE_PASSES,
+    passes: int = colorimetry.CONVERGENCE_PASSES, fast: bool = True, substeps_max: int = colorimetry.MAX_SUBSTEPS,
 ):
     """
     The unpolarised ``R_lambda`` averaged over each nm's hat function (:func:`explorer.colorimetry.hat_average`),
@@ -321,20 +328,27 @@ def converged_reflectance_spectra(
     them, hat averages integrate them. ``spectra @ colour_matching_functions()`` is the integral of
     ``R_lambda`` against the CMFs interpolated linearly between their 1-nm nodes.
 
+    ``fast``: the tables' real float32 path where it applies (:func:`reflectance_spectra`, ~1e-5);
+    otherwise Yeh's exact complex float64 reflectance (:func:`bragg_reflectance`), as :func:`reference_rgb` uses.
+    ``substeps_max`` caps the refinement (samples per nm).
+
     Returns
     -------
     spectra : ndarray, shape ``(cos_theta.size, 471)``
     substeps : ndarray of int, shape ``(cos_theta.size,)``
         Samples per nm each angle needed.
     """
-    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
-    return colorimetry.converged_spectra(
-        lambda wavelengths, rows: reflectance_spectra(cos_theta[rows], mirror, wavelengths),
+    # Each distinct angle once (a view's pixels share a few: the slice view's rows, a sphere's symmetry).
+    cos_theta, inverse = np.unique(np.asarray(cos_theta, dtype=np.float64).ravel(), return_inverse=True)
+    spectra, substeps = colorimetry.converged_spectra(
+        lambda wavelengths, rows: _spectra(cos_theta[rows], mirror, wavelengths, fast),
         cos_theta.size,
-        substeps_min=substeps_for(mirror, cos_theta),
+        substeps_min=min(substeps_for(mirror, cos_theta), substeps_max),
         tolerance=tolerance,
         passes=passes,
+        substeps_max=substeps_max,
     )
+    return spectra[inverse.ravel()], substeps[inverse.ravel()]
 
 
 def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
@@ -358,11 +372,11 @@ def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> 
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     if step is None:
-        spectra, _ = converged_reflectance_spectra(cos_theta, mirror)
+        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, fast=False)
     else:
         flat = cos_theta.ravel()
         spectra = colorimetry.fixed_step_spectra(
-            lambda wavelengths, rows: reflectance_spectra(flat[rows], mirror, wavelengths), flat.size, step
+            lambda wavelengths, rows: _spectra(flat[rows], mirror, wavelengths, fast=False), flat.size, step
         )
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
 
@@ -789,6 +803,7 @@ def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
     return estimate / np.maximum(brightest, colorimetry.CONVERGENCE_FLOOR)
 
 
+@functools.lru_cache(maxsize=32)
 def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: int = TABLE_MAX_SIZE) -> np.ndarray:
     """
     The converged spectral reference (:func:`reference_rgb`) over ``cos theta`` in [0, 1], entry ``k`` of
@@ -798,7 +813,7 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
     :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), every interval is halved: its
     midpoint computed where the estimate says so, interpolated linearly elsewhere (which leaves the
     texture's lookups unchanged there). The resolution so follows the colour, which varies fastest
-    near Brewster's and the critical angles for large ``N``.
+    near Brewster's and the critical angles for large ``N``. Cached per mirror (32 of them).
     """
     cos_theta = np.linspace(0.0, 1.0, size)
     table = _converged_rgb(cos_theta, mirror)
@@ -813,7 +828,9 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
         finer[0::2], finer[1::2] = table, values
         table = finer
         cos_theta = np.linspace(0.0, 1.0, table.shape[0])
-    return table.astype(np.float32)
+    table = table.astype(np.float32)
+    table.setflags(write=False)  # cached (a mirror's table is rebuilt in seconds for large N): read-only
+    return table
 
 
 def _rows(geometry: CellGeometry) -> CellGeometry:

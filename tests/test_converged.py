@@ -143,3 +143,20 @@ def test_thin_film_reference_equals_brute_force_integral():
         brute = colorimetry.xyz_to_rgb(np.trapezoid(R[:, :, None] * weights[None], wavelengths, axis=1))
         converged = thinfilm.reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta, d)
         assert relative_error(converged, brute).max() <= CONVERGED_RTOL, film
+
+
+#: Method 4 (s = 3) under a host: the median ΔE2000 over theta the issue asks for.
+HOST_IMPROVED_MEDIAN_DE = 2.0
+
+
+def test_improved_method_under_a_host_median_delta_E():
+    """Water-like layers in air (n1 = 1.33, n2 = 1.8, nh = 1) on the Figure 4 grid, against the converged reference."""
+    cos_theta = np.cos(np.radians(np.linspace(0.0, 89.5, 46)))
+    medians = {}
+    for Lambda, delta in FIGURE4:
+        mirror = bragg.BraggMirror(1.33, 1.8, Lambda, delta, 20, nh=1.0)
+        dE = colorimetry.delta_E_2000(bragg.reference_rgb(cos_theta, mirror), bragg.approximate_rgb(cos_theta, mirror, 3, variant="improved"))
+        assert np.isfinite(dE).all()
+        medians[(Lambda, delta)] = float(np.median(dE))
+    too_high = {k: round(v, 2) for k, v in medians.items() if v > HOST_IMPROVED_MEDIAN_DE}
+    assert not too_high, too_high
