@@ -200,7 +200,8 @@ def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
 
 
 #: The layer tables' finest sampling (samples per nm): their colours converge to 2e-4 up to N ~ 100 and
-#: stay within ~1e-3 at N = 1000, where finer samplings would cost tens of seconds per layer.
+#: stay within ~1e-3 at N = 1000, where finer samplings would cost tens of seconds per layer. They stop
+#: at the first halving that changes the colour by less than 2e-4 (one pass: half the cost of two).
 LAYER_MAX_SUBSTEPS = 64
 
 
@@ -213,7 +214,7 @@ def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
     1-nm CMFs, a row gives the converged reference colour; so does Eq. 28's transmissivity ``1 - R``,
     whose integral is linear in ``R``.
     """
-    spectra, _ = bragg.converged_reflectance_spectra(cos_theta, mirror, substeps_max=LAYER_MAX_SUBSTEPS)
+    spectra, _ = bragg.converged_reflectance_spectra(cos_theta, mirror, passes=1, substeps_max=LAYER_MAX_SUBSTEPS)
     return spectra
 
 
