@@ -336,13 +336,13 @@ def format_thin_film(document: dict) -> str:
     """The thin-film tables: ΔE2000 per configuration and method, and the relative frame times."""
     methods = [name for name, _ in THIN_FILM_METHODS[1:]] + ["1-nm sum"]
     lines = ["Thin film: median / max ΔE2000 against the converged spectral reference over θ ∈ [0°, 89.5°]", ""]
-    header = f"{'configuration':<22}" + "".join(f"{m:>15}" for m in methods)
+    header = f"{'configuration':<22}" + "".join(f"{m:>17}" for m in methods)
     lines += [header, "-" * len(header)]
     cells: dict[str, dict[str, str]] = {}
     for row in document["accuracy"]:
         cells.setdefault(row["configuration"], {})[row["method"]] = f"{row['dE_median']:.2g} / {row['dE_max']:.2g}"
     for configuration, row in cells.items():
-        lines.append(f"{configuration:<22}" + "".join(f"{row[m]:>15}" for m in methods))
+        lines.append(f"{configuration:<22}" + "".join(f"{row[m]:>17}" for m in methods))
     size = document["size"]
     lines += ["", f"Frame time of a {size}x{size} lit sphere (Figure 7 film) on {document['device']}, relative to GGX + Schlick", ""]
     for row in document["timing"]:
