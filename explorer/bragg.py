@@ -428,12 +428,12 @@ def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
     closed form. It equals 1 at band edges and ``~ R^e / 2`` for weak contrast (what the paper's
     empirical ``w~0 ~ 0.53`` of Appendix B approximates). Our improvement, not in the paper.
 
-    Under a host ``nh != n1`` (Appendix D): the coherent average of :func:`_fringe_average_under_host`.
+    Under a host ``nh != n1`` (Appendix D): the coherent average of :func:`fringe_average_under_host`.
     """
     r1, t1 = airy_slab_coefficients(omega, geometry)
     a = cos_K_Lambda(omega, geometry)
     if not geometry.host_is_n1:
-        return _fringe_average_under_host(r1, t1, omega, geometry, a)
+        return fringe_average_under_host(r1, t1, omega, geometry, a)
     t1_2_sin2 = np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0)
     denominator = np.abs(r1) ** 2 + t1_2_sin2
     ratio = np.divide(t1_2_sin2, denominator, out=np.ones_like(denominator), where=denominator > 0.0)
@@ -444,7 +444,7 @@ def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
 FRINGE_B_MIN = 1e-12
 
 
-def _fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.ndarray:
+def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.ndarray:
     """
     ``|r_hN|^2`` (Appendix D) averaged over the fringes, coherently: the host's interface reflects in
     phase with the mirror, and the incoherent :func:`under_host` misses a slow modulation of up to
