@@ -300,9 +300,7 @@ def bragg_reflectance(cos_theta, wavelength, mirror: BraggMirror, polarisation: 
 
 
 def _spectra(cos_theta, mirror: BraggMirror, wavelengths, fast: bool) -> np.ndarray:
-    if fast:
-        return reflectance_spectra(cos_theta, mirror, wavelengths)
-    return bragg_reflectance(np.asarray(cos_theta)[:, None], wavelengths, mirror)
+    return reflectance_spectra(cos_theta, mirror, wavelengths, float64=not fast)
 
 
 def substeps_for(mirror: BraggMirror, cos_theta) -> int:
@@ -329,7 +327,8 @@ def converged_reflectance_spectra(
     ``R_lambda`` against the CMFs interpolated linearly between their 1-nm nodes.
 
     ``fast``: the tables' real float32 path where it applies (:func:`reflectance_spectra`, ~1e-5);
-    otherwise Yeh's exact complex float64 reflectance (:func:`bragg_reflectance`), as :func:`reference_rgb` uses.
+    otherwise float64 throughout (to ~1e-12 of Yeh's complex :func:`bragg_reflectance`), as
+    :func:`reference_rgb` uses.
     ``substeps_max`` caps the refinement (samples per nm).
 
     Returns
@@ -338,8 +337,10 @@ def converged_reflectance_spectra(
     substeps : ndarray of int, shape ``(cos_theta.size,)``
         Samples per nm each angle needed.
     """
-    # Each distinct angle once (a view's pixels share a few: the slice view's rows, a sphere's symmetry).
-    cos_theta, inverse = np.unique(np.asarray(cos_theta, dtype=np.float64).ravel(), return_inverse=True)
+    # Each distinct angle once (a view's pixels share a few: the slice view's rows, a sphere's symmetry),
+    # up to 1e-12 in cos theta (pixels compute the same angle with different roundings; the colour moves
+    # by ~1e-11 over such a step).
+    cos_theta, inverse = np.unique(np.round(np.asarray(cos_theta, dtype=np.float64).ravel(), 12), return_inverse=True)
     spectra, substeps = colorimetry.converged_spectra(
         lambda wavelengths, rows: _spectra(cos_theta[rows], mirror, wavelengths, fast),
         cos_theta.size,
@@ -709,7 +710,7 @@ TABLE_SIZE = 256
 FLOAT32_MAX_N = 100
 
 
-def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows) -> np.ndarray:
+def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows, float64: bool = False) -> np.ndarray:
     """
     Unpolarised Eqs. 2, 8, 9, 10 in real (float32) arithmetic, for angles where every wave propagates
     and ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-5, several times faster (the
@@ -717,9 +718,10 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
     their sines and cosines. With Eq. 2's own term ``Q = (sin K Lambda / sin N K Lambda)^2`` (Eq. 9's
     sinh ratio in band gaps), ``R = |r1|^2 / (|r1|^2 + |t1|^2 Q)``, where
     ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels).
-    float64 above :data:`FLOAT32_MAX_N` cells.
+    float64 above :data:`FLOAT32_MAX_N` cells, or when ``float64`` (the reference: then equal to the
+    complex path to ~1e-12, several times faster).
     """
-    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N else np.float64
+    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N and not float64 else np.float64
     omega = omega.astype(f32)
     first = geometries[0]
     psi = omega * first.p1.real[rows, None].astype(f32)
@@ -749,7 +751,7 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
 ROW_BLOCK = 32
 
 
-def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS) -> np.ndarray:
+def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS, float64: bool = False) -> np.ndarray:
     """
     Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every wavelength (nm; by default every nm
     of :data:`explorer.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``.
@@ -769,7 +771,7 @@ def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.
     block = max(1, ROW_BLOCK * 471 // max(omega.size, 1))
     for start in range(0, real_rows.size, block):
         rows = real_rows[start : start + block]
-        spectra[rows] = _reflectance_real(omega, geometries, rows)
+        spectra[rows] = _reflectance_real(omega, geometries, rows, float64)
     for start in range(0, other_rows.size, block):
         rows = other_rows[start : start + block]
         spectra[rows] = sum(
