@@ -142,6 +142,8 @@ CONVERGENCE_FLOOR = 0.05
 MAX_SUBSTEPS = 1024
 #: Samples (rows x wavelengths) per call of a spectrum function: bounds the temporaries' memory.
 CHUNK_SAMPLES = 1 << 18
+#: Samples kept per block of rows while refining (float64: 128 MB).
+MAX_BLOCK_SAMPLES = 1 << 24
 
 
 def colour_matching_functions_at(wavelength) -> np.ndarray:
@@ -258,6 +260,15 @@ def converged_spectra(
         colour = xyz_to_rgb(averaged @ colour_matching_functions())
         streak = np.zeros(active.size, dtype=int)
         while active.size and K < substeps_max:
+            if active.size > 1 and active.size * fine.shape[-1] * 2 > MAX_BLOCK_SAMPLES:
+                # Too many samples to refine these rows together: refine them in halves, from this sampling.
+                for half in np.array_split(active, 2):
+                    sub_spectra, sub_substeps = converged_spectra(
+                        lambda wavelengths, sub_rows, half=half: spectrum(wavelengths, half[sub_rows]),
+                        half.size, K, tolerance, passes, substeps_max,
+                    )
+                    result[half], substeps[half] = sub_spectra, sub_substeps
+                break
             midpoints = HAT_LOW + (np.arange((WAVELENGTHS.size + 1) * K) + 0.5) / K
             finer = np.empty((active.size, 2 * fine.shape[-1] - 1))
             finer[:, 0::2] = fine
