@@ -443,6 +443,8 @@ def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
 
 #: Below this |B|^2 the fringes' weight vanishes and the average is its limit |P / S|^2.
 FRINGE_B_MIN = 1e-12
+#: A pole of r_hN on the real x axis (never for real indices) is moved off it by this much.
+FRINGE_Q_MIN = 1e-6
 
 
 def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.ndarray:
@@ -454,10 +456,13 @@ def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.nd
     With ``u = N K Lambda``, ``U_{N-1} = sin u / sin t`` and ``U_{N-2} = (sin u cos t - cos u sin t) / sin t``
     (``t = K Lambda`` held fixed over a fringe), Appendix D's ``r_N = r1 / (A + B x)`` where ``x = cot u``,
     ``A = 1 - cos t t_cell`` and ``B = sin t t_cell``; then ``r_hN = (P + Q x) / (S + T x)`` with
-    ``P = r1 + r_h1 A``, ``Q = r_h1 B``, ``S = A + r_h1 r1``, ``T = B``. As ``u`` sweeps a fringe, ``x``
-    sweeps the real line with density ``1 / (pi (1 + x^2))``, so the average is
-    ``(1 / pi) int |P + Q x|^2 / (|S + T x|^2 (1 + x^2)) dx``, by residues in the upper half plane at
-    ``x = i`` and at the root of ``(S + T x)(S* + T* x)`` there.
+    ``P = r1 + r_h1 A``, ``Q = r_h1 B``, ``S = A + r_h1 r1``, ``T = B``, i.e. ``alpha + beta / (x - z)``
+    with ``alpha = Q / T``, ``beta = (P T - Q S) / T^2``, ``z = -S / T = p + i q``. As ``u`` sweeps a fringe,
+    ``x`` sweeps the real line with the Cauchy density ``1 / (pi (1 + x^2))``, whose averages are
+    ``<1 / (x - z)> = 1 / (-i sign(q) - z)`` and ``<1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2))``
+    (two Cauchy densities convolved): so ``<|r_hN|^2> = |alpha|^2 + 2 Re(alpha* beta <1 / (x - z)>) +
+    |beta|^2 <1 / |x - z|^2>``. For a lossless cell ``z`` lies on the imaginary axis, ``|z| >= 1``: no
+    term is singular, also where the cell barely reflects.
     """
     t_cell = t1 * np.exp(1j * omega * geometry.p1)
     sin_t = np.sqrt(np.maximum(1.0 - a * a, 0.0))
@@ -465,20 +470,17 @@ def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.nd
     B = sin_t * t_cell
     r_h1 = geometry.r_h1
     P, Q, S, T = r1 + r_h1 * A, r_h1 * B, A + r_h1 * r1, B
-    Pc, Qc, Sc, Tc = np.conj(P), np.conj(Q), np.conj(S), np.conj(T)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        residue_i = (P + Q * 1j) * (Pc + Qc * 1j) / ((S + T * 1j) * (Sc + Tc * 1j) * 2j)
-        z1 = -S / T  # the root of S + T x; its conjugate is the root of S* + T* x
-        upper = np.imag(z1) > 0.0
-        z = np.where(upper, z1, np.conj(z1))
-        residue_z = np.where(
-            upper,
-            (P + Q * z) * (Pc + Qc * z) / (T * (Sc + Tc * z) * (1.0 + z * z)),
-            (P + Q * z) * (Pc + Qc * z) / ((S + T * z) * Tc * (1.0 + z * z)),
-        )
-        average = np.real(2j * (residue_i + residue_z))
+    fringes = np.abs(B) ** 2 > FRINGE_B_MIN
+    T = np.where(fringes, T, 1.0)
+    alpha, beta, z = Q / T, (P * T - Q * S) / T**2, -S / T
+    p, q = np.real(z), np.abs(np.imag(z))
+    q = np.maximum(q, FRINGE_Q_MIN)
+    mean_pole = 1.0 / (1j * np.where(np.imag(z) > 0.0, -1.0, 1.0) - z)
+    mean_pole_2 = (1.0 + q) / (q * ((1.0 + q) ** 2 + p * p))
+    average = np.abs(alpha) ** 2 + 2.0 * np.real(np.conj(alpha) * beta * mean_pole) + np.abs(beta) ** 2 * mean_pole_2
+    # At a band edge (sin t -> 0) the fringes' weight vanishes: the limit |P / S|^2.
     limit = np.abs(P) ** 2 / np.maximum(np.abs(S) ** 2, 1e-300)
-    return np.clip(np.where(np.abs(B) ** 2 > FRINGE_B_MIN, average, limit), 0.0, 1.0)
+    return np.clip(np.where(fringes, average, limit), 0.0, 1.0)
 
 
 def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:

@@ -68,7 +68,9 @@ FIGURE4_PAPER_MEDIAN_DE = 10.0
 FIGURE4_PAPER_MAX_DE = 25.0
 #: Tabulated method: table nodes against the reference (float32 fast path), and linear interpolation
 #: between nodes on smooth mirrors away from grazing incidence.
-TABLE_NODE_ATOL = 1e-4
+#: The table at its nodes against the reference: both converged, independently (float32 and float64
+#: samples, the table's capped at 1/128 nm), each to 2e-4 of the colour's brightest channel.
+TABLE_NODE_ATOL = 5e-4
 TABLE_INTERPOLATION_ATOL = 2e-3
 #: Below this cos(theta) (theta > 87.1 deg) the colour curves too fast for a 256-entry table.
 TABLE_INTERPOLATION_COS_MIN = 0.05

@@ -250,27 +250,24 @@ float reflectance_envelope(float omega, CellGeometry g) {
     return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
-// |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = (P + Q x) / (S + T x) with x = cot(N K Lambda)
-// spanning the real line with density 1 / (pi (1 + x^2)); by residues at x = i and at the root of
-// (S + T x)(S* + T* x) in the upper half plane.
+// |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
+// spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
+// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/bragg.py has the derivation).
 const float FRINGE_B_MIN = 1e-12;
+const float FRINGE_Q_MIN = 1e-6;
 float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
     vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
     float sin_t = sqrt(max(1.0 - a * a, 0.0));
     vec2 A = vec2(1.0, 0.0) - a * t_cell, B = sin_t * t_cell;
     vec2 P = r1 + cmul(g.r_h1, A), Q = cmul(g.r_h1, B), S = A + cmul(g.r_h1, r1), T = B;
-    vec2 Pc = cconj(P), Qc = cconj(Q), Sc = cconj(S), Tc = cconj(T);
+    // At a band edge (sin t -> 0) the fringes' weight vanishes: the limit |P / S|^2.
     if (cabs2(B) <= FRINGE_B_MIN) return clamp(cabs2(P) / max(cabs2(S), 1e-30), 0.0, 1.0);
-    const vec2 I = vec2(0.0, 1.0);
-    vec2 residue_i = cdiv(cmul(P + cmul(Q, I), Pc + cmul(Qc, I)), cmul(cmul(S + cmul(T, I), Sc + cmul(Tc, I)), 2.0 * I));
-    vec2 z1 = -cdiv(S, T);
-    bool upper = z1.y > 0.0;
-    vec2 z = upper ? z1 : cconj(z1);
-    vec2 one_plus_z2 = vec2(1.0, 0.0) + cmul(z, z);
-    vec2 numerator = cmul(P + cmul(Q, z), Pc + cmul(Qc, z));
-    vec2 residue_z = upper ? cdiv(numerator, cmul(cmul(T, Sc + cmul(Tc, z)), one_plus_z2))
-                           : cdiv(numerator, cmul(cmul(S + cmul(T, z), Tc), one_plus_z2));
-    return clamp(cmul(2.0 * I, residue_i + residue_z).x, 0.0, 1.0);
+    vec2 alpha = cdiv(Q, T), beta = cdiv(cmul(P, T) - cmul(Q, S), cmul(T, T)), z = -cdiv(S, T);
+    float p = z.x, q = max(abs(z.y), FRINGE_Q_MIN);
+    vec2 mean_pole = cinv(vec2(0.0, z.y > 0.0 ? -1.0 : 1.0) - z);
+    float mean_pole_2 = (1.0 + q) / (q * ((1.0 + q) * (1.0 + q) + p * p));
+    float average = cabs2(alpha) + 2.0 * cmul(cconj(alpha), cmul(beta, mean_pole)).x + cabs2(beta) * mean_pole_2;
+    return clamp(average, 0.0, 1.0);
 }
 
 // Yeh's R averaged over its fringes: 1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda) (ours).
