@@ -788,6 +788,9 @@ def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.
 TABLE_TOLERANCE = 5e-4
 #: 256 entries refined four times.
 TABLE_MAX_SIZE = 16 * (TABLE_SIZE - 1) + 1
+#: At most this many midpoints computed in all: mirrors whose colour the table cannot follow anyway
+#: (fringes unresolved at any sampling, e.g. N = 1000 and Lambda = 1500 nm) stop refining early.
+TABLE_MAX_REFINED = 2 * (TABLE_SIZE - 1)
 
 
 #: The table's finest sampling (samples per nm): N ~ 100 mirrors converge well before it; at N = 1000 the
@@ -822,14 +825,17 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
     :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), every interval is halved: its
     midpoint computed where the estimate says so, interpolated linearly elsewhere (which leaves the
     texture's lookups unchanged there). The resolution so follows the colour, which varies fastest
-    near Brewster's and the critical angles for large ``N``. Cached per mirror (32 of them).
+    near Brewster's and the critical angles for large ``N``, within :data:`TABLE_MAX_REFINED` computed
+    midpoints. Cached per mirror (32 of them).
     """
     cos_theta = np.linspace(0.0, 1.0, size)
     table = _converged_rgb(cos_theta, mirror)
+    budget = TABLE_MAX_REFINED
     while 2 * table.shape[0] - 1 <= max_size:
         refine = _interpolation_error_estimate(table) > TABLE_TOLERANCE
-        if not refine.any():
+        if not refine.any() or refine.sum() > budget:
             break
+        budget -= int(refine.sum())
         midpoints = 0.5 * (cos_theta[:-1] + cos_theta[1:])
         values = 0.5 * (table[:-1] + table[1:])
         values[refine] = _converged_rgb(midpoints[refine], mirror)
