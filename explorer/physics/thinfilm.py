@@ -697,15 +697,20 @@ def _with_axis(*arrays):
     return tuple(np.asarray(a, dtype=np.float64)[..., None] for a in arrays)
 
 
-def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d) -> np.ndarray:
+def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, step: float | None = None) -> np.ndarray:
     """
-    The spectral reference: the exact Airy reflectance at every nm from 360 to 830, both polarisations
-    averaged, integrated against the CMFs (:mod:`explorer.physics.colorimetry`), in linear sRGB.
+    The spectral reference: the exact Airy reflectance, both polarisations averaged, integrated against
+    the CMFs (:mod:`explorer.physics.colorimetry`), in linear sRGB.
 
     Parameters
     ----------
     eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d : array_like
         As in :func:`airy_reflectance`, broadcast against each other.
+    step : float, optional
+        ``None``: the converged integral against the CMFs interpolated linearly
+        (:func:`explorer.physics.colorimetry.converged_spectra`; a thick film's fringes are narrower than a
+        nanometre). A number: samples every ``1 / round(1 / step)`` nm; ``step = 1`` is the paper's
+        sum over every nm from 360 to 830, what the shader's method 0 computes.
 
     Returns
     -------
@@ -716,8 +721,20 @@ def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d) -> np.
     Belcour & Barla (2017), Eq. 4 with a 1 nm step (their ground truth, Section 4).
     """
     validate_film(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d)
-    spectra = airy_reflectance(*_with_axis(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d), colorimetry.WAVELENGTHS)
-    return colorimetry.spectrum_to_rgb(spectra)
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d)))
+    shape, flat = arrays[0].shape, [a.ravel() for a in arrays]
+
+    def spectrum(wavelengths, rows):
+        return airy_reflectance(*(a[rows][:, None] for a in flat), wavelengths)
+
+    count = flat[0].size
+    if step is None:
+        # Fringes as from the optical path 2 eta_2 d cos theta_2 <= 2 eta_2 d.
+        path = 2.0 * float(np.max(flat[1] * flat[5], initial=0.0))
+        spectra, _ = colorimetry.converged_spectra(spectrum, count, substeps_min=colorimetry.substeps_for_fringes(path))
+    else:
+        spectra = colorimetry.fixed_step_spectra(spectrum, count, step)
+    return colorimetry.spectrum_to_rgb(spectra).reshape(shape + (3,))
 
 
 def naive_rgb(

@@ -14,6 +14,7 @@ const float OMEGA_LOW = 2.0 * PI / WAVELENGTH_HIGH;
 const float OMEGA_HIGH = 2.0 * PI / WAVELENGTH_LOW;
 const float COS_THETA_MIN = 1e-6;
 const float MAX_DECAY = 40.0;
+const int CHEBYSHEV_BITS = 10;  // binary powering up to N = 1023
 
 struct BraggMirror {
     float n1, n2, Lambda, delta, N, nh;
@@ -98,9 +99,13 @@ void chebyshev_U_d(float a, float d, float N, out float U_N1, out float U_N2, ou
         // low-precision polynomials, whose error sin(N t) would multiply by N.
         a = a >= 0.0 ? 1.0 - d : d - 1.0;
         float sin_t = sqrt(d * (2.0 - d));
+        // A constant trip count (N <= 1000 < 2^10), which compilers unroll: llvmpipe ends a shader's
+        // loops after 65535 iterations in all, and a fine-step spectral reference needs every one of them.
         vec2 z = vec2(a, sin_t), power = vec2(1.0, 0.0);
-        for (int n = int(N); n > 0; n >>= 1) {
-            if ((n & 1) != 0) power = cmul(power, z);
+        int n = int(N);
+        for (int bit = 0; bit < CHEBYSHEV_BITS; ++bit) {
+            if ((n >> bit) == 0) continue;
+            if (((n >> bit) & 1) != 0) power = cmul(power, z);
             z = cmul(z, z);
         }
         U_N1 = power.y / sin_t;                                    // sin(N t) / sin t
@@ -196,13 +201,21 @@ float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
                   reflectance_polarised(omega, cell_geometry(cos_theta, mirror, 1)));
 }
 
-// The spectral reference: R_lambda at every nm from 360 to 830, both polarisations, against the CMFs.
-vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
+// The spectral reference: R_lambda, both polarisations, sampled every 1/K nm with K = round(1 / step_nm),
+// against the CMFs interpolated linearly (explorer/bragg.py, reference_rgb with a step; the samples'
+// trapezoids against the hat functions of explorer/colorimetry.py). step_nm = 1: the paper's sum over every
+// nm from 360 to 830, which misses or hits the narrow resonances beside band edges for N of a few tens
+// and more; a finer step converges towards the integral (numpy's reference_rgb without a step).
+vec3 reference_rgb(float cos_theta, BraggMirror mirror, float step_nm) {
     CellGeometry g_s = cell_geometry(cos_theta, mirror, 0), g_p = cell_geometry(cos_theta, mirror, 1);
+    int K = max(1, int(floor(1.0 / step_nm + 0.5)));
+    float inverse_K = 1.0 / float(K);
     vec3 xyz = vec3(0.0);
     bool real = is_real_path(g_s);  // both polarisations then share the phases' trig
-    for (int i = 0; i < CMF_COUNT; ++i) {
-        float omega = 2.0 * PI / (CMF_FIRST_WAVELENGTH + float(i));
+    // The hats' support is (359, 831) nm: its end samples have zero weight.
+    for (int j = 1; j < (CMF_COUNT + 1) * K; ++j) {
+        float wavelength = CMF_FIRST_WAVELENGTH - 1.0 + float(j) * inverse_K;
+        float omega = 2.0 * PI / wavelength;
         float R;
         if (real) {
             vec4 h = half_angles(omega * g_s.p1.x, omega * g_s.p2.x);
@@ -210,10 +223,13 @@ vec3 reference_rgb(float cos_theta, BraggMirror mirror) {
         } else {
             R = 0.5 * (reflectance_polarised(omega, g_s) + reflectance_polarised(omega, g_p));
         }
-        xyz += R * colour_matching_functions(i);
+        xyz += R * colour_matching_functions_at(wavelength);
     }
-    return xyz_to_rgb(xyz);
+    return xyz_to_rgb(xyz * inverse_K);
 }
+
+// The paper's 1-nm sum.
+vec3 reference_rgb(float cos_theta, BraggMirror mirror) { return reference_rgb(cos_theta, mirror, 1.0); }
 
 // ---- Envelope and landmarks (Section 3.2.1, Appendices A, B) -------------------------------------
 
@@ -234,14 +250,36 @@ float reflectance_envelope(float omega, CellGeometry g) {
     return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
+// |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
+// spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
+// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/bragg.py has the derivation).
+const float FRINGE_B_MIN = 1e-12;
+const float FRINGE_Q_MIN = 1e-6;
+float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
+    vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
+    float sin_t = sqrt(max(1.0 - a * a, 0.0));
+    vec2 A = vec2(1.0, 0.0) - a * t_cell, B = sin_t * t_cell;
+    vec2 P = r1 + cmul(g.r_h1, A), Q = cmul(g.r_h1, B), S = A + cmul(g.r_h1, r1), T = B;
+    // At a band edge (sin t -> 0) the fringes' weight vanishes: the limit |P / S|^2.
+    if (cabs2(B) <= FRINGE_B_MIN) return clamp(cabs2(P) / max(cabs2(S), 1e-30), 0.0, 1.0);
+    vec2 alpha = cdiv(Q, T), beta = cdiv(cmul(P, T) - cmul(Q, S), cmul(T, T)), z = -cdiv(S, T);
+    float p = z.x, q = max(abs(z.y), FRINGE_Q_MIN);
+    vec2 mean_pole = cinv(vec2(0.0, z.y > 0.0 ? -1.0 : 1.0) - z);
+    float mean_pole_2 = (1.0 + q) / (q * ((1.0 + q) * (1.0 + q) + p * p));
+    float average = cabs2(alpha) + 2.0 * cmul(cconj(alpha), cmul(beta, mean_pole)).x + cabs2(beta) * mean_pole_2;
+    return clamp(average, 0.0, 1.0);
+}
+
 // Yeh's R averaged over its fringes: 1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda) (ours).
+// Under a host nh != n1, the coherent average above.
 float reflectance_fringe_average(float omega, CellGeometry g) {
     vec2 r1, t1;
     airy_slab_coefficients(omega, g, r1, t1);
     float a = cos_K_Lambda(omega, g);
+    if (!g.host_is_n1) return fringe_average_under_host(r1, t1, omega, g, a);
     float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
     float denominator = cabs2(r1) + t1_2_sin2;
-    return under_host(denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0, g);
+    return denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0;
 }
 
 // Appendix B: w~ = w~0 + (1 - w~0)(1 - cos theta_1)^5, w~0 = 0.735 R12 + 0.532.

@@ -15,6 +15,17 @@ const float CUMULATIVE_SIZE = 472.0;
 // CMFs at wavelength 360 + index nm.
 vec3 colour_matching_functions(int index) { return texelFetch(cmf_1nm, ivec2(index, 0), 0).rgb; }
 
+// The CMFs interpolated linearly between their 1 nm nodes, zero from 359 and 831 nm outwards: the hat
+// functions the converged spectral integral weights a spectrum with.
+vec3 colour_matching_functions_at(float wavelength) {
+    float x = wavelength - CMF_FIRST_WAVELENGTH;
+    float i = floor(x);
+    int k = int(i);
+    vec3 low = (k >= 0 && k < CMF_COUNT) ? colour_matching_functions(k) : vec3(0.0);
+    vec3 high = (k + 1 >= 0 && k + 1 < CMF_COUNT) ? colour_matching_functions(k + 1) : vec3(0.0);
+    return mix(low, high, x - i);
+}
+
 // C(lambda) (Eq. 16): node k sits at the centre of texel k.
 vec3 cmf_cumulative_at(float wavelength) {
     return texture(cmf_cumulative, vec2((wavelength - CUMULATIVE_START + 0.5) / CUMULATIVE_SIZE, 0.5)).rgb;
