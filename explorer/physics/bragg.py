@@ -81,18 +81,6 @@ class BraggMirror:
     def eta_h(self) -> float:
         return self.n1 if self.nh is None else self.nh
 
-    @classmethod
-    def from_parameters(cls, values: dict) -> "BraggMirror":
-        """Build a mirror from a material's parameter values (``n1, n2, Lambda, delta, N, nh``)."""
-        return cls(
-            n1=float(values["n1"]),
-            n2=float(values["n2"]),
-            Lambda=float(values["Lambda"]),
-            delta=float(values["delta"]),
-            N=int(round(float(values["N"]))),
-            nh=float(values["nh"]) if "nh" in values else None,
-        )
-
 
 # --------------------------------------------------------------------------------------------------
 # Per-angle quantities
@@ -166,11 +154,6 @@ def airy_slab_coefficients(omega, geometry: CellGeometry) -> tuple[np.ndarray, n
     r12_2 = geometry.r12 * geometry.r12
     denominator = 1.0 - r12_2 * phase2
     return geometry.r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * phase / denominator
-
-
-def C_squared(r1, t1) -> np.ndarray:
-    """``|C|^2 = |r1|^2 / (1 - |r1|^2)`` (Section 3.1), with ``1 - |r1|^2 = |t1|^2`` for a lossless slab."""
-    return np.abs(r1) ** 2 / np.abs(t1) ** 2
 
 
 def cos_K_Lambda(omega, geometry: CellGeometry) -> np.ndarray:
