@@ -7,7 +7,7 @@
 #include "lib/complex.glsl"
 #include "lib/microfacet.glsl"
 
-const int LOBES_MAX = 4;             // explorer.lobes.MAX_INTERFACES
+const int LOBES_MAX = 4;             // explorer.physics.lobes.MAX_INTERFACES
 const int FGD_COS_COUNT = 33;
 const int FGD_ALPHA_COUNT = 16;
 const int FGD_ETA_COUNT = 33;
@@ -23,12 +23,12 @@ struct LobeStack {
     float alpha[LOBES_MAX + 1];
     vec3 tau[LOBES_MAX + 1];
     bool conductor;
-    bool tir;            // explorer.lobes.Stack.tir: light going up sees the FGD of its own side
+    bool tir;            // explorer.physics.lobes.Stack.tir: light going up sees the FGD of its own side
     vec3 eta_base;
     vec3 kappa_base;
 };
 
-const float VARIANCE_MAX = 1e6;  // explorer.lobes.VARIANCE_MAX: f(1) diverges; 0 x it must stay 0
+const float VARIANCE_MAX = 1e6;  // explorer.physics.lobes.VARIANCE_MAX: f(1) diverges; 0 x it must stay 0
 float variance_from_roughness(float alpha) {
     float a = pow(clamp(alpha, 0.0, 1.0), 1.1);
     return min(a / max(1.0 - a, 1.0 / VARIANCE_MAX), VARIANCE_MAX);
@@ -61,14 +61,14 @@ vec2 fresnel_sp_conductor(float cos_theta, float eta, float kappa) {
     return vec2(cabs2(rs), cabs2(rp));
 }
 
-// Node index and fraction on count uniform nodes over [lo, hi], clamped (explorer.lobes._axis).
+// Node index and fraction on count uniform nodes over [lo, hi], clamped (explorer.physics.lobes._axis).
 void lobes_axis(float value, int count, float lo, float hi, out int i, out float f) {
     float x = (clamp(value, lo, hi) - lo) / (hi - lo) * float(count - 1);
     i = min(int(floor(x)), count - 2);
     f = x - float(i);
 }
 
-// The table's warped cosine (explorer.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2.
+// The table's warped cosine (explorer.physics.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2.
 float fgd_cos_coordinate(float cos_theta, float eta) {
     float c = clamp(cos_theta, 0.0, 1.0), c_c = sqrt(max(1.0 - eta * eta, 0.0));
     if (c_c <= 0.0) return c;
@@ -90,7 +90,7 @@ vec2 fgd_dielectric(sampler2D table, float cos_theta, float alpha, float eta) {
             correction += w * ((1.0 - fc) * texelFetch(table, ivec2(ic, row), 0).r + fc * texelFetch(table, ivec2(ic + 1, row), 0).r);
         }
     }
-    // Shared by s and p in proportion to their Fresnel terms (explorer.lobes.fgd_dielectric).
+    // Shared by s and p in proportion to their Fresnel terms (explorer.physics.lobes.fgd_dielectric).
     vec2 F = fresnel_sp(cos_theta, eta);
     float mean = 0.5 * (F.x + F.y);
     float target = clamp(mean + correction, 0.0, 1.0);
@@ -108,7 +108,7 @@ vec2 fgd_conductor(sampler2D moments, float cos_theta, float alpha, float eta, f
     return clamp(m.x * fresnel_sp_conductor(m.y, eta, kappa), 0.0, 1.0);
 }
 
-// The adding equations (explorer.lobes.lobes_and_statistics): lobe energies R_k and variances sigma_k at
+// The adding equations (explorer.physics.lobes.lobes_and_statistics): lobe energies R_k and variances sigma_k at
 // incidence cos_theta, k < s.count (the others 0). Rs/Rp: energies per polarisation.
 void lobes(LobeStack s, sampler2D fgd_table, sampler2D moments, float cos_theta, out vec3 energy[LOBES_MAX], out vec3 variance[LOBES_MAX]) {
     float c = clamp(cos_theta, LOBES_COS_MIN, 1.0);

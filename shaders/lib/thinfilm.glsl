@@ -24,7 +24,7 @@
 // (hardware filtering weights have 8 bits on many GPUs).
 uniform sampler2D sensitivity_fourier;
 
-// explorer.thinfilm.COS_THETA_MIN (renamed: lib/bragg.glsl has its own COS_THETA_MIN).
+// explorer.physics.thinfilm.COS_THETA_MIN (renamed: lib/bragg.glsl has its own COS_THETA_MIN).
 const float FILM_COS_THETA_MIN = 1e-6;
 const vec3 NAIVE_WAVELENGTHS = vec3(606.0, 539.0, 445.0);
 const float SENSITIVITY_FOURIER_STEP = 10.0;
@@ -302,7 +302,7 @@ void sensitivity_fourier_transform(float mu, int sensitivity, out vec3 re, out v
 // S^(m D) for m = 0..m_max: they depend on the film's OPD only, so both polarisations share them. For
 // the table, S^(0) = 1 and the carriers of m D are the m-th powers of those of D: four texel fetches and
 // no trig per harmonic.
-// The pre-filtered table (explorer.thinfilm.sensitivity_fourier_prefiltered), bound by the host on first
+// The pre-filtered table (explorer.physics.thinfilm.sensitivity_fourier_prefiltered), bound by the host on first
 // use: 4096 x (2 x PREFILTER_LEVELS) texels, rows k = 0..127 the real parts and rows 128 + k the imaginary
 // parts of the envelope convolved with a Gaussian of standard deviation k PREFILTER_SIGMA_STEP nm.
 uniform sampler2D sensitivity_fourier_prefiltered;

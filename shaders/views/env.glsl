@@ -28,7 +28,7 @@
 // (-z) and u = 0.75 is +x: u = 0.5 + atan(x, -z) / 2 pi. Both angles come from atan, not acos: Mesa's
 // inverse trigonometry is a polynomial with errors near 1e-4 rad at worst, a small fraction of a texel of
 // any environment up to 8k wide, and atan(length(d.xz), d.y) stays accurate at the poles where acos(d.y)
-// loses digits. Linear filtering, repeat in u, clamp in v, level 0. Twin: explorer.env.EnvironmentMap.
+// loses digits. Linear filtering, repeat in u, clamp in v, level 0. Twin: explorer.views.env.EnvironmentMap.
 #include "lib/views.glsl"
 #include "lib/sampling.glsl"
 

@@ -1,5 +1,5 @@
 // The gradient view: column i shows the mirror's reflectance at theta = 90 deg (i + 0.5) / W, every row
-// the same (the colour strips of Figure 4). Twin: explorer.render.view_cos_theta('gradient', ...).
+// the same (the colour strips of Figure 4). Twin: explorer.views.geometry.view_cos_theta('gradient', ...).
 uniform vec2 resolution;
 out vec4 frag_colour;
 

@@ -4,7 +4,7 @@
 // N = (x, y, sqrt(1 - x^2 - y^2)) and the pixel is view_brdf(L, V, N, X, Y) max(0, N.L) (lib/views.glsl: 0
 // unless N.L > 0 and N.V > 0, non-finite channels 0), outside 0. The frame is
 // BRDF Explorer's lit sphere (src/shaderTemplates/brdftemplatesphere.frag): X = normalize(cross((0, 1, 0),
-// N)), Y = normalize(cross(N, X)). Twin: explorer.render.render_numpy(model, 'lit', ...).
+// N)), Y = normalize(cross(N, X)). Twin: explorer.views.render.render_numpy(model, 'lit', ...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;

@@ -3,7 +3,7 @@
 // disc |p| < 1 it shows the outgoing direction V at theta_o = 90 deg |p| and azimuth phi_o of p (+x to the
 // right, +y up), N = (0, 0, 1), X = (1, 0, 0), Y = (0, 1, 0); the pixel is view_brdf(L, V, N, X, Y) cos(theta_o)
 // (lib/views.glsl: 0 for a light below the horizon, non-finite channels 0), outside 0. The 5, 30, 60 and 90 deg circles are drawn by the host on PNG output only.
-// Twin: explorer.render.render_numpy(model, 'scatter', ...).
+// Twin: explorer.views.render.render_numpy(model, 'scatter', ...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;

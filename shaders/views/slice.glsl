@@ -4,7 +4,7 @@
 // theta_d = 0 at the bottom). As there, D = (theta_d, phi_d) is rotated about Y by theta_h and about N by
 // phi_h into L, and V is L reflected about H = (theta_h, phi_h); the pixel is view_brdf(L, V, N, X, Y)
 // (lib/views.glsl: non-finite channels 0), no cosine. At phi_d = 90 deg, L.z = V.z = cos(theta_h) cos(theta_d) > 0: both stay above the horizon.
-// Twin: explorer.render.render_numpy(model, 'slice', ...).
+// Twin: explorer.views.render.render_numpy(model, 'slice', ...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;

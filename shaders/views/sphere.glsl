@@ -1,6 +1,6 @@
 // The sphere view: an orthographic unit sphere in a uniform white environment. Pixel (i, j), j from the
 // top, lies at x = 2 (i + 0.5) / W - 1, y = 1 - 2 (j + 0.5) / H; inside the disc it shows the mirror's
-// reflectance at cos theta = sqrt(1 - x^2 - y^2), outside 0. Twin: explorer.render.view_cos_theta.
+// reflectance at cos theta = sqrt(1 - x^2 - y^2), outside 0. Twin: explorer.views.geometry.view_cos_theta.
 #include "lib/views.glsl"
 
 uniform vec2 resolution;

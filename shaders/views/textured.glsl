@@ -1,4 +1,4 @@
-// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.render) with a film
+// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a film
 // thickness that varies over it (Belcour & Barla 2017, Section 5, Figures 12-15). The material must
 // define textured_BRDF(L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered) (shaders/thin_film.brd).
 // Planar parametrisation (explorer/thickness.py): pixel p = (x, y) reads D_inc (nm) from dinc_texture at
@@ -6,7 +6,7 @@
 // prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
 // host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
 // The rule of lib/views.glsl's view_brdf applies: 0 unless N.L > 0 and N.V > 0, non-finite channels 0.
-// Twin: explorer.render.render_numpy(model, 'textured', ..., thickness=...).
+// Twin: explorer.views.render.render_numpy(model, 'textured', ..., thickness=...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;
