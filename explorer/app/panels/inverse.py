@@ -49,6 +49,11 @@ class LobeEdit:
         return (tuple(self.energy), self.sigma, self.layers, self.base, self.t, self.u)
 
 
+def _c(values) -> np.ndarray:
+    """An array as ImPlot takes it: 1D, contiguous float64."""
+    return np.ascontiguousarray(values, dtype=np.float64).ravel()
+
+
 def _pick(candidates, f: float):
     """The sample at fraction ``f`` of ``candidates`` (None when there are none)."""
     return None if len(candidates) == 0 else candidates[int(round(np.clip(f, 0.0, 1.0) * (len(candidates) - 1)))]
@@ -241,7 +246,7 @@ class InversePanel(Panel):
             self.member_b = None
         if len(self.edits) < lobes.MAX_INTERFACES and imgui.button("add a lobe below"):
             self.edits[-1].base = "dielectric"  # only the bottom lobe may sit on a conductor
-            self.edits.append(LobeEdit(energy=[0.2, 0.2, 0.2], sigma=0.05, layers=1))
+            self.edits.append(LobeEdit(energy=[0.12, 0.08, 0.04], sigma=0.05, layers=1))
             self.member_b = None
         record(state, "inverse:add")
         imgui.same_line()
@@ -352,69 +357,73 @@ class InversePanel(Panel):
 
         edit, choice = self.edits[k - 1], s.choices[k - 1]
         height = max(160.0, min(300.0, imgui.get_content_region_avail().x * 0.8))
-        flags = implot.Flags_.no_legend if cls.kind == "two_layer" else 0
-        if not implot.begin_plot(f"lobe {k}: class##class{k}", imgui.ImVec2(-1, height), flags):
+        if not implot.begin_plot(f"lobe {k}: class##class{k}", imgui.ImVec2(-1, height), implot.Flags_.no_legend):
             return
+        always = implot.Cond_.always  # the class changes with the lobe: the axes follow it
         grey = implot.Spec(fill_color=imgui.ImVec4(0.6, 0.6, 0.6, 0.3))
+        point = implot.Spec(marker_size=5.0, marker_fill_color=imgui.ImVec4(1, 1, 0, 1), marker_line_color=imgui.ImVec4(1, 1, 0, 1))
         if cls.kind == "two_layer":
+            caption = "light grey: the class (tau >= 0 on every channel); red, green, blue: one channel's; hatched: invalid. Drag the yellow point, or walk t and u."
             implot.setup_axes("eta_top (eta_1)", "eta (eta_2)")
-            implot.setup_axes_limits(1.0, 4.0, 1.0, 4.0)
+            implot.setup_axes_limits(1.0, 4.0, 1.0, 4.0, always)
             texture = self._class_texture(k, cls)
-            implot.plot_image("class (grey), invalid hatched", imgui.ImTextureRef(texture.glo), implot.Point(1.0, 1.0), implot.Point(4.0, 4.0))
+            implot.plot_image("class", imgui.ImTextureRef(texture.glo), implot.Point(1.0, 1.0), implot.Point(4.0, 4.0))
             if choice:
                 changed, x, y, *_ = implot.drag_point(k, choice["eta_top"], choice["eta"], imgui.ImVec4(1, 1, 0, 1), 6.0)
                 if changed and cls.valid.any():
                     edit.t, edit.u = nearest_point(cls, x, y)
         elif cls.kind == "two_layer_conductor":
-            implot.setup_axes("eta_top (eta_1)", "bottom roughness alpha")
-            implot.setup_axes_limits(1.0, 4.0, 0.0, 1.0)
+            caption = "the bottom roughness against eta_top; shaded: no conductor base reaches the lobe (outside N1). The base's own class: u."
             alpha = np.nan_to_num(cls.alpha, nan=0.0)
-            implot.plot_shaded("invalid eta_top", cls.eta_top, np.where(cls.valid, 0.0, 1.0), 0.0, grey)
-            implot.plot_line("alpha (N1)", cls.eta_top, np.where(cls.valid, alpha, np.nan))
+            top = float(max(alpha[cls.valid].max() if cls.valid.any() else 0.0, 1e-3)) * 1.3
+            implot.setup_axes("eta_top (eta_1)", "bottom alpha")
+            implot.setup_axes_limits(1.0, 4.0, 0.0, top, always)
+            implot.plot_shaded("outside N1", _c(cls.eta_top), _c(np.where(cls.valid, 0.0, top)), 0.0, grey)
+            implot.plot_line("alpha", _c(cls.eta_top), _c(np.where(cls.valid, alpha, np.nan)), implot.Spec(line_weight=2.0))
             if choice:
                 x = np.array([choice["eta_top"]])
-                implot.plot_scatter("point", x, np.interp(x, cls.eta_top, alpha))
+                implot.plot_scatter("point", _c(x), _c(np.interp(x, cls.eta_top, alpha)), point)
         elif cls.kind == "conductor":
+            caption = "kappa(eta) per channel (Fig. 4b): thick where valid (Eqs. 10 and 9, kappa >= eta), shaded below where not; dots: the point t."
+            kappa_valid = cls.kappa[cls.valid]
+            top = float(kappa_valid.max() * 1.2) if kappa_valid.size else 1.0
             implot.setup_axes("eta", "kappa")
+            implot.setup_axes_limits(0.0, float(np.nanmax(cls.eta)), 0.0, top, always)
             for c, colour in enumerate(CHANNELS):
-                col = imgui.ImVec4(*colour, 1.0)
                 eta, kappa, valid = cls.eta[:, c], cls.kappa[:, c], cls.valid[:, c]
-                implot.plot_line(f"{'RGB'[c]} (all)", eta, kappa, implot.Spec(line_color=imgui.ImVec4(*colour, 0.35)))
-                implot.plot_shaded(f"{'RGB'[c]} invalid", eta, np.where(valid, np.nan, np.nan_to_num(kappa)), 0.0, grey)
-                implot.plot_line(f"{'RGB'[c]} valid", eta, np.where(valid, kappa, np.nan), implot.Spec(line_color=col, line_weight=2.5))
+                implot.plot_shaded(f"{'RGB'[c]} invalid", _c(eta), _c(np.where(valid, np.nan, np.nan_to_num(kappa))), 0.0, grey)
+                implot.plot_line(f"{'RGB'[c]} (all)", _c(eta), _c(kappa), implot.Spec(line_color=imgui.ImVec4(*colour, 0.45)))
+                implot.plot_line(f"{'RGB'[c]} valid", _c(eta), _c(np.where(valid, kappa, np.nan)),
+                                 implot.Spec(line_color=imgui.ImVec4(*colour, 1.0), line_weight=3.0))
             if s.stack is not None:
-                implot.plot_scatter("point", s.stack.eta[s.stack.count].copy(), s.stack.kappa[s.stack.count].copy(),
-                                    implot.Spec(marker_size=5.0))
+                implot.plot_scatter("point", _c(s.stack.eta[s.stack.count]), _c(s.stack.kappa[s.stack.count]), point)
         elif k > 1:
-            # A 1-layer dielectric lobe under others: tau above it per channel against eta (Algorithm 4).
-            implot.setup_axes("eta", "tau above the interface")
+            caption = "tau above the interface per channel against its eta (Algorithm 4); shaded: tau < 0 on some channel (invalid)."
             tau = np.nan_to_num(cls.tau, nan=0.0, posinf=0.0, neginf=0.0)
-            top = float(max(tau.max(), 0.1))
-            implot.setup_axes_limits(1.0, 4.0, min(float(tau.min()), 0.0), top, implot.Cond_.always)
-            implot.plot_shaded("invalid (tau < 0)", cls.eta, np.where(cls.valid, np.nan, top), min(float(tau.min()), 0.0), grey)
+            low, top = min(float(tau.min()), 0.0), float(max(tau.max(), 0.1))
+            implot.setup_axes("eta", "tau above")
+            implot.setup_axes_limits(1.0, 4.0, low, top, always)
+            implot.plot_shaded("invalid (tau < 0)", _c(cls.eta), _c(np.where(cls.valid, np.nan, top)), low, grey)
             for c, colour in enumerate(CHANNELS):
-                implot.plot_line(f"tau {'RGB'[c]}", cls.eta, tau[:, c], implot.Spec(line_color=imgui.ImVec4(*colour, 1.0)))
+                implot.plot_line(f"tau {'RGB'[c]}", _c(cls.eta), _c(tau[:, c]), implot.Spec(line_color=imgui.ImVec4(*colour, 1.0)))
             if choice:
-                x = np.array([choice["eta"]])
-                implot.plot_scatter("point", x, np.array([np.interp(x[0], cls.eta, tau.max(axis=1))]))
+                implot.plot_scatter("point", _c([choice["eta"]]), _c([np.interp(choice["eta"], cls.eta, tau.max(axis=1))]), point)
         else:
-            # In air: Eq. 7's roots, FGD(eta) = R (Figure 4a at eta_0 = 1); eta < 1 and eta > 4 hatched.
-            implot.setup_axes("eta", "energy at normal incidence")
+            caption = "in air the class is Eq. 7's roots, FGD(eta) = R (Fig. 4a at eta_0 = 1); shaded: eta < 1, eta > 4."
             top = max(0.6, 1.2 * max(edit.energy))
-            implot.setup_axes_limits(0.25, 5.0, 0.0, top, implot.Cond_.always)
+            implot.setup_axes("eta", "energy at normal incidence")
+            implot.setup_axes_limits(0.25, 5.0, 0.0, top, always)
             eta = np.linspace(0.25, 5.0, 200)
             fgd = fgd_normal(float(lobes.roughness_from_variance(edit.sigma)), eta)
-            implot.plot_shaded("eta < 1", np.array([0.25, 1.0]), np.array([top, top]), 0.0, grey)
-            implot.plot_shaded("eta > 4", np.array([4.0, 5.0]), np.array([top, top]), 0.0, grey)
-            implot.plot_line("FGD(eta)", eta, fgd)
-            implot.plot_inf_lines("R", np.array([max(edit.energy)]), implot.Spec(flags=implot.InfLinesFlags_.horizontal))
-            if len(cls.eta):
-                implot.plot_scatter("roots", cls.eta.astype(np.float64), np.full(len(cls.eta), max(edit.energy)))
+            implot.plot_shaded("eta < 1", _c([0.25, 1.0]), _c([top, top]), 0.0, grey)
+            implot.plot_shaded("eta > 4", _c([4.0, 5.0]), _c([top, top]), 0.0, grey)
+            implot.plot_line("FGD(eta)", _c(eta), _c(fgd))
+            implot.plot_inf_lines("R", _c([max(edit.energy)]), implot.Spec(flags=implot.InfLinesFlags_.horizontal))
+            if choice:
+                implot.plot_scatter("point", _c([choice["eta"]]), _c([max(edit.energy)]), point)
         implot.end_plot()
         record(self.state, f"inverse:plot_{k}")
-        if cls.kind == "two_layer":
-            imgui.text_wrapped("light grey: the class (tau >= 0 on every channel); red, green, blue: one channel's; "
-                               "hatched: invalid. Drag the yellow point, or walk t and u.")
+        imgui.text_wrapped(caption)
 
     def _class_texture(self, k: int, cls):
         """Lobe ``k``'s 2-layer class as a texture, rebuilt for each new solution."""
