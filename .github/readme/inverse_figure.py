@@ -8,6 +8,7 @@ inverse_compare.png: two members of one class, as the Inverse window's "compare 
 (Figures 5, 8, 10): the stacks the window retrieves at class points A and B of the 2-layer coloured lobe,
 in the env view (the shipped default sky, SPP samples per pixel): A | A left, B right | B. Same lobe at
 normal incidence (R = [0.1, 0.2, 0.1], sigma = 0.03); they part at grazing angles.
+inverse_app.png: the Inverse window on that lobe, in a scripted session under Xvfb.
 Run: .venv/bin/python .github/readme/inverse_figure.py   (about a minute on llvmpipe)
 """
 
@@ -59,3 +60,24 @@ split[:, SIZE // 2:] = images["B"][:, SIZE // 2:]
 split[:, SIZE // 2 - 1: SIZE // 2 + 1] = 255  # the seam
 Image.fromarray(np.concatenate([images["A"], split, images["B"]], axis=1)).save(OUT / "inverse_compare.png", optimize=True)
 print("wrote .github/readme/inverse_compare.png")
+
+# The Inverse window itself: the Figure-12 lobe typed in, its point walked, under a virtual display.
+import json
+import os
+import subprocess
+
+from explorer.dev.xvfb import virtual_display
+
+with tempfile.TemporaryDirectory() as tmp, virtual_display() as display:
+    shot = Path(tmp) / "window.png"
+    actions = [{"wait": 2}, {"view_size": 256}, {"click": "mode:env"}, {"focus": "Inverse"}, {"wait": 3},
+               {"type": "inverse:R_1", "text": "0.1,0.2,0.1"}, {"wait": 1},
+               {"drag": "inverse:t_1", "from": 0.3, "to": 0.12, "frames": 4}, {"wait": 60},
+               {"window_screenshot": str(shot)}, {"quit": True}]
+    (Path(tmp) / "script.json").write_text(json.dumps(actions))
+    env = {**os.environ, "DISPLAY": display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(ROOT)}
+    subprocess.run([sys.executable, "-m", "explorer.cli.commands", "open", str(ROOT / "shaders" / "layered_lobes.brd"),
+                    "--script", str(Path(tmp) / "script.json"), "--window-size", "1280x1000"], cwd=tmp, env=env, check=True)
+    window = Image.open(shot).convert("RGB")
+    window.crop((window.width * 26 // 100, 0, window.width, 640)).save(OUT / "inverse_app.png", optimize=True)
+print("wrote .github/readme/inverse_app.png")

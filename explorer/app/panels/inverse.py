@@ -257,7 +257,6 @@ class InversePanel(Panel):
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), s.error)
             imgui.pop_text_wrap_pos()
-        self._stack_line(imgui, s)
         if imgui.button("apply") and s.stack is not None:
             self._apply()
         record(state, "inverse:apply")
@@ -271,6 +270,7 @@ class InversePanel(Panel):
         record(state, "inverse:compare")
         for k, cls in enumerate(s.classes, start=1):
             self._plot(imgui, k, cls, s)
+        self._stack_line(imgui, s)
 
     def _lobe_widgets(self, imgui, k: int, edit: LobeEdit, bottom: bool) -> None:
         state = self.state
