@@ -313,3 +313,81 @@ def test_switching_materials_keeps_the_app_alive(x_display, tmp_path, gl_rendere
         png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
         assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2, (mode, material_path.name)
         assert np.abs(headless).max() > 0.05, "an empty image"
+
+
+LOBES_MATERIAL = REPO_ROOT / "shaders" / "layered_lobes.brd"
+#: The Inverse window's sphere resolution (lit, a 2-layer stack: ~30 ms a frame on llvmpipe).
+INVERSE_VIEW_SIZE = 256
+
+
+def same_values(a: dict, b: dict) -> bool:
+    """Two resolved parameter sets are equal (numbers and colours to 1e-9)."""
+    return a.keys() == b.keys() and all(np.allclose(np.asarray(a[k], float), np.asarray(b[k], float), rtol=0, atol=1e-9) for k in a)
+
+
+def test_inverse_panel_walks_an_equivalence_class(x_display, tmp_path, gl_renderer):
+    """
+    The Inverse window: a 2-layer lobe typed in, its class walked to two points through the t and u sliders,
+    each sphere screenshot the headless render of the stack invert_lobes returns for that point; the two
+    stacks differ and give the same lobe at normal incidence. Compare shows the two members (a nonzero ΔE),
+    and an unachievable lobe shows its one-line error in red while the app stays alive.
+    """
+    from explorer.materials.lobes_model import values_from_stack
+    from explorer.physics.inverse import Lobe, forward_lobes, invert_lobes
+
+    shots = [tmp_path / "a.png", tmp_path / "b.png"]
+    window = tmp_path / "error.png"
+    walk = [({"from": 0.3, "to": 0.05}, {"from": 0.3, "to": 0.05}), ({"from": 0.05, "to": 0.45}, {"from": 0.05, "to": 0.4})]
+    actions = [{"wait": 2}, {"view_size": INVERSE_VIEW_SIZE}, {"click": "mode:lit"}, {"focus": "Inverse"}, {"wait": 3},
+               {"type": "inverse:R_1", "text": "0.1,0.2,0.1"}, {"wait": 1}, {"type": "inverse:sigma_typed_1", "text": "0.02"}, {"wait": 1},
+               {"click": "inverse:layers_1:2"}, {"wait": 2}]
+    for shot, (t, u) in zip(shots, walk):
+        actions += [{"drag": "inverse:t_1", **t, "frames": 4}, {"wait": 1}, {"drag": "inverse:u_1", **u, "frames": 4},
+                    {"wait": 3}, {"wait_complete": True}, {"screenshot": str(shot)}]
+    actions += [{"click": "inverse:keep_b"}, {"wait": 1}, {"drag": "inverse:t_1", "from": 0.45, "to": 0.05, "frames": 4}, {"wait": 2},
+                {"click": "inverse:compare"}, {"wait": 3}, {"wait_complete": True}, {"wait": 3}, {"focus": "Inverse"}, {"wait": 2},
+                {"type": "inverse:R_1", "text": "0.7"}, {"wait": 3}, {"window_screenshot": str(window)}, {"quit": True}]
+    _, report = run_session(x_display, LOBES_MATERIAL, actions, tmp_path)
+    log = report["script_log"]
+    assert log.count("dragged inverse:t_1") == 3 and "typed inverse:sigma_typed_1" in log and "clicked inverse:compare" in log, log
+    material = load_material(LOBES_MATERIAL)
+    stacks = []
+    for shot in shots:
+        info = report["screenshot_info"][str(shot)]
+        inverse = info["inverse"]
+        assert inverse["error"] == "" and inverse["lobes"] == [{"R": [0.1, 0.2, 0.1], "sigma": 0.02, "layers": 2, "base": "dielectric"}]
+        lobe = Lobe([0.1, 0.2, 0.1], 0.02, 2)
+        stack = invert_lobes([lobe], inverse["choices"])
+        stacks.append(stack)
+        values = material.resolve(values_from_stack(stack))
+        assert same_values(material.resolve(info["values"]), values), "the sphere shows the retrieved stack"
+        headless = gl_renderer.render(material, values, "lit", INVERSE_VIEW_SIZE, INVERSE_VIEW_SIZE)
+        png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+        assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
+        np.testing.assert_allclose(np.load(shot.with_suffix(".npy")), headless, rtol=1e-3, atol=2e-3)
+        assert np.abs(headless).max() > 0.05, "an empty image"
+        energies, _ = forward_lobes(stack, [2])
+        np.testing.assert_allclose(energies[0], lobe.energy, atol=1e-3)
+    a, b = stacks
+    assert abs(a.eta[1].mean() - b.eta[1].mean()) > 0.05 or abs(a.eta[2].mean() - b.eta[2].mean()) > 0.05, "two members, not one"
+    assert report["mean_delta_e"] is not None and report["mean_delta_e"] > 0.0  # Compare rendered A | B
+    error = report["inverse"]["error"]
+    assert error.startswith("lobe 1: ") and "0.7" in error and len(error.splitlines()) == 1, error
+    pixels = np.asarray(Image.open(window).convert("RGB")).astype(int)
+    red = (np.abs(pixels - np.array([255, 89, 76])) <= 3).all(axis=-1)
+    assert red.sum() > 50, "the error is shown in red"
+
+
+def test_inverse_panel_opens_the_lobes_material(x_display, tmp_path):
+    """From another material the Inverse window's button opens layered_lobes with the retrieved stack."""
+    from explorer.materials.lobes_model import values_from_stack
+    from explorer.physics.inverse import Lobe, invert_lobes
+
+    actions = [{"wait": 2}, {"view_size": 128}, {"focus": "Inverse"}, {"wait": 3}, {"click": "inverse:open"}, {"wait": 3}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert report["material"] == str(LOBES_MATERIAL) and report["error"] == "", report["script_log"]
+    inverse = report["inverse"]
+    lobe = inverse["lobes"][0]
+    stack = invert_lobes([Lobe(lobe["R"], lobe["sigma"], lobe["layers"], lobe["base"])], inverse["choices"])
+    material = load_material(LOBES_MATERIAL)
+    assert same_values(material.resolve(report["values"]), material.resolve(values_from_stack(stack)))

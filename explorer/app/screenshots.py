@@ -76,6 +76,6 @@ def take_screenshot(state: AppState, scheduler: Scheduler) -> None:
     state.screenshots.append(str(path.with_suffix(".png")))
     state.screenshot_info[str(path.with_suffix(".png"))] = {
         "material": str(state.material_path), "view": "env" if samples is not None else state.main_view(),
-        "values": state.json_values(), "samples": samples,
+        "values": state.json_values(), "samples": samples, "inverse": state.inverse,
     }
     state.status = f"wrote {path.with_suffix('.png')} and {path.with_suffix('.npy')}"

@@ -36,7 +36,8 @@ class ScriptRobot:
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
     until complete; in ``env``, until a whole sample); ``{"window_screenshot": PATH}`` the whole window;
-    ``{"file_path": PATH}`` types PATH into the Files tab's path field; ``{"view_size": N}`` picks the
+    ``{"type": LABEL, "text": TEXT}`` clicks a text field (one that selects all on focus), types TEXT and
+    presses Enter (the Inverse window's ``inverse:R_1``, ``inverse:sigma_typed_1``); ``{"file_path": PATH}`` types PATH into the Files tab's path field; ``{"view_size": N}`` picks the
     sphere's resolution (the combo's values); ``{"key": "F12"}`` presses and releases a key (ImGui's
     name), then waits for a screenshot it asked for; ``{"focus": TITLE}`` brings a docked window to the
     front; ``{"write": PATH, "text": TEXT}`` writes a file (a user's editor between two reloads);
@@ -81,6 +82,8 @@ class ScriptRobot:
             done = self._drag(state, io, action, step)
         elif "click" in action:
             done = self._click(state, io, action, step)
+        elif "type" in action:
+            done = self._type(state, io, action, step)
         elif "screenshot" in action:
             if step == 0:
                 state.pending_screenshot = str(action["screenshot"])
@@ -186,5 +189,24 @@ class ScriptRobot:
             io.add_mouse_button_event(0, False)
         else:
             self.script.log.append(f"clicked {action['click']}")
+            return True
+        return False
+
+    def _type(self, state, io, action: dict, step: int) -> bool:
+        """Click the field (it selects its text), type the characters, press Enter."""
+        from imgui_bundle import imgui
+
+        if step <= 2:  # press and release on the field; at step 0 True only when it never appeared
+            return self._click(state, io, {"click": action["type"]}, step)
+        if step == 3:
+            pass  # a frame for the field to take focus and select its text
+        elif step == 4:
+            io.add_input_characters_utf8(str(action["text"]))
+        elif step == 5:
+            io.add_key_event(imgui.Key.enter, True)
+        elif step == 6:
+            io.add_key_event(imgui.Key.enter, False)
+        else:
+            self.script.log.append(f"typed {action['type']}")
             return True
         return False

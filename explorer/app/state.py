@@ -70,6 +70,7 @@ class AppState:
         ("s", "p", "average", "envelope", "gaps", "landmarks", "boxes"), True))
     file_path: str = "params.json"
     status: str = ""
+    inverse: dict | None = None  # the Inverse window's lobes, class points and error (reported with screenshots)
     error: str = ""  # the material's load/compile error, shown in red; the last good shader stays
     # Requests, served when the frame allows.
     pending_screenshot: str | None = None

@@ -15,7 +15,6 @@ from explorer.materials.brd import load_material
 from explorer.errors import LocatedError
 from explorer.app.panels import PANELS, dock_layout
 from explorer.app.panels.base import record
-from explorer.app.panels.base import record
 from explorer.app.scheduler import Scheduler
 from explorer.app.screenshots import screenshot_name, take_screenshot, window_shot
 from explorer.app.script import ScriptRobot
@@ -224,7 +223,7 @@ class App:
             "light": s.light, "camera": s.camera, "view_size": s.view_size, "exposure": s.exposure,
             "frames": s.frame_times, "screenshots": s.screenshots, "screenshot_info": s.screenshot_info,
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
-            "mean_delta_e": s.mean_delta_e,
+            "mean_delta_e": s.mean_delta_e, "inverse": s.inverse,
         }
         self.report_path.write_text(json.dumps(report, indent=1))
 

@@ -8,6 +8,7 @@ from explorer.app.panels.base import Panel
 from explorer.app.panels.brdf_views import ScatterPanel, SlicePanel
 from explorer.app.panels.compare import ComparePanel
 from explorer.app.panels.files import FilesPanel
+from explorer.app.panels.inverse import InversePanel
 from explorer.app.panels.parameters import ParametersPanel
 from explorer.app.panels.polar import PolarPanel
 from explorer.app.panels.spectrum import SpectrumPanel
@@ -17,7 +18,7 @@ from explorer.app.panels.strips import StripsPanel
 #: The windows, in the order they are drawn (a docked window's first tab is the first of its dock here).
 PANELS: tuple[type[Panel], ...] = (
     ParametersPanel, FilesPanel, SpherePanel, ComparePanel, SlicePanel, ScatterPanel, SpectrumPanel, PolarPanel,
-    StripsPanel,
+    StripsPanel, InversePanel,
 )
 
 
