@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from test_cli import cli
+from conftest import run_cli_process as cli
 
 
 def test_bench_layers_json():
