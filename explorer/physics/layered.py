@@ -46,10 +46,6 @@ MAX_LAYERS = 3
 # Parameters
 
 
-def _one_line(message: str) -> str:
-    return " ".join(str(message).split())
-
-
 @dataclass(frozen=True)
 class RoughBraggLayer:
     """
