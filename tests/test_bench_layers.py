@@ -1,4 +1,4 @@
-"""``bragg-explorer bench --layers`` (issue #3 item 2 and the slice-view accuracy study): its JSON document."""
+"""``bragg-explorer bench --layers`` (host-table timings and the slice-view accuracy study): its JSON document."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ def test_bench_layers_json():
     for r in rows:
         assert r["size"] == 64 and r["pixels"] > 0
         basic, paper, ours = (r[name] for name in ("basic", "subdivided s=3", "improved s=3"))
-        # Subdividing helps, our variant more, and ours meets the issue's goal (median <= 2 at s = 3).
+        # Subdividing helps, our variant more, and ours meets the goal (median <= 2 at s = 3).
         assert ours["dE_median"] < paper["dE_median"] < basic["dE_median"]
         assert ours["dE_median"] <= 2.0
         # The tabulated method follows the reference within the 256-entry table's known limit (README).

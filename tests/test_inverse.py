@@ -17,7 +17,7 @@ from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.physics import inverse, lobes
 from explorer.physics.inverse import InverseError, Lobe
 
-#: The issue's bound for forward(inverse(lobes)) at normal incidence.
+#: The bound for forward(inverse(lobes)) at normal incidence.
 ROUND_TRIP_TOLERANCE = 1e-3
 #: The colour channels other than the one that sets a roughness keep their own variance (Sec. 5.2.3);
 #: measured up to 1.2e-3 on the cases below.

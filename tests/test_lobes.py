@@ -2,7 +2,7 @@
 
 Independent references: ``tmm.inc_tmm`` (incoherent multilayers) for smooth stacks, a brute-force
 integration of the GGX BRDF over outgoing directions for the FGD table. GL against the numpy twin with
-test_brdf_views' rule (2e-3 of a pixel's largest channel).
+tests/twins.py's BRDF_TOLERANCE (2e-3 of a pixel's largest channel), the gradient included.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from test_brdf_views import SIZE
 from twins import BRDF_TOLERANCE, LIGHTS, assert_twins_equal, render_both
 
 MATERIAL = REPO_ROOT / "shaders" / "layered_lobes.brd"
-#: Smooth stacks against tmm's incoherent multilayer, every angle (the issue's bound).
+#: Smooth stacks against tmm's incoherent multilayer, every angle, within this.
 TMM_TOLERANCE = 1e-3
 #: The FGD table (trilinear, 48^2 quadrature) against a brute-force integral off the table's nodes, more
 #: than alpha from a critical angle (within it, at alpha < 0.1, the 33-node table misses the sharp rise of

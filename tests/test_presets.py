@@ -44,7 +44,7 @@ def test_preset_resolves_within_range(stem, preset):
         assert float(values[name]) == pytest.approx(float(value))
 
 
-def test_stack_presets_cover_the_issue_figures():
+def test_stack_presets_cover_the_papers_figures():
     presets = load_presets(PRESET_DIR / "bragg_stack.toml").presets
     for prefix, count in {"figure1_": 11, "figure7_": 4, "figure10_": 24, "figure11_": 7, "figure12_": 9, "table3_": 3,
                           "supplemental10_": 9, "supplemental11_": 9}.items():
