@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX as PREFIX, REPO_ROOT, CliRun, run_cli, run_cli_process
+from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX as PREFIX, REPO_ROOT, CliRun, one_line_error, run_cli
+from conftest import run_cli_process
 from twins import Twins, assert_twins_equal
 
 
@@ -134,16 +135,11 @@ def cli_runs(tmp_path_factory):
 
 
 def check_one_line_failure(failure: FailureRun) -> str:
-    run = failure.run
-    assert run.returncode != 0
-    assert "Traceback" not in run.stderr and "Traceback" not in run.stdout
-    lines = run.stderr.splitlines()
-    assert len(lines) == 1, f"expected one line on stderr, got {len(lines)}:\n{run.stderr}"
-    assert lines[0].startswith(PREFIX), lines[0]
+    line = one_line_error(failure.run)
     # Nothing written: no output, no temporary file; a previous output is left as it was.
     after = {p.name: (p.read_bytes() if p.is_file() else b"") for p in failure.directory.iterdir()}
     assert after == failure.before, f"files changed in the output directory: {sorted(after)}"
-    return lines[0][len(PREFIX):]
+    return line[len(PREFIX):]
 
 
 def test_unknown_set_name(cli_runs):

@@ -20,7 +20,7 @@ from explorer.gpu.programs import specialisation
 from explorer.materials.models import model_for
 from explorer.views.render import render_numpy
 from test_gl_views import SWEEP_SIZES
-from twins import GL_ATOL, assert_twins_equal, render_both
+from twins import GL_ATOL, Twins, assert_twins_equal, render_both
 
 SHADERS = REPO_ROOT / "shaders"
 #: Halves, and values either side of one.
@@ -134,7 +134,7 @@ def test_cli_set_and_engines_agree_on_a_half(gl_renderer, tmp_path):
         images[engine] = np.load(out)
     material = load_material(BRAGG_MATERIAL)
     method_1 = render_numpy(model_for(material, material.resolve({"method": 1, "N": 9})), "gradient", 48, 1)
-    assert np.abs(images["gl"] - images["numpy"]).max() <= GL_ATOL
+    assert_twins_equal(Twins.of(images["gl"], images["numpy"], "gradient"), "CLI gl and numpy at method=0.5")
     assert np.abs(images["numpy"] - method_1).max() <= 1e-6
 
 

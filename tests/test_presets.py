@@ -103,13 +103,11 @@ def test_ggx_schlick_twin_is_microfacet_times_schlick():
 @pytest.mark.gl
 def test_ggx_schlick_gl_equals_numpy(gl_renderer):
     from explorer.materials.brd import load_material
-    from explorer.views.render import render_numpy
+    from twins import assert_twins_equal, render_both
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
     values = material.resolve({"alpha": 0.25, "F0": 0.1})
-    gl = gl_renderer.render(material, values, "lit", 24, 24)
-    reference = render_numpy(GGXSchlickModel(values), "lit", 24, 24)
-    assert np.abs(gl - reference).max() < 2e-3
+    assert_twins_equal(render_both(gl_renderer, material, values, "lit", (24, 24), light=None), "ggx_schlick lit")
 
 
 def test_preset_then_set_overrides(tmp_path):
