@@ -8,7 +8,13 @@ integration must never pass by skipping the GPU half of the product. The failure
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import subprocess
+import sys
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -32,6 +38,72 @@ def one_line_error(run) -> str:
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(CLI_ERROR_PREFIX), run.stderr
     return lines[0]
+
+
+@dataclass
+class CliRun:
+    """What a CLI run left: like :class:`subprocess.CompletedProcess` (``returncode``, ``stdout``, ``stderr``)."""
+
+    args: list[str]
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+class GLContextInProcess(BaseException):
+    """An in-process CLI run tried to create a GL context (a BaseException: the CLI must not catch it)."""
+
+
+def run_cli(*args, cwd: Path | str = REPO_ROOT) -> CliRun:
+    """
+    ``bragg-explorer ARGS`` in this process, from ``cwd``: :func:`explorer.cli.commands.main`, the one
+    path by which every error becomes one line and an exit status, with stdout and stderr captured and
+    warnings ignored. For bad input and GPU-free outputs; a subprocess remains where the process is the
+    point (``python3 -m explorer``, the bootstrap, no display, the wheel, the app) or where the CLI draws
+    with GL: a second GL context would replace the session's current one, so creating one here raises
+    :class:`GLContextInProcess`.
+    """
+    import moderngl
+
+    from explorer.cli.commands import main
+
+    def no_context(*_, **__):
+        raise GLContextInProcess("run_cli: this command creates a GL context; run it in a subprocess")
+
+    argv = [str(arg) for arg in args]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    previous = os.getcwd()
+    create = moderngl.create_standalone_context
+    moderngl.create_standalone_context = no_context
+    try:
+        os.chdir(cwd)
+        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                main(argv)
+                returncode = 0
+            except SystemExit as exit_:
+                if isinstance(exit_.code, str):
+                    print(exit_.code, file=sys.stderr)
+                returncode = exit_.code if isinstance(exit_.code, int) else int(exit_.code is not None)
+    finally:
+        moderngl.create_standalone_context = create
+        os.chdir(previous)
+    return CliRun(argv, returncode, stdout.getvalue(), stderr.getvalue())
+
+
+#: Seconds for one CLI subprocess (imports colour-science, may compile shaders on llvmpipe).
+CLI_TIMEOUT = 300
+
+
+def run_cli_process(*args, cwd: Path | str = REPO_ROOT) -> CliRun:
+    """``python -m explorer.cli.commands ARGS`` in a subprocess from ``cwd``: for the commands that draw with GL."""
+    argv = [str(arg) for arg in args]
+    completed = subprocess.run(
+        [sys.executable, "-m", "explorer.cli.commands", *argv], cwd=cwd, capture_output=True, text=True,
+        timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
+    )
+    return CliRun(argv, completed.returncode, completed.stdout, completed.stderr)
 
 
 def running_in_ci() -> bool:

@@ -1,5 +1,5 @@
 """
-The interactive explorer (issue #4) in scripted sessions under a virtual X display (Xvfb).
+The interactive explorer in scripted sessions under a virtual X display (Xvfb).
 
 Each session runs ``bragg-explorer open FILE --script S --report R`` in a subprocess whose DISPLAY is
 an Xvfb started here: the script moves the mouse and presses its button through ImGui's IO (what the

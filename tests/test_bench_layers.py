@@ -1,10 +1,10 @@
-"""``bragg-explorer bench --layers`` (issue #3 item 2 and the slice-view accuracy study): its JSON document."""
+"""``bragg-explorer bench --layers`` (host-table timings and the slice-view accuracy study): its JSON document."""
 
 from __future__ import annotations
 
 import json
 
-from test_cli import cli
+from conftest import run_cli_process as cli
 
 
 def test_bench_layers_json():
@@ -21,7 +21,7 @@ def test_bench_layers_json():
     for r in rows:
         assert r["size"] == 64 and r["pixels"] > 0
         basic, paper, ours = (r[name] for name in ("basic", "subdivided s=3", "improved s=3"))
-        # Subdividing helps, our variant more, and ours meets the issue's goal (median <= 2 at s = 3).
+        # Subdividing helps, our variant more, and ours meets the goal (median <= 2 at s = 3).
         assert ours["dE_median"] < paper["dE_median"] < basic["dE_median"]
         assert ours["dE_median"] <= 2.0
         # The tabulated method follows the converged reference to 2e-3 of a pixel's largest channel.

@@ -1,26 +1,21 @@
-"""shaders/bragg_layer.brd (issue #3, item 3): one rough Bragg layer over a diffuse base, GL against numpy.
+"""shaders/bragg_layer.brd: one rough Bragg layer over a diffuse base, GL against numpy.
 
-The numpy twin is :class:`explorer.materials.models.BraggLayerModel`; the tolerance is test_brdf_views' rule (2e-3
-relative to a pixel's largest |channel| where it exceeds 1e-3, absolute below).
+The numpy twin is :class:`explorer.materials.models.BraggLayerModel`; the tolerance is tests/twins.py's
+BRDF_TOLERANCE (2e-3 relative to a pixel's largest |channel| where it exceeds 1e-3, absolute below).
 """
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.physics import bragg, colorimetry, layered, microfacet
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggLayerModel, model_for
 from explorer.materials.presets import PRESET_DIR, load_presets
-from explorer.views.render import render_numpy
-from explorer.views.geometry import rim_distance
-from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, SMALL, assert_twin_equal
+from test_brdf_views import SIZE, SMALL
+from twins import assert_twins_equal, render_both
 
 LAYER_MATERIAL = REPO_ROOT / "shaders" / "bragg_layer.brd"
 
@@ -51,13 +46,9 @@ def directions(count: int, seed: int) -> np.ndarray:
 @pytest.mark.parametrize("view", ["lit", "slice"])
 def test_gl_equals_numpy_twin(gl_renderer, layer_material, case, view):
     overrides, (width, height) = CASES[case]
-    values = layer_material.resolve(overrides)
-    light = LIGHTS[view]
-    gl = gl_renderer.render(layer_material, values, view, width, height, light=light)
-    reference = render_numpy(model_for(layer_material, values), view, width, height, light=light)
-    compared = rim_distance(view, width, height) > RIM_EXCLUSION
-    assert_twin_equal(gl, reference, compared, f"bragg_layer {case}, {view}")
-    assert np.abs(reference).max() > 0.05, "an empty image"
+    twins = render_both(gl_renderer, layer_material, layer_material.resolve(overrides), view, (width, height))
+    assert_twins_equal(twins, f"bragg_layer {case}, {view}")
+    assert np.abs(twins.reference).max() > 0.05, "an empty image"
 
 
 @pytest.mark.parametrize("method", [0, 1, 3, 4])
@@ -103,11 +94,7 @@ def test_base_term_is_rho_d_over_pi_times_the_transmission_table(layer_material)
 
 def test_alpha_out_of_range_is_one_line(tmp_path):
     out = tmp_path / "x.png"
-    run = subprocess.run(
-        [sys.executable, "-m", "explorer.cli.commands", "render", "shaders/bragg_layer.brd", "--view", "lit", "--set", "alpha=2",
-         "--size", "8", "--out", str(out)],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
+    run = run_cli("render", "shaders/bragg_layer.brd", "--view", "lit", "--set", "alpha=2", "--size", "8", "--out", out)
     line = one_line_error(run)
     assert "alpha" in line and "[0, 1]" in line
     assert not out.exists()

@@ -1,9 +1,9 @@
-"""shaders/bragg_stack.brd (issue #3, item 3): the single-reflection BRDF of layered Bragg structures (Eq. 34)
+"""shaders/bragg_stack.brd: the single-reflection BRDF of layered Bragg structures (Eq. 34)
 evaluated spectrally per pixel from the host's tables, GL against its numpy twin.
 
 The numpy twin is :class:`explorer.materials.models.BraggStackModel` (over :func:`explorer.physics.layered.single_reflection_brdf`);
-the tolerance is test_brdf_views' rule (2e-3 relative to a pixel's largest |channel| where it exceeds 1e-3,
-absolute below). The physics of Eq. 34 itself (reciprocity, coating, white furnace, N = 1 slab) is tested in
+the tolerance is tests/twins.py's BRDF_TOLERANCE (2e-3 relative to a pixel's largest |channel| where it
+exceeds 1e-3, absolute below), in every view. The physics of Eq. 34 itself (reciprocity, coating, white furnace, N = 1 slab) is tested in
 test_layered.py.
 """
 
@@ -12,20 +12,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.physics import bragg, colorimetry, layered
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggStackModel, model_for
-from explorer.views.render import render_numpy
-from explorer.views.geometry import rim_distance
 from test_bragg_layer import directions
-from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
-from test_cli import cli
+from test_brdf_views import SIZE
+from twins import BRDF_TOLERANCE, FLOOR, Tolerance, assert_twins_equal, render_both
 
 STACK_MATERIAL = REPO_ROOT / "shaders" / "bragg_stack.brd"
 #: The slice view's last row and column reach theta_h, theta_d = 89 deg, where float32 directions lose
 #: ~5e-3 of Eq. 17's value (G1 / cos and D at grazing angles): those pixels get this tolerance.
 GRAZING_RTOL = 1e-2
+GRAZING_TOLERANCE = Tolerance(f"{GRAZING_RTOL:g} x max(value, {FLOOR:g}) at grazing", atol=GRAZING_RTOL * FLOOR, rtol=GRAZING_RTOL)
 
 #: One to three layers, a coating, Appendix D's host (the jewel beetle of Table 3), coloured bases.
 CASES = {
@@ -47,31 +46,24 @@ def stack_material():
 @pytest.mark.parametrize("case", list(CASES))
 @pytest.mark.parametrize("view", ["lit", "slice", "scatter"])
 def test_gl_equals_numpy_twin(gl_renderer, stack_material, case, view):
-    values = stack_material.resolve(CASES[case])
-    width, height = SIZE
-    light = LIGHTS[view]
-    gl = gl_renderer.render(stack_material, values, view, width, height, light=light)
-    reference = render_numpy(model_for(stack_material, values), view, width, height, light=light)
-    compared = rim_distance(view, width, height) > RIM_EXCLUSION
+    twins = render_both(gl_renderer, stack_material, stack_material.resolve(CASES[case]), view, SIZE)
+    what = f"bragg_stack {case}, {view}"
     if view == "slice":
+        width, height = SIZE
         grazing = np.zeros((height, width), bool)
         grazing[-1, :] = grazing[:, -1] = True
-        scale = np.maximum(np.abs(reference[grazing]).max(axis=-1), 1e-3)
-        assert np.all(np.abs(gl[grazing] - reference[grazing]).max(axis=-1) <= GRAZING_RTOL * scale)
-        compared &= ~grazing
-    assert_twin_equal(gl, reference, compared, f"bragg_stack {case}, {view}")
-    assert np.abs(reference).max() > 0.05, "an empty image"
+        assert_twins_equal(twins.where(twins.compared & grazing), what, GRAZING_TOLERANCE)
+        twins = twins.where(twins.compared & ~grazing)
+    assert_twins_equal(twins, what, BRDF_TOLERANCE)
+    assert np.abs(twins.reference).max() > 0.05, "an empty image"
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize("view", ["sphere", "gradient"])
 def test_specular_colour_views(gl_renderer, stack_material, view):
     values = stack_material.resolve(CASES["three layers, coated"])
-    width, height = (24, 24) if view == "sphere" else (64, 2)
-    gl = gl_renderer.render(stack_material, values, view, width, height)
-    reference = render_numpy(model_for(stack_material, values), view, width, height)
-    compared = rim_distance(view, width, height) > RIM_EXCLUSION
-    assert_twin_equal(gl, reference, compared, f"bragg_stack {view}")
+    twins = render_both(gl_renderer, stack_material, values, view, (24, 24) if view == "sphere" else (64, 2))
+    assert_twins_equal(twins, f"bragg_stack {view}", BRDF_TOLERANCE)
 
 
 def test_smooth_limit_colour_of_one_uncoated_layer_is_the_mirror_reference(stack_material):
@@ -158,7 +150,7 @@ def test_no_nan_or_inf_over_a_sweep(stack_material):
 @pytest.mark.parametrize("assignment, named", [("layers=4", "layers"), ("alpha_2=-0.1", "alpha_2"), ("alpha_1=1.5", "alpha_1")])
 def test_bad_parameters_are_one_line(tmp_path, assignment, named):
     out = tmp_path / "x.png"
-    run = cli("render", "shaders/bragg_stack.brd", "--view", "lit", "--set", assignment, "--size", "8", "--out", out)
+    run = run_cli("render", "shaders/bragg_stack.brd", "--view", "lit", "--set", assignment, "--size", "8", "--out", out)
     assert named in one_line_error(run)
     assert not out.exists()
 

@@ -8,7 +8,7 @@ our own files in tests/data/brdf (limb_darkening, anisotropic_ward, compact_lobe
 lommel_seeliger, non_finite_channels; twins in tests/brdf_twins.py). Every material of tests/data/brdf
 (but the bad_* files) and every shipped shaders/*.brd is rendered in lit, slice and scatter, lights
 included that leave most of the sphere dark, below the horizon or straight above (the H = N pixel),
-with no NaN or infinity, and equal to its numpy twin with test_brdf_views' tolerances.
+with no NaN or infinity, and equal to its numpy twin with the BRDF views' tolerance (tests/twins.py).
 """
 
 from __future__ import annotations
@@ -20,9 +20,8 @@ import brdf_twins
 from conftest import BRDF_DATA, REPO_ROOT
 from explorer.materials.brd import load_material
 from explorer.materials.models import model_for
-from explorer.views.render import render_numpy
-from explorer.views.geometry import brdf_view_geometry, finite_or_zero, rim_distance, view_brdf
-from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
+from explorer.views.geometry import brdf_view_geometry, finite_or_zero, view_brdf
+from twins import assert_twins_equal, compared_pixels, render_both
 
 #: Odd sides: the disc views have a centre pixel (x = y = 0), where H = N under a light straight above.
 SIZE = (35, 27)
@@ -85,15 +84,13 @@ def test_every_material_has_a_twin():
 def test_views_are_finite_and_equal_their_twins(gl_renderer, path):
     m = material(path)
     values = m.resolve()
-    model = model_for(m, values)
     width, height = SMALL if path.name == "bragg_stack.brd" else SIZE
     for view, light in VIEW_LIGHTS:
         what = f"{path.name}, {view}, light {light}"
-        gl = gl_renderer.render(m, values, view, width, height, light=light)
+        gl, reference, _ = twins = render_both(gl_renderer, m, values, view, (width, height), light=light)
         assert np.isfinite(gl).all(), f"{what}: GLSL non-finite at {np.argwhere(~np.isfinite(gl))[:3].tolist()}"
-        reference = render_numpy(model, view, width, height, light=light)
         assert np.isfinite(reference).all(), f"{what}: numpy non-finite"
-        assert_twin_equal(gl, reference, rim_distance(view, width, height) > RIM_EXCLUSION, what)
+        assert_twins_equal(twins, what)
         if light is not None and light[0] > 90.0 and view == "scatter":  # no pair in the domain
             assert (gl == 0.0).all() and (reference == 0.0).all(), what
         if view == "lit":  # nothing where the light is below the surface
@@ -145,7 +142,7 @@ def test_non_finite_channels_keep_the_finite_one(gl_renderer):
         gl = gl_renderer.render(m, m.resolve(), view, width, height, light=light)
         *_, inside, factor = brdf_view_geometry(view, width, height, light)
         assert (gl[..., :2] == 0.0).all(), view
-        shown = inside & (rim_distance(view, width, height) > RIM_EXCLUSION) & (factor > 1e-3)
+        shown = inside & compared_pixels(view, width, height) & (factor > 1e-3)
         np.testing.assert_allclose(gl[..., 2][shown], -0.25 * factor[shown], rtol=1e-5, err_msg=view)
 
 
@@ -159,11 +156,9 @@ def test_textured_view_follows_the_rule(gl_renderer):
     thickness = ThicknessTexture.from_file(dinc_range=(0.0, 1125.0))
     width, height = SIZE
     light = (115.0, 30.0)
-    gl = gl_renderer.render(m, values, "textured", width, height, light=light,
-                            inputs=thickness.gl_inputs(width, height), uniforms={"prefilter": thickness.prefilter})
-    reference = render_numpy(model_for(m, values), "textured", width, height, light=light, thickness=thickness)
-    assert np.isfinite(gl).all() and np.abs(reference).max() > 0.01
-    assert_twin_equal(gl, reference, rim_distance("textured", width, height) > RIM_EXCLUSION, "textured")
+    twins = render_both(gl_renderer, m, values, "textured", (width, height), light=light, thickness=thickness)
+    assert np.isfinite(twins.gl).all() and np.abs(twins.reference).max() > 0.01
+    assert_twins_equal(twins, "textured")
 
 
 #: The env view: a few samples per pixel of every material, to find NaN rather than to converge.

@@ -1,49 +1,24 @@
-"""The command line, run as users run it: ``python -m explorer.cli.commands ...`` in a subprocess.
+"""The command line: bad input, ``info``, and renders on the GPU.
 
 Bad input must end with exactly one line on stderr (naming the file and line where there is one),
 a non-zero exit status, no traceback, and no output file (nor a temporary one) left behind. The
-commands that need no GPU run concurrently, once per module, to keep the suite fast.
+commands that need no GPU run in this process (conftest.run_cli, through the CLI's ``main``), once per
+module; those that draw with GL in a subprocess (conftest.run_cli_process).
 """
 
 from __future__ import annotations
 
 import json
-import os
 import re
-import subprocess
-import sys
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT
-
-#: Seconds for one CLI run (imports colour-science, may compile shaders on llvmpipe).
-CLI_TIMEOUT = 300
-#: Concurrent CLI runs.
-WORKERS = 4
-#: The .npy output against the numpy twin, per linear channel (the GL tests' tolerance).
-GL_ATOL = 2e-3
-RIM_EXCLUSION = 1e-4
-PREFIX = "bragg-explorer: error: "
-
-
-@dataclass
-class Run:
-    returncode: int
-    stdout: str
-    stderr: str
-
-
-def cli(*args, cwd: Path = REPO_ROOT) -> Run:
-    completed = subprocess.run(
-        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)],
-        cwd=cwd, capture_output=True, text=True, timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
-    return Run(completed.returncode, completed.stdout, completed.stderr)
+from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX as PREFIX, REPO_ROOT, CliRun, one_line_error, run_cli
+from conftest import run_cli_process
+from twins import Twins, assert_twins_equal
 
 
 def relative(path: Path) -> str:
@@ -74,7 +49,7 @@ def parameters_section(path: Path) -> list[list[str]]:
 
 
 # --------------------------------------------------------------------------------------------------
-# Commands that need no GPU: run them all at once
+# Commands that need no GPU: run them all once, in this process
 
 
 #: Malformed material files and the line each message must name (None: the whole file).
@@ -129,14 +104,14 @@ def failure_cases(out: Path) -> dict[str, list[str]]:
 
 @dataclass
 class FailureRun:
-    run: Run
+    run: CliRun
     directory: Path
     before: dict[str, bytes]
 
 
 @pytest.fixture(scope="module")
 def cli_runs(tmp_path_factory):
-    """Every GPU-free command of this module, run concurrently: failures and ``info --json``."""
+    """Every GPU-free command of this module: failures and ``info --json``."""
     root = tmp_path_factory.mktemp("cli")
     jobs, failures = {}, {}
     for index, (case, args) in enumerate(failure_cases(root).items()):
@@ -151,8 +126,7 @@ def cli_runs(tmp_path_factory):
         jobs[("fail", case)] = [a.replace("{dir}", str(directory)) for a in args]
     for name, path in INFO_FILES.items():
         jobs[("info", name)] = ["info", relative(path), "--json"]
-    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
-        results = dict(zip(jobs, pool.map(lambda args: cli(*args), jobs.values())))
+    results = {job: run_cli(*args) for job, args in jobs.items()}
     for (kind, case), run in results.items():
         if kind == "fail":
             failures[case].run = run
@@ -161,16 +135,11 @@ def cli_runs(tmp_path_factory):
 
 
 def check_one_line_failure(failure: FailureRun) -> str:
-    run = failure.run
-    assert run.returncode != 0
-    assert "Traceback" not in run.stderr and "Traceback" not in run.stdout
-    lines = run.stderr.splitlines()
-    assert len(lines) == 1, f"expected one line on stderr, got {len(lines)}:\n{run.stderr}"
-    assert lines[0].startswith(PREFIX), lines[0]
+    line = one_line_error(failure.run)
     # Nothing written: no output, no temporary file; a previous output is left as it was.
     after = {p.name: (p.read_bytes() if p.is_file() else b"") for p in failure.directory.iterdir()}
     assert after == failure.before, f"files changed in the output directory: {sorted(after)}"
-    return lines[0][len(PREFIX):]
+    return line[len(PREFIX):]
 
 
 def test_unknown_set_name(cli_runs):
@@ -271,7 +240,7 @@ def test_render_png_and_npy(gl_renderer, tmp_path):
     material = relative(BRAGG_MATERIAL)
     png, npy = tmp_path / "sphere.png", tmp_path / "sphere.npy"
     for out in (png, npy):
-        run = cli("render", material, "--view", "sphere", "--size", "32", "--out", out)
+        run = run_cli_process("render", material, "--view", "sphere", "--size", "32", "--out", out)
         assert run.returncode == 0, run.stderr
         assert "Traceback" not in run.stderr
         assert len(run.stdout.splitlines()) == 1 and str(out) in run.stdout
@@ -290,19 +259,17 @@ def test_render_png_and_npy(gl_renderer, tmp_path):
 def test_render_npy_equals_numpy_twin(gl_renderer, bragg_material, tmp_path):
     from explorer.materials.models import model_for
     from explorer.views.render import render_numpy
-    from explorer.views.geometry import rim_distance
 
     out = tmp_path / "basic.npy"
     size = (40, 24)
-    run = cli("render", relative(BRAGG_MATERIAL), "--view", "sphere", "--size", f"{size[0]}x{size[1]}",
+    run = run_cli_process("render", relative(BRAGG_MATERIAL), "--view", "sphere", "--size", f"{size[0]}x{size[1]}",
               "--set", "method=1", "--set", "Lambda=300", "--out", out)
     assert run.returncode == 0, run.stderr
     image = np.load(out)
     assert image.dtype == np.float32 and image.shape == (size[1], size[0], 3)
     values = bragg_material.resolve({"method": "1", "Lambda": "300"})
     reference = render_numpy(model_for(bragg_material, values), "sphere", *size)
-    compared = rim_distance("sphere", *size) > RIM_EXCLUSION
-    assert np.abs(image - reference)[compared].max() <= GL_ATOL
+    assert_twins_equal(Twins.of(image, reference, "sphere"), "CLI sphere .npy")
     assert np.abs(reference).max() > 0.05  # a visible mirror, not an empty image
 
 
@@ -315,7 +282,7 @@ def test_glsl_compile_error_names_file_and_line(gl_renderer, tmp_path):
     broken.write_text("".join(text))
     out_dir = tmp_path / "out"
     out_dir.mkdir()
-    run = cli("render", broken, "--size", "8", "--set", "method=0", "--out", out_dir / "x.png")
+    run = run_cli_process("render", broken, "--size", "8", "--set", "method=0", "--out", out_dir / "x.png")
     failure = FailureRun(run, out_dir, {})
     message = check_one_line_failure(failure)
     assert message.startswith(f"{broken}:{target + 1}: "), message

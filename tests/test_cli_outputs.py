@@ -1,20 +1,21 @@
 """
 ``render``'s outputs and inputs beyond the basics: ``--exposure``, OpenEXR output, ``--params`` files;
 built-in materials by bare name (``render``, ``info``, ``presets``) and ``presets`` of a material that has
-none. Through the CLI in subprocesses (test_cli's helper); numpy-engine gradients where the GPU adds nothing.
+none. Through the CLI in this process (conftest.run_cli): numpy-engine gradients where the GPU adds nothing;
+the one GL render in a subprocess (conftest.run_cli_process).
 """
 
 from __future__ import annotations
 
 import json
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX, REPO_ROOT, one_line_error
-from test_cli import WORKERS, cli, relative
+from conftest import BRAGG_MATERIAL, BRDF_DATA, CLI_ERROR_PREFIX, REPO_ROOT, one_line_error, run_cli_process
+from conftest import run_cli as cli
+from test_cli import relative
 
 from explorer.app.parameter_files import save_values
 from explorer.materials.brd import load_material
@@ -66,7 +67,7 @@ def test_exr_is_linear_float32_rgb(tmp_path):
 
 @pytest.mark.gl
 def test_exr_of_a_gl_render(gl_renderer, bragg_material, tmp_path):
-    run = cli("render", MATERIAL, "--view", "sphere", "--size", "16", "--set", "method=3", "--out", tmp_path / "s.exr")
+    run = run_cli_process("render", MATERIAL, "--view", "sphere", "--size", "16", "--set", "method=3", "--out", tmp_path / "s.exr")
     assert run.returncode == 0, run.stderr
     expected = gl_renderer.render(bragg_material, bragg_material.resolve({"method": "3"}), "sphere", 16, 16)
     np.testing.assert_allclose(read_exr(tmp_path / "s.exr"), expected, rtol=0, atol=1e-6)
@@ -87,9 +88,7 @@ def test_params_files_then_set(tmp_path):
         "preset.npy": ["--preset", "figure3", "--params", tmp_path / "set.json"],
     }
     base = ["--engine", "numpy", "--view", "gradient", "--size", "24x4", "--set", "method=1"]
-    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
-        runs = dict(zip(jobs, pool.map(lambda item: cli("render", MATERIAL, *base, *item[1], "--out", tmp_path / item[0]),
-                                       jobs.items())))
+    runs = {name: cli("render", MATERIAL, *base, *extra, "--out", tmp_path / name) for name, extra in jobs.items()}
     for name, run in runs.items():
         assert run.returncode == 0 and run.stderr == "", f"{name}: {run.stderr}"
     image = {name: np.load(tmp_path / name) for name in jobs}
@@ -147,8 +146,7 @@ def bad_runs(tmp_path_factory):
     (root / "out").mkdir()
     cases = bad_inputs(root)
     assert list(cases) == BAD_CASES
-    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
-        runs = dict(zip(cases, pool.map(lambda case: cli(*case[0]), cases.values())))
+    runs = {name: cli(*args) for name, (args, _) in cases.items()}
     return root, cases, runs
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
 from explorer.physics import microfacet
 from explorer.views.env import (
     DEFAULT_ENVIRONMENT, EnvironmentFileError, EnvironmentMap, direction_to_uv, env_integral_numpy,
@@ -26,7 +26,6 @@ from explorer.views.env import (
 )
 from explorer.gpu.env import ProgressiveEnvRender
 from explorer.views.geometry import brdf_view_geometry, rim_distance
-from test_cli import cli
 
 GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
@@ -502,8 +501,6 @@ def test_progressive_bookkeeping(gl_renderer, smooth):
 
 
 def test_cli_bad_environment_input(tmp_path):
-    from concurrent.futures import ThreadPoolExecutor
-
     text = tmp_path / "notes.hdr"
     text.write_text("not an image\n")
     grey = tmp_path / "grey.png"
@@ -518,13 +515,9 @@ def test_cli_bad_environment_input(tmp_path):
         "spp 0": (["--spp", "0"], "--spp"),
         "spp not a number": (["--spp", "many"], "--spp"),
     }
-    with ThreadPoolExecutor(4) as pool:
-        runs = dict(zip(cases, pool.map(
-            lambda args: cli("render", GGX, "--view", "env", "--size", "8", "--engine", "numpy", "--out", out, *args),
-            [args for args, _ in cases.values()],
-        )))
-        lit = pool.submit(cli, "render", GGX, "--view", "lit", "--size", "8", "--spp", "4", "--out", out).result()
-    runs["--spp on lit"] = lit
+    runs = {name: run_cli("render", GGX, "--view", "env", "--size", "8", "--engine", "numpy", "--out", out, *args)
+            for name, (args, _) in cases.items()}
+    runs["--spp on lit"] = run_cli("render", GGX, "--view", "lit", "--size", "8", "--spp", "4", "--out", out)
     cases["--spp on lit"] = ([], "--view")
     for name, (_, named) in cases.items():
         line = one_line_error(runs[name])
@@ -540,7 +533,7 @@ def test_cli_env_with_an_exr(gl_renderer, tmp_path):
     environment = tmp_path / "sky.exr"
     assert _cv2().imwrite(str(environment), smooth_environment(32, 16).pixels[:, :, ::-1])
     out = tmp_path / "env.npy"
-    run = cli("render", GGX, "--view", "env", "--env", environment, "--spp", "16", "--size", "20", "--out", out)
+    run = run_cli_process("render", GGX, "--view", "env", "--env", environment, "--spp", "16", "--size", "20", "--out", out)
     assert run.returncode == 0, run.stderr
     image = np.load(out)
     assert image.shape == (20, 20, 3) and np.isfinite(image).all()

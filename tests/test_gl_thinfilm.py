@@ -1,4 +1,4 @@
-"""The thin-film material (issue #5, item 2): shaders/lib/thinfilm.glsl and shaders/thin_film.brd
+"""The thin-film material (Belcour & Barla 2017): shaders/lib/thinfilm.glsl and shaders/thin_film.brd
 against their numpy twins (explorer.physics.thinfilm, explorer.materials.thinfilm_model.ThinFilmModel).
 
 - every method of thin_film.brd, in the ``gradient`` and ``sphere`` views, on dielectric and conducting
@@ -7,7 +7,7 @@ against their numpy twins (explorer.physics.thinfilm, explorer.materials.thinfil
   the Fourier methods the least exact, a few 1e-4 at worst on random films);
 - the GLSL functions one by one (Airy reflectance per polarisation and wavelength, C_m, the sensitivity
   transforms) through small materials written here;
-- the issue's cross-check: a Bragg mirror with N = 1 (nh = n1, method 0) is the thin film (n2, d2)
+- a cross-check: a Bragg mirror with N = 1 (nh = n1, method 0) is the thin film (n2, d2)
   between n1 and n1 (method 0), in GL;
 - no NaN or Inf over random parameters and the parameter box's corners; the BRDF's numpy twin against
   explorer.physics.microfacet's Eq. 17; bad input through the CLI.
@@ -15,39 +15,31 @@ against their numpy twins (explorer.physics.thinfilm, explorer.materials.thinfil
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
-import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
 from explorer.tables import luts
 from explorer.physics import microfacet, thinfilm
 from explorer.materials.brd import load_material
 from explorer.materials.models import MODELS, model_for
 from explorer.views.render import render_numpy
-from explorer.views.geometry import rim_distance, view_cos_theta
+from explorer.views.geometry import view_cos_theta
 from explorer.materials.thinfilm_model import ThinFilmModel
+from twins import COLOUR_TOLERANCE, LIGHTS, Twins, assert_black_outside, assert_twins_equal, render_both
 
 THIN_FILM_MATERIAL = REPO_ROOT / "shaders" / "thin_film.brd"
 THINFILM_GLSL = REPO_ROOT / "shaders" / "lib" / "thinfilm.glsl"
 
-#: Per linear RGB channel, absolute (the product's GL tolerance).
-GL_ATOL = 2e-3
 #: The GLSL functions tested one by one: spectral values, far from the views' 2e-3.
 FUNCTION_ATOL = 1e-4
-#: Sphere pixels with |x^2 + y^2 - 1| below this are skipped (float32 decides inside/outside there).
-RIM_EXCLUSION = 1e-4
 #: W = 180: the last column at theta = 89.75 deg. The reference costs ~0.3 s per 256x256 on llvmpipe.
 VIEW_SIZES = {"gradient": (180, 1), "sphere": (32, 32)}
 SWEEP_SIZES = {"gradient": (48, 1), "sphere": (12, 12)}
 METHODS = [0, 1, 2, 3, 4, 5]
-CLI_TIMEOUT = 300
 
 #: Films as the CLI passes values (strings) or a UI would (floats).
 FILMS = {
@@ -69,23 +61,6 @@ FILMS = {
 @pytest.fixture(scope="module")
 def thin_film_material():
     return load_material(THIN_FILM_MATERIAL)
-
-
-def compare(renderer, material, overrides, view, size):
-    values = material.resolve(overrides)
-    gl = renderer.render(material, values, view, *size)
-    reference = render_numpy(model_for(material, values), view, *size)
-    assert gl.shape == reference.shape == (size[1], size[0], 3)
-    return gl, reference
-
-
-def max_error(gl, reference, view, size):
-    compared = rim_distance(view, *size) > RIM_EXCLUSION
-    assert np.isfinite(reference[compared]).all(), "numpy twin: non-finite pixels"
-    assert np.isfinite(gl[compared]).all(), "GLSL: non-finite pixels"
-    error = np.abs(gl - reference).max(axis=-1)
-    error[~compared] = 0.0
-    return error
 
 
 # --------------------------------------------------------------------------------------------------
@@ -305,22 +280,13 @@ def test_glsl_sensitivity_fourier_transform(gl_renderer, tmp_path, sensitivity, 
 @pytest.mark.parametrize("film", list(FILMS))
 def test_gl_equals_numpy_twin(gl_renderer, thin_film_material, film, method, view):
     overrides = {**FILMS[film], "method": method if method % 2 else str(method)}
-    size = VIEW_SIZES[view]
-    gl, reference = compare(gl_renderer, thin_film_material, overrides, view, size)
-    error = max_error(gl, reference, view, size)
-    worst = np.unravel_index(error.argmax(), error.shape)
-    assert error.max() <= GL_ATOL, (
-        f"max |GL - numpy| = {error.max():.2e} at pixel {worst} (GL {gl[worst]}, numpy {reference[worst]})"
-    )
+    twins = render_both(gl_renderer, thin_film_material, thin_film_material.resolve(overrides), view, VIEW_SIZES[view])
+    assert_twins_equal(twins, f"method {method}, {film}, {view}")
     if view == "sphere":
-        outside = ~view_cos_theta(view, *size)[1] & (rim_distance(view, *size) > RIM_EXCLUSION)
-        np.testing.assert_array_equal(gl[outside], 0.0)
+        assert_black_outside(twins)
 
 
-#: The BRDF views (tests/test_brdf_views.py's rule): relative 2e-3 of a pixel's largest |channel| above
-#: 1e-3, absolute below; their lights; a small image (the reference method runs per pixel).
-BRDF_RTOL, BRDF_FLOOR = 2e-3, 1e-3
-BRDF_LIGHTS = {"lit": (30.0, 120.0), "slice": None, "scatter": (50.0, 200.0)}
+#: The BRDF views (twins.BRDF_TOLERANCE, twins.LIGHTS) in a small image: the reference method runs per pixel.
 BRDF_SIZE = (20, 16)
 BRDF_FILMS = {
     "figure 7, alpha 0.2": {},
@@ -329,25 +295,17 @@ BRDF_FILMS = {
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("view", list(BRDF_LIGHTS))
+@pytest.mark.parametrize("view", list(LIGHTS))
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("film", list(BRDF_FILMS))
 def test_brdf_views_gl_equals_numpy_twin(gl_renderer, thin_film_material, film, method, view):
     values = thin_film_material.resolve({**BRDF_FILMS[film], "method": method})
-    light = BRDF_LIGHTS[view]
-    gl = gl_renderer.render(thin_film_material, values, view, *BRDF_SIZE, light=light)
-    reference = render_numpy(model_for(thin_film_material, values), view, *BRDF_SIZE, light=light)
-    compared = rim_distance(view, *BRDF_SIZE) > RIM_EXCLUSION
-    assert np.isfinite(gl[compared]).all() and np.isfinite(reference[compared]).all()
-    scale = np.maximum(np.abs(reference).max(axis=-1), BRDF_FLOOR)
-    ratio = np.abs(gl - reference).max(axis=-1) / (BRDF_RTOL * scale)
-    ratio[~compared] = 0.0
-    worst = np.unravel_index(ratio.argmax(), ratio.shape)
-    assert ratio.max() <= 1.0, f"{ratio.max() * BRDF_RTOL:.2e} relative at {worst}: GL {gl[worst]}, numpy {reference[worst]}"
-    assert np.abs(reference).max() > 0.05, "an empty image"
+    twins = render_both(gl_renderer, thin_film_material, values, view, BRDF_SIZE)
+    assert_twins_equal(twins, f"method {method}, {film}, {view}")
+    assert np.abs(twins.reference).max() > 0.05, "an empty image"
 
 
-#: The issue's cross-check: (n1, n2, Lambda, delta) of a one-cell Bragg mirror under nh = n1.
+#: The cross-check: (n1, n2, Lambda, delta) of a one-cell Bragg mirror under nh = n1.
 BRAGG_CELLS = [
     (1.0, 1.5, 500.0, 0.5),
     (1.6, 1.2, 800.0, 0.3),  # n2 < n1: the layer turns evanescent beyond 48.6 deg
@@ -367,8 +325,7 @@ def test_bragg_mirror_with_one_cell_is_a_thin_film_in_gl(gl_renderer, bragg_mate
     for view, size in VIEW_SIZES.items():
         bragg_image = gl_renderer.render(bragg_material, mirror, view, *size)
         film_image = gl_renderer.render(thin_film_material, film, view, *size)
-        error = max_error(bragg_image, film_image, view, size)
-        assert error.max() <= GL_ATOL, (view, error.max())
+        assert_twins_equal(Twins.of(bragg_image, film_image, view), f"one cell against the film, {view}", COLOUR_TOLERANCE)
         # Not vacuous: the film is coloured, not a grey interface.
         inside = view_cos_theta(view, *size)[1]
         assert np.ptp(film_image[inside], axis=-1).max() > 0.01
@@ -416,36 +373,22 @@ def test_gl_sweep_and_corners_are_finite(gl_renderer, thin_film_material):
 # The command line
 
 
-def cli(*args) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
-        timeout=CLI_TIMEOUT, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
+@pytest.mark.parametrize("assignment", ["d=-1", "kappa3=-1", "eta3=0"])
+def test_cli_bad_value_is_one_line(tmp_path, assignment):
+    """Bad thickness or kappa3: one line naming the parameter's declaration, a non-zero exit, no file."""
+    material = str(THIN_FILM_MATERIAL.relative_to(REPO_ROOT))
+    line = one_line_error(run_cli("render", material, "--set", assignment, "--out", tmp_path / "bad.png"))
+    assert "thin_film.brd" in line and assignment.split("=")[0] in line and "range" in line, line
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.gl
-def test_cli(gl_renderer, tmp_path, thin_film_material):
-    """Bad thickness or kappa3: one line naming the parameter's declaration, a non-zero exit, no file.
-    A good render: the .npy equals the numpy twin."""
+def test_cli_npy_equals_numpy_twin(gl_renderer, tmp_path, thin_film_material):
     material = str(THIN_FILM_MATERIAL.relative_to(REPO_ROOT))
-    jobs = {
-        "d=-1": ["render", material, "--set", "d=-1", "--out", tmp_path / "bad_d.png"],
-        "kappa3=-1": ["render", material, "--set", "kappa3=-1", "--out", tmp_path / "bad_kappa.png"],
-        "eta3=0": ["render", material, "--set", "eta3=0", "--out", tmp_path / "bad_eta3.png"],
-        "good": ["render", material, "--view", "sphere", "--size", "24", "--set", "method=3", "--set", "kappa3=2",
-                 "--out", tmp_path / "good.npy"],
-    }
-    with ThreadPoolExecutor(max_workers=len(jobs)) as pool:
-        runs = dict(zip(jobs, pool.map(lambda args: cli(*args), jobs.values())))
-    for case in ("d=-1", "kappa3=-1", "eta3=0"):
-        run, name = runs[case], case.split("=")[0]
-        line = one_line_error(run)
-        assert "thin_film.brd" in line and name in line and "range" in line, line
-    assert not any(tmp_path.glob("bad_*")) and not any(p.name.startswith(".") for p in tmp_path.iterdir())
-    good = runs["good"]
+    good = run_cli_process("render", material, "--view", "sphere", "--size", "24", "--set", "method=3", "--set", "kappa3=2",
+                           "--out", tmp_path / "good.npy")
     assert good.returncode == 0, good.stderr
     image = np.load(tmp_path / "good.npy")
     values = thin_film_material.resolve({"method": "3", "kappa3": "2"})
     reference = render_numpy(model_for(thin_film_material, values), "sphere", 24, 24)
-    error = max_error(image, reference, "sphere", (24, 24))
-    assert error.max() <= GL_ATOL
+    assert_twins_equal(Twins.of(image, reference, "sphere"), "CLI sphere .npy")

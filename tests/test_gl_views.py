@@ -14,12 +14,9 @@ import pytest
 from explorer.physics import bragg, colorimetry
 from explorer.materials.models import model_for
 from explorer.views.render import render_numpy
-from explorer.views.geometry import rim_distance, view_cos_theta
+from explorer.views.geometry import view_cos_theta
+from twins import COLOUR_TOLERANCE, Twins, assert_black_outside, assert_twins_equal, render_both
 
-#: Per linear RGB channel, absolute.
-GL_ATOL = 2e-3
-#: Sphere pixels with |x^2 + y^2 - 1| below this are skipped (float32 decides inside/outside there).
-RIM_EXCLUSION = 1e-4
 #: W = 180: the last column is at theta = 89.75 deg, so the gradient reaches beyond 89.5 deg.
 VIEW_SIZES = {"gradient": (180, 1), "sphere": (32, 32)}
 SWEEP_SIZES = {"gradient": (48, 1), "sphere": (12, 12)}
@@ -44,16 +41,6 @@ def object_colour_bounds() -> tuple[np.ndarray, np.ndarray]:
     return np.minimum(per_wavelength, 0.0).sum(axis=0), np.maximum(per_wavelength, 0.0).sum(axis=0)
 
 
-def compare(renderer, material, overrides, view, size):
-    values = material.resolve(overrides)
-    width, height = size
-    gl = renderer.render(material, values, view, width, height)
-    reference = render_numpy(model_for(material, values), view, width, height)
-    assert gl.shape == reference.shape == (height, width, 3)
-    assert gl.dtype == np.float32
-    return gl, reference
-
-
 def test_gradient_reaches_grazing():
     cos_theta, inside = view_cos_theta("gradient", *VIEW_SIZES["gradient"])
     assert inside.all()
@@ -67,22 +54,12 @@ def test_gradient_reaches_grazing():
 @pytest.mark.parametrize("mirror", list(MIRRORS))
 def test_gl_equals_numpy_twin(gl_renderer, bragg_material, mirror, method, view):
     overrides = {**MIRRORS[mirror], "method": method if method % 2 else str(method)}
-    gl, reference = compare(gl_renderer, bragg_material, overrides, view, VIEW_SIZES[view])
-    compared = rim_distance(view, *VIEW_SIZES[view]) > RIM_EXCLUSION
+    twins = render_both(gl_renderer, bragg_material, bragg_material.resolve(overrides), view, VIEW_SIZES[view])
+    compared = twins.compared
     assert compared.sum() >= 0.9 * compared.size if view == "gradient" else compared.sum() > 500
-    assert np.isfinite(reference[compared]).all(), "numpy twin: non-finite pixels"
-    assert np.isfinite(gl[compared]).all(), "GLSL: non-finite pixels"
-    error = np.abs(gl - reference).max(axis=-1)
-    error[~compared] = 0.0
-    worst = np.unravel_index(error.argmax(), error.shape)
-    assert error.max() <= GL_ATOL, (
-        f"max |GL - numpy| = {error.max():.2e} at pixel {worst} "
-        f"(GL {gl[worst]}, numpy {reference[worst]})"
-    )
+    assert_twins_equal(twins, f"method {method}, {mirror}, {view}")
     if view == "sphere":
-        outside = ~view_cos_theta(view, *VIEW_SIZES[view])[1] & compared
-        np.testing.assert_array_equal(gl[outside], 0.0)
-        np.testing.assert_array_equal(reference[outside], 0.0)
+        assert_black_outside(twins)
 
 
 @pytest.mark.gl
@@ -94,9 +71,7 @@ def test_tabulated_gl_equals_spectral_reference_on_a_smooth_mirror(gl_renderer, 
         tabulated = gl_renderer.render(bragg_material, bragg_material.resolve({**beetle, "method": 3}), view, *size)
         values = bragg_material.resolve({**beetle, "method": 0})
         reference = render_numpy(model_for(bragg_material, values), view, *size)
-        compared = rim_distance(view, *size) > RIM_EXCLUSION
-        error = np.abs(tabulated - reference)[compared]
-        assert error.max() <= GL_ATOL, (view, error.max())
+        assert_twins_equal(Twins.of(tabulated, reference, view), f"method 3 against the reference, {view}", COLOUR_TOLERANCE)
 
 
 def random_parameters(material, rng) -> dict:

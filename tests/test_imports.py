@@ -1,5 +1,5 @@
 """
-The package's import graph has no cycles (issue 12): every ``import`` of an ``explorer`` module, at
+The package's import graph has no cycles: every ``import`` of an ``explorer`` module, at
 module level or inside a function, is an edge; a cycle means the layers are not layered.
 """
 

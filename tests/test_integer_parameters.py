@@ -19,9 +19,8 @@ from explorer.materials.brd import load_material, round_integer
 from explorer.gpu.programs import specialisation
 from explorer.materials.models import model_for
 from explorer.views.render import render_numpy
-from explorer.views.geometry import rim_distance
-from test_brdf_views import LIGHTS, assert_twin_equal
-from test_gl_views import GL_ATOL, RIM_EXCLUSION, SWEEP_SIZES
+from test_gl_views import SWEEP_SIZES
+from twins import GL_ATOL, Twins, assert_twins_equal, render_both
 
 SHADERS = REPO_ROOT / "shaders"
 #: Halves, and values either side of one.
@@ -53,20 +52,7 @@ def sweep_cases():
 
 def render_pair(renderer, material, values, view):
     """GL and numpy images of ``material`` at ``values`` (not resolved: fractional ints stay fractional)."""
-    size = SWEEP_SIZES.get(view, BRDF_SIZE) if view in ("gradient", "sphere") else BRDF_SIZE
-    light = LIGHTS.get(view)
-    gl = renderer.render(material, values, view, *size, light=light)
-    numpy_image = render_numpy(model_for(material, values), view, *size, light=light)
-    return gl, numpy_image, rim_distance(view, *size) > RIM_EXCLUSION
-
-
-def assert_equal_images(gl, numpy_image, compared, view, what):
-    assert np.isfinite(gl[compared]).all() and np.isfinite(numpy_image[compared]).all(), what
-    if view in ("gradient", "sphere"):
-        error = np.abs(gl - numpy_image).max(axis=-1)[compared]
-        assert error.max() <= GL_ATOL, f"{what}: max |GL - numpy| = {error.max():.2e}"
-    else:
-        assert_twin_equal(gl, numpy_image, compared, what)
+    return render_both(renderer, material, values, view, SWEEP_SIZES.get(view, BRDF_SIZE))
 
 
 @pytest.mark.gl
@@ -75,8 +61,9 @@ def test_gl_equals_numpy_at_fractional_integer_values(gl_renderer, name, value, 
     material_file, base, parameter, _, _ = SWEEPS[name]
     material = load_material(SHADERS / material_file)
     values = {**material.resolve(base), parameter: value}
-    gl, numpy_image, compared = render_pair(gl_renderer, material, values, view)
-    assert_equal_images(gl, numpy_image, compared, view, f"{material_file} {parameter}={value} {view}")
+    twins = render_pair(gl_renderer, material, values, view)
+    assert_twins_equal(twins, f"{material_file} {parameter}={value} {view}")
+    gl = twins.gl
     # Both are the image of the rounded integer (halves up), not of any other rounding.
     rounded = {**values, parameter: float(round_integer(value))}
     gl_rounded, _, _ = render_pair(gl_renderer, material, rounded, view)
@@ -136,18 +123,18 @@ def test_resolve_rounds_what_the_cli_and_presets_pass():
 @pytest.mark.gl
 def test_cli_set_and_engines_agree_on_a_half(gl_renderer, tmp_path):
     """``render --set method=0.5`` (GL, specialised) and ``--engine numpy``: both method 1, to GL_ATOL."""
-    from test_cli import cli
+    from conftest import run_cli_process
 
     images = {}
     for engine in ("gl", "numpy"):
         out = tmp_path / f"{engine}.npy"
-        run = cli("render", BRAGG_MATERIAL, "--view", "gradient", "--size", "48x1", "--set", "method=0.5",
+        run = run_cli_process("render", BRAGG_MATERIAL, "--view", "gradient", "--size", "48x1", "--set", "method=0.5",
                   "--set", "N=8.5", "--engine", engine, "--out", out)
         assert run.returncode == 0, run.stderr
         images[engine] = np.load(out)
     material = load_material(BRAGG_MATERIAL)
     method_1 = render_numpy(model_for(material, material.resolve({"method": 1, "N": 9})), "gradient", 48, 1)
-    assert np.abs(images["gl"] - images["numpy"]).max() <= GL_ATOL
+    assert_twins_equal(Twins.of(images["gl"], images["numpy"], "gradient"), "CLI gl and numpy at method=0.5")
     assert np.abs(images["numpy"] - method_1).max() <= 1e-6
 
 
@@ -220,11 +207,10 @@ def test_brdf_explorer_floats_with_whole_number_ranges_get_float_sliders(tmp_pat
 
 def test_cli_reports_a_bad_int_declaration_in_one_line(tmp_path):
     """``info`` on a .brd whose int has a fractional default: one line naming file:line, non-zero exit."""
-    from conftest import one_line_error
-    from test_cli import cli
+    from conftest import one_line_error, run_cli
 
     path = tmp_path / "bad_int.brd"
     path.write_text("analytic\n::begin parameters\nfloat k 0 1 .5\nint N 1 1000 20.5\n::end parameters\n"
                     "::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(k); }\n::end shader\n")
-    line = one_line_error(cli("info", path))
+    line = one_line_error(run_cli("info", path))
     assert line.endswith(f"{path}:4: int 'N': default '20.5' is not an integer"), line

@@ -9,18 +9,15 @@ classes independently of the forward model's tables.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.physics import inverse, lobes
 from explorer.physics.inverse import InverseError, Lobe
 
-#: The issue's bound for forward(inverse(lobes)) at normal incidence.
+#: The bound for forward(inverse(lobes)) at normal incidence.
 ROUND_TRIP_TOLERANCE = 1e-3
 #: The colour channels other than the one that sets a roughness keep their own variance (Sec. 5.2.3);
 #: measured up to 1.2e-3 on the cases below.
@@ -172,13 +169,6 @@ def test_bad_lobes_say_which_constraint_fails(lobe_list, message):
     with pytest.raises(InverseError, match=message) as error:
         inverse.invert_lobes(lobe_list, choices)
     assert "\n" not in str(error.value)
-
-
-def run_cli(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "explorer", *args], cwd=REPO_ROOT, capture_output=True, text=True, timeout=120,
-        env={**os.environ, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONWARNINGS": "ignore"},
-    )
 
 
 def test_cli_inverse_json_prints_a_stack_that_renders():

@@ -2,7 +2,7 @@
 
 Independent references: ``tmm.inc_tmm`` (incoherent multilayers) for smooth stacks, a brute-force
 integration of the GGX BRDF over outgoing directions for the FGD table. GL against the numpy twin with
-test_brdf_views' rule (2e-3 of a pixel's largest channel).
+tests/twins.py's BRDF_TOLERANCE (2e-3 of a pixel's largest channel), the gradient included.
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ from explorer.materials.brd import load_material
 from explorer.views.env import EnvironmentMap, env_integral_numpy
 from explorer.gpu.env import ProgressiveEnvRender
 from explorer.materials.models import model_for
-from explorer.views.render import render_numpy
-from explorer.views.geometry import brdf_view_geometry, rim_distance
-from test_brdf_views import LIGHTS, RIM_EXCLUSION, SIZE, assert_twin_equal
+from explorer.views.geometry import brdf_view_geometry
+from test_brdf_views import SIZE
+from twins import BRDF_TOLERANCE, LIGHTS, assert_twins_equal, render_both
 
 MATERIAL = REPO_ROOT / "shaders" / "layered_lobes.brd"
-#: Smooth stacks against tmm's incoherent multilayer, every angle (the issue's bound).
+#: Smooth stacks against tmm's incoherent multilayer, every angle, within this.
 TMM_TOLERANCE = 1e-3
 #: The FGD table (trilinear, 48^2 quadrature) against a brute-force integral off the table's nodes, more
 #: than alpha from a critical angle (within it, at alpha < 0.1, the 33-node table misses the sharp rise of
@@ -193,14 +193,9 @@ def material():
 @pytest.mark.parametrize("case", list(CASES))
 @pytest.mark.parametrize("view", ["lit", "slice", "scatter", "gradient"])
 def test_gl_equals_numpy_twin(gl_renderer, material, case, view):
-    values = material.resolve(CASES[case])
-    width, height = SIZE
-    light = LIGHTS.get(view)
-    gl = gl_renderer.render(material, values, view, width, height, light=light)
-    reference = render_numpy(model_for(material, values), view, width, height, light=light)
-    compared = rim_distance(view, width, height) > RIM_EXCLUSION
-    assert_twin_equal(gl, reference, compared, f"layered_lobes {case}, {view}")
-    assert np.abs(reference).max() > 0.05, "an empty image"
+    twins = render_both(gl_renderer, material, material.resolve(CASES[case]), view, SIZE)
+    assert_twins_equal(twins, f"layered_lobes {case}, {view}", BRDF_TOLERANCE)
+    assert np.abs(twins.reference).max() > 0.05, "an empty image"
 
 
 @pytest.mark.gl
@@ -253,16 +248,10 @@ def test_tir_term_keeps_the_lobe_beyond_the_critical_angle_inside():
     assert np.all(lobes.reflectance(with_tir, 1.0) < lobes.reflectance(plain, 1.0) - 1e-3)
 
 
-def test_cli_negative_optical_depth_is_one_line():
-    import os
-    import subprocess
-    import sys
+def test_cli_negative_optical_depth_is_one_line(tmp_path):
+    from conftest import one_line_error, run_cli
 
-    from conftest import one_line_error
-
-    run = subprocess.run(
-        [sys.executable, "-m", "explorer", "render", str(MATERIAL), "--set", "tau_1=0,-1,0", "--view", "lit",
-         "--size", "8", "--engine", "numpy", "--out", "unused.png"],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=120, env={**os.environ, "BRAGG_EXPLORER_NO_SETUP": "1"},
-    )
+    run = run_cli("render", MATERIAL, "--set", "tau_1=0,-1,0", "--view", "lit", "--size", "8", "--engine", "numpy",
+                  "--out", tmp_path / "unused.png")
+    assert not (tmp_path / "unused.png").exists()
     assert "tau_1 = [0.0, -1.0, 0.0] must be >= 0" in one_line_error(run)

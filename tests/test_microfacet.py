@@ -16,7 +16,7 @@ from explorer.physics import bragg, colorimetry, layered, microfacet
 from explorer.physics.bragg import BraggMirror
 
 SEED = 20240603
-#: Appendix C: each row of the tabulated filter integrates to G1(theta_i) (the issue's tolerance).
+#: Appendix C: each row of the tabulated filter integrates to G1(theta_i) within this.
 APPENDIX_C_ATOL = 1e-3
 #: Appendix C, what the quadrature of microfacet.transmission_filter_table actually achieves.
 APPENDIX_C_ACHIEVED = 2e-5

@@ -4,27 +4,18 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.materials.models import GGXSchlickModel
 from explorer.materials.presets import PRESET_DIR, PresetError, all_preset_files, load_presets
 
 PRESET_FILES = sorted(PRESET_DIR.glob("*.toml"))
 #: A fast method per material for the GL smoke test.
 FAST_METHOD = {"thin_film": 1, "bragg_mirror": 1, "bragg_layer": 1}
-
-
-def cli(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)], cwd=REPO_ROOT, capture_output=True, text=True,
-        timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
 
 
 def all_presets():
@@ -53,7 +44,7 @@ def test_preset_resolves_within_range(stem, preset):
         assert float(values[name]) == pytest.approx(float(value))
 
 
-def test_stack_presets_cover_the_issue_figures():
+def test_stack_presets_cover_the_papers_figures():
     presets = load_presets(PRESET_DIR / "bragg_stack.toml").presets
     for prefix, count in {"figure1_": 11, "figure7_": 4, "figure10_": 24, "figure11_": 7, "figure12_": 9, "table3_": 3,
                           "supplemental10_": 9, "supplemental11_": 9}.items():
@@ -112,18 +103,16 @@ def test_ggx_schlick_twin_is_microfacet_times_schlick():
 @pytest.mark.gl
 def test_ggx_schlick_gl_equals_numpy(gl_renderer):
     from explorer.materials.brd import load_material
-    from explorer.views.render import render_numpy
+    from twins import assert_twins_equal, render_both
 
     material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
     values = material.resolve({"alpha": 0.25, "F0": 0.1})
-    gl = gl_renderer.render(material, values, "lit", 24, 24)
-    reference = render_numpy(GGXSchlickModel(values), "lit", 24, 24)
-    assert np.abs(gl - reference).max() < 2e-3
+    assert_twins_equal(render_both(gl_renderer, material, values, "lit", (24, 24), light=None), "ggx_schlick lit")
 
 
 def test_preset_then_set_overrides(tmp_path):
     out = tmp_path / "x.npy"
-    run = cli("render", "shaders/thin_film.brd", "--engine", "numpy", "--view", "gradient", "--size", "8x2",
+    run = run_cli("render", "shaders/thin_film.brd", "--engine", "numpy", "--view", "gradient", "--size", "8x2",
               "--preset", "figure17_boar", "--set", "d=100", "--set", "method=3", "--out", out)
     assert run.returncode == 0, run.stderr
     got = np.load(out)
@@ -141,21 +130,21 @@ def test_preset_then_set_overrides(tmp_path):
 
 
 def test_unknown_preset_is_one_line(tmp_path):
-    run = cli("render", "shaders/bragg_mirror.brd", "--preset", "no_such", "--size", "8", "--out", tmp_path / "x.png")
+    run = run_cli("render", "shaders/bragg_mirror.brd", "--preset", "no_such", "--size", "8", "--out", tmp_path / "x.png")
     line = one_line_error(run)
     assert "no_such" in line and "figure3" in line and "table3_red" in line
     assert not (tmp_path / "x.png").exists()
 
 
 def test_presets_command_lists_name_material_description():
-    run = cli("presets")
+    run = run_cli("presets")
     assert run.returncode == 0, run.stderr
     assert "figure1_leather" in run.stdout and "thin_film.brd" in run.stdout and "table3_purple" in run.stdout
-    run = cli("presets", "thin_film", "--json")
+    run = run_cli("presets", "thin_film", "--json")
     rows = json.loads(run.stdout)
     assert {r["material"] for r in rows} == {"shaders/thin_film.brd"}
     assert all(r["description"] for r in rows)
-    run = cli("presets", "no_such_material")
+    run = run_cli("presets", "no_such_material")
     assert run.returncode != 0 and len(run.stderr.strip().splitlines()) == 1
 
 
@@ -189,6 +178,6 @@ def test_malformed_presets_file_is_one_located_line(tmp_path, body, line, words)
 
 def test_malformed_presets_file_through_the_cli(tmp_path):
     path = write_presets(tmp_path, '[a]\nfigure = "F"\ndescription = "D"\neta2 = 9\n')
-    run = cli("render", path.parent.parent / "thin_film.brd", "--preset", "a", "--size", "8", "--out", tmp_path / "x.png")
+    run = run_cli("render", path.parent.parent / "thin_film.brd", "--preset", "a", "--size", "8", "--out", tmp_path / "x.png")
     line = one_line_error(run)
     assert "thin_film.toml:6:" in line and "eta2" in line

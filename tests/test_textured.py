@@ -1,19 +1,15 @@
 """
-Spatially varying film thickness (issue #5 item 3; Belcour & Barla 2017, Section 5, Figures 12-15): the
+Spatially varying film thickness (Belcour & Barla 2017, Section 5, Figures 12-15): the
 ``textured`` view, its numpy twin, the pre-filtered Fourier table, the removal of aliasing, bad input.
 """
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
-from test_brdf_views import RIM_EXCLUSION, assert_twin_equal
+from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
+from twins import Twins, assert_twins_equal, render_both
 
 THIN_FILM = REPO_ROOT / "shaders" / "thin_film.brd"
 #: Not square, so that a swapped width and height or flipped rows show.
@@ -33,20 +29,6 @@ def film():
 def noise_texture(size: int = 256, low: float = 0.0, high: float = 1125.0, seed: int = 0):
     rng = np.random.default_rng(seed)
     return (low + (high - low) * rng.random((size, size))).astype(np.float32)
-
-
-def render_both(renderer, material, overrides, thickness, size=SIZE):
-    from explorer.materials.models import model_for
-    from explorer.views.render import render_numpy
-
-    values = material.resolve(overrides)
-    width, height = size
-    gl = renderer.render(
-        material, values, "textured", width, height,
-        inputs=thickness.gl_inputs(width, height), uniforms={"prefilter": thickness.prefilter},
-    )
-    reference = render_numpy(model_for(material, values), "textured", width, height, thickness=thickness)
-    return gl, reference
 
 
 # -- physics -------------------------------------------------------------------------------------------
@@ -123,29 +105,29 @@ def test_footprint_moments_of_a_constant_and_of_a_checkerboard():
 @pytest.mark.gl
 @pytest.mark.parametrize("method", [0, 1, 2, 3, 4, 5])
 def test_textured_gl_equals_numpy(gl_renderer, film, method):
-    from explorer.views.geometry import rim_distance
     from explorer.views.thickness import ThicknessTexture
 
     thickness = ThicknessTexture.from_file(dinc_range=(0.0, 1125.0))
-    gl, reference = render_both(gl_renderer, film, {"method": method, "alpha": 0.3}, thickness)
-    assert np.abs(reference).max() > 0.01
-    assert_twin_equal(gl, reference, rim_distance("textured", *SIZE) > RIM_EXCLUSION, f"textured method {method}")
+    twins = render_both(gl_renderer, film, film.resolve({"method": method, "alpha": 0.3}), "textured", SIZE,
+                        light=None, thickness=thickness)
+    assert np.abs(twins.reference).max() > 0.01
+    assert_twins_equal(twins, f"textured method {method}")
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize("method", [1, 2, 3])
 @pytest.mark.parametrize("texture", ["default", "noise"])
 def test_textured_prefiltered_gl_equals_numpy(gl_renderer, film, method, texture):
-    from explorer.views.geometry import rim_distance
     from explorer.views.thickness import ThicknessTexture
 
     if texture == "noise":
         thickness = ThicknessTexture(noise_texture(), prefilter=True)
     else:
         thickness = ThicknessTexture.from_file(dinc_range=(0.0, 1125.0), prefilter=True)
-    gl, reference = render_both(gl_renderer, film, {"method": method, "alpha": 0.3, "eta3": 1.5, "kappa3": 0.8}, thickness)
-    assert np.abs(reference).max() > 0.01
-    assert_twin_equal(gl, reference, rim_distance("textured", *SIZE) > RIM_EXCLUSION, f"prefiltered method {method}, {texture}")
+    values = film.resolve({"method": method, "alpha": 0.3, "eta3": 1.5, "kappa3": 0.8})
+    twins = render_both(gl_renderer, film, values, "textured", SIZE, light=None, thickness=thickness)
+    assert np.abs(twins.reference).max() > 0.01
+    assert_twins_equal(twins, f"prefiltered method {method}, {texture}")
 
 
 @pytest.mark.gl
@@ -181,13 +163,6 @@ def test_prefiltering_removes_aliasing(gl_renderer, film):
 # -- the command line --------------------------------------------------------------------------------------
 
 
-def cli(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "explorer.cli.commands", *map(str, args)],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"},
-    )
-
-
 def bad_cases(tmp_path):
     text = tmp_path / "notes.png"
     text.write_text("not an image\n")
@@ -204,15 +179,10 @@ def bad_cases(tmp_path):
 
 
 def test_cli_bad_thickness_input(tmp_path):
-    from concurrent.futures import ThreadPoolExecutor
-
     out = tmp_path / "out.png"
     cases = bad_cases(tmp_path)
-    with ThreadPoolExecutor(4) as pool:
-        runs = dict(zip(cases, pool.map(
-            lambda args: cli("render", THIN_FILM, "--view", "textured", "--size", "8", "--engine", "numpy", "--out", out, *args),
-            [args for args, _ in cases.values()],
-        )))
+    runs = {name: run_cli("render", THIN_FILM, "--view", "textured", "--size", "8", "--engine", "numpy", "--out", out, *args)
+            for name, (args, _) in cases.items()}
     for name, (args, named) in cases.items():
         line = one_line_error(runs[name])
         assert named in line, f"{name}: {line}"
@@ -222,8 +192,6 @@ def test_cli_bad_thickness_input(tmp_path):
 
 @pytest.mark.gl
 def test_cli_textured_npy_equals_numpy(gl_renderer, tmp_path):
-    from explorer.views.geometry import rim_distance
-
     texture = tmp_path / "stripes.png"
     from PIL import Image
 
@@ -231,10 +199,10 @@ def test_cli_textured_npy_equals_numpy(gl_renderer, tmp_path):
     outputs = {}
     for engine in ("gl", "numpy"):
         outputs[engine] = tmp_path / f"{engine}.npy"
-        run = cli(
+        run = run_cli_process(
             "render", THIN_FILM, "--view", "textured", "--size", "36x28", "--set", "method=2", "--set", "alpha=0.3",
             "--texture", texture, "--dinc-range", "100,900", "--prefilter", "on", "--engine", engine, "--out", outputs[engine],
         )
         assert run.returncode == 0, run.stderr
-    assert_twin_equal(np.load(outputs["gl"]), np.load(outputs["numpy"]).astype(np.float32),
-                      rim_distance("textured", 36, 28) > RIM_EXCLUSION, "CLI textured")
+    assert_twins_equal(Twins.of(np.load(outputs["gl"]), np.load(outputs["numpy"]).astype(np.float32), "textured"),
+                       "CLI textured")

@@ -1,5 +1,5 @@
 """
-The interactive explorer (issue #4): a glfw window, Dear ImGui and ImPlot (``imgui-bundle``), moderngl.
+The interactive explorer: a glfw window, Dear ImGui and ImPlot (``imgui-bundle``), moderngl.
 
 ``bragg-explorer`` (no argument, with a display) opens it on the default Bragg mirror;
 ``bragg-explorer open FILE.brd|FILE.brdf [--preset NAME]`` on another material. Its images are the

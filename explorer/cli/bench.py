@@ -352,7 +352,7 @@ def format_thin_film(document: dict) -> str:
 
 
 # --------------------------------------------------------------------------------------------------
-# Rough layers (issue #3): host-table timings and the slice view's accuracy
+# Rough layers: host-table timings and the slice view's accuracy
 
 #: Roughnesses of the slice study and of the F_alpha timings.
 LAYER_ALPHAS = (0.025, 0.1, 0.4)
@@ -513,7 +513,7 @@ def format_layers(document: dict) -> str:
 
 
 # --------------------------------------------------------------------------------------------------
-# bench --app (issue #4): the explorer's frame times while a slider is dragged
+# bench --app: the explorer's frame times while a slider is dragged
 
 
 #: The methods of bragg_mirror.brd timed by ``bench --app``, fastest first.

@@ -369,7 +369,7 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
-    With --layers: issue #3's host-table timings and the slice view's accuracy (64x64; --repeats, default 5 here).
+    With --layers: the rough layers' host-table timings and the slice view's accuracy (64x64; --repeats, default 5 here).
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
@@ -421,7 +421,7 @@ def default_job():
         click.echo(f"wrote out/bragg_mirror_{view}.png ({size[0]}x{size[1]}, exact spectral colours, tabulated)")
 
 
-from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  (issue 11: layered lobes)
+from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  (the layered lobes' commands)
 
 cli.add_command(inverse_command)
 cli.add_command(figure_command)

@@ -158,15 +158,3 @@ def presets_for(material_path: str | os.PathLike[str]) -> PresetFile:
 def all_preset_files(directory: Path = PRESET_DIR) -> list[PresetFile]:
     """Every presets file of ``directory``, sorted by name."""
     return [load_presets(p) for p in sorted(directory.glob("*.toml"))]
-
-
-def find_preset_file(material: str) -> PresetFile:
-    """``material``: a material file's path, or the stem of one in ``shaders/`` (``thin_film``)."""
-    candidate = Path(material)
-    if candidate.suffix in (".brd", ".brdf") or candidate.exists():
-        return presets_for(candidate)
-    path = PRESET_DIR / f"{candidate.name}.toml"
-    if not path.is_file():
-        valid = ", ".join(p.stem for p in sorted(PRESET_DIR.glob("*.toml"))) or "(none)"
-        raise PresetError(material, None, f"no presets for this material; materials with presets: {valid}")
-    return load_presets(path)

@@ -38,16 +38,12 @@ import numpy as np
 from explorer.physics import bragg, colorimetry, microfacet
 from explorer.physics.fresnel import fresnel_reflectance
 
-#: At most this many rough Bragg layers in a stack (the issue's 1 to 3).
+#: At most this many rough Bragg layers in a stack.
 MAX_LAYERS = 3
 
 
 # --------------------------------------------------------------------------------------------------
 # Parameters
-
-
-def _one_line(message: str) -> str:
-    return " ".join(str(message).split())
 
 
 @dataclass(frozen=True)
@@ -556,7 +552,7 @@ def layer_choice_probabilities(stack: LayeredBragg, cos_theta, tables=None) -> t
 
 
 # --------------------------------------------------------------------------------------------------
-# Timings (the goals of issue #3: F_alpha for a new alpha within 100 ms, a layer's tables within 10 ms)
+# Timings (the goals: F_alpha for a new alpha within 100 ms, a layer's tables within 10 ms)
 
 
 def figure7_layers() -> dict[str, tuple[RoughBraggLayer, float]]:

@@ -169,15 +169,6 @@ def smith_G1_over_cos(cos_theta_i, alpha) -> np.ndarray:
     return np.where(np.asarray(cos_theta_i) > 0.0, value, 0.0)
 
 
-def smith_G(cos_theta_i, cos_theta_o, alpha) -> np.ndarray:
-    """
-    The separable shadowing-masking term ``G(i, o, m) = G1(i, m) G1(o, m)`` (Eq. 19), for a visible
-    microfacet (``i.m`` and ``o.m`` of the signs of ``i.n`` and ``o.n``: always so for the half vector
-    of a reflection above the surface).
-    """
-    return smith_G1(cos_theta_i, alpha) * smith_G1(cos_theta_o, alpha)
-
-
 # --------------------------------------------------------------------------------------------------
 # The microfacet Bragg BRDF (Eq. 17)
 

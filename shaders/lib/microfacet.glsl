@@ -26,11 +26,6 @@ float smith_G1_over_cos(float cos_theta_i, float alpha) {
     return 2.0 / (c + sqrt(c * c + a * a * (1.0 - c * c)));
 }
 
-// The separable G = G1(i) G1(o) (Eq. 19).
-float smith_G(float cos_theta_i, float cos_theta_o, float alpha) {
-    return smith_G1(cos_theta_i, alpha) * smith_G1(cos_theta_o, alpha);
-}
-
 // h = (i + o) / |i + o|; +N where i = -o.
 vec3 half_vector(vec3 i, vec3 o, vec3 N) {
     vec3 s = i + o;
