@@ -1,5 +1,5 @@
 """
-The converged spectral reference (issue: "exact" colours that are exact).
+The converged spectral reference: "exact" colours that are exact.
 
 The paper's reference samples R_lambda at every nm; beside band edges the pass band's transmission
 resonances are narrower than that, so 1-nm samples hit or miss them. ``bragg.reference_rgb`` without a
