@@ -39,10 +39,11 @@ def _load(path: str | Path) -> Material:
 
 def parse_size(text: str | None, view: str) -> tuple[int, int]:
     """``W`` or ``WxH`` (a square for ``W`` alone, except the gradient, which keeps its height)."""
-    from explorer.views.geometry import DEFAULT_SIZES
+    from explorer.views.geometry import view_named
 
+    default_size = view_named(view).default_size
     if text is None:
-        return DEFAULT_SIZES[view]
+        return default_size
     parts = text.lower().split("x")
     try:
         numbers = [int(p) for p in parts]
@@ -51,23 +52,23 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
     if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > 16384:
         raise click.BadParameter(f"{text!r} is not W or WxH with sizes in 1..16384", param_hint="--size")
     if len(numbers) == 1:
-        return (numbers[0], DEFAULT_SIZES[view][1] if view == "gradient" else numbers[0])
+        return (numbers[0], numbers[0] if view_named(view).square else default_size[1])
     return numbers[0], numbers[1]
 
 
 def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     """``THETA,PHI`` in degrees (theta in [0, 180] from +z, phi from +x; theta <= 90 for ``scatter``)."""
-    from explorer.views.geometry import LIGHT_VIEWS
+    from explorer.views.geometry import LIGHT_VIEWS, view_named
 
     if text is None:
         return None
-    if view not in LIGHT_VIEWS:
+    top = view_named(view).light_theta_max
+    if top is None:
         raise click.BadParameter(f"the {view} view has no light (--light is for {', '.join(LIGHT_VIEWS)})", param_hint="--light")
     try:
         theta, phi = (float(part) for part in text.split(","))
     except ValueError:
         raise click.BadParameter(f"{text!r} is not THETA,PHI in degrees (e.g. 30,0)", param_hint="--light") from None
-    top = 90.0 if view == "scatter" else 180.0
     if not (np.isfinite(theta) and np.isfinite(phi)) or not 0.0 <= theta <= top:
         raise click.BadParameter(f"{text!r}: THETA must be in [0, {top:g}] and PHI finite", param_hint="--light")
     return theta, phi
@@ -262,7 +263,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
     (--engine numpy: the exact integral, slow; use a small --size).
     """
-    from explorer.views.geometry import scatter_circles
+    from explorer.views.geometry import scatter_circles, view_named
 
     check_output(Path(out))
     exposure_factor = parse_exposure(exposure, Path(out))
@@ -299,7 +300,8 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     elif env_file is not None or spp is not None:
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
     image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
-    write_image(image, Path(out), scatter_circles(width, height) if view == "scatter" else None, exposure_factor)
+    circles = scatter_circles(width, height) if view_named(view).circles else None
+    write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
     click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
 

@@ -14,16 +14,57 @@ evaluate the material at the same angle; the physics then runs in float64.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-VIEWS = ("gradient", "sphere", "lit", "slice", "scatter", "textured", "env")
-DEFAULT_SIZES = {
-    "gradient": (256, 32), "sphere": (256, 256), "lit": (256, 256), "slice": (256, 256), "scatter": (256, 256),
-    "textured": (256, 256), "env": (256, 256),
-}
+@dataclass(frozen=True)
+class View:
+    """
+    What one view is (its template is ``shaders/views/NAME.glsl``, its numpy twin
+    :func:`explorer.views.render.render_numpy`): what it evaluates of a material (``reflectance``,
+    ``brdf``, ``textured_brdf`` or ``environment``), its default size, whether ``--size W`` means a
+    square, and the largest polar angle of its light (``None``: it takes no light).
+    """
+
+    name: str
+    evaluates: str
+    default_size: tuple[int, int] = (256, 256)
+    square: bool = True
+    light_theta_max: float | None = None
+    #: Circles of constant theta_o drawn on PNG output (the paper's Figure 9).
+    circles: bool = False
+
+    @property
+    def takes_light(self) -> bool:
+        return self.light_theta_max is not None
+
+
+#: Every view, in the order the CLI lists them.
+VIEW_REGISTRY: dict[str, View] = {view.name: view for view in (
+    View("gradient", "reflectance", default_size=(256, 32), square=False),
+    View("sphere", "reflectance"),
+    View("lit", "brdf", light_theta_max=180.0),
+    View("slice", "brdf"),
+    View("scatter", "brdf", light_theta_max=90.0, circles=True),
+    View("textured", "textured_brdf", light_theta_max=180.0),
+    View("env", "environment"),
+)}
+VIEWS = tuple(VIEW_REGISTRY)
+DEFAULT_SIZES = {name: view.default_size for name, view in VIEW_REGISTRY.items()}
 #: Views that evaluate the material's BRDF(L, V, N, X, Y); those that take a light direction.
-BRDF_VIEWS = ("lit", "slice", "scatter")
-LIGHT_VIEWS = ("lit", "scatter", "textured")
+BRDF_VIEWS = tuple(name for name, view in VIEW_REGISTRY.items() if view.evaluates == "brdf")
+LIGHT_VIEWS = tuple(name for name, view in VIEW_REGISTRY.items() if view.takes_light)
+
+
+def view_named(name: str) -> View:
+    """The registered view ``name``; a one-line ``ValueError`` listing the views otherwise."""
+    try:
+        return VIEW_REGISTRY[name]
+    except KeyError:
+        raise ValueError(f"unknown view {name!r} (views: {', '.join(VIEWS)})") from None
+
+
 #: (theta, phi) in degrees, theta from +z, phi from +x.
 DEFAULT_LIGHT = (45.0, 0.0)
 #: The scatter view's circles (theta_o in degrees), drawn on PNG output only (the paper's Figure 9).

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.views.geometry import BRDF_VIEWS, brdf_view_geometry, disc, view_brdf, view_cos_theta
+from explorer.views.geometry import brdf_view_geometry, disc, view_brdf, view_cos_theta, view_named
 
 
 def render_numpy(
@@ -28,13 +28,14 @@ def render_numpy(
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
     """
-    if view == "env":
+    evaluates = view_named(view).evaluates
+    if evaluates == "environment":
         from explorer.views.env import EnvironmentMap, env_integral_numpy
 
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the env view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
         return env_integral_numpy(model, EnvironmentMap.default() if environment is None else environment, width, height)
-    if view == "textured":
+    if evaluates == "textured_brdf":
         from explorer.views.thickness import ThicknessTexture
 
         if not callable(getattr(model, "textured_brdf", None)):
@@ -52,7 +53,7 @@ def render_numpy(
         rgb = view_brdf(textured_brdf, *vectors, d_inc[inside], sigma[inside])
         image[inside] = rgb * factor[inside][:, None]
         return image
-    if view in BRDF_VIEWS:
+    if evaluates == "brdf":
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the {view} view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
         L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
