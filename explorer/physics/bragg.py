@@ -377,9 +377,10 @@ def _spectrum_function(cos_theta, mirror: BraggMirror, float64: bool):
         is_real = real[rows]
         block = max(1, ROW_BLOCK * 471 // max(omega.shape[-1], 1))
         for mask, fast_path in ((is_real, True), (~is_real, False)):
-            where = np.flatnonzero(mask)
+            # Slices where every row takes one path (the usual case), to spare the gathers.
+            where = np.arange(rows.size) if mask.all() else np.flatnonzero(mask)
             for start in range(0, where.size, block):
-                at = where[start : start + block]
+                at = slice(start, start + block) if mask.all() else where[start : start + block]
                 om = omega[at] if per_row else omega
                 if fast_path:
                     out[at] = _reflectance_real(om, geometries, rows[at], float64)

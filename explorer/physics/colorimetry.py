@@ -273,7 +273,10 @@ def converged_spectra(
     ``substeps_min`` is the sampling that resolves the spectra's fringes at :data:`WAVELENGTH_MIN`
     (:func:`substeps_for_fringes`): fringes ``lambda^2 / path`` apart widen towards the red, so a cell at
     ``lambda`` may stop from ``substeps_min (WAVELENGTH_MIN / lambda)^2`` samples per nm (a power of 2),
-    its first comparison made from a quarter of that.
+    its first comparison made from a quarter of that. Cells whose trapezoid sums move less than their
+    budget between the first two samplings stop there (flat spectra: band gaps, the CMFs' dark ends). With
+    ``passes <= 1`` (quick tables) a whole row also stops there when its colour moved less than
+    ``tolerance`` (what a uniform refinement would do; its fringes' changes cancel).
 
     Parameters
     ----------
@@ -321,17 +324,33 @@ def converged_spectra(
     result = (4.0 * trap - coarse) / 3.0  # Simpson's values: the result, refined in place
     substeps = np.full(row_count, K)
 
+    def budgets():
+        colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
+        return tolerance * np.maximum(np.abs(colour).max(axis=-1), CONVERGENCE_FLOOR) / cells
+
+    # Cells whose trapezoid sums already moved less than their budget from K0 to 2 K0 (flat spectra: band
+    # gaps; the CMFs' dark ends) are done: Simpson's error is below the trapezoid's, itself ~1/3 of that change.
+    change = np.abs(trap[0] - coarse[0]) * weight_left + np.abs(trap[1] - coarse[1]) * weight_right
+    done = (change < budgets()[:, None]) & (K >= floor)
+    if passes <= 1:
+        # One pass (the host's quick tables): a row whose colour moved less than the tolerance from K0 to
+        # 2 K0 samples per nm is done, as a uniform refinement would stop there (its fringes' changes cancel).
+        def row_colour(moments):
+            return xyz_to_rgb((moments[0][:, 1:] + moments[1][:, :-1]) @ colour_matching_functions())
+
+        fine_colour = row_colour(trap)
+        brightest = np.maximum(np.abs(fine_colour).max(axis=-1), CONVERGENCE_FLOOR)
+        row_done = np.abs(fine_colour - row_colour(coarse)).max(axis=-1) < tolerance * brightest
+        done |= row_done[:, None] & (K >= floor)
     # The active (row, cell) pairs, flat.
-    pair = np.arange(row_count * cells)
-    trap_l, trap_r = trap[0].ravel(), trap[1].ravel()
-    simp_l, simp_r = result[0].ravel().copy(), result[1].ravel().copy()
+    pair = np.flatnonzero(~done.ravel())
+    trap_l, trap_r = trap[0].ravel()[pair], trap[1].ravel()[pair]
+    simp_l, simp_r = result[0].ravel()[pair], result[1].ravel()[pair]
     result_l, result_r = result[0].reshape(-1), result[1].reshape(-1)
     streak = np.zeros(pair.size, dtype=np.int64)
     needed = max(1, int(passes) - 1)
     while pair.size and K < substeps_max:
-        spectra = result[0][:, 1:] + result[1][:, :-1]
-        colour = xyz_to_rgb(spectra @ colour_matching_functions())
-        budget = tolerance * np.maximum(np.abs(colour).max(axis=-1), CONVERGENCE_FLOOR) / cells
+        budget = budgets()
         pair_row, pair_cell = np.divmod(pair, cells)
         t = (np.arange(K) + 0.5) / K
         values = _evaluate_points(spectrum, (HAT_LOW + pair_cell)[:, None] + t, pair_row)
