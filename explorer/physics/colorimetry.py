@@ -140,6 +140,8 @@ CONVERGENCE_PASSES = 2
 CONVERGENCE_FLOOR = 0.05
 #: The finest sampling: 1/1024 nm.
 MAX_SUBSTEPS = 1024
+#: Each nm cell's budget is weighted by the CMFs at its nodes, at least this fraction of their largest.
+WEIGHT_FLOOR = 0.05
 #: Samples (rows x wavelengths) per call of a spectrum function: bounds the temporaries' memory.
 CHUNK_SAMPLES = 1 << 18
 #: Samples kept per block of rows while refining (float64: 128 MB).
@@ -275,8 +277,8 @@ def converged_spectra(
     ``lambda`` may stop from ``substeps_min (WAVELENGTH_MIN / lambda)^2`` samples per nm (a power of 2),
     its first comparison made from a quarter of that. Cells whose trapezoid sums move less than their
     budget between the first two samplings stop there (flat spectra: band gaps, the CMFs' dark ends). With
-    ``passes <= 1`` (quick tables) a whole row also stops there when its colour moved less than
-    ``tolerance`` (what a uniform refinement would do; its fringes' changes cancel).
+    ``passes <= 1`` (quick tables) a whole row also stops at the first halving that moves its colour by
+    less than ``tolerance`` (what a uniform refinement would do; its fringes' changes cancel).
 
     Parameters
     ----------
@@ -310,6 +312,10 @@ def converged_spectra(
     # Bounds on the change of the brightest channel per unit change of each integral of a cell: (cells,).
     weight_left = np.abs(cmfs[:-1] @ to_rgb.T).max(axis=-1)
     weight_right = np.abs(cmfs[1:] @ to_rgb.T).max(axis=-1)
+    # Held to at least a fraction of the largest, so that the hat averages under the CMFs' dark ends
+    # converge too (the layer tables' spectra are used per wavelength, not only through their colour).
+    weight_left = np.maximum(weight_left, WEIGHT_FLOOR * weight_left.max())
+    weight_right = np.maximum(weight_right, WEIGHT_FLOOR * weight_right.max())
 
     # The first two samplings of every cell share their wavelengths across rows.
     trap = np.empty((2, row_count, cells))  # trapezoid sums at 2 K0: left and right integrals
@@ -341,7 +347,11 @@ def converged_spectra(
         fine_colour = row_colour(trap)
         brightest = np.maximum(np.abs(fine_colour).max(axis=-1), CONVERGENCE_FLOOR)
         row_done = np.abs(fine_colour - row_colour(coarse)).max(axis=-1) < tolerance * brightest
-        done |= row_done[:, None] & (K >= floor)
+        stopped = row_done[:, None] & (K >= floor) & ~done
+        # Cells not converged themselves keep their trapezoid sums: Simpson's extrapolation from samplings
+        # that miss their fringes would move them further (the row's colour is converged either way).
+        result[:, stopped] = trap[:, stopped]
+        done |= stopped
     # The active (row, cell) pairs, flat.
     pair = np.flatnonzero(~done.ravel())
     trap_l, trap_r = trap[0].ravel()[pair], trap[1].ravel()[pair]
@@ -349,6 +359,7 @@ def converged_spectra(
     result_l, result_r = result[0].reshape(-1), result[1].reshape(-1)
     streak = np.zeros(pair.size, dtype=np.int64)
     needed = max(1, int(passes) - 1)
+    row_colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
     while pair.size and K < substeps_max:
         budget = budgets()
         pair_row, pair_cell = np.divmod(pair, cells)
@@ -365,6 +376,15 @@ def converged_spectra(
         passed = (change < budget[pair_row]) & (K >= floor[pair_cell])
         streak = np.where(passed, streak + 1, 0)
         keep = streak < needed
+        if passes <= 1:
+            # One pass: a row whose colour this halving moved less than the tolerance stops (uniform criterion).
+            colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
+            brightest = np.maximum(np.abs(colour).max(axis=-1), CONVERGENCE_FLOOR)
+            row_done = np.abs(colour - row_colour).max(axis=-1) < tolerance * brightest
+            row_colour = colour
+            stopped = keep & row_done[pair_row] & (K >= floor[pair_cell])
+            result_l[pair[stopped]], result_r[pair[stopped]] = new_l[stopped], new_r[stopped]
+            keep &= ~stopped
         pair, streak = pair[keep], streak[keep]
         trap_l, trap_r, simp_l, simp_r = new_l[keep], new_r[keep], new_simp_l[keep], new_simp_r[keep]
     return result[0][:, 1:] + result[1][:, :-1], substeps
