@@ -325,7 +325,7 @@ def converged_reflectance_spectra(
     # by ~1e-11 over such a step).
     cos_theta, inverse = np.unique(np.round(np.asarray(cos_theta, dtype=np.float64).ravel(), 12), return_inverse=True)
     spectra, substeps = colorimetry.converged_spectra(
-        lambda wavelengths, rows: _spectra(cos_theta[rows], mirror, wavelengths, fast),
+        _spectrum_function(cos_theta, mirror, float64=not fast),
         cos_theta.size,
         substeps_min=min(substeps_for(mirror, cos_theta), substeps_max),
         tolerance=tolerance,
@@ -333,6 +333,45 @@ def converged_reflectance_spectra(
         substeps_max=substeps_max,
     )
     return spectra[inverse.ravel()], substeps[inverse.ravel()]
+
+
+def _take(geometry: CellGeometry, rows) -> CellGeometry:
+    """The geometry at some of its angles (``rows`` may repeat), with a trailing axis (:func:`_rows`)."""
+    fields = {k: (v[rows][:, None] if isinstance(v, np.ndarray) else v) for k, v in vars(geometry).items()}
+    return CellGeometry(**fields)
+
+
+def _spectrum_function(cos_theta, mirror: BraggMirror, float64: bool):
+    """
+    ``spectrum(wavelengths, rows)`` for :func:`explorer.physics.colorimetry.converged_spectra`: the values of
+    :func:`reflectance_spectra` at the angles ``cos_theta[rows]`` (rows may repeat; ``wavelengths`` 1D,
+    shared, or 2D, one set per row), with the angles' geometry computed once.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
+    first = geometries[0]
+    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
+
+    def spectrum(wavelengths, rows):
+        omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
+        rows = np.asarray(rows)
+        per_row = omega.ndim == 2
+        out = np.empty((rows.size, omega.shape[-1]))
+        is_real = real[rows]
+        block = max(1, ROW_BLOCK * 471 // max(omega.shape[-1], 1))
+        for mask, fast_path in ((is_real, True), (~is_real, False)):
+            # Slices where every row takes one path (the usual case), to spare the gathers.
+            where = np.arange(rows.size) if mask.all() else np.flatnonzero(mask)
+            for start in range(0, where.size, block):
+                at = slice(start, start + block) if mask.all() else where[start : start + block]
+                om = omega[at] if per_row else omega
+                if fast_path:
+                    out[at] = _reflectance_real(om, geometries, rows[at], float64)
+                else:
+                    out[at] = sum(reflectance_polarised(om, _take(g, rows[at])) for g in geometries) / len(geometries)
+        return out
+
+    return spectrum
 
 
 def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
@@ -739,7 +778,8 @@ ROW_BLOCK = 32
 def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS, float64: bool = False) -> np.ndarray:
     """
     Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every wavelength (nm; by default every nm
-    of :data:`explorer.physics.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``.
+    of :data:`explorer.physics.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``. A 2D
+    ``wavelengths`` of shape ``(n_angles, M)`` gives each angle its own wavelengths.
 
     Angles where every wave propagates and ``nh == n1`` take the real fast path
     (:func:`_reflectance_real`), by blocks of rows; the others (total internal reflection, a host
@@ -751,16 +791,18 @@ def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.
     first = geometries[0]
     # Classified by the cosines, not the optical thicknesses (a zero-thickness evanescent layer has p = 0).
     real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
-    spectra = np.empty((cos_theta.size, omega.size))
+    per_row = omega.ndim == 2
+    spectra = np.empty((cos_theta.size, omega.shape[-1]))
     real_rows, other_rows = np.flatnonzero(real), np.flatnonzero(~real)
-    block = max(1, ROW_BLOCK * 471 // max(omega.size, 1))
+    block = max(1, ROW_BLOCK * 471 // max(omega.shape[-1], 1))
     for start in range(0, real_rows.size, block):
         rows = real_rows[start : start + block]
-        spectra[rows] = _reflectance_real(omega, geometries, rows, float64)
+        spectra[rows] = _reflectance_real(omega[rows] if per_row else omega, geometries, rows, float64)
     for start in range(0, other_rows.size, block):
         rows = other_rows[start : start + block]
         spectra[rows] = sum(
-            reflectance_polarised(omega, _rows(cell_geometry(cos_theta[rows], mirror, pol))) for pol in POLARISATIONS
+            reflectance_polarised(omega[rows] if per_row else omega, _rows(cell_geometry(cos_theta[rows], mirror, pol)))
+            for pol in POLARISATIONS
         ) / len(POLARISATIONS)
     return spectra
 

@@ -140,6 +140,8 @@ CONVERGENCE_PASSES = 2
 CONVERGENCE_FLOOR = 0.05
 #: The finest sampling: 1/1024 nm.
 MAX_SUBSTEPS = 1024
+#: Each nm cell's budget is weighted by the CMFs at its nodes, at least this fraction of their largest.
+WEIGHT_FLOOR = 0.05
 #: Samples (rows x wavelengths) per call of a spectrum function: bounds the temporaries' memory.
 CHUNK_SAMPLES = 1 << 18
 #: Samples kept per block of rows while refining (float64: 128 MB).
@@ -213,6 +215,39 @@ def fixed_step_spectra(spectrum, row_count: int, step: float) -> np.ndarray:
     return hat_average(_evaluate(spectrum, fine_wavelengths(K), np.arange(row_count)), K)
 
 
+def _evaluate_points(spectrum, wavelengths: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """
+    ``spectrum`` at a different set of wavelengths per row: ``wavelengths`` of shape ``(rows.size, M)``
+    (rows may repeat), in chunks of at most :data:`CHUNK_SAMPLES` samples.
+    """
+    step = max(1, CHUNK_SAMPLES // max(wavelengths.shape[-1], 1))
+    out = np.empty(wavelengths.shape)
+    for i in range(0, rows.size, step):
+        out[i : i + step] = spectrum(wavelengths[i : i + step], rows[i : i + step])
+    return out
+
+
+def _cell_moments(fine: np.ndarray, K: int) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Per 1-nm cell ``[359 + c, 360 + c]`` (472 of them), the trapezoid integrals of ``R (1 - t)`` and ``R t``
+    (``t`` from 0 to 1 across the cell) from samples at :func:`fine_wavelengths` ``(K)``: the cell's shares
+    of the hat averages of its left and right nodes.
+    """
+    cells = WAVELENGTHS.size + 1
+    body = fine[..., :-1].reshape(fine.shape[:-1] + (cells, K))
+    ends = fine[..., K::K]
+    t = np.arange(K) / K
+    weight_left = (1.0 - t) / K
+    weight_left[0] *= 0.5
+    weight_right = t / K
+    return body @ weight_left, body @ weight_right + ends * (0.5 / K)
+
+
+def _padded_cmfs() -> np.ndarray:
+    """The CMFs at the 473 nodes 359..831 nm (zero at both ends)."""
+    return np.vstack([np.zeros(3), colour_matching_functions(), np.zeros(3)])
+
+
 def converged_spectra(
     spectrum,
     row_count: int,
@@ -222,20 +257,38 @@ def converged_spectra(
     substeps_max: int = MAX_SUBSTEPS,
 ) -> tuple[np.ndarray, np.ndarray]:
     """
-    Hat-averaged spectra (:func:`hat_average`) refined until their colour has converged.
+    Hat-averaged spectra (:func:`hat_average`) refined, nm cell by nm cell, until their colour has converged.
 
-    Each row starts sampled every ``1 / substeps_min`` nm; the step is halved (reusing every sample)
-    until ``passes`` halvings in a row change its linear sRGB by less than ``tolerance`` times its
-    brightest channel (at least :data:`CONVERGENCE_FLOOR`), or the step reaches ``1 / substeps_max`` nm.
+    Each hat average ``Rbar_i`` is the sum of two cells' integrals: ``R (1 - t)`` over the 1-nm cell right of
+    node ``i`` and ``R t`` over the cell left of it (``t`` rising from 0 to 1 across a cell). A cell's
+    integrals are trapezoid sums at samplings ``K, 2K, 4K...`` (samples per nm, each reusing the previous
+    one's samples), Richardson-extrapolated between successive ones (Simpson's rule: the integrands are
+    smooth within a cell, whose ends are the CMFs' nodes). A cell's sampling doubles until ``passes - 1``
+    comparisons in a row (at least one; each spans two halvings) change its share of the row's linear sRGB
+    (its integrals' changes times the brightest channel of the CMFs at its two nodes) by less than its
+    budget: ``tolerance`` times the row's brightest channel (at least :data:`CONVERGENCE_FLOOR`), divided
+    equally among the 472 cells, so that the cells' changes summed stay under the row's tolerance. Smooth
+    cells stop after a few samples per nm; those beside band edges or under narrow resonances go on, to
+    ``substeps_max``. Active cells share one sampling at each step and are refined together (vectorised),
+    only their new wavelengths evaluated.
+
+    ``substeps_min`` is the sampling that resolves the spectra's fringes at :data:`WAVELENGTH_MIN`
+    (:func:`substeps_for_fringes`): fringes ``lambda^2 / path`` apart widen towards the red, so a cell at
+    ``lambda`` may stop from ``substeps_min (WAVELENGTH_MIN / lambda)^2`` samples per nm (a power of 2),
+    its first comparison made from a quarter of that. Cells whose trapezoid sums move less than their
+    budget between the first two samplings stop there (flat spectra: band gaps, the CMFs' dark ends). With
+    ``passes <= 1`` (quick tables) a whole row also stops at the first halving that moves its colour by
+    less than ``tolerance`` (what a uniform refinement would do; its fringes' changes cancel).
 
     Parameters
     ----------
     spectrum : callable
-        ``spectrum(wavelengths, rows)`` -> ``(rows.size, wavelengths.size)``: the spectra of the rows
-        (integer indices) at the wavelengths (nm).
+        ``spectrum(wavelengths, rows)`` -> ``(rows.size, wavelengths.shape[-1])``: the spectra of the rows
+        (integer indices, which may repeat) at the wavelengths (nm), either one set shared by every row
+        (1D) or one set per row (2D, shape ``(rows.size, M)``).
     row_count : int
     substeps_min, substeps_max : int
-        Powers of 2: the coarsest and finest samplings, in samples per nm.
+        Powers of 2, samples per nm.
 
     Returns
     -------
@@ -243,47 +296,98 @@ def converged_spectra(
         ``spectra @ colour_matching_functions()`` is the converged integral against the CMFs
         interpolated linearly.
     substeps : ndarray of int, shape (row_count,)
-        The sampling each row ended at.
+        The finest sampling any cell of the row ended at.
     """
-    K0 = int(substeps_min)
+    cells = WAVELENGTHS.size + 1
+    substeps_max = max(1, int(substeps_max))
+    centres = HAT_LOW + 0.5 + np.arange(cells)
+    floor = np.array([_power_of_two_at_least(x) for x in int(substeps_min) * (WAVELENGTH_MIN / centres) ** 2])
+    floor = np.minimum(floor, substeps_max)
+    K0 = max(1, int(floor.min()) // 4)
     rows = np.arange(row_count)
-    result = np.empty((row_count, WAVELENGTHS.size))
-    substeps = np.full(row_count, K0)
-    # Blocks of rows, so that a block's finest samples stay within a few tens of MB.
-    block = max(1, min(row_count, (1 << 22) // ((WAVELENGTHS.size + 1) * max(K0, 8))))
+    if K0 >= substeps_max // 2:
+        return fixed_step_spectra(spectrum, row_count, 1.0 / substeps_max), np.full(row_count, substeps_max)
+    cmfs = _padded_cmfs()
+    to_rgb = _xyz_to_rgb_matrix()
+    # Bounds on the change of the brightest channel per unit change of each integral of a cell: (cells,).
+    weight_left = np.abs(cmfs[:-1] @ to_rgb.T).max(axis=-1)
+    weight_right = np.abs(cmfs[1:] @ to_rgb.T).max(axis=-1)
+    # Held to at least a fraction of the largest, so that the hat averages under the CMFs' dark ends
+    # converge too (the layer tables' spectra are used per wavelength, not only through their colour).
+    weight_left = np.maximum(weight_left, WEIGHT_FLOOR * weight_left.max())
+    weight_right = np.maximum(weight_right, WEIGHT_FLOOR * weight_right.max())
+
+    # The first two samplings of every cell share their wavelengths across rows.
+    trap = np.empty((2, row_count, cells))  # trapezoid sums at 2 K0: left and right integrals
+    coarse = np.empty((2, row_count, cells))  # at K0
+    block = max(1, CHUNK_SAMPLES * 4 // (cells * 2 * K0))
     for start in range(0, row_count, block):
         active = rows[start : start + block]
-        K = K0
-        fine = _evaluate(spectrum, fine_wavelengths(K), active)
-        averaged = hat_average(fine, K)
-        result[active] = averaged
-        colour = xyz_to_rgb(averaged @ colour_matching_functions())
-        streak = np.zeros(active.size, dtype=int)
-        while active.size and K < substeps_max:
-            if active.size > 1 and active.size * fine.shape[-1] * 2 > MAX_BLOCK_SAMPLES:
-                # Too many samples to refine these rows together: refine them in halves, from this sampling.
-                for half in np.array_split(active, 2):
-                    sub_spectra, sub_substeps = converged_spectra(
-                        lambda wavelengths, sub_rows, half=half: spectrum(wavelengths, half[sub_rows]),
-                        half.size, K, tolerance, passes, substeps_max,
-                    )
-                    result[half], substeps[half] = sub_spectra, sub_substeps
-                break
-            midpoints = HAT_LOW + (np.arange((WAVELENGTHS.size + 1) * K) + 0.5) / K
-            finer = np.empty((active.size, 2 * fine.shape[-1] - 1))
-            finer[:, 0::2] = fine
-            finer[:, 1::2] = _evaluate(spectrum, midpoints, active)
-            fine, K = finer, 2 * K
-            averaged = hat_average(fine, K)
-            finer_colour = xyz_to_rgb(averaged @ colour_matching_functions())
-            brightest = np.maximum(np.abs(finer_colour).max(axis=-1), CONVERGENCE_FLOOR)
-            change = np.abs(finer_colour - colour).max(axis=-1) / brightest
-            streak = np.where(change < tolerance, streak + 1, 0)
-            result[active] = averaged
-            substeps[active] = K
-            keep = streak < passes
-            active, fine, colour, streak = active[keep], fine[keep], finer_colour[keep], streak[keep]
-    return result, substeps
+        fine = _evaluate(spectrum, fine_wavelengths(2 * K0), active)
+        coarse[0, active], coarse[1, active] = _cell_moments(fine[:, ::2], K0)
+        trap[0, active], trap[1, active] = _cell_moments(fine, 2 * K0)
+    K = 2 * K0
+    result = (4.0 * trap - coarse) / 3.0  # Simpson's values: the result, refined in place
+    substeps = np.full(row_count, K)
+
+    def budgets():
+        colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
+        return tolerance * np.maximum(np.abs(colour).max(axis=-1), CONVERGENCE_FLOOR) / cells
+
+    # Cells whose trapezoid sums already moved less than their budget from K0 to 2 K0 (flat spectra: band
+    # gaps; the CMFs' dark ends) are done: Simpson's error is below the trapezoid's, itself ~1/3 of that change.
+    change = np.abs(trap[0] - coarse[0]) * weight_left + np.abs(trap[1] - coarse[1]) * weight_right
+    done = (change < budgets()[:, None]) & (K >= floor)
+    if passes <= 1:
+        # One pass (the host's quick tables): a row whose colour moved less than the tolerance from K0 to
+        # 2 K0 samples per nm is done, as a uniform refinement would stop there (its fringes' changes cancel).
+        def row_colour(moments):
+            return xyz_to_rgb((moments[0][:, 1:] + moments[1][:, :-1]) @ colour_matching_functions())
+
+        fine_colour = row_colour(trap)
+        brightest = np.maximum(np.abs(fine_colour).max(axis=-1), CONVERGENCE_FLOOR)
+        row_done = np.abs(fine_colour - row_colour(coarse)).max(axis=-1) < tolerance * brightest
+        stopped = row_done[:, None] & (K >= floor) & ~done
+        # Cells not converged themselves keep their trapezoid sums: Simpson's extrapolation from samplings
+        # that miss their fringes would move them further (the row's colour is converged either way).
+        result[:, stopped] = trap[:, stopped]
+        done |= stopped
+    # The active (row, cell) pairs, flat.
+    pair = np.flatnonzero(~done.ravel())
+    trap_l, trap_r = trap[0].ravel()[pair], trap[1].ravel()[pair]
+    simp_l, simp_r = result[0].ravel()[pair], result[1].ravel()[pair]
+    result_l, result_r = result[0].reshape(-1), result[1].reshape(-1)
+    streak = np.zeros(pair.size, dtype=np.int64)
+    needed = max(1, int(passes) - 1)
+    row_colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
+    while pair.size and K < substeps_max:
+        budget = budgets()
+        pair_row, pair_cell = np.divmod(pair, cells)
+        t = (np.arange(K) + 0.5) / K
+        values = _evaluate_points(spectrum, (HAT_LOW + pair_cell)[:, None] + t, pair_row)
+        new_l = 0.5 * trap_l + values @ ((1.0 - t) / (2.0 * K))
+        new_r = 0.5 * trap_r + values @ (t / (2.0 * K))
+        new_simp_l = (4.0 * new_l - trap_l) / 3.0
+        new_simp_r = (4.0 * new_r - trap_r) / 3.0
+        change = np.abs(new_simp_l - simp_l) * weight_left[pair_cell] + np.abs(new_simp_r - simp_r) * weight_right[pair_cell]
+        K *= 2
+        result_l[pair], result_r[pair] = new_simp_l, new_simp_r
+        substeps[pair_row] = K
+        passed = (change < budget[pair_row]) & (K >= floor[pair_cell])
+        streak = np.where(passed, streak + 1, 0)
+        keep = streak < needed
+        if passes <= 1:
+            # One pass: a row whose colour this halving moved less than the tolerance stops (uniform criterion).
+            colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
+            brightest = np.maximum(np.abs(colour).max(axis=-1), CONVERGENCE_FLOOR)
+            row_done = np.abs(colour - row_colour).max(axis=-1) < tolerance * brightest
+            row_colour = colour
+            stopped = keep & row_done[pair_row] & (K >= floor[pair_cell])
+            result_l[pair[stopped]], result_r[pair[stopped]] = new_l[stopped], new_r[stopped]
+            keep &= ~stopped
+        pair, streak = pair[keep], streak[keep]
+        trap_l, trap_r, simp_l, simp_r = new_l[keep], new_r[keep], new_simp_l[keep], new_simp_r[keep]
+    return result[0][:, 1:] + result[1][:, :-1], substeps
 
 
 def delta_E_2000(rgb_a: np.ndarray, rgb_b: np.ndarray) -> np.ndarray:
