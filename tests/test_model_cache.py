@@ -58,3 +58,38 @@ def test_prepare_model_on_a_worker_thread_then_bind_uses_it(gl_renderer, counted
 def test_a_material_without_a_model_is_always_ready(gl_renderer):
     material = load_material(REPO_ROOT / "tests" / "data" / "brdf" / "lambert.brdf")
     assert gl_renderer.model_ready(material, material.resolve({}))
+
+
+@pytest.mark.gl
+def test_draft_table_while_dragging_then_the_real_one(gl_renderer):
+    """
+    The tabulated method's draft (the 1-nm table, shown while a slider moves) is drawn at once, is not
+    "ready", and is replaced, texture included, by the converged table on prepare_model: the image then
+    equals a fresh renderer's.
+    """
+    from explorer.materials.models import model_for
+    from explorer.physics import bragg
+    from explorer.views.geometry import view_cos_theta
+
+    material = load_material(MIRROR)
+    values = material.resolve({"method": 3, "Lambda": 500, "N": 60, "delta": 0.5})
+    assert gl_renderer.prepare_draft(material, values) and not gl_renderer.model_ready(material, values)
+    draft = gl_renderer.render(material, values, "gradient", 128, 2)
+    model = model_for(material, values)
+    cos_theta, _ = view_cos_theta("gradient", 128, 2)
+    expected_draft = bragg.tabulated_rgb(bragg.draft_rgb_table(model.mirror), cos_theta)
+    np.testing.assert_allclose(draft, expected_draft, rtol=0, atol=2e-3)
+    gl_renderer.prepare_model(material, values)
+    assert gl_renderer.model_ready(material, values)
+    real = gl_renderer.render(material, values, "gradient", 128, 2)
+    np.testing.assert_array_equal(real, Renderer(gl_renderer.ctx).render(material, values, "gradient", 128, 2))
+    # The draft is the 1-nm sum, not converged: at N = 60 it differs visibly near the band edges.
+    assert np.abs(real - draft).max() > 2e-3
+
+
+def test_materials_without_draft_tables_are_not_drafted(gl_renderer):
+    material = load_material(MIRROR)
+    values = material.resolve({"method": 1, "Lambda": 321})  # a placeholder texel only: nothing to draft
+    assert not gl_renderer.prepare_draft(material, values) and not gl_renderer.model_ready(material, values)
+    lambert = load_material(REPO_ROOT / "tests" / "data" / "brdf" / "lambert.brdf")
+    assert gl_renderer.prepare_draft(lambert, lambert.resolve({}))  # no model: drawable as it is

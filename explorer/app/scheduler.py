@@ -28,9 +28,10 @@ SIDE_DRAG_BUDGET_MS = 0.0
 class TablePrefetcher:
     """
     The parameter values the sphere shows. While a slider is dragged the host's tables (the tabulated
-    method's ~10 ms, a stack's layers) are built on a worker thread as the frame draws, and the sphere
-    shows the newest values whose tables are ready: one frame behind the slider. Otherwise they are
-    built on the spot, so a released slider always shows its own values.
+    method's converged table, a stack's layers) are built on a worker thread as the frame draws, and the
+    sphere shows the current values with the model's quick draft tables where it has them (the tabulated
+    method's 1-nm table, ~10 ms), else the newest values whose tables are ready. Once the slider is
+    released the real tables are built on the spot, so a released slider always shows its own values.
     """
 
     def __init__(self, renderer):
@@ -42,7 +43,7 @@ class TablePrefetcher:
 
     def values(self, material, values: dict, dragging: bool) -> dict:
         """The values to draw ``material`` with this frame (``values``, or the newest ready ones while dragging)."""
-        if self.renderer.model_ready(material, values):
+        if self.renderer.model_ready(material, values) or (dragging and self.renderer.model_drawable(material, values)):
             self.ready_values = dict(values)
             return values
         if dragging and self.ready_values is not None:
@@ -54,12 +55,21 @@ class TablePrefetcher:
                 if self._executor is None:
                     self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="tables")
                 self._future_values = dict(values)
-                self._future = self._executor.submit(self.renderer.prepare_model, material, self._future_values)
+                self._future = self._executor.submit(self._prepare_while_dragging, material, self._future_values)
             return self.ready_values
         if self._future is not None:
             concurrent.futures.wait([self._future])  # its errors resurface in the bindings, with the current values
+        try:
+            self.renderer.prepare_model(material, values)  # a released slider shows its real tables, not a draft
+        except Exception:  # noqa: BLE001 - raised again by the bindings, with the current values
+            pass
         self.ready_values = dict(values)
         return values
+
+    def _prepare_while_dragging(self, material, values: dict) -> None:
+        """The model's quick draft tables where it has them (the real ones follow on release), else the real ones."""
+        if not self.renderer.prepare_draft(material, values):
+            self.renderer.prepare_model(material, values)
 
     def forget(self) -> None:
         """Another material: none of the previous one's values may reach its uniforms."""

@@ -122,6 +122,14 @@ class Renderer:
         """
         self.models.prepare(material, values)
 
+    def model_drawable(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Whether binding ``material`` at ``values`` needs no numpy work if its draft tables will do."""
+        return self.models.drawable(material, values)
+
+    def prepare_draft(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Quick draft tables of ``material`` at ``values`` (~10 ms), True when it can be drawn with them now."""
+        return self.models.prepare_draft(material, values)
+
     # -- bindings and the draw primitive ------------------------------------------------------------
 
     def bindings(
@@ -168,9 +176,11 @@ class Renderer:
                 entry[1] = entry[0].textures()
             for name, table in entry[1].items():
                 if name in program:
-                    if key is None or self._model_texture_keys.get(name) != key or name not in self._model_textures:
+                    # A draft and the real tables share the values' key: the texture's key tells them apart.
+                    texture_key = None if key is None else (key, entry[2])
+                    if texture_key is None or self._model_texture_keys.get(name) != texture_key or name not in self._model_textures:
                         self._model_texture(name, table)
-                        self._model_texture_keys[name] = key
+                        self._model_texture_keys[name] = texture_key
                     textures[name] = self._model_textures[name]
             self.last_table_ms = (time.perf_counter() - start) * 1e3
         return bound, textures

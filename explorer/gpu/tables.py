@@ -19,7 +19,11 @@ MODEL_CACHE_SIZE = 8
 
 
 class ModelCache:
-    """``(material path, model, values) -> [model, its textures() or None]``, least recently used first."""
+    """
+    ``(material path, model, values) -> [model, its textures() or None, draft]``, least recently used
+    first; ``draft``: the textures are the model's ``draft_textures()``, quick stand-ins shown while a
+    slider moves, replaced by the real ones on :meth:`prepare`.
+    """
 
     def __init__(self, size: int = MODEL_CACHE_SIZE):
         self.size = size
@@ -38,14 +42,14 @@ class ModelCache:
 
     def entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
         """
-        ``(key, [model, tables])`` of ``material`` at ``values`` (None: it has no model), from the cache
-        or built here; key None: uncached. ``tables`` is None until someone asks the model for them.
+        ``(key, [model, tables, draft])`` of ``material`` at ``values`` (None: it has no model), from the
+        cache or built here; key None: uncached. ``tables`` is None until someone asks the model for them.
         """
         values = material.physical_values(values)
         key = self.key(material, values)
         if key is None:
             model = model_for(material, values)
-            return None, ([model, None] if model is not None else None)
+            return None, ([model, None, False] if model is not None else None)
         with self._lock:
             entry = self._models.get(key)
             if entry is not None:
@@ -54,7 +58,7 @@ class ModelCache:
         model = model_for(material, values)
         if model is None:
             return key, None
-        return key, self._store(key, [model, None])
+        return key, self._store(key, [model, None, False])
 
     def _store(self, key: tuple, entry: list) -> list:
         with self._lock:
@@ -71,6 +75,15 @@ class ModelCache:
         key = self.key(material, material.physical_values(values))
         with self._lock:
             entry = self._models.get(key) if key is not None else None
+        return entry is not None and entry[1] is not None and not entry[2]
+
+    def drawable(self, material: Material, values: Mapping[str, object]) -> bool:
+        """Whether ``material`` at ``values`` can be drawn without numpy work, its draft tables accepted."""
+        if self.ready(material, values):
+            return True
+        key = self.key(material, material.physical_values(values))
+        with self._lock:
+            entry = self._models.get(key) if key is not None else None
         return entry is not None and entry[1] is not None
 
     def prepare(self, material: Material, values: Mapping[str, object]) -> None:
@@ -82,4 +95,26 @@ class ModelCache:
         model = model_for(material, values)
         if model is None or key is None:
             return
-        self._store(key, [model, model.textures()])
+        self._store(key, [model, model.textures(), False])
+
+    def prepare_draft(self, material: Material, values: Mapping[str, object]) -> bool:
+        """
+        Store ``material``'s quick draft tables at ``values`` (its model's ``draft_textures()``) unless real
+        or draft ones are there; True when ``values`` can be drawn now without building the real tables.
+        """
+        if self.ready(material, values):
+            return True
+        values = material.physical_values(values)
+        key = self.key(material, values)
+        if key is None:
+            return False
+        with self._lock:
+            entry = self._models.get(key)
+        if entry is not None and entry[2]:
+            return True
+        model = entry[0] if entry is not None else model_for(material, values)
+        draft = getattr(model, "draft_textures", lambda: None)() if model is not None else None
+        if draft is None:
+            return False
+        self._store(key, [model, draft, True])
+        return True

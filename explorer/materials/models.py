@@ -81,6 +81,13 @@ class BraggMirrorModel:
         # Only the tabulated method reads its table; the others get a placeholder texel.
         return {"bragg_table": self.table if self.method == 3 else np.zeros((1, 3), np.float32)}
 
+    def draft_textures(self) -> dict[str, np.ndarray] | None:
+        """
+        Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's table from the
+        1-nm sum, :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
+        """
+        return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method == 3 else None
+
 
 @functools.lru_cache(maxsize=16)
 def _transmission_rgb_table(mirror: bragg.BraggMirror, alpha: float, size: int) -> np.ndarray:
