@@ -43,10 +43,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.physics import microfacet
-from explorer.physics.lobes_fgd import (  # re-exported: the model's Fresnel terms and table coordinates
-    ETA_TABLE_MAX, FGD_ALPHA_COUNT, FGD_COS_COUNT, FGD_COS_FLOOR, FGD_ETA_COUNT, FGD_QUADRATURE, _axis,
-    _critical_cos, _fresnel_dielectric_mean, fgd_alpha_nodes, fgd_cos_coordinate, fgd_cos_from_coordinate,
-    fgd_cos_nodes, fgd_eta_nodes, fresnel_sp, generate_fgd_correction, generate_ggx_moments, normal_reflectance,
+from explorer.physics.lobes_fgd import (  # the Fresnel terms and table coordinates the model reads
+    ETA_TABLE_MAX, FGD_ALPHA_COUNT, FGD_COS_COUNT, FGD_ETA_COUNT, _axis, fgd_cos_coordinate, fresnel_sp,
+    normal_reflectance,
 )
 
 #: Upper bound on dielectric indices (Bati et al. use eta_max = 4 "for illustration").
