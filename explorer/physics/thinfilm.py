@@ -651,11 +651,12 @@ def D_max(epsilon: float = 0.05, sensitivity: str = "table") -> float:
 
 
 def spectral_integration_fourier(
-    terms: FilmTerms, m_max: int = 3, sensitivity: str = "table", sigma_D_inc=None
+    terms: FilmTerms, m_max: int = 3, sensitivity: str = "table", sigma_D_inc=None, remainder: bool = True
 ) -> np.ndarray:
     """
     Eq. 10 for one polarisation: ``R_j = C_0 S^_j(0) + 2 sum_{m=1}^{m_max} C_m [cos(m phi_2) Re S^_j(mD)
-    + sin(m phi_2) Im S^_j(mD)]``, with ``S^_j(0) = 1`` for the table (white).
+    + sin(m phi_2) Im S^_j(mD)]``, with ``S^_j(0) = 1`` for the table (white), plus the series' remainder
+    (:func:`fourier_remainder`) unless ``remainder`` is False (the paper's plain truncation).
 
     With ``sigma_D_inc`` (the standard deviation of ``D_inc``, nm; Section 5) each ``S^_j(mD)`` is the
     pre-filtered table at standard deviation ``m cos(theta_2) sigma_D_inc``
@@ -678,15 +679,64 @@ def spectral_integration_fourier(
     rgb = C_0(terms)[..., None] * np.real(sensitivity_fourier_transform(np.zeros_like(D), sensitivity))
     if sigma_D_inc is not None:
         sigma_D = sigma_D_inc * np.where(terms.film_propagates, terms.cos_theta_2.real, 0.0)
-    for m in range(1, int(m_max) + 1):
+    def harmonic(m):  # z_m = e^{-i m phi_2} S^_j(m D): the m-th term is 2 C_m Re z_m
         if sigma_D_inc is None:
             S = sensitivity_fourier_transform(m * D, sensitivity)
         else:
             S = sensitivity_fourier_transform_prefiltered(m * D, m * sigma_D)
-        rgb = rgb + 2.0 * C_m(terms, m)[..., None] * (
-            np.cos(m * phi_2)[..., None] * S.real + np.sin(m * phi_2)[..., None] * S.imag
-        )
+        return np.exp(-1j * m * phi_2)[..., None] * S
+
+    z = harmonic(0)
+    for m in range(1, int(m_max) + 1):
+        z = harmonic(m)
+        rgb = rgb + 2.0 * C_m(terms, m)[..., None] * z.real
+    if remainder:
+        rgb = rgb + fourier_remainder(terms, int(m_max), z, harmonic(int(m_max) + 1))
     return rgb
+
+
+#: The least ``|z_M|`` for which :func:`fourier_remainder` extrapolates (GLSL: the same, in float32).
+REMAINDER_MIN = 1e-15
+
+
+def fourier_remainder(terms: FilmTerms, m_max: int, z_M, z_next) -> np.ndarray:
+    """
+    The terms of Eq. 10 beyond ``m_max``, summed in closed form.
+
+    The coefficients are geometric, ``C_m = C_M R_l^(m - M)`` (Eq. 6), and the harmonics
+    ``z_m = e^{-i m phi_2} S^_j(m D)`` are extrapolated geometrically from the last two,
+    ``z_m ~ z_M r^(m - M)`` with ``r = z_(M+1) / z_M`` (``|r| <= 1``), so
+    ``sum_{m > M} 2 C_m Re z_m = 2 C_M Re(z_M q / (1 - q))``, ``q = R_l r``.
+
+    The extrapolation is exact as ``D -> 0`` (``S^_j(m D) ~ e^{-2 pi i m D nu_j}``: a flat spectrum, the
+    Airy reflectance at one phase) and vanishes where ``S^_j(M D)`` has decayed, where the paper's
+    truncation is accurate. Near total internal reflection inside the film (``R_l -> 1``, ``D -> 0``)
+    the truncated series overshoots, up to a luminance of 1.05 for a flat white; the remainder brings
+    it back under 1 and to within ~1e-2 of the converged reference.
+
+    Parameters
+    ----------
+    terms : FilmTerms
+    m_max : int
+        ``M``, the last harmonic summed explicitly (0 sums all of them here).
+    z_M, z_next : ndarray of complex, shape ``terms.R12.shape + (3,)``
+        ``z_M`` and ``z_(M+1)``.
+
+    Returns
+    -------
+    ndarray, shape ``terms.R12.shape + (3,)``
+
+    References
+    ----------
+    Belcour & Barla (2017), Eqs. 5-6 and 10 (the series this sums).
+    """
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        # Below 1e-15 the remainder is negligible (it is of the order of z_M) and r ill-defined.
+        resolved = np.abs(z_M) > REMAINDER_MIN
+        r = np.where(resolved, z_next / np.where(resolved, z_M, 1.0), 0.0)
+        r = r / np.maximum(np.abs(r), 1.0)
+        q = terms.R_l[..., None] * r
+        return 2.0 * C_m(terms, m_max)[..., None] * (z_M * q / (1.0 - q)).real
 
 
 # --------------------------------------------------------------------------------------------------

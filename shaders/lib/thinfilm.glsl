@@ -38,8 +38,11 @@ const float GAUSSIAN_FIT_NORM = 1.0685e-7;
 // sensitivity: 0 = 'table', 1 = 'gaussian' (the 'exact' transform is numpy's validation only).
 const int SENSITIVITY_TABLE = 0;
 const int SENSITIVITY_GAUSSIAN = 1;
-// Eq. 10 is truncated at m_max <= M_MAX_LIMIT here.
+// Eq. 10 is summed explicitly to m_max <= M_MAX_LIMIT, the rest in closed form (fourier_remainder), which
+// needs the harmonic m_max + 1: the sample arrays hold SAMPLES = M_MAX_LIMIT + 2 entries.
 const int M_MAX_LIMIT = 3;
+const int SAMPLES = M_MAX_LIMIT + 2;
+const float REMAINDER_MIN = 1e-15;
 
 // ---- Complex helpers ----------------------------------------------------------------------------
 
@@ -334,13 +337,13 @@ bool sensitivity_fourier_envelope_prefiltered(float mu, float sigma, out vec3 re
 // Table-based S^(m D) for m = 0..m_max: the carrier exp(+2 pi i m D / carrier) by powers times the
 // demodulated envelope, read from the prefiltered table at standard deviation m sigma_D when sigma_D >= 0
 // (Section 5), from sensitivity_fourier otherwise.
-void sensitivity_samples_table(float D_, float sigma_D, int m_max, out vec3 re[M_MAX_LIMIT + 1], out vec3 im[M_MAX_LIMIT + 1]) {
-    for (int m = 0; m <= M_MAX_LIMIT; ++m) { re[m] = vec3(0.0); im[m] = vec3(0.0); }
+void sensitivity_samples_table(float D_, float sigma_D, int m_max, out vec3 re[SAMPLES], out vec3 im[SAMPLES]) {
+    for (int m = 0; m < SAMPLES; ++m) { re[m] = vec3(0.0); im[m] = vec3(0.0); }
     re[0] = vec3(1.0);  // S^(0) = E(0) = sum_lambda s_j(lambda) = 1 (white): the table's node 0, exactly
     vec3 c, s, power_c = vec3(1.0), power_s = vec3(0.0);
     sensitivity_fourier_carrier(D_, c, s);
-    for (int m = 1; m <= M_MAX_LIMIT; ++m) {
-        if (m > m_max) break;
+    for (int m = 1; m < SAMPLES; ++m) {
+        if (m > m_max + 1) break;
         vec3 next_c = power_c * c - power_s * s;
         power_s = power_c * s + power_s * c;
         power_c = next_c;
@@ -353,34 +356,58 @@ void sensitivity_samples_table(float D_, float sigma_D, int m_max, out vec3 re[M
     }
 }
 
-void sensitivity_samples(float D_, int m_max, int sensitivity, out vec3 re[M_MAX_LIMIT + 1], out vec3 im[M_MAX_LIMIT + 1]) {
+void sensitivity_samples(float D_, int m_max, int sensitivity, out vec3 re[SAMPLES], out vec3 im[SAMPLES]) {
     if (sensitivity == SENSITIVITY_TABLE) {
         sensitivity_samples_table(D_, -1.0, m_max, re, im);
         return;
     }
-    for (int m = 0; m <= M_MAX_LIMIT; ++m) {
+    for (int m = 0; m < SAMPLES; ++m) {
         re[m] = vec3(0.0); im[m] = vec3(0.0);
-        if (m <= m_max) sensitivity_fourier_transform(float(m) * D_, sensitivity, re[m], im[m]);
+        if (m <= m_max + 1) sensitivity_fourier_transform(float(m) * D_, sensitivity, re[m], im[m]);
     }
 }
 
-// Eq. 10 for one polarisation from the samples S^(m D): R_j = C_0 Re S^_j(0) + 2 sum_m C_m [cos(m phi_2)
-// Re S^_j(m D) + sin(m phi_2) Im S^_j(m D)], e^{i m phi_2} by powers of the phasor.
-vec3 spectral_integration_fourier_samples(FilmTerms t, int m_max, vec3 re[M_MAX_LIMIT + 1], vec3 im[M_MAX_LIMIT + 1]) {
-    vec3 rgb = C_0(t) * re[0];
-    float R = R_l(t), factor = -2.0 * sqrt_T12T21(t) * T23(t) / one_minus_R_l2(t);  // 2 C_m = factor R_l^m
-    vec2 phase = exp_i_phi_2(t), phase_m = vec2(1.0, 0.0);
-    for (int m = 1; m <= M_MAX_LIMIT; ++m) {
-        if (m > m_max) break;
-        factor *= R;
-        phase_m = cmul(phase_m, phase);
-        rgb += factor * (phase_m.x * re[m] + phase_m.y * im[m]);
+// The terms of Eq. 10 beyond m_max in closed form (explorer.physics.thinfilm.fourier_remainder): with
+// z_m = e^{-i m phi_2} S^(m D) extrapolated geometrically, z_m ~ z_M r^(m - M), r = z_(M+1) / z_M
+// (|r| <= 1), and C_m = C_M R_l^(m - M), they sum to 2 C_M Re(z_M q / (1 - q)), q = R_l r. Exact as
+// D -> 0; it keeps the series under 1 near total internal reflection in the film, where R_l -> 1.
+vec3 fourier_remainder(float R, float two_C_M, vec3 z_re, vec3 z_im, vec3 next_re, vec3 next_im) {
+    vec3 rgb;
+    for (int j = 0; j < 3; ++j) {
+        vec2 z = vec2(z_re[j], z_im[j]), next = vec2(next_re[j], next_im[j]);
+        float power = dot(z, z);  // |z| > REMAINDER_MIN, else the remainder is negligible
+        vec2 r = power > REMAINDER_MIN * REMAINDER_MIN ? cmul(next, vec2(z.x, -z.y)) / power : vec2(0.0);
+        r /= max(length(r), 1.0);
+        vec2 q = R * r, one_minus_q = vec2(1.0 - q.x, -q.y);
+        vec2 zq = cmul(z, q);
+        rgb[j] = two_C_M * dot(zq, one_minus_q) / dot(one_minus_q, one_minus_q);  // Re(zq / (1 - q))
     }
     return rgb;
 }
 
+// Eq. 10 for one polarisation from the samples S^(m D): R_j = C_0 Re S^_j(0) + 2 sum_m C_m [cos(m phi_2)
+// Re S^_j(m D) + sin(m phi_2) Im S^_j(m D)], e^{i m phi_2} by powers of the phasor, plus the remainder.
+vec3 spectral_integration_fourier_samples(FilmTerms t, int m_max, vec3 re[SAMPLES], vec3 im[SAMPLES]) {
+    vec3 rgb = C_0(t) * re[0];
+    float R = R_l(t), factor = -2.0 * sqrt_T12T21(t) * T23(t) / one_minus_R_l2(t);  // 2 C_m = factor R_l^m
+    vec2 phase = exp_i_phi_2(t), phase_m = vec2(1.0, 0.0);
+    vec3 z_re = re[0], z_im = im[0];  // z_m = conj(e^{i m phi_2}) S^(m D)
+    for (int m = 1; m <= M_MAX_LIMIT; ++m) {
+        if (m > m_max) break;
+        factor *= R;
+        phase_m = cmul(phase_m, phase);
+        z_re = phase_m.x * re[m] + phase_m.y * im[m];
+        z_im = phase_m.x * im[m] - phase_m.y * re[m];
+        rgb += factor * z_re;
+    }
+    int next = min(m_max + 1, SAMPLES - 1);
+    phase_m = cmul(phase_m, phase);
+    vec3 next_re = phase_m.x * re[next] + phase_m.y * im[next], next_im = phase_m.x * im[next] - phase_m.y * re[next];
+    return rgb + fourier_remainder(R, factor, z_re, z_im, next_re, next_im);
+}
+
 vec3 spectral_integration_fourier(FilmTerms t, int m_max, int sensitivity) {
-    vec3 re[M_MAX_LIMIT + 1], im[M_MAX_LIMIT + 1];
+    vec3 re[SAMPLES], im[SAMPLES];
     sensitivity_samples(D(t), m_max, sensitivity, re, im);
     return spectral_integration_fourier_samples(t, m_max, re, im);
 }
@@ -441,7 +468,7 @@ vec3 fourier_rgb(float eta_1, float eta_2, float eta_3, float kappa_3, float cos
                             cabs2(airy_reflection_coefficient_from_terms(p, NAIVE_WAVELENGTHS[j])));
         return rgb;
     }
-    vec3 re[M_MAX_LIMIT + 1], im[M_MAX_LIMIT + 1];
+    vec3 re[SAMPLES], im[SAMPLES];
     sensitivity_samples(D(s), m_max, sensitivity, re, im);
     return 0.5 * (spectral_integration_fourier_samples(s, m_max, re, im) + spectral_integration_fourier_samples(p, m_max, re, im));
 }
@@ -476,7 +503,7 @@ vec3 fourier_rgb_prefiltered(float eta_1, float eta_2, float eta_3, float kappa_
         return rgb;
     }
     float D_ = D(s), sigma_D = sigma_D_inc * s.cos_theta_2.x;
-    vec3 re[M_MAX_LIMIT + 1], im[M_MAX_LIMIT + 1];
+    vec3 re[SAMPLES], im[SAMPLES];
     sensitivity_samples_table(D_, sigma_D, m_max, re, im);
     return 0.5 * (spectral_integration_fourier_samples(s, m_max, re, im) + spectral_integration_fourier_samples(p, m_max, re, im));
 }
