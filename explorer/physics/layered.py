@@ -503,19 +503,27 @@ def _host_angle(cos_theta, n1: float, coating: bool) -> tuple[np.ndarray, np.nda
 def stack_specular_rgb(stack: LayeredBragg, cos_theta, tables=None) -> np.ndarray:
     """
     The smooth limit's specular colour of a stack at incidence ``cos_theta`` (in air), in linear sRGB: the
-    weight of the mirror reflection, ``F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} t_k(theta')^2``, with
-    ``F`` the coating's Fresnel reflectance, ``theta'`` the refracted angle, ``R_l`` Yeh's reflectance and
-    ``t_k`` the integrated transmissivity (Eq. 28) of the layers above. What the ``sphere`` and
-    ``gradient`` views show for ``shaders/bragg_stack.brd``; not part of Eq. 34 (which has no Dirac term
-    for rough layers).
+    weight of the mirror reflection, ``F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2``,
+    with ``F`` the coating's Fresnel reflectance, ``theta'`` the refracted angle and ``R_l`` Yeh's
+    reflectance. What the ``sphere`` and ``gradient`` views show for ``shaders/bragg_stack.brd``; not part
+    of Eq. 34 (which has no Dirac term for rough layers).
+
+    In the smooth limit (``alpha -> 0``) each layer is one Bragg mirror, which transmits ``1 - R_l`` (Yeh's
+    ``R + T = 1`` for lossless layers) and ``F_alpha`` of Eq. 28 tends to the identity. The integrated
+    transmissivity of the rough layer must not be used here: it averages ``T`` over the half-vector
+    angles of the layer's roughness, so beside a band edge or the host's total internal reflection it
+    exceeds ``1 - R_l(theta')``, and the sum reflected up to 1.15 times the incident light. With smooth
+    transmissions every wavelength's sum is at most 1 (by induction over the layers, each term at most
+    what the layers above let through), so the luminance of the colour is too.
     """
     tables = stack_tables(stack) if tables is None else tuple(tables)
     theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
     through = ((1.0 - F) ** 2)[..., None]
     spectrum = 0.0
     for table in tables:
-        spectrum = spectrum + through * lookup(table.reflectance, theta)
-        through = through * lookup(table.transmissivity, theta) ** 2
+        R = lookup(table.reflectance, theta)
+        spectrum = spectrum + through * R
+        through = through * (1.0 - R) ** 2
     return colorimetry.spectrum_to_rgb(spectrum) + F[..., None]  # F is flat: white is (1, 1, 1)
 
 

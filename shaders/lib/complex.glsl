@@ -12,6 +12,14 @@ vec2 cconj(vec2 a) { return vec2(a.x, -a.y); }
 float cabs2(vec2 a) { return dot(a, a); }
 vec2 cdiv(vec2 a, vec2 b) { return cmul(a, cconj(b)) / dot(b, b); }
 vec2 cinv(vec2 a) { return cconj(a) / dot(a, a); }
+// The same, scaled by the divisor's largest part first: |b|^2 neither overflows nor underflows in float32.
+vec2 cdiv_scaled(vec2 a, vec2 b) {
+    float m = max(abs(b.x), abs(b.y));
+    if (m == 0.0) return a / 0.0;
+    vec2 bs = b / m;
+    return cmul(a / m, cconj(bs)) / dot(bs, bs);
+}
+vec2 cinv_scaled(vec2 a) { return cdiv_scaled(vec2(1.0, 0.0), a); }
 
 // exp(i z) = exp(-y) (cos x + i sin x)
 vec2 cexpi(vec2 z) { return exp(-z.y) * vec2(cos(z.x), sin(z.x)); }

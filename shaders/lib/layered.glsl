@@ -81,10 +81,10 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
 }
 
 // The smooth limit's specular colour at incidence cos_theta (what the gradient and sphere views show):
-// F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} t_k(theta')^2, with t_k the integrated transmissivity and
-// theta' the refracted angle (without a coating: theta' = theta, F = 0).
-vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count,
-                        sampler2D reflectance_table, sampler2D transmissivity_table) {
+// F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2, theta' the refracted angle (without a
+// coating: theta' = theta, F = 0). Smooth layers transmit 1 - R (the rough layer's integrated
+// transmissivity would exceed it beside band edges: see explorer.physics.layered.stack_specular_rgb).
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table) {
     float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
     float F = 0.0, through = 1.0;
     if (coating) {
@@ -98,12 +98,10 @@ vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count
     table_row(atan(s, c), k, f);
     vec3 used = layer_mask(layer_count);
     vec3 xyz = vec3(0.0);
-    float flat_sum = 0.0;
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k, f) * used;
-        vec3 t = mix(vec3(1.0), table_fetch(transmissivity_table, j, k, f), used);
-        float t1 = t.x * t.x, t2 = t1 * t.y * t.y;
-        xyz += colour_matching_functions(j) * (through * (R.x + t1 * R.y + t2 * R.z));
+        vec3 t = (1.0 - R) * (1.0 - R);
+        xyz += colour_matching_functions(j) * (through * (R.x + t.x * (R.y + t.y * R.z)));
     }
     return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)
 }

@@ -39,25 +39,49 @@ vec3 roughness_from_variance(vec3 sigma) {
 }
 
 // [R_s, R_p] of a smooth dielectric interface of relative index eta; 1 beyond the critical angle.
+// For eta > 1 in terms of u = 1 / eta, so a huge index (eta^2 overflows float32 from 1.8e19) gives
+// numpy's float64 answer, |r| -> 1.
 vec2 fresnel_sp(float cos_theta, float eta) {
-    float c = clamp(cos_theta, 0.0, 1.0), n2 = eta * eta;
-    float q2 = n2 - (1.0 - c * c);
+    float c = clamp(cos_theta, 0.0, 1.0), s2 = 1.0 - c * c;
+    if (eta > 1.0) {
+        float u = 1.0 / eta, w = sqrt(max(1.0 - s2 * u * u, 0.0));  // w = cos theta_t
+        float rs = (c * u - w) / (c * u + w), rp = (c - u * w) / max(c + u * w, 1e-30);
+        return c + u * w > 0.0 ? vec2(rs * rs, rp * rp) : vec2(1.0);
+    }
+    float n2 = eta * eta;
+    float q2 = n2 - s2;
     if (q2 <= 0.0) return vec2(1.0);
     float q = sqrt(q2);  // eta cos theta_t
     float rs = (c - q) / max(c + q, 1e-30), rp = (n2 * c - q) / max(n2 * c + q, 1e-30);
     return c + q > 0.0 ? vec2(rs * rs, rp * rp) : vec2(1.0);
 }
 
-// The same towards a conductor eta + i kappa (relative indices).
+// The principal square root (Re >= 0) of z.
+vec2 csqrt_principal(vec2 z) {
+    float m = max(abs(z.x), abs(z.y)), r = m > 0.0 ? m * length(z / m) : 0.0;  // |z| without overflow
+    return vec2(sqrt(max(0.5 * (r + z.x), 0.0)), sqrt(max(0.5 * (r - z.x), 0.0)) * (z.y < 0.0 ? -1.0 : 1.0));
+}
+
+// The same towards a conductor n = eta + i kappa (relative indices). With u = 1 / n and
+// w = cos theta_t = sqrt(1 - sin^2 u^2): r_s = (c u - w) / (c u + w), r_p = (c - u w) / (c + u w), the
+// forms of (c - q) / (c + q) and (n^2 c - q) / (n^2 c + q) (q = n w) whose parts stay within float32 for
+// any |n| >= 1 (eta_base = 1e10 would overflow n^2 |n|^2); below, the direct forms.
 vec2 fresnel_sp_conductor(float cos_theta, float eta, float kappa) {
-    float c = clamp(cos_theta, 0.0, 1.0);
-    vec2 n2 = cmul(vec2(eta, kappa), vec2(eta, kappa));
-    vec2 z = n2 - vec2(1.0 - c * c, 0.0);
-    // principal square root of z
-    float r = length(z);
-    vec2 q = vec2(sqrt(max(0.5 * (r + z.x), 0.0)), sqrt(max(0.5 * (r - z.x), 0.0)) * (z.y < 0.0 ? -1.0 : 1.0));
-    vec2 rs = cdiv(vec2(c, 0.0) - q, vec2(c, 0.0) + q);
-    vec2 rp = cdiv(c * n2 - q, c * n2 + q);
+    float c = clamp(cos_theta, 0.0, 1.0), s2 = 1.0 - c * c;
+    vec2 n = vec2(eta, kappa);
+    vec2 rs, rp;
+    if (max(abs(eta), abs(kappa)) >= 1.0) {
+        vec2 u = cinv_scaled(n);
+        vec2 w = csqrt_principal(vec2(1.0, 0.0) - s2 * cmul(u, u));
+        vec2 uw = cmul(u, w);
+        rs = cdiv_scaled(c * u - w, c * u + w);
+        rp = cdiv_scaled(vec2(c, 0.0) - uw, vec2(c, 0.0) + uw);
+    } else {
+        vec2 n2 = cmul(n, n);
+        vec2 q = csqrt_principal(n2 - vec2(s2, 0.0));
+        rs = cdiv(vec2(c, 0.0) - q, vec2(c, 0.0) + q);
+        rp = cdiv(c * n2 - q, c * n2 + q);
+    }
     return vec2(cabs2(rs), cabs2(rp));
 }
 
