@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error, run_cli
-from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.physics import bragg, colorimetry, layered
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggLayerModel, model_for
 from explorer.materials.presets import PRESET_DIR, load_presets

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from explorer.materials.brd import Material, MaterialError, load_material
 from explorer.errors import LocatedError
-from explorer.resources import PRESET_DIR, SHADER_DIR
+from explorer.resources import PRESET_DIR
 
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")

@@ -45,7 +45,6 @@ import numpy as np
 from explorer.physics import microfacet
 from explorer.physics.lobes_fgd import (  # the Fresnel terms and table coordinates the model reads
     ETA_TABLE_MAX, FGD_ALPHA_COUNT, FGD_COS_COUNT, FGD_ETA_COUNT, _axis, fgd_cos_coordinate, fresnel_sp,
-    normal_reflectance,
 )
 
 #: Upper bound on dielectric indices (Bati et al. use eta_max = 4 "for illustration").
