@@ -134,7 +134,7 @@ def run_cli(args: Sequence[str] | None = None) -> NoReturn:
     except ModuleNotFoundError as exc:
         if exc.name in ("explorer.cli.commands", "explorer"):
             print(
-                "[setup] error: explorer/cli.py is missing (no explorer.cli.commands module to run)",
+                "[setup] error: explorer/cli/commands.py is missing (no explorer.cli.commands module to run)",
                 file=sys.stderr,
             )
             raise SystemExit(1) from None

@@ -151,7 +151,7 @@ class ShaderBuilder:
     >>> b = ShaderBuilder(["shaders/lib"])                  # doctest: +SKIP
     >>> b.add_source(material.uniform_declarations(), "<uniforms>")
     >>> b.add_source(material.shader, material.path, material.shader_line)
-    >>> b.add_file("shaders/views/sphere.frag")
+    >>> b.add_file("shaders/views/sphere.glsl")
     >>> program = b.build()
     """
 

@@ -41,14 +41,14 @@ def stack_from_values(values: Mapping[str, object]) -> lobes.Stack:
 
 
 def fgd_texture() -> np.ndarray:
-    """``luts/lobes_fgd_correction`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, the correction in red."""
+    """``luts/lobes_fgd_correction.npy`` as a ``(33 * 16, 32, 3)`` texture: rows eta-major, the correction in red."""
     table = luts.load("lobes_fgd_correction")
     rows = table.reshape(-1, table.shape[-1])
     return np.stack([rows, np.zeros_like(rows), np.zeros_like(rows)], axis=-1).astype(np.float32)
 
 
 def moments_texture() -> np.ndarray:
-    """``luts/lobes_ggx_moments`` as a ``(16, 32, 3)`` texture: channels E, cbar_d, 0."""
+    """``luts/lobes_ggx_moments.npy`` as a ``(16, 32, 3)`` texture: channels E, cbar_d, 0."""
     table = luts.load("lobes_ggx_moments")
     return np.stack([table[0], table[1], np.zeros_like(table[0])], axis=-1).astype(np.float32)
 

@@ -9,7 +9,7 @@ method what the shader computes
 ====== ==========================================================================================
 0      spectral reference: the Airy reflectance at every nm from 360 to 830, both polarisations
 1-3    the paper's Fourier-space spectral integration (Eq. 10) truncated at m = method, with the
-       tabulated transform of the convention's sensitivities (``luts/sensitivity_fourier``)
+       tabulated transform of the convention's sensitivities (``luts/sensitivity_fourier.npy``)
 4      the same at m = 3 with the paper's Gaussian fits of the XYZ sensitivities
 5      naive RGB: the Airy reflectance at :data:`explorer.physics.thinfilm.NAIVE_WAVELENGTHS`
 ====== ==========================================================================================

@@ -1,4 +1,4 @@
-// Bragg mirrors: twin of explorer/bragg.py, function for function and under the same names.
+// Bragg mirrors: twin of explorer/physics/bragg.py, function for function and under the same names.
 // Fourneau, Pacanowski, Barla (2024), Interactive Exploration of Vivid Material Iridescence using
 // Bragg Mirrors: Sections 3.1-3.2, Appendices A, B, D. Equation numbers are the paper's.
 //
@@ -128,7 +128,7 @@ void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float sca
 // 1 - cos K Lambda = 2 (1 - Theta) sin^2 h- + 2 Theta sin^2 h+ and 1 + cos K Lambda = the same with cos^2:
 // no cancellation against 1, so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda
 // would amplify an absolute error of cos K Lambda. Four trig calls in all; sin phi = sin(h+ - h-) comes free.
-// float64 (explorer/bragg.py) needs none of this.
+// float64 (explorer/physics/bragg.py) needs none of this.
 void chebyshev_U_half_angles(vec4 half_angles, float Omega_, float N, out float U_N1, out float U_N2, out float scale) {
     float sm = half_angles.x, cm = half_angles.y, sp = half_angles.z, cp = half_angles.w;
     float Theta = 0.5 + 0.25 * Omega_;
@@ -202,8 +202,8 @@ float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
 }
 
 // The spectral reference: R_lambda, both polarisations, sampled every 1/K nm with K = round(1 / step_nm),
-// against the CMFs interpolated linearly (explorer/bragg.py, reference_rgb with a step; the samples'
-// trapezoids against the hat functions of explorer/colorimetry.py). step_nm = 1: the paper's sum over every
+// against the CMFs interpolated linearly (explorer/physics/bragg.py, reference_rgb with a step; the samples'
+// trapezoids against the hat functions of explorer/physics/colorimetry.py). step_nm = 1: the paper's sum over every
 // nm from 360 to 830, which misses or hits the narrow resonances beside band edges for N of a few tens
 // and more; a finer step converges towards the integral (numpy's reference_rgb without a step).
 vec3 reference_rgb(float cos_theta, BraggMirror mirror, float step_nm) {
@@ -252,7 +252,7 @@ float reflectance_envelope(float omega, CellGeometry g) {
 
 // |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
 // spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
-// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/bragg.py has the derivation).
+// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/physics/bragg.py has the derivation).
 const float FRINGE_B_MIN = 1e-12;
 const float FRINGE_Q_MIN = 1e-6;
 float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {

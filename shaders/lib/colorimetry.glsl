@@ -1,4 +1,4 @@
-// The colour convention (explorer/colorimetry.py) and the CMF tables of luts/ (explorer/luts.py).
+// The colour convention (explorer/physics/colorimetry.py) and the CMF tables of luts/ (explorer/tables/luts.py).
 // Tables are 2D textures of height 1 (moderngl has no 1D textures). The host binds: cmf_1nm (471 texels, CMFs at 360..830 nm, sum(ybar) = 1), cmf_cumulative (472 texels,
 // their cumulative integral at the bin edges 359.5 + k nm, linear filtering, clamped to edge) and
 // xyz_to_rgb_matrix (XYZ with E white -> linear sRGB with white (1, 1, 1)).

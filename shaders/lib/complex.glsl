@@ -1,5 +1,5 @@
 // Complex arithmetic on vec2 (x = real part, y = imaginary part).
-// Waves travel as exp(+i k z), as in explorer/fresnel.py.
+// Waves travel as exp(+i k z), as in explorer/physics/fresnel.py.
 
 // A macro, not a constant: a material's code precedes the library in a program, and BRDF Explorer's files
 // declare their own PI (a const, which this later #define leaves alone, or a #define, which it keeps).

@@ -1,4 +1,4 @@
-// Fresnel equations with Snell's law and total internal reflection: twin of explorer/fresnel.py.
+// Fresnel equations with Snell's law and total internal reflection: twin of explorer/physics/fresnel.py.
 #include "lib/complex.glsl"
 
 // Cosine of the refraction angle (complex: purely imaginary, Im > 0, under total internal reflection).

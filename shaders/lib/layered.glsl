@@ -1,4 +1,4 @@
-// Layered Bragg structures: twin of explorer/layered.py (Fourneau et al. 2024, Sections 4.2-4.3).
+// Layered Bragg structures: twin of explorer/physics/layered.py (Fourneau et al. 2024, Sections 4.2-4.3).
 // Per-layer tables come from the host, one layer per channel (r, g, b = layers 1, 2, 3; zeros unused):
 // rows theta = k THETA_STEP (k = 0..360, in the host medium), columns lambda = 360 + j nm (j = 0..470).
 // They are read with texelFetch and interpolated here in float32, as explorer.physics.layered.lookup does:

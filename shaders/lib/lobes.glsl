@@ -1,4 +1,4 @@
-// Belcour's (2018) atomic decomposition of layered materials: twin of explorer/lobes.py (Bati, Barla &
+// Belcour's (2018) atomic decomposition of layered materials: twin of explorer/physics/lobes.py (Bati, Barla &
 // Pacanowski 2021, Section 4: Eqs. 2-6, BRDF Eq. 3). Energies per polarisation (s, p) and RGB channel,
 // variances per channel; the host binds luts/lobes_fgd_correction.npy as lobes_fgd (rows eta-major,
 // alpha-minor; columns cos theta; the unpolarised FGD - F in red) and luts/lobes_ggx_moments.npy as lobes_ggx_moments

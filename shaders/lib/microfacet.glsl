@@ -1,4 +1,4 @@
-// GGX microfacets: twin of explorer/microfacet.py (Fourneau et al. 2024, Eqs. 17-19; Walter et al. 2007).
+// GGX microfacets: twin of explorer/physics/microfacet.py (Fourneau et al. 2024, Eqs. 17-19; Walter et al. 2007).
 // Directions point away from the surface; the normal is N (n = +z in the numpy twin).
 #include "lib/complex.glsl"
 

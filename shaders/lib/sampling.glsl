@@ -1,6 +1,6 @@
 // Monte Carlo sampling for the env view (shaders/views/env.glsl): a hash for random numbers, cosine and
-// GGX visible-normal sampling and their densities. Twins: explorer/microfacet.py (sample_ggx_visible_normal,
-// ggx_visible_normal_pdf, ggx_reflection_pdf) and explorer/env.py (pcg4d, sample_cosine_hemisphere).
+// GGX visible-normal sampling and their densities. Twins: explorer/physics/microfacet.py (sample_ggx_visible_normal,
+// ggx_visible_normal_pdf, ggx_reflection_pdf) and explorer/views/env.py (pcg4d, sample_cosine_hemisphere).
 // GGX's D and G1 come from lib/microfacet.glsl (its PI is a macro that a material's own PI does not clash with).
 #include "lib/microfacet.glsl"
 

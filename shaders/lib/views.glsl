@@ -1,4 +1,4 @@
-// What the views share (sphere, lit, scatter, textured, env, slice; twins in explorer/render.py). Included
+// What the views share (sphere, lit, scatter, textured, env, slice; twins in explorer/views/render.py and explorer/views/geometry.py). Included
 // after the material's source: view_brdf calls its BRDF.
 
 // Pixel (i, j), j from the top, at p = (2 (i + 0.5) / W - 1, 1 - 2 (j + 0.5) / H); false outside the unit disc.
@@ -18,7 +18,7 @@ void lit_sphere_frame(vec2 p, float r2, out vec3 normal, out vec3 tangent, out v
 }
 
 // The rule of every view that evaluates a material's BRDF (lit, slice, scatter, textured, env; the numpy
-// twins in explorer/render.py have the same names): the BRDF is evaluated only where the light and the
+// twins in explorer/views/geometry.py have the same names): the BRDF is evaluated only where the light and the
 // view are both strictly above the surface, N.L > 0 and N.V > 0, and is 0 elsewhere (BRDF Explorer's lit
 // sphere evaluates it everywhere and relies on max(BRDF, 0) and the cosine, but Minnaert's or Ward's
 // pow(N.L N.V, e) and sqrt(N.L N.V) are NaN below the horizon and NaN * 0 stays NaN). A channel the

@@ -1,7 +1,7 @@
 // The env view: the lit view's orthographic unit sphere (V = (0, 0, 1), N and BRDF Explorer's frame X, Y
 // from lib/views.glsl) under an environment map, by progressive Monte Carlo. Each pass adds
 // samples_per_pass samples per pixel of the estimator f(L, V) cos theta_L Le(L) / pdf(L); the host blends
-// the passes additively (explorer/env.py, ProgressiveEnvRender) and divides by the sample count.
+// the passes additively (explorer/gpu/env.py, ProgressiveEnvRender) and divides by the sample count.
 //
 // Random numbers: the PCG4D hash of (pixel, sample index, seed), the sample index counted from the first
 // sample of the render (first_sample + s): the same numbers however the host splits the samples into passes.

@@ -1,7 +1,7 @@
 // The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a film
 // thickness that varies over it (Belcour & Barla 2017, Section 5, Figures 12-15). The material must
 // define textured_BRDF(L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered) (shaders/thin_film.brd).
-// Planar parametrisation (explorer/thickness.py): pixel p = (x, y) reads D_inc (nm) from dinc_texture at
+// Planar parametrisation (explorer/views/thickness.py): pixel p = (x, y) reads D_inc (nm) from dinc_texture at
 // u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinearly between texel centres, clamped.
 // prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
 // host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
