@@ -1,4 +1,4 @@
-"""Decision logic of explorer/bootstrap.py, with every probe faked: nothing is installed."""
+"""Decision logic of explorer/dev/bootstrap.py, with every probe faked: nothing is installed."""
 
 from __future__ import annotations
 

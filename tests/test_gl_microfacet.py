@@ -1,4 +1,4 @@
-"""The GLSL twin of explorer/microfacet.py (shaders/lib/microfacet.glsl) against numpy."""
+"""The GLSL twin of explorer/physics/microfacet.py (shaders/lib/microfacet.glsl) against numpy."""
 
 from __future__ import annotations
 
