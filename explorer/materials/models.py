@@ -241,7 +241,8 @@ class SchlickFresnelModel:
         return np.repeat(value[..., None], 3, axis=-1)
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
-        return self.reflectance(_cos_half_angle(L, V))
+        # Fresnel-weighted Lambertian: F(theta_d) / pi, so that the albedo is at most 1.
+        return self.reflectance(_cos_half_angle(L, V)) / np.pi
 
     def textures(self) -> dict[str, np.ndarray]:
         return {}
