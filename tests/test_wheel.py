@@ -142,6 +142,7 @@ def test_installed_package_is_the_wheel(installed):
                if p.is_file() and "__pycache__" not in p.parts}
     missing = sorted(name for name in tracked if f"explorer/{name}" not in names)
     assert not missing, f"not in the wheel: {missing}"
+    assert not [name for name in names if name.startswith("explorer/dev/")], "the checkout's set-up is in the wheel"
 
 
 def _render_jobs(installed: Installed) -> dict[str, list[str]]:
