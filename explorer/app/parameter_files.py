@@ -96,10 +96,12 @@ def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mappin
 
 
 def _write_text(path: os.PathLike[str] | str, text: str) -> None:
+    from explorer.files import OutputError, write_text_atomic
+
     try:
-        Path(path).write_text(text, encoding="utf-8")
-    except OSError as error:
-        raise ParameterFileError(_display(path), None, f"cannot write ({error.strerror})") from None
+        write_text_atomic(path, text)
+    except OutputError as error:  # its message names the path already
+        raise ParameterFileError(_display(path), None, str(error).split(": ", 1)[-1]) from None
 
 
 def _apply(material: Material, raw: Mapping[str, object], where: str, lines: Mapping[str, int]) -> LoadedValues:

@@ -399,8 +399,12 @@ def bench(as_json, size, repeats, thin_film, layers, app):
 @_errors
 def accuracy(as_json, plot, strips):
     """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings)."""
-    from explorer.cli.bench import figure4_strips, run_accuracy
+    from explorer.cli.bench import FIGURE_SUFFIXES, STRIP_SUFFIXES, figure4_strips, run_accuracy
+    from explorer.files import check_output as check_file
 
+    for path, suffixes in ((plot, FIGURE_SUFFIXES), (strips, STRIP_SUFFIXES)):
+        if path:
+            check_file(path, suffixes)  # before the seconds of work
     if strips:
         figure4_strips(Path(strips))
     run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)

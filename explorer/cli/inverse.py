@@ -130,8 +130,14 @@ def figure_command(lobe_spec, out, samples):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from explorer.cli.bench import FIGURE_SUFFIXES, save_figure
+    from explorer.files import OutputError, check_output
     from explorer.physics.inverse import one_layer_class, two_layer_class
 
+    try:
+        check_output(out, FIGURE_SUFFIXES)
+    except OutputError as error:
+        _fail(str(error))
     lobe, _ = parse_lobe(lobe_spec)
     colours = ("tab:red", "tab:green", "tab:blue")
     fig, ax = plt.subplots(figsize=(5.5, 4.5), dpi=110)
@@ -174,9 +180,9 @@ def figure_command(lobe_spec, out, samples):
         ax.set_title(f"1-layer dielectric class: R = {lobe.energy.max():.3g}, σ = {lobe.variance:g}", fontsize=9)
     fig.tight_layout()
     try:
-        fig.savefig(out)
-    except OSError as error:
-        _fail(f"cannot write {out}: {error.strerror or error}")
+        save_figure(fig, out)
+    except OutputError as error:
+        _fail(str(error))
     finally:
         plt.close(fig)
     click.echo(f"wrote {out}")

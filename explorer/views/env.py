@@ -254,8 +254,11 @@ def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
     cv2 = _cv2()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(os.fspath(path), generate_default_environment()[:, :, ::-1]):
-        raise OSError(f"{path}: OpenCV could not write it")
+    from explorer.files import atomic_output
+
+    with atomic_output(path) as temporary:
+        if not cv2.imwrite(os.fspath(temporary), generate_default_environment()[:, :, ::-1]):
+            raise OSError(f"{path}: OpenCV could not write it")
     return path
 
 

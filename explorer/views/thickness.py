@@ -59,7 +59,10 @@ def write_default_texture(path: Path = DEFAULT_TEXTURE) -> Path:
     from PIL import Image
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(generate_default_texture(), mode="L").save(path, format="PNG")
+    from explorer.files import atomic_output
+
+    with atomic_output(path, (".png",)) as temporary:
+        Image.fromarray(generate_default_texture(), mode="L").save(temporary, format="PNG")
     return path
 
 
