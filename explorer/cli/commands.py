@@ -22,6 +22,8 @@ from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
 
 PROG = "bragg-explorer"
+#: The largest ``--size`` side parsed at all; each engine then checks its own limits.
+MAX_SIZE = 1 << 16
 
 
 def _fail(message: str) -> None:
@@ -49,8 +51,9 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
         numbers = [int(p) for p in parts]
     except ValueError:
         numbers = []
-    if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > 16384:
-        raise click.BadParameter(f"{text!r} is not W or WxH with sizes in 1..16384", param_hint="--size")
+    # A sanity bound only: the GL engine checks the context's own limits (explorer.gpu.GLLimits).
+    if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > MAX_SIZE:
+        raise click.BadParameter(f"{text[:40]!r} is not W or WxH with sizes in 1..{MAX_SIZE}", param_hint="--size")
     if len(numbers) == 1:
         return (numbers[0], numbers[0] if view_named(view).square else default_size[1])
     return numbers[0], numbers[1]
@@ -121,12 +124,15 @@ def render_material(
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
     from explorer.gpu import Renderer
 
+    renderer = Renderer()
+    renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
-        return Renderer().render(
+        renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
+        return renderer.render(
             material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
             uniforms={"prefilter": thickness.prefilter},
         )
-    return Renderer().render(material, values, view, width, height, light=light)
+    return renderer.render(material, values, view, width, height, light=light)
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:

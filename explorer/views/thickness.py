@@ -72,11 +72,17 @@ def load_grey(path: str | Path) -> np.ndarray:
     rows from the top; 16-bit images keep their precision. One-line :class:`LocatedError` naming the
     file when it is missing or not an image.
     """
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     path = Path(path)
     try:
-        with Image.open(path) as image:
+        with warnings.catch_warnings():
+            # Pillow only warns between its limit and twice it: both are refused here (decompression bombs).
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            image = Image.open(path)
+        with image:
             image.load()
             if image.mode in ("I;16", "I;16B", "I;16L", "I"):
                 grey = np.asarray(image, dtype=np.float64) / 65535.0
@@ -90,6 +96,9 @@ def load_grey(path: str | Path) -> np.ndarray:
         raise LocatedError(path, None, "thickness texture is a directory, not an image") from None
     except UnidentifiedImageError:
         raise LocatedError(path, None, "thickness texture is not an image Pillow can read") from None
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning):
+        raise LocatedError(path, None, f"thickness texture has more pixels than the limit, {Image.MAX_IMAGE_PIXELS} "
+                                       "(PIL.Image.MAX_IMAGE_PIXELS, against decompression bombs)") from None
     except (OSError, ValueError, SyntaxError) as error:
         raise LocatedError(path, None, f"thickness texture cannot be read ({' '.join(str(error).split())})") from None
     if grey.ndim != 2 or grey.size == 0 or not np.all(np.isfinite(grey)):
@@ -116,11 +125,13 @@ class ThicknessTexture:
 
     d_inc: np.ndarray
     prefilter: bool = False
+    #: Where it came from (messages name it).
+    source: str = "<array>"
 
     @classmethod
     def from_file(cls, path: str | Path = DEFAULT_TEXTURE, dinc_range=DEFAULT_DINC_RANGE, prefilter: bool = False):
         low, high = dinc_range
-        return cls((low + (high - low) * load_grey(path)).astype(np.float32), bool(prefilter))
+        return cls((low + (high - low) * load_grey(path)).astype(np.float32), bool(prefilter), str(path))
 
     def sample(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Bilinear D_inc at ``(u, v)`` (float32 arithmetic for the coordinates, as the shader's)."""
