@@ -10,6 +10,7 @@ there is one, and a non-zero exit; an output file is either complete or not writ
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -24,6 +25,21 @@ from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
 PROG = "bragg-explorer"
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
 MAX_SIZE = 1 << 16
+
+
+#: Set (to 1) for an unexpected error's traceback, as ``--debug`` does.
+DEBUG_ENV = "BRAGG_EXPLORER_DEBUG"
+
+
+def _debug(argv: list[str]) -> bool:
+    """``--debug`` before the command (``bragg-explorer --debug render ...``) or :data:`DEBUG_ENV` set."""
+    flags = argv[: next((i for i, a in enumerate(argv) if not a.startswith("-")), len(argv))]
+    return "--debug" in flags or os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
+
+
+def _terminate(signum, _frame) -> None:
+    """SIGTERM as ``SystemExit``: outputs being written (:func:`explorer.files.atomic_output`) are cleaned up."""
+    raise SystemExit(128 + signum)
 
 
 def _fail(message: str) -> None:
@@ -165,8 +181,9 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
+@click.option("--debug", is_flag=True, help=f"Print the traceback of an unexpected error (a bug); also {DEBUG_ENV}=1.")
 @click.pass_context
-def cli(ctx: click.Context) -> None:
+def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() before click parses
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
     Without a command: open the explorer on the default Bragg mirror when a display exists; without
@@ -364,8 +381,8 @@ def presets(material, as_json):
 
 @cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
-@click.option("--size", default=512, show_default=True, help="Sphere size for GPU timings.")
-@click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
+@click.option("--size", default=512, show_default=True, type=click.IntRange(min=1), help="Sphere size for GPU timings.")
+@click.option("--repeats", default=3, show_default=True, type=click.IntRange(min=1), help="Interleaved repeats per method (medians).")
 @click.option("--thin-film", "thin_film", is_flag=True,
               help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
 @click.option("--layers", is_flag=True,
@@ -440,7 +457,17 @@ cli.add_command(figure_command)
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point: click's usage errors too end as one line (not click's usage block)."""
+    """
+    Entry point: click's usage errors too end as one line (not click's usage block), and so does an
+    unexpected error, said to be a bug (its traceback with ``--debug`` or ``BRAGG_EXPLORER_DEBUG=1``).
+    """
+    import signal
+    import threading
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = _debug(argv)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:
         cli.main(args=argv, prog_name=PROG, standalone_mode=False)
     except click.exceptions.Exit as exit_:
@@ -448,8 +475,25 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         _fail("aborted")
     except click.ClickException as error:
-        click.echo(f"{PROG}: error: {' '.join(error.format_message().split())}", err=True)
+        click.echo(f"{PROG}: error: {' '.join(error.format_message().split())[:500]}", err=True)
         sys.exit(error.exit_code)
+    except (LocatedError, OutputError) as error:  # bad input that a command did not turn into a line itself
+        _fail(str(error))
+    except MemoryError:
+        _fail("out of memory (a smaller --size, --samples or input image needs less)")
+    except RecursionError:
+        _fail("input nested too deeply")
+    except Exception as error:  # the last resort: each known bad input has its own message above
+        if debug:
+            import traceback
+
+            traceback.print_exc()
+        what = " ".join(str(error).split())[:200]
+        _fail(f"internal error (a bug): {type(error).__name__}{': ' + what if what else ''}; "
+              f"run with --debug (bragg-explorer --debug ...) or {DEBUG_ENV}=1 for the traceback")
+    finally:
+        if main_thread and previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

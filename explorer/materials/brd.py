@@ -578,10 +578,12 @@ class _Parser:
             )
         elif kind.startswith("::"):
             raise self.error(number, f"missing 'analytic' header before {kind!r}")
-        else:
+        elif _IDENTIFIER_RE.match(kind) and len(kind) <= 32:
             raise self.error(
                 number, f"unsupported material kind {kind!r}; only 'analytic' materials can be loaded"
             )
+        else:  # not a word: the file is likely no material at all, and its text is not shown
+            raise self.error(number, "not a material file (expected 'analytic' on the first line)")
 
     def begin(self, number: int, tokens: list[str]) -> None:
         if len(tokens) < 2:

@@ -20,13 +20,14 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from explorer.materials.brd import Material, MaterialError, load_material
 from explorer.errors import LocatedError
-from explorer.resources import PRESET_DIR, SHADER_DIR
+from explorer.resources import MATERIAL_SUFFIXES, PRESET_DIR, SHADER_DIR
 
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")
@@ -88,6 +89,12 @@ def _find_line(lines: list[str], table: str | None, key: str | None = None) -> i
     return None
 
 
+def _long_integer_line(text: str) -> int | None:
+    """1-based line of the first run of digits too long for Python's ``int()``."""
+    found = re.search(r"\d{%d,}" % (sys.get_int_max_str_digits() + 1), text)
+    return text.count("\n", 0, found.start()) + 1 if found else None
+
+
 def load_presets(path: str | os.PathLike[str]) -> PresetFile:
     """Read and validate one presets file (see the module docstring)."""
     path = Path(path)
@@ -105,10 +112,17 @@ def load_presets(path: str | os.PathLike[str]) -> PresetFile:
         found = _TOML_LINE.search(message)
         line = int(found.group(1)) if found else None
         raise PresetError(where, line, "not valid TOML: " + _TOML_LINE.sub("", message).strip()) from None
+    except RecursionError:
+        raise PresetError(where, None, "not valid presets: nested too deeply") from None
+    except ValueError:  # an integer beyond Python's digit limit (4300): tomllib's int() refuses it
+        raise PresetError(where, _long_integer_line(text), "an integer is too long (a parameter value is a number in its range)") from None
     lines = text.splitlines()
     material_name = data.get("material")
     if not isinstance(material_name, str):
         raise PresetError(where, _find_line(lines, None, "material"), "needs a top-level material = \"FILE.brd\"")
+    if Path(material_name).suffix.lower() not in MATERIAL_SUFFIXES:  # nor is another file read, or shown
+        raise PresetError(where, _find_line(lines, None, "material"),
+                          f"material must name a {' or '.join(MATERIAL_SUFFIXES)} file, not {material_name[:80]!r}")
     material_path = path.parent.parent / material_name
     if not material_path.is_file():
         material_path = path.parent / material_name

@@ -29,6 +29,9 @@ from explorer.resources import DEFAULT_TEXTURE
 
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
+#: The largest D_inc (nm) ``--dinc-range`` accepts: the OPD at normal incidence, 2 eta_2 d, of the thickest
+#: film shaders/thin_film.brd declares (d <= 3000 nm, eta2 <= 3); the Fourier table reaches 40950 nm.
+DINC_MAX = 18000.0
 #: Methods the prefiltering applies to: the tabulated Fourier ones (Eq. 10 with the pre-filtered table).
 PREFILTER_METHODS = (1, 2, 3)
 MAX_FOOTPRINT_SAMPLES = 32
@@ -113,9 +116,9 @@ def parse_dinc_range(text: str | None) -> tuple[float, float]:
     try:
         low, high = (float(part) for part in text.split(","))
     except ValueError:
-        raise LocatedError("--dinc-range", None, f"{text!r} is not MIN,MAX in nm of D_inc (e.g. 0,1125)") from None
-    if not (math.isfinite(low) and math.isfinite(high)) or not 0.0 <= low <= high:
-        raise LocatedError("--dinc-range", None, f"{text!r}: need 0 <= MIN <= MAX, finite (nm of D_inc)")
+        raise LocatedError("--dinc-range", None, f"{text[:60]!r} is not MIN,MAX in nm of D_inc (e.g. 0,1125)") from None
+    if not (math.isfinite(low) and math.isfinite(high)) or not 0.0 <= low <= high <= DINC_MAX:
+        raise LocatedError("--dinc-range", None, f"{text[:60]!r}: need 0 <= MIN <= MAX <= {DINC_MAX:g} (nm of D_inc)")
     return low, high
 
 
