@@ -32,9 +32,8 @@ DEBUG_ENV = "BRAGG_EXPLORER_DEBUG"
 
 
 def _debug(argv: list[str]) -> bool:
-    """``--debug`` before the command (``bragg-explorer --debug render ...``) or :data:`DEBUG_ENV` set."""
-    flags = argv[: next((i for i, a in enumerate(argv) if not a.startswith("-")), len(argv))]
-    return "--debug" in flags or os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
+    """``--debug`` anywhere on the command line, or :data:`DEBUG_ENV` set (not to 0)."""
+    return "--debug" in argv or os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
 
 
 def _terminate(signum, _frame) -> None:
@@ -466,6 +465,8 @@ def main(argv: list[str] | None = None) -> None:
 
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = _debug(argv)
+    if "--debug" in argv[1:]:  # after the command too (the group's own option comes first)
+        argv = argv[:1] + [a for a in argv[1:] if a != "--debug"]
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:

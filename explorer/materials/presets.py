@@ -74,19 +74,29 @@ def _display(path: Path) -> str:
         return str(path)
 
 
-def _find_line(lines: list[str], table: str | None, key: str | None = None) -> int | None:
-    """1-based line of ``[table]``, or of ``key = ...`` inside it (``table`` None: the top level)."""
+_KEY_LINE = re.compile(r'^"?([^"=\s]+)"?\s*=')
+
+
+def _line_index(lines: list[str]) -> dict[tuple[str | None, str | None], int]:
+    """
+    1-based lines of a TOML text's tables and keys, by ``(table, None)`` and ``(table, key)`` (``table`` None:
+    the top level), first occurrence each: one pass over the file, however many keys are looked up.
+    """
+    index: dict[tuple[str | None, str | None], int] = {}
     current: str | None = None
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
         if stripped.startswith("["):
             current = stripped.split("]")[0].strip("[ ").strip('"')
-            if key is None and current == table:
-                return number
-            continue
-        if key is not None and current == table and re.match(rf'^"?{re.escape(key)}"?\s*=', stripped):
-            return number
-    return None
+            index.setdefault((current, None), number)
+        elif found := _KEY_LINE.match(stripped):
+            index.setdefault((current, found.group(1)), number)
+    return index
+
+
+def _find_line(index: dict, table: str | None, key: str | None = None) -> int | None:
+    """1-based line of ``[table]``, or of ``key = ...`` inside it (``table`` None: the top level)."""
+    return index.get((table, key))
 
 
 def _long_integer_line(text: str) -> int | None:
@@ -116,7 +126,7 @@ def load_presets(path: str | os.PathLike[str]) -> PresetFile:
         raise PresetError(where, None, "not valid presets: nested too deeply") from None
     except ValueError:  # an integer beyond Python's digit limit (4300): tomllib's int() refuses it
         raise PresetError(where, _long_integer_line(text), "an integer is too long (a parameter value is a number in its range)") from None
-    lines = text.splitlines()
+    lines = _line_index(text.splitlines())
     material_name = data.get("material")
     if not isinstance(material_name, str):
         raise PresetError(where, _find_line(lines, None, "material"), "needs a top-level material = \"FILE.brd\"")
