@@ -34,3 +34,11 @@ class LocatedError(Exception):
     def __str__(self) -> str:
         where = self.path if self.line is None else f"{self.path}:{self.line}"
         return " ".join(f"{where}: {self.message}".splitlines())
+
+
+class OutputError(Exception):
+    """An output file cannot be written (one line naming it); raised before any work where it can be."""
+
+
+class InternalError(Exception):
+    """Marks a bug: an error that bad input should never cause (the CLI reports it as one)."""

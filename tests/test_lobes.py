@@ -254,4 +254,4 @@ def test_cli_negative_optical_depth_is_one_line(tmp_path):
     run = run_cli("render", MATERIAL, "--set", "tau_1=0,-1,0", "--view", "lit", "--size", "8", "--engine", "numpy",
                   "--out", tmp_path / "unused.png")
     assert not (tmp_path / "unused.png").exists()
-    assert "tau_1 = [0.0, -1.0, 0.0] must be >= 0" in one_line_error(run)
+    assert "parameter 'tau_1': component -1 is outside its range [0, 100]" in one_line_error(run)  # the declared range

@@ -96,10 +96,12 @@ def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mappin
 
 
 def _write_text(path: os.PathLike[str] | str, text: str) -> None:
+    from explorer.files import OutputError, write_text_atomic
+
     try:
-        Path(path).write_text(text, encoding="utf-8")
-    except OSError as error:
-        raise ParameterFileError(_display(path), None, f"cannot write ({error.strerror})") from None
+        write_text_atomic(path, text)
+    except OutputError as error:  # its message names the path already
+        raise ParameterFileError(_display(path), None, str(error).split(": ", 1)[-1]) from None
 
 
 def _apply(material: Material, raw: Mapping[str, object], where: str, lines: Mapping[str, int]) -> LoadedValues:
@@ -121,11 +123,15 @@ def load_json(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
     """Read values saved by :func:`save_json` and check them against ``material``."""
     where = _display(path)
     try:
-        document = json.loads(Path(path).read_text(encoding="utf-8"))
+        # Integers as floats: one too long for an int (Python's 4300-digit limit) or for a float (1e400)
+        # is then an infinite value, which the parameter's range refuses, naming the key.
+        document = json.loads(Path(path).read_text(encoding="utf-8"), parse_int=float)
     except OSError as error:
-        raise ParameterFileError(where, None, f"cannot read ({error.strerror})") from None
+        raise ParameterFileError(where, None, f"cannot read ({error.strerror or error})") from None
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise ParameterFileError(where, getattr(error, "lineno", None), f"not valid JSON ({getattr(error, 'msg', error)})") from None
+    except RecursionError:
+        raise ParameterFileError(where, None, "not a parameter set: nested too deeply") from None
     raw = document.get("values") if isinstance(document, dict) else None
     if not isinstance(raw, dict):
         raise ParameterFileError(where, None, 'expected an object with "values": {NAME: VALUE, ...}')
@@ -148,8 +154,8 @@ def parse_bparam(text: str, where: str) -> tuple[str | None, dict[str, object], 
         tokens = stripped.split()
         if first:
             first = False
-            if tokens[0] != "bparam":
-                raise ParameterFileError(where, number, f"expected 'bparam MATERIAL' on the first line, got {tokens[0]!r}")
+            if tokens[0] != "bparam":  # the line itself is not shown: the file may be anything
+                raise ParameterFileError(where, number, "not a .bparam file (expected 'bparam MATERIAL' on the first line)")
             material_file = stripped[len("bparam"):].strip() or None
             continue
         if tokens[0] == "::begin":

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.files import atomic_output
 from explorer.views.images import OutputError, write_image
 from explorer.app.scheduler import Scheduler
 from explorer.app.state import AppState
@@ -40,7 +41,8 @@ def window_shot(state: AppState, ctx) -> None:
     gl.glPixelStorei(gl.GL_PACK_ALIGNMENT, 1)
     data = gl.glReadPixels(0, 0, width, height, gl.GL_RGB, gl.GL_UNSIGNED_BYTE)
     pixels = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
-    Image.fromarray(np.ascontiguousarray(pixels), mode="RGB").save(state.pending_window_shot)
+    with atomic_output(state.pending_window_shot, (".png",)) as temporary:
+        Image.fromarray(np.ascontiguousarray(pixels), mode="RGB").save(temporary, format="PNG")
     state.screenshots.append(state.pending_window_shot)
     state.pending_window_shot = None
 

@@ -225,7 +225,9 @@ class App:
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse,
         }
-        self.report_path.write_text(json.dumps(report, indent=1))
+        from explorer.files import write_text_atomic
+
+        write_text_atomic(self.report_path, json.dumps(report, indent=1))
 
     # -- UI ----------------------------------------------------------------------------------------
 

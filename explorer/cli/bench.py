@@ -19,7 +19,18 @@ import numpy as np
 
 from explorer.physics import bragg, colorimetry
 from explorer.materials.brd import load_material
+from explorer.files import atomic_output
 from explorer.resources import SHADER_DIR
+
+#: What matplotlib's figures (``accuracy --plot``, ``figure --out``) and Figure 4's strips are written as.
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
+STRIP_SUFFIXES = (".png",)
+
+
+def save_figure(figure, path, **options) -> None:
+    """A matplotlib figure to ``path`` (a format of :data:`FIGURE_SUFFIXES`, by its suffix), atomically."""
+    with atomic_output(path, FIGURE_SUFFIXES) as temporary:
+        figure.savefig(temporary, format=Path(path).suffix.lower()[1:], **options)
 
 BENCH_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)
@@ -219,8 +230,10 @@ def plot_accuracy(rows: list[dict], path: Path) -> None:
     axes[0].set_ylabel("median ΔE2000 vs reference")
     axes[-1].legend(fontsize=7, ncol=2)
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    try:
+        save_figure(figure, path, dpi=110)
+    finally:
+        plt.close(figure)
 
 
 def run_accuracy(as_json: bool = False, plot: Path | None = None) -> list[dict]:
@@ -258,7 +271,8 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
             cells.append(np.ones((cells[-1].shape[0], gap, 3), np.float32))
         rows.append(np.concatenate(cells[:-1], axis=1))
         rows.append(np.ones((gap, rows[-1].shape[1], 3), np.float32))
-    Image.fromarray(encode_srgb8(np.concatenate(rows[:-1]))).save(path)
+    with atomic_output(path, STRIP_SUFFIXES) as temporary:
+        Image.fromarray(encode_srgb8(np.concatenate(rows[:-1]))).save(temporary, format="PNG")
 
 
 # --------------------------------------------------------------------------------------------------

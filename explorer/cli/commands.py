@@ -10,6 +10,7 @@ there is one, and a non-zero exit; an output file is either complete or not writ
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -22,6 +23,22 @@ from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
 
 PROG = "bragg-explorer"
+#: The largest ``--size`` side parsed at all; each engine then checks its own limits.
+MAX_SIZE = 1 << 16
+
+
+#: Set (to 1) for an unexpected error's traceback, as ``--debug`` does.
+DEBUG_ENV = "BRAGG_EXPLORER_DEBUG"
+
+
+def _debug(argv: list[str]) -> bool:
+    """``--debug`` anywhere on the command line, or :data:`DEBUG_ENV` set (not to 0)."""
+    return "--debug" in argv or os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
+
+
+def _terminate(signum, _frame) -> None:
+    """SIGTERM as ``SystemExit``: outputs being written (:func:`explorer.files.atomic_output`) are cleaned up."""
+    raise SystemExit(128 + signum)
 
 
 def _fail(message: str) -> None:
@@ -49,8 +66,9 @@ def parse_size(text: str | None, view: str) -> tuple[int, int]:
         numbers = [int(p) for p in parts]
     except ValueError:
         numbers = []
-    if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > 16384:
-        raise click.BadParameter(f"{text!r} is not W or WxH with sizes in 1..16384", param_hint="--size")
+    # A sanity bound only: the GL engine checks the context's own limits (explorer.gpu.GLLimits).
+    if len(numbers) not in (1, 2) or min(numbers) < 1 or max(numbers) > MAX_SIZE:
+        raise click.BadParameter(f"{text[:40]!r} is not W or WxH with sizes in 1..{MAX_SIZE}", param_hint="--size")
     if len(numbers) == 1:
         return (numbers[0], numbers[0] if view_named(view).square else default_size[1])
     return numbers[0], numbers[1]
@@ -121,12 +139,15 @@ def render_material(
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
     from explorer.gpu import Renderer
 
+    renderer = Renderer()
+    renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
-        return Renderer().render(
+        renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
+        return renderer.render(
             material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
             uniforms={"prefilter": thickness.prefilter},
         )
-    return Renderer().render(material, values, view, width, height, light=light)
+    return renderer.render(material, values, view, width, height, light=light)
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
@@ -159,8 +180,9 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
+@click.option("--debug", is_flag=True, help=f"Print the traceback of an unexpected error (a bug); also {DEBUG_ENV}=1.")
 @click.pass_context
-def cli(ctx: click.Context) -> None:
+def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() before click parses
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
     Without a command: open the explorer on the default Bragg mirror when a display exists; without
@@ -358,8 +380,8 @@ def presets(material, as_json):
 
 @cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
-@click.option("--size", default=512, show_default=True, help="Sphere size for GPU timings.")
-@click.option("--repeats", default=3, show_default=True, help="Interleaved repeats per method (medians).")
+@click.option("--size", default=512, show_default=True, type=click.IntRange(min=1), help="Sphere size for GPU timings.")
+@click.option("--repeats", default=3, show_default=True, type=click.IntRange(min=1), help="Interleaved repeats per method (medians).")
 @click.option("--thin-film", "thin_film", is_flag=True,
               help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
 @click.option("--layers", is_flag=True,
@@ -399,8 +421,12 @@ def bench(as_json, size, repeats, thin_film, layers, app):
 @_errors
 def accuracy(as_json, plot, strips):
     """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings)."""
-    from explorer.cli.bench import figure4_strips, run_accuracy
+    from explorer.cli.bench import FIGURE_SUFFIXES, STRIP_SUFFIXES, figure4_strips, run_accuracy
+    from explorer.files import check_output as check_file
 
+    for path, suffixes in ((plot, FIGURE_SUFFIXES), (strips, STRIP_SUFFIXES)):
+        if path:
+            check_file(path, suffixes)  # before the seconds of work
     if strips:
         figure4_strips(Path(strips))
     run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)
@@ -430,7 +456,19 @@ cli.add_command(figure_command)
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point: click's usage errors too end as one line (not click's usage block)."""
+    """
+    Entry point: click's usage errors too end as one line (not click's usage block), and so does an
+    unexpected error, said to be a bug (its traceback with ``--debug`` or ``BRAGG_EXPLORER_DEBUG=1``).
+    """
+    import signal
+    import threading
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = _debug(argv)
+    if "--debug" in argv[1:]:  # after the command too (the group's own option comes first)
+        argv = argv[:1] + [a for a in argv[1:] if a != "--debug"]
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:
         cli.main(args=argv, prog_name=PROG, standalone_mode=False)
     except click.exceptions.Exit as exit_:
@@ -438,8 +476,25 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         _fail("aborted")
     except click.ClickException as error:
-        click.echo(f"{PROG}: error: {' '.join(error.format_message().split())}", err=True)
+        click.echo(f"{PROG}: error: {' '.join(error.format_message().split())[:500]}", err=True)
         sys.exit(error.exit_code)
+    except (LocatedError, OutputError) as error:  # bad input that a command did not turn into a line itself
+        _fail(str(error))
+    except MemoryError:
+        _fail("out of memory (a smaller --size, --samples or input image needs less)")
+    except RecursionError:
+        _fail("input nested too deeply")
+    except Exception as error:  # the last resort: each known bad input has its own message above
+        if debug:
+            import traceback
+
+            traceback.print_exc()
+        what = " ".join(str(error).split())[:200]
+        _fail(f"internal error (a bug): {type(error).__name__}{': ' + what if what else ''}; "
+              f"run with --debug (bragg-explorer --debug ...) or {DEBUG_ENV}=1 for the traceback")
+    finally:
+        if main_thread and previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

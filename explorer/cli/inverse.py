@@ -26,49 +26,58 @@ def _fail(message: str) -> None:
     sys.exit(1)
 
 
-def _numbers(text: str, key: str):
+def _numbers(text: str, key: str, low: float = -np.inf, high: float = np.inf, below: bool = False):
+    """One number or ``r,g,b`` in ``[low, high]`` (``[low, high)`` with ``below``), or a one-line usage error."""
+    shown = text if len(text) <= 40 else text[:37] + "..."
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
-        raise click.UsageError(f"--lobe {key}={text!r}: not a number or r,g,b") from None
+        raise click.UsageError(f"--lobe {key}={shown!r}: not a number or r,g,b") from None
     if len(values) not in (1, 3) or not all(np.isfinite(values)):
-        raise click.UsageError(f"--lobe {key}={text!r}: one number or r,g,b")
+        raise click.UsageError(f"--lobe {key}={shown!r}: one number or r,g,b")
+    if not all(low <= v < high if below else low <= v <= high for v in values):
+        raise click.UsageError(f"--lobe {key}={shown!r}: outside the model's domain [{low:g}, {high:g}{')' if below else ']'}")
     return values[0] if len(values) == 1 else values
 
 
 def parse_lobe(spec: str):
     """``(Lobe, choices)`` from one ``--lobe`` string."""
     from explorer.physics.inverse import Lobe
+    from explorer.physics.lobes import VARIANCE_MAX
 
+    shown = repr(spec if len(spec) <= 60 else spec[:57] + "...")
     fields = {}
     for part in re.split(r"[;\s]+", spec.strip()):
         if not part:
             continue
         if "=" not in part:
-            raise click.UsageError(f"--lobe {spec!r}: expected KEY=VALUE, got {part!r}")
+            raise click.UsageError(f"--lobe {shown}: expected KEY=VALUE, got {part[:40]!r}")
         key, value = part.split("=", 1)
         fields[key.strip()] = value.strip()
     unknown = set(fields) - {"R", "sigma", "layers", "base", *CHOICE_KEYS}
     if unknown:
-        raise click.UsageError(f"--lobe {spec!r}: unknown key {sorted(unknown)[0]!r} (R, sigma, layers, base, {', '.join(CHOICE_KEYS)})")
+        raise click.UsageError(f"--lobe {shown}: unknown key {sorted(unknown)[0][:20]!r} (R, sigma, layers, base, {', '.join(CHOICE_KEYS)})")
     if "R" not in fields or "sigma" not in fields:
-        raise click.UsageError(f"--lobe {spec!r}: R and sigma are required")
+        raise click.UsageError(f"--lobe {shown}: R and sigma are required")
     base = fields.get("base", "dielectric")
     if base not in ("dielectric", "conductor"):
-        raise click.UsageError(f"--lobe {spec!r}: base must be dielectric or conductor")
+        raise click.UsageError(f"--lobe {shown}: base must be dielectric or conductor")
     layers = fields.get("layers", "1")
     if layers not in ("1", "2"):
-        raise click.UsageError(f"--lobe {spec!r}: layers must be 1 or 2")
-    sigma = _numbers(fields["sigma"], "sigma")
+        raise click.UsageError(f"--lobe {shown}: layers must be 1 or 2")
+    # The forward model's domain: energies are fractions, and a variance reaches VARIANCE_MAX at alpha = 1
+    # (Belcour's f(alpha), explorer.physics.lobes), beyond which it would be silently clamped.
+    sigma = _numbers(fields["sigma"], "sigma", 0.0, VARIANCE_MAX, below=True)
     if isinstance(sigma, list):
-        raise click.UsageError(f"--lobe {spec!r}: sigma is one number")
-    lobe = Lobe(_numbers(fields["R"], "R"), sigma, int(layers), base)
+        raise click.UsageError(f"--lobe {shown}: sigma is one number")
+    lobe = Lobe(_numbers(fields["R"], "R", 0.0, 1.0), sigma, int(layers), base)
     choices = {key: _numbers(fields[key], key) for key in CHOICE_KEYS if key in fields}
     return lobe, choices
 
 
 def _solve(lobe_specs, tir=False):
     from explorer.physics.inverse import InverseError, forward_lobes, invert_lobes
+    from explorer.physics.lobes import StackError
 
     if not lobe_specs:
         raise click.UsageError("give at least one --lobe")
@@ -76,9 +85,9 @@ def _solve(lobe_specs, tir=False):
     lobe_list = [lobe for lobe, _ in parsed]
     try:
         stack = invert_lobes(lobe_list, [choice for _, choice in parsed], tir=tir)
-    except InverseError as error:
-        _fail(str(error))
-    energies, variances = forward_lobes(stack, [lobe.layers for lobe in lobe_list])
+        energies, variances = forward_lobes(stack, [lobe.layers for lobe in lobe_list])
+    except (InverseError, StackError) as error:  # a choice outside the stack's domain (eta <= 0, tau < 0, ...)
+        _fail(" ".join(str(error).split()))
     return lobe_list, stack, energies, variances
 
 
@@ -130,8 +139,14 @@ def figure_command(lobe_spec, out, samples):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from explorer.cli.bench import FIGURE_SUFFIXES, save_figure
+    from explorer.files import OutputError, check_output
     from explorer.physics.inverse import one_layer_class, two_layer_class
 
+    try:
+        check_output(out, FIGURE_SUFFIXES)
+    except OutputError as error:
+        _fail(str(error))
     lobe, _ = parse_lobe(lobe_spec)
     colours = ("tab:red", "tab:green", "tab:blue")
     fig, ax = plt.subplots(figsize=(5.5, 4.5), dpi=110)
@@ -174,9 +189,9 @@ def figure_command(lobe_spec, out, samples):
         ax.set_title(f"1-layer dielectric class: R = {lobe.energy.max():.3g}, σ = {lobe.variance:g}", fontsize=9)
     fig.tight_layout()
     try:
-        fig.savefig(out)
-    except OSError as error:
-        _fail(f"cannot write {out}: {error.strerror or error}")
+        save_figure(fig, out)
+    except OutputError as error:
+        _fail(str(error))
     finally:
         plt.close(fig)
     click.echo(f"wrote {out}")

@@ -5,7 +5,7 @@ numpy models' tables (:mod:`.tables`), the :class:`Renderer` and its one draw pr
 (:mod:`.progressive`, :mod:`.display`) and the environment view's Monte Carlo (:mod:`.env`).
 """
 
-from explorer.gpu.context import GLUnavailable, create_context
+from explorer.gpu.context import GLLimitError, GLLimits, GLUnavailable, create_context, gl_limits
 from explorer.gpu.renderer import Renderer
 
-__all__ = ["GLUnavailable", "Renderer", "create_context"]
+__all__ = ["GLLimitError", "GLLimits", "GLUnavailable", "Renderer", "create_context", "gl_limits"]

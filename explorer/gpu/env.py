@@ -23,6 +23,10 @@ def environment_texture(ctx, environment: EnvironmentMap):
     """``environment`` as a float RGB texture of ``ctx``: LINEAR, repeat in u, clamp in v, row 0 at v = 0."""
     import moderngl
 
+    from explorer.gpu.context import gl_limits
+
+    # Beyond GL_MAX_TEXTURE_SIZE the driver makes no texture and sampling reads zeros: refuse first.
+    gl_limits(ctx).check_texture(environment.width, environment.height, 3, environment.name)
     texture = ctx.texture((environment.width, environment.height), 3, environment.pixels.tobytes(), dtype="f4")
     texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
     texture.repeat_x = True
@@ -87,9 +91,10 @@ class ProgressiveEnvRender:
         self.last_pass_ms: float | None = None
         #: Measured cost of one sample over the whole image (ms), None before the first.
         self.sample_ms: float | None = None
+        renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(self.ctx, environment)
-        self._targets = [self.ctx.texture((self.width, self.height), 4, dtype="f4") for _ in range(2)]
-        self._framebuffer = self.ctx.framebuffer(color_attachments=self._targets)
+        self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
+        self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
         self.reset()
 

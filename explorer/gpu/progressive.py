@@ -111,9 +111,12 @@ class ProgressiveView:
         self.full = self._framebuffer(size)
 
     def _framebuffer(self, size):
-        texture = self.ctx.texture(size, 4, dtype="f4")
         import moderngl
 
+        from explorer.gpu.context import gl_limits
+
+        gl_limits(self.ctx).check_target(*size, origin="view size")
+        texture = self.ctx.texture(size, 4, dtype="f4")
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         return self.ctx.framebuffer(color_attachments=[texture])
 

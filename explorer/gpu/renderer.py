@@ -16,7 +16,7 @@ from explorer.tables import luts
 from explorer.materials.brd import Material
 from explorer.materials.glsl import ShaderError
 from explorer.views.geometry import light_direction
-from explorer.gpu.context import VERTEX_SHADER, create_context
+from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
 
@@ -26,6 +26,8 @@ class Renderer:
 
     def __init__(self, ctx=None):
         self.ctx = ctx if ctx is not None else create_context()
+        #: What this context allows, checked before every size-dependent allocation.
+        self.limits: GLLimits = gl_limits(self.ctx)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
         self._model_textures: dict[str, object] = {}
@@ -80,6 +82,9 @@ class Renderer:
         """A view's per-render inputs (``(h, w)`` or ``(h, w, c)`` float arrays, row 0 = texel row 0) as NEAREST textures."""
         import moderngl
 
+        for name, array in inputs.items():
+            shape = np.shape(array)
+            self.limits.check_texture(shape[1], shape[0], shape[2] if len(shape) > 2 else 1, name)
         for texture in self._inputs.values():
             texture.release()
         self._inputs = {}
@@ -255,12 +260,32 @@ class Renderer:
 
     def _headless(self, material, values, view, width, height, light, inputs, uniforms):
         """The program and a float framebuffer of one headless render, bound: ``(program, framebuffer, bindings)``."""
+        self.limits.check_target(width, height)  # before the program, the tables and the target
         direction = light_direction(light)
         program = self.program(material, view, values)
         bound, textures = self.bindings(program, material, values, inputs, uniforms)
         bound["light_direction"] = tuple(float(c) for c in direction)
-        framebuffer = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype="f4")])
+        framebuffer = self.target(width, height)
         return program, framebuffer, {"uniforms": bound, "textures": textures}
+
+    def target(self, width: int, height: int, count: int = 1, texture: bool = False):
+        """
+        A framebuffer of ``count`` float RGBA attachments (renderbuffers, or textures), checked against
+        :attr:`limits` first; a driver that still finds it incomplete is a :class:`GLLimitError` too.
+        """
+        import moderngl
+
+        from explorer.gpu.context import GLLimitError
+
+        self.limits.check_target(width, height)
+        make = self.ctx.texture if texture else self.ctx.renderbuffer
+        attachments = [make((width, height), 4, dtype="f4") for _ in range(count)]
+        try:
+            return self.ctx.framebuffer(color_attachments=attachments)
+        except moderngl.Error as error:
+            for attachment in attachments:
+                attachment.release()
+            raise GLLimitError("--size", None, f"{width}x{height}: this GL cannot allocate it ({' '.join(str(error).split())})") from None
 
     @staticmethod
     def _release(framebuffer) -> None:

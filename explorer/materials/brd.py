@@ -39,6 +39,10 @@ Rules, following BRDF Explorer's ``BRDFBase::loadBRDF`` where it has one:
   meets the physics, and it reaches GLSL as a ``float`` uniform holding that
   exact integer, so shader code reads it like any float.
 
+* ``color NAME R G B [MIN MAX]``: each component lies in the declared range, or in
+  `COLOR_RANGE` ([0, 1], a reflectance) when the line declares none (a ``.brdf``
+  file cannot declare one: its range is widened to hold its default).
+
 This module never imports GL: it only turns text into data and GLSL snippets.
 """
 
@@ -48,6 +52,7 @@ import math
 import numbers
 import os
 import re
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -124,8 +129,12 @@ _PARAMETER_USAGE = {
     "float": "float NAME MIN MAX DEFAULT",
     "int": "int NAME MIN MAX DEFAULT",
     "bool": "bool NAME 0|1",
-    "color": "color NAME R G B",
+    "color": "color NAME R G B [MIN MAX]",
 }
+#: A colour's range when its line declares none: a reflectance or an albedo, what BRDF Explorer's
+#: colour picker edits. A ``.brd`` colour that is another quantity (an index, an optical depth) declares
+#: its own (``color NAME R G B MIN MAX``); a ``.brdf`` file, which cannot, gets [0, 1] widened to its default.
+COLOR_RANGE = (0.0, 1.0)
 # An int is uploaded as a float uniform holding an exact integer: shader code keeps its float arithmetic.
 _GLSL_TYPES = {"float": "float", "int": "float", "bool": "bool", "color": "vec3"}
 _TRUE_WORDS = frozenset({"1", "true", "yes", "on"})
@@ -175,6 +184,23 @@ def _fmt(x: float) -> str:
     return str(int(x)) if float(x).is_integer() and abs(x) < 1e15 else repr(float(x))
 
 
+def _to_float(value: numbers.Real) -> float:
+    """``float(value)``; an integer too large for a float is infinite (then outside every range), not an error."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    """``repr(value)``, cut to ``limit`` characters (a message stays one short line whatever the input)."""
+    try:
+        text = repr(value)
+    except ValueError:  # an int beyond Python's digit limit for str()
+        text = f"<an integer of more than {sys.get_int_max_str_digits()} digits>"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def _parse_number(text: str) -> float | None:
     """Return `text` as a float, or None when it is not a plain number."""
     text = text.strip()
@@ -192,7 +218,8 @@ class Parameter:
     type : {'float', 'int', 'bool', 'color'}
         The parameter kind (``int``: declared so in a ``.brd`` file).
     min, max : float or None
-        The slider range of a float or an int; None for bool and color.
+        The range of a float or an int (its slider), and of each component of a color
+        (:data:`COLOR_RANGE` unless declared); None for a bool.
     default : float or bool or tuple of 3 floats
         The value used when nothing overrides it.
     line : int
@@ -254,11 +281,11 @@ class Parameter:
         if isinstance(value, str):
             number = _parse_number(value)
             if number is None:
-                raise ValueError(f"{value!r} is not a number")
+                raise ValueError(f"{_short(value)} is not a number")
         elif isinstance(value, numbers.Real) and not isinstance(value, bool):
-            number = float(value)  # also numpy scalars
+            number = _to_float(value)  # also numpy scalars
         else:
-            raise ValueError(f"expected a number, got {value!r}")
+            raise ValueError(f"expected a number, got {_short(value)}")
         assert self.min is not None and self.max is not None
         # "not (a <= x <= b)" also rejects NaN.
         if not self.min <= number <= self.max:
@@ -280,26 +307,33 @@ class Parameter:
                 return True
             if word in _FALSE_WORDS:
                 return False
-        raise ValueError(f"{value!r} is not a boolean (use 0|1|true|false|yes|no|on|off)")
+        raise ValueError(f"{_short(value)} is not a boolean (use 0|1|true|false|yes|no|on|off)")
 
-    @staticmethod
-    def _coerce_color(value: Any) -> tuple[float, float, float]:
+    def _coerce_color(self, value: Any) -> tuple[float, float, float]:
         if isinstance(value, str):
             parts = [_parse_number(p) for p in value.split(",")]
             if len(parts) not in (1, 3) or None in parts:
-                raise ValueError(f"{value!r} is not a color (use r,g,b or one number for grey)")
+                raise ValueError(f"{_short(value)} is not a color (use r,g,b or one number for grey)")
             components = [float(p) for p in parts if p is not None]
         elif isinstance(value, numbers.Real) and not isinstance(value, bool):
-            components = [float(value)]
+            components = [_to_float(value)]
         else:
             try:
-                components = [float(c) for c in value]
-            except (TypeError, ValueError):
-                raise ValueError(f"{value!r} is not a color (use r,g,b or one number for grey)") from None
+                if isinstance(value, (bool, str, bytes)) or not all(
+                    isinstance(c, numbers.Real) and not isinstance(c, bool) for c in value
+                ):
+                    raise TypeError
+                components = [_to_float(c) for c in value]
+            except TypeError:
+                raise ValueError(f"{_short(value)} is not a color (use r,g,b or one number for grey)") from None
             if len(components) != 3:
                 raise ValueError(f"a color needs 3 components, got {len(components)}")
         if not all(math.isfinite(c) for c in components):
-            raise ValueError(f"{value!r} is not a finite color")
+            raise ValueError(f"{_short(value)} is not a finite color")
+        lo, hi = (COLOR_RANGE if self.min is None or self.max is None else (self.min, self.max))
+        for c in components:
+            if not lo <= c <= hi:
+                raise ValueError(f"component {_fmt(c)} is outside its range [{_fmt(lo)}, {_fmt(hi)}]")
         r, g, b = components * 3 if len(components) == 1 else components
         return (r, g, b)
 
@@ -544,10 +578,12 @@ class _Parser:
             )
         elif kind.startswith("::"):
             raise self.error(number, f"missing 'analytic' header before {kind!r}")
-        else:
+        elif _IDENTIFIER_RE.match(kind) and len(kind) <= 32:
             raise self.error(
                 number, f"unsupported material kind {kind!r}; only 'analytic' materials can be loaded"
             )
+        else:  # not a word: the file is likely no material at all, and its text is not shown
+            raise self.error(number, "not a material file (expected 'analytic' on the first line)")
 
     def begin(self, number: int, tokens: list[str]) -> None:
         if len(tokens) < 2:
@@ -611,10 +647,13 @@ class _Parser:
             expected = "float, bool or color" if brdf_explorer_file else "float, int, bool or color"
             where = " in BRDF Explorer's .brdf files (int is for .brd files)" if kind == "int" else ""
             raise self.error(number, f"unknown parameter type {kind!r}{where} (expected {expected})")
-        expected = len(usage.split())
-        if len(tokens) != expected:
+        expected = len(usage.replace("[", "").replace("]", "").split())
+        allowed = (expected - 2, expected) if kind == "color" and not brdf_explorer_file else (expected - 2,) if kind == "color" else (expected,)
+        if len(tokens) not in allowed:
+            fields = " or ".join(str(n - 1) for n in allowed)
+            shown = usage if len(allowed) > 1 else usage.replace(" [MIN MAX]", "")
             raise self.error(
-                number, f"{'an' if kind == 'int' else 'a'} {kind} parameter has {expected - 1} fields ({usage}), got {len(tokens) - 1}"
+                number, f"{'an' if kind == 'int' else 'a'} {kind} parameter has {fields} fields ({shown}), got {len(tokens) - 1}"
             )
         name = tokens[1]
         self.check_name(number, name)
@@ -623,7 +662,7 @@ class _Parser:
                 raise self.error(number, f"bool {name!r}: default must be 0 or 1, got {tokens[2]!r}")
             param = Parameter(name, "bool", None, None, tokens[2] == "1", number)
         else:
-            fields = ("red", "green", "blue") if kind == "color" else ("min", "max", "default")
+            fields = ("red", "green", "blue", "min", "max") if kind == "color" else ("min", "max", "default")
             values: list[float] = []
             for label, token in zip(fields, tokens[2:]):
                 value = _parse_number(token)
@@ -642,9 +681,25 @@ class _Parser:
                     )
                 param = Parameter(name, kind, lo, hi, default, number)
             else:
-                param = Parameter(name, "color", None, None, (values[0], values[1], values[2]), number)
+                param = self.color(number, name, values, brdf_explorer_file)
         self.names[name] = number
         self.parameters.append(param)
+
+    def color(self, number: int, name: str, values: list[float], brdf_explorer_file: bool) -> Parameter:
+        """A colour line's parameter: its declared range, else :data:`COLOR_RANGE` (see there)."""
+        default = (values[0], values[1], values[2])
+        if len(values) == 5:
+            lo, hi = values[3], values[4]
+            if lo > hi:
+                raise self.error(number, f"color {name!r}: min {_fmt(lo)} is greater than max {_fmt(hi)}")
+        elif brdf_explorer_file:
+            lo, hi = min(COLOR_RANGE[0], *default), max(COLOR_RANGE[1], *default)
+        else:
+            lo, hi = COLOR_RANGE
+        if not all(lo <= c <= hi for c in default):
+            declared = "" if len(values) == 5 else "; declare another range: color NAME R G B MIN MAX"
+            raise self.error(number, f"color {name!r}: default {' '.join(map(_fmt, default))} is outside [{_fmt(lo)}, {_fmt(hi)}]{declared}")
+        return Parameter(name, "color", lo, hi, default, number)
 
     def check_name(self, number: int, name: str) -> None:
         if not _IDENTIFIER_RE.match(name):

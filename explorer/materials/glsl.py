@@ -313,14 +313,21 @@ class _Assembly:
         self.out.append(self.line_directive(number + 1, self.source_number(name)))
 
     def resolve(self, target: str, name: str, number: int, base: Path | None) -> Path:
+        """
+        The file ``#include target`` names, confined: relative, without ``..``, found inside the including
+        file's folder or an include folder, and resolving (symbolic links followed) inside that folder.
+        Anything else is a :class:`ShaderError` naming the include, and nothing outside is read.
+        """
         dirs = ([base] if base is not None else []) + self.builder.include_dirs
-        if os.path.isabs(target):
-            dirs = []
-            candidates = [Path(target)]
-        else:
-            candidates = [d / target for d in dirs]
-        for candidate in candidates:
+        parts = re.split(r"[\\/]", target)
+        if os.path.isabs(target) or target.startswith(("/", "\\")) or re.match(r"[A-Za-z]:", target) or ".." in parts:
+            raise ShaderError(name, number, f"#include {target!r} leaves the material's folder and the shader library "
+                                            "(includes are relative, without '..')")
+        for folder in dirs:
+            candidate = folder / target
             if candidate.is_file():
+                if not candidate.resolve().is_relative_to(folder.resolve()):
+                    raise ShaderError(name, number, f"#include {target!r} resolves outside {os.path.normpath(folder)} (a link)")
                 return candidate
         searched = ", ".join(os.path.normpath(d) for d in dirs) or "(no directories)"
         raise ShaderError(name, number, f"cannot find include {target!r}; searched: {searched}")

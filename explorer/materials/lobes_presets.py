@@ -15,6 +15,7 @@ from pathlib import Path
 
 from explorer.physics.inverse import InverseError, Lobe, invert_lobes
 from explorer.materials.lobes_model import values_from_stack
+from explorer.files import write_text_atomic
 from explorer.resources import PRESET_DIR
 
 PRESET_FILE = PRESET_DIR / "layered_lobes.toml"
@@ -122,7 +123,7 @@ def write(path: Path = PRESET_FILE) -> dict:
     for name, (figure, description, values) in presets.items():
         lines += ["", f"[{name}]", f'figure = "{figure}"', f'description = "{description}"']
         lines += [f"{key} = {_value_text(value)}" for key, value in values.items()]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    write_text_atomic(path, "\n".join(lines) + "\n")
     return failures
 
 

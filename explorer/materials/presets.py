@@ -20,13 +20,14 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from explorer.materials.brd import Material, MaterialError, load_material
 from explorer.errors import LocatedError
-from explorer.resources import PRESET_DIR
+from explorer.resources import MATERIAL_SUFFIXES, PRESET_DIR
 
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")
@@ -73,19 +74,35 @@ def _display(path: Path) -> str:
         return str(path)
 
 
-def _find_line(lines: list[str], table: str | None, key: str | None = None) -> int | None:
-    """1-based line of ``[table]``, or of ``key = ...`` inside it (``table`` None: the top level)."""
+_KEY_LINE = re.compile(r'^"?([^"=\s]+)"?\s*=')
+
+
+def _line_index(lines: list[str]) -> dict[tuple[str | None, str | None], int]:
+    """
+    1-based lines of a TOML text's tables and keys, by ``(table, None)`` and ``(table, key)`` (``table`` None:
+    the top level), first occurrence each: one pass over the file, however many keys are looked up.
+    """
+    index: dict[tuple[str | None, str | None], int] = {}
     current: str | None = None
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
         if stripped.startswith("["):
             current = stripped.split("]")[0].strip("[ ").strip('"')
-            if key is None and current == table:
-                return number
-            continue
-        if key is not None and current == table and re.match(rf'^"?{re.escape(key)}"?\s*=', stripped):
-            return number
-    return None
+            index.setdefault((current, None), number)
+        elif found := _KEY_LINE.match(stripped):
+            index.setdefault((current, found.group(1)), number)
+    return index
+
+
+def _find_line(index: dict, table: str | None, key: str | None = None) -> int | None:
+    """1-based line of ``[table]``, or of ``key = ...`` inside it (``table`` None: the top level)."""
+    return index.get((table, key))
+
+
+def _long_integer_line(text: str) -> int | None:
+    """1-based line of the first run of digits too long for Python's ``int()``."""
+    found = re.search(r"\d{%d,}" % (sys.get_int_max_str_digits() + 1), text)
+    return text.count("\n", 0, found.start()) + 1 if found else None
 
 
 def load_presets(path: str | os.PathLike[str]) -> PresetFile:
@@ -105,10 +122,17 @@ def load_presets(path: str | os.PathLike[str]) -> PresetFile:
         found = _TOML_LINE.search(message)
         line = int(found.group(1)) if found else None
         raise PresetError(where, line, "not valid TOML: " + _TOML_LINE.sub("", message).strip()) from None
-    lines = text.splitlines()
+    except RecursionError:
+        raise PresetError(where, None, "not valid presets: nested too deeply") from None
+    except ValueError:  # an integer beyond Python's digit limit (4300): tomllib's int() refuses it
+        raise PresetError(where, _long_integer_line(text), "an integer is too long (a parameter value is a number in its range)") from None
+    lines = _line_index(text.splitlines())
     material_name = data.get("material")
     if not isinstance(material_name, str):
         raise PresetError(where, _find_line(lines, None, "material"), "needs a top-level material = \"FILE.brd\"")
+    if Path(material_name).suffix.lower() not in MATERIAL_SUFFIXES:  # nor is another file read, or shown
+        raise PresetError(where, _find_line(lines, None, "material"),
+                          f"material must name a {' or '.join(MATERIAL_SUFFIXES)} file, not {material_name[:80]!r}")
     material_path = path.parent.parent / material_name
     if not material_path.is_file():
         material_path = path.parent / material_name

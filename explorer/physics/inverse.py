@@ -433,8 +433,8 @@ def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
     partial = _Partial(tir=tir)
     total = np.zeros(3)
     for k, (lobe, choice) in enumerate(zip(lobe_list, choices), start=1):
-        if lobe.variance < 0.0:
-            raise InverseError(f"lobe {k}: variance sigma = {lobe.variance:.4g} must be >= 0")
+        if not 0.0 <= lobe.variance < lobes.VARIANCE_MAX:  # beyond, f(alpha) would clamp it (alpha = 1)
+            raise InverseError(f"lobe {k}: variance sigma = {lobe.variance:.4g} must lie in [0, {lobes.VARIANCE_MAX:g})")
         if np.any(lobe.energy <= 0.0) or np.any(lobe.energy >= 1.0):
             raise InverseError(f"lobe {k}: energy {_fmt(lobe.energy)} must lie in (0, 1)")
         if lobe.layers not in (1, 2):

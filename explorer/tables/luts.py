@@ -37,7 +37,9 @@ lobes_fgd_correction, lobes_ggx_moments
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
 import json
 import sys
 from pathlib import Path
@@ -47,6 +49,7 @@ import numpy as np
 
 from explorer.physics import colorimetry
 from explorer import resources
+from explorer.files import OutputError, write_bytes_atomic, write_text_atomic
 
 #: The shipped tables (read-only: see :func:`load`).
 LUT_DIR = resources.LUT_DIR
@@ -168,10 +171,44 @@ def _sha256(path: Path) -> str:
 
 
 def _read_manifest(directory: Path) -> dict:
+    """The manifest's ``{"tables": {name: entry}}``; an unreadable or malformed one reads as empty (regenerate)."""
     try:
-        return json.loads((directory / MANIFEST).read_text())
-    except (OSError, ValueError):
+        manifest = json.loads((directory / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
         return {"tables": {}}
+    if not isinstance(manifest, dict) or not isinstance(manifest.get("tables"), dict):
+        return {"tables": {}}
+    manifest["tables"] = {k: v for k, v in manifest["tables"].items() if isinstance(v, dict)}
+    return manifest
+
+
+def _read_table(name: str, directory: Path) -> np.ndarray | str:
+    """
+    Table ``name`` of ``directory`` as its manifest records it, or why not (a string). The file is read once
+    and its bytes checked against the manifest's checksum before they are parsed: a table replaced while
+    it is read (another process regenerating it, :func:`generate`) is never half-read.
+    """
+    entry = _read_manifest(directory)["tables"].get(name)
+    path = directory / f"{name}.npy"
+    if entry is None:
+        return "not in the manifest"
+    if not path.exists():
+        return "file missing"
+    if {k: entry.get(k) for k in _expected_spec(name)} != _expected_spec(name):
+        return "generated with other parameters"
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        return f"unreadable ({error.strerror or error})"
+    if entry.get("sha256") != hashlib.sha256(data).hexdigest():
+        return "checksum mismatch"
+    try:
+        table = np.load(io.BytesIO(data), allow_pickle=False)
+    except (ValueError, EOFError, OSError):
+        return "not a .npy file"
+    if list(table.shape) != list(TABLES[name]["spec"]["shape"]) or table.dtype != np.float64:
+        return "not the recorded shape"
+    return table
 
 
 def _expected_spec(name: str) -> dict:
@@ -180,33 +217,53 @@ def _expected_spec(name: str) -> dict:
 
 def staleness(name: str, directory: Path = LUT_DIR) -> str | None:
     """Why table ``name`` cannot be used as it is (``None`` when it is up to date)."""
-    entry = _read_manifest(directory).get("tables", {}).get(name)
-    path = directory / f"{name}.npy"
-    if entry is None:
-        return "not in the manifest"
-    if not path.exists():
-        return "file missing"
-    if {k: entry.get(k) for k in _expected_spec(name)} != _expected_spec(name):
-        return "generated with other parameters"
-    if entry.get("sha256") != _sha256(path):
-        return "checksum mismatch"
-    return None
+    found = _read_table(name, directory)
+    return found if isinstance(found, str) else None
+
+
+@contextlib.contextmanager
+def _manifest_lock(directory: Path):
+    """An exclusive lock on ``directory``'s manifest while it is read, updated and replaced (POSIX; none elsewhere)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    with open(directory / f".{MANIFEST}.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def generate(name: str, directory: Path = LUT_DIR) -> np.ndarray:
-    """Generate table ``name``, write it to ``directory`` and record it in the manifest."""
+    """
+    Generate table ``name``, write it to ``directory`` and record it in the manifest.
+
+    Both files are written whole to a temporary file and renamed (:func:`explorer.files.atomic_output`):
+    a process loading the tables meanwhile reads the old table or the new one, never part of one. The
+    manifest's read-modify-write is serialised by a lock, so that concurrent regenerations keep every entry.
+    """
     table = np.ascontiguousarray(TABLES[name]["generate"]())
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / f"{name}.npy"
-    np.save(path, table)
-    manifest = _read_manifest(directory)
-    manifest.setdefault("tables", {})[name] = {
-        "file": path.name,
-        "source": _source(),
-        **_expected_spec(name),
-        "sha256": _sha256(path),
-    }
-    (directory / MANIFEST).write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n")
+    buffer = io.BytesIO()
+    np.save(buffer, table)
+    data = buffer.getvalue()
+    try:
+        write_bytes_atomic(path, data)
+        with _manifest_lock(directory):
+            manifest = _read_manifest(directory)
+            manifest["tables"][name] = {
+                "file": path.name,
+                "source": _source(),
+                **_expected_spec(name),
+                "sha256": hashlib.sha256(data).hexdigest(),
+            }
+            write_text_atomic(directory / MANIFEST, json.dumps(manifest, indent=2, sort_keys=True) + "\n")
+    except OutputError as error:
+        raise OSError(str(error)) from None  # load() falls back to the table in memory
     return table
 
 
@@ -242,12 +299,14 @@ def load(name: str, directory: Path | None = None, log: Callable[[str], None] | 
     key = (name, directory)
     if key in _cache:
         return _cache[key]
-    reason = staleness(name, directory)
-    if reason is None:
-        table = np.load(directory / f"{name}.npy")
-    elif shipped and staleness(name, cache_lut_dir()) is None:
-        table = np.load(cache_lut_dir() / f"{name}.npy")
+    found = _read_table(name, directory)
+    cached = _read_table(name, cache_lut_dir()) if shipped and isinstance(found, str) else None
+    if not isinstance(found, str):
+        table = found
+    elif cached is not None and not isinstance(cached, str):
+        table = cached
     else:
+        reason = found
         target = cache_lut_dir() if shipped else directory
         where = f" into {target}" if shipped else ""
         (log or (lambda m: print(m, file=sys.stderr)))(f"luts: regenerating {name} ({reason}){where}")

@@ -56,9 +56,48 @@ class EnvironmentFileError(LocatedError):
     """An environment file is missing or not an HDR image (one line naming it)."""
 
 
+def max_pixels() -> int:
+    """The most pixels an input image may have: Pillow's decompression-bomb limit, for every format."""
+    from PIL import Image
+
+    return int(Image.MAX_IMAGE_PIXELS or 1 << 62)
+
+
+def header_size(path: str | os.PathLike[str]) -> tuple[int, int] | None:
+    """
+    ``(width, height)`` from a Radiance ``.hdr`` header (its ``-Y H +X W`` resolution line) or an OpenEXR
+    header (its ``dataWindow``), read before any pixel is decoded; None when the header is not one of those.
+    """
+    import re
+    import struct
+
+    with open(path, "rb") as stream:
+        head = stream.read(1 << 16)
+    if head[:4] == b"\x76\x2f\x31\x01":  # OpenEXR: attributes name\0 type\0 size value, until an empty name
+        at = 8
+        while at < len(head) and head[at] != 0:
+            name_end = head.find(b"\0", at)
+            type_end = head.find(b"\0", name_end + 1)
+            if name_end < 0 or type_end < 0 or type_end + 5 > len(head):
+                return None
+            (size,) = struct.unpack_from("<i", head, type_end + 1)
+            value = type_end + 5
+            if head[at:name_end] == b"dataWindow" and size == 16 and value + 16 <= len(head):
+                x0, y0, x1, y1 = struct.unpack_from("<4i", head, value)
+                return x1 - x0 + 1, y1 - y0 + 1
+            at = value + max(size, 0)
+        return None
+    found = re.search(rb"\n\n([-+][YX]) (\d{1,12}) ([-+][YX]) (\d{1,12})\s", head)
+    if found is None:
+        return None
+    first, second = int(found.group(2)), int(found.group(4))
+    return (second, first) if found.group(1).endswith(b"Y") else (first, second)
+
+
 def _cv2():
     """OpenCV with OpenEXR enabled (it is off by default) and its own logging silenced (errors are ours)."""
     os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
+    os.environ.setdefault("OPENCV_IO_MAX_IMAGE_PIXELS", str(max_pixels()))  # the same limit as Pillow's
     import cv2
 
     cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
@@ -152,6 +191,13 @@ class EnvironmentMap:
             raise EnvironmentFileError(name, None, "environment file is a directory, not an image")
         if not os.access(path, os.R_OK):
             raise EnvironmentFileError(name, None, "environment file is not readable")
+        try:
+            size = header_size(path)
+        except OSError as error:
+            raise EnvironmentFileError(name, None, f"environment file is not readable ({error.strerror or error})") from None
+        if size is not None and size[0] * size[1] > max_pixels():
+            raise EnvironmentFileError(name, None, f"a {size[0]}x{size[1]} environment has more pixels than the limit, "
+                                                   f"{max_pixels()} (PIL.Image.MAX_IMAGE_PIXELS, against decompression bombs)")
         cv2 = _cv2()
         try:
             image = cv2.imread(name, cv2.IMREAD_UNCHANGED)
@@ -254,8 +300,11 @@ def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
     cv2 = _cv2()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(os.fspath(path), generate_default_environment()[:, :, ::-1]):
-        raise OSError(f"{path}: OpenCV could not write it")
+    from explorer.files import atomic_output
+
+    with atomic_output(path) as temporary:
+        if not cv2.imwrite(os.fspath(temporary), generate_default_environment()[:, :, ::-1]):
+            raise OSError(f"{path}: OpenCV could not write it")
     return path
 
 

@@ -6,10 +6,14 @@ linear), written atomically. Shared by the CLI, the benchmarks and the app's scr
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from explorer.errors import OutputError
+from explorer.files import atomic_output, check_output as _check_output
+
+__all__ = ["OUTPUT_SUFFIXES", "OVERLAY_RGB", "OutputError", "check_output", "write_image"]
 
 #: What ``render --out`` writes, by suffix.
 OUTPUT_SUFFIXES = (".png", ".npy", ".exr")
@@ -17,27 +21,14 @@ OUTPUT_SUFFIXES = (".png", ".npy", ".exr")
 OVERLAY_RGB = (255, 0, 0)
 
 
-class OutputError(Exception):
-    """An output file cannot be written."""
-
-
 def check_output(out: Path) -> Path:
-    """The directory ``out`` goes to, or :class:`OutputError` before any work is done."""
-    if out.suffix.lower() not in OUTPUT_SUFFIXES:
-        raise OutputError(f"{out}: the output must end in .png, .npy or .exr")
-    if out.is_dir():
-        raise OutputError(f"{out}: is a directory")
-    directory = out.parent if str(out.parent) else Path(".")
-    if not directory.is_dir():
-        raise OutputError(f"{out}: directory {directory} does not exist")
-    if not os.access(directory, os.W_OK):
-        raise OutputError(f"{out}: directory {directory} is not writable")
-    return directory
+    """The directory ``out`` goes to, or :class:`OutputError` before any work is done (:func:`explorer.files.check_output`)."""
+    return _check_output(out, OUTPUT_SUFFIXES)
 
 
 def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
     """
-    Write a linear RGB image atomically (a temporary file, renamed): never a partial file.
+    Write a linear RGB image atomically (:func:`explorer.files.atomic_output`): never a partial file.
 
     Parameters
     ----------
@@ -55,30 +46,19 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
 
     from explorer.physics.colorimetry import encode_srgb8
 
-    suffix = out.suffix.lower()
-    directory = check_output(out)
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix, dir=directory)
-    except OSError as error:
-        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
+    suffix = Path(out).suffix.lower()
+    with atomic_output(out, OUTPUT_SUFFIXES) as temporary:
+        if suffix == ".exr":
+            _write_exr(image, os.fspath(temporary), out)
+            return
+        with open(temporary, "wb") as stream:
             if suffix == ".npy":
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
-            elif suffix == ".png":
+            else:
                 pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
                 if overlay is not None:
                     pixels[overlay] = OVERLAY_RGB
                 Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
-        if suffix == ".exr":
-            _write_exr(image, temporary, out)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes private files; an image follows the umask
-        os.replace(temporary, out)
-    except OSError as error:
-        Path(temporary).unlink(missing_ok=True)
-        raise OutputError(f"{out}: cannot write ({error.strerror})") from None
 
 
 def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:

@@ -29,6 +29,9 @@ from explorer.resources import DEFAULT_TEXTURE
 
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
+#: The largest D_inc (nm) ``--dinc-range`` accepts: the OPD at normal incidence, 2 eta_2 d, of the thickest
+#: film shaders/thin_film.brd declares (d <= 3000 nm, eta2 <= 3); the Fourier table reaches 40950 nm.
+DINC_MAX = 18000.0
 #: Methods the prefiltering applies to: the tabulated Fourier ones (Eq. 10 with the pre-filtered table).
 PREFILTER_METHODS = (1, 2, 3)
 MAX_FOOTPRINT_SAMPLES = 32
@@ -59,7 +62,10 @@ def write_default_texture(path: Path = DEFAULT_TEXTURE) -> Path:
     from PIL import Image
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(generate_default_texture(), mode="L").save(path, format="PNG")
+    from explorer.files import atomic_output
+
+    with atomic_output(path, (".png",)) as temporary:
+        Image.fromarray(generate_default_texture(), mode="L").save(temporary, format="PNG")
     return path
 
 
@@ -69,11 +75,17 @@ def load_grey(path: str | Path) -> np.ndarray:
     rows from the top; 16-bit images keep their precision. One-line :class:`LocatedError` naming the
     file when it is missing or not an image.
     """
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     path = Path(path)
     try:
-        with Image.open(path) as image:
+        with warnings.catch_warnings():
+            # Pillow only warns between its limit and twice it: both are refused here (decompression bombs).
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            image = Image.open(path)
+        with image:
             image.load()
             if image.mode in ("I;16", "I;16B", "I;16L", "I"):
                 grey = np.asarray(image, dtype=np.float64) / 65535.0
@@ -87,6 +99,9 @@ def load_grey(path: str | Path) -> np.ndarray:
         raise LocatedError(path, None, "thickness texture is a directory, not an image") from None
     except UnidentifiedImageError:
         raise LocatedError(path, None, "thickness texture is not an image Pillow can read") from None
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning):
+        raise LocatedError(path, None, f"thickness texture has more pixels than the limit, {Image.MAX_IMAGE_PIXELS} "
+                                       "(PIL.Image.MAX_IMAGE_PIXELS, against decompression bombs)") from None
     except (OSError, ValueError, SyntaxError) as error:
         raise LocatedError(path, None, f"thickness texture cannot be read ({' '.join(str(error).split())})") from None
     if grey.ndim != 2 or grey.size == 0 or not np.all(np.isfinite(grey)):
@@ -101,9 +116,9 @@ def parse_dinc_range(text: str | None) -> tuple[float, float]:
     try:
         low, high = (float(part) for part in text.split(","))
     except ValueError:
-        raise LocatedError("--dinc-range", None, f"{text!r} is not MIN,MAX in nm of D_inc (e.g. 0,1125)") from None
-    if not (math.isfinite(low) and math.isfinite(high)) or not 0.0 <= low <= high:
-        raise LocatedError("--dinc-range", None, f"{text!r}: need 0 <= MIN <= MAX, finite (nm of D_inc)")
+        raise LocatedError("--dinc-range", None, f"{text[:60]!r} is not MIN,MAX in nm of D_inc (e.g. 0,1125)") from None
+    if not (math.isfinite(low) and math.isfinite(high)) or not 0.0 <= low <= high <= DINC_MAX:
+        raise LocatedError("--dinc-range", None, f"{text[:60]!r}: need 0 <= MIN <= MAX <= {DINC_MAX:g} (nm of D_inc)")
     return low, high
 
 
@@ -113,11 +128,13 @@ class ThicknessTexture:
 
     d_inc: np.ndarray
     prefilter: bool = False
+    #: Where it came from (messages name it).
+    source: str = "<array>"
 
     @classmethod
     def from_file(cls, path: str | Path = DEFAULT_TEXTURE, dinc_range=DEFAULT_DINC_RANGE, prefilter: bool = False):
         low, high = dinc_range
-        return cls((low + (high - low) * load_grey(path)).astype(np.float32), bool(prefilter))
+        return cls((low + (high - low) * load_grey(path)).astype(np.float32), bool(prefilter), str(path))
 
     def sample(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Bilinear D_inc at ``(u, v)`` (float32 arithmetic for the coordinates, as the shader's)."""
