@@ -78,7 +78,7 @@ def test_gl_equals_numpy_at_fractional_integer_values(gl_renderer, name, value, 
 @pytest.mark.parametrize("material_file, parameter, value, other", [
     ("bragg_mirror.brd", "method", 0.5, 0.0),
     ("bragg_mirror.brd", "method", 2.5, 2.0),
-    ("thin_film.brd", "method", 0.5, 0.0),
+    ("thin_film.brd", "method", 4.5, 4.0),  # naive RGB against Gaussian fits (methods 0 and 1 now agree to 6e-3)
     ("bragg_stack.brd", "layers", 1.5, 1.0),
 ])
 def test_halves_round_up_not_to_even(gl_renderer, material_file, parameter, value, other):
