@@ -140,8 +140,8 @@ def glsl_constant(name: str) -> np.ndarray:
     [
         ("FILM_COS_THETA_MIN", thinfilm.COS_THETA_MIN),
         ("NAIVE_WAVELENGTHS", thinfilm.NAIVE_WAVELENGTHS),
-        ("SENSITIVITY_FOURIER_STEP", luts.SENSITIVITY_FOURIER_STEP),
-        ("SENSITIVITY_FOURIER_CARRIER_NM", luts.SENSITIVITY_FOURIER_CARRIER_NM),
+        ("SENSITIVITY_FOURIER_STEP", thinfilm.SENSITIVITY_FOURIER_STEP),
+        ("SENSITIVITY_FOURIER_CARRIER_NM", thinfilm.SENSITIVITY_FOURIER_CARRIER_NM),
         ("GAUSSIAN_FIT_VAL", thinfilm.GAUSSIAN_FIT_VAL),
         ("GAUSSIAN_FIT_POS", thinfilm.GAUSSIAN_FIT_POS),
         ("GAUSSIAN_FIT_VAR", thinfilm.GAUSSIAN_FIT_VAR),
@@ -157,7 +157,7 @@ def test_glsl_constants_are_the_python_ones(name, value):
 def test_table_node_zero_is_white():
     """lib/thinfilm.glsl takes S^(0) = 1 + 0i without fetching it: the table's first node, exactly."""
     table = luts.load("sensitivity_fourier")
-    assert table.shape == (2, luts.SENSITIVITY_FOURIER_COUNT, 3)
+    assert table.shape == (2, thinfilm.SENSITIVITY_FOURIER_COUNT, 3)
     np.testing.assert_array_equal(table[:, 0].astype(np.float32), [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]])
 
 

@@ -80,3 +80,59 @@ def test_find_cycle_finds_one():
 def test_no_import_cycles():
     cycle = find_cycle(import_graph())
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+#: The packages from the bottom up: a package imports only packages of a lower rank (or its own).
+#: ``errors`` is the foundation, ``resources`` (paths) and ``files`` (atomic outputs) stand on it; the
+#: store ``tables`` knows no physics; ``views`` (what each pixel of a view shows, without GL) comes below
+#: ``gpu``, which draws the views; ``cli`` opens the ``app``; ``dev`` (the checkout's set-up and
+#: regeneration scripts, not in the wheel) and ``__main__`` stand outside.
+LAYERS = {
+    "errors": 0,
+    "resources": 1, "files": 1,
+    "tables": 2,
+    "physics": 3,
+    "materials": 4,
+    "views": 5,
+    "gpu": 6,
+    "app": 7,
+    "cli": 8,
+    "dev": 9, "__main__": 10,
+}
+
+
+def package_of(module: str) -> str:
+    """``explorer.physics.bragg`` -> ``physics``; ``explorer`` itself -> ``""``."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def package_violations(graph: dict[str, set[str]]) -> list[str]:
+    """Every import of a package of the same or a higher rank than the importer's (a package's own excluded)."""
+    bad = []
+    for module, targets in sorted(graph.items()):
+        source = package_of(module)
+        for target in sorted(targets):
+            destination = package_of(target)
+            if not source or not destination or destination == source:
+                continue
+            if LAYERS[destination] >= LAYERS[source]:
+                bad.append(f"{module} ({source}) imports {target} ({destination})")
+    return bad
+
+
+def test_every_package_has_a_rank():
+    assert {p.name.removesuffix(".py") for p in PACKAGE.iterdir() if p.name != "__init__.py" and
+            (p.suffix == ".py" or (p / "__init__.py").exists())} == set(LAYERS)
+
+
+def test_packages_import_only_packages_below():
+    """From the bottom: errors, resources and files, tables (the store), physics, materials, views, gpu,
+    app, cli. The store knows no physics: the physics modules register their tables with it."""
+    violations = package_violations(import_graph())
+    assert not violations, "imports against the package order:\n" + "\n".join(violations)
+
+
+def test_the_package_check_sees_an_upward_import():
+    graph = {"explorer.tables.luts": {"explorer.physics.colorimetry"}, "explorer.physics.colorimetry": {"explorer.tables.luts"}}
+    assert package_violations(graph) == ["explorer.tables.luts (tables) imports explorer.physics.colorimetry (physics)"]

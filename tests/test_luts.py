@@ -37,10 +37,10 @@ def test_committed_tables_are_up_to_date(name):
     table = committed(name)
     assert table.dtype == np.float64
     manifest = json.loads((luts.LUT_DIR / luts.MANIFEST).read_text())["tables"][name]
-    assert list(table.shape) == manifest["shape"] == luts.TABLES[name]["spec"]["shape"]
+    assert list(table.shape) == manifest["shape"] == luts.TABLES[name].spec["shape"]
     assert "colour-science" in manifest["source"]
     # And they are what the generator writes today, to rounding: never bit for bit across machines.
-    np.testing.assert_allclose(table, luts.TABLES[name]["generate"](), rtol=0, atol=REGENERATED_ATOL)
+    np.testing.assert_allclose(table, luts.TABLES[name].generate(), rtol=0, atol=REGENERATED_ATOL)
 
 
 def test_committed_tables_content():
@@ -124,17 +124,17 @@ def test_stale_table_in_unwritable_place_is_used_from_memory(tmp_path):
 
 def test_cumulative_at_node_edges():
     white = colorimetry.white_xyz()
-    first, last = luts.CUMULATIVE_START, colorimetry.WAVELENGTH_MAX + 0.5
-    np.testing.assert_array_equal(luts.cmf_cumulative_at(first), 0.0)
-    np.testing.assert_allclose(luts.cmf_cumulative_at(last), white, rtol=0, atol=CUMULATIVE_ATOL)
+    first, last = colorimetry.CUMULATIVE_START, colorimetry.WAVELENGTH_MAX + 0.5
+    np.testing.assert_array_equal(colorimetry.cmf_cumulative_at(first), 0.0)
+    np.testing.assert_allclose(colorimetry.cmf_cumulative_at(last), white, rtol=0, atol=CUMULATIVE_ATOL)
     # Clamped outside, as an edge-clamped texture.
-    np.testing.assert_array_equal(luts.cmf_cumulative_at(np.array([100.0, 300.0])), 0.0)
-    np.testing.assert_allclose(luts.cmf_cumulative_at(np.array([900.0, 2e4])), [white, white], atol=CUMULATIVE_ATOL)
+    np.testing.assert_array_equal(colorimetry.cmf_cumulative_at(np.array([100.0, 300.0])), 0.0)
+    np.testing.assert_allclose(colorimetry.cmf_cumulative_at(np.array([900.0, 2e4])), [white, white], atol=CUMULATIVE_ATOL)
     # At every node: the sum of the bins below it.
     nodes = first + np.arange(colorimetry.WAVELENGTHS.size + 1)
     expected = np.concatenate([np.zeros((1, 3)), np.cumsum(colorimetry.colour_matching_functions(), axis=0)])
-    np.testing.assert_allclose(luts.cmf_cumulative_at(nodes), expected, rtol=0, atol=CUMULATIVE_ATOL)
-    assert luts.cmf_cumulative_at(np.zeros((4, 5))).shape == (4, 5, 3)
+    np.testing.assert_allclose(colorimetry.cmf_cumulative_at(nodes), expected, rtol=0, atol=CUMULATIVE_ATOL)
+    assert colorimetry.cmf_cumulative_at(np.zeros((4, 5))).shape == (4, 5, 3)
 
 
 def box_integral(a: float, b: float) -> np.ndarray:
@@ -151,7 +151,7 @@ def test_box_spectrum_on_bin_edges_is_the_1nm_sum():
         lo, hi = a - 0.5, b + 0.5
         inside = (colorimetry.WAVELENGTHS >= a) & (colorimetry.WAVELENGTHS <= b)
         expected = colorimetry.spectrum_to_xyz(inside.astype(float))
-        span = luts.cmf_cumulative_at(hi) - luts.cmf_cumulative_at(lo)
+        span = colorimetry.cmf_cumulative_at(hi) - colorimetry.cmf_cumulative_at(lo)
         np.testing.assert_allclose(span, expected, rtol=0, atol=CUMULATIVE_ATOL)
 
 
@@ -160,7 +160,7 @@ def test_box_spectrum_anywhere_is_the_overlap_sum():
     rng = np.random.default_rng(17)
     for _ in range(200):
         a, b = np.sort(rng.uniform(340.0, 850.0, size=2))
-        span = luts.cmf_cumulative_at(b) - luts.cmf_cumulative_at(a)
+        span = colorimetry.cmf_cumulative_at(b) - colorimetry.cmf_cumulative_at(a)
         np.testing.assert_allclose(span, box_integral(a, b), rtol=0, atol=CUMULATIVE_ATOL)
 
 

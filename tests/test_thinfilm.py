@@ -214,7 +214,7 @@ def test_fourier_series_converges_to_the_spectral_reference(film):
 
 def test_sensitivity_table_is_current_and_samples_the_transform():
     assert luts.staleness("sensitivity_fourier") is None
-    step, count = luts.SENSITIVITY_FOURIER_STEP, luts.SENSITIVITY_FOURIER_COUNT
+    step, count = thinfilm.SENSITIVITY_FOURIER_STEP, thinfilm.SENSITIVITY_FOURIER_COUNT
     nodes = np.arange(0, count, 37) * step
     exact = thinfilm.sensitivity_fourier_transform(nodes, "exact")
     np.testing.assert_allclose(thinfilm.sensitivity_fourier_transform(nodes), exact, rtol=0, atol=1e-12)

@@ -11,7 +11,7 @@ from typing import Mapping
 
 import numpy as np
 
-from explorer.physics import colorimetry
+from explorer.physics import colorimetry, thinfilm
 from explorer.tables import luts
 from explorer.materials.brd import Material
 from explorer.materials.glsl import ShaderError
@@ -69,7 +69,7 @@ class Renderer:
 
     def _library_textures(self) -> dict[str, object]:
         fourier = self.ctx.texture(
-            (luts.SENSITIVITY_FOURIER_COUNT, 2), 3, luts.load("sensitivity_fourier").astype("f4").tobytes(), dtype="f4"
+            (thinfilm.SENSITIVITY_FOURIER_COUNT, 2), 3, luts.load("sensitivity_fourier").astype("f4").tobytes(), dtype="f4"
         )
         return {
             "cmf_1nm": self._texture(luts.load("cmf_1nm").reshape(1, -1, 3), linear=False),

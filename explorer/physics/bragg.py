@@ -31,7 +31,6 @@ import numpy as np
 
 from explorer.physics import colorimetry
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
-from explorer.tables.luts import cmf_cumulative_at
 
 #: Bisection steps for each landmark (Airy point, band-gap edges). The GLSL twin uses the same count.
 BISECTION_STEPS = 12
@@ -604,8 +603,8 @@ def subdivisions_by_mass(omega_low, omega_high, s):
     """
     if s <= 0:
         return np.ones_like(omega_low)
-    mass = (cmf_cumulative_at(wavelength_of(omega_low)) - cmf_cumulative_at(wavelength_of(omega_high))).sum(axis=-1)
-    total = cmf_cumulative_at(WAVELENGTH_HIGH).sum()
+    mass = (colorimetry.cmf_cumulative_at(wavelength_of(omega_low)) - colorimetry.cmf_cumulative_at(wavelength_of(omega_high))).sum(axis=-1)
+    total = colorimetry.cmf_cumulative_at(WAVELENGTH_HIGH).sum()
     return np.maximum(1.0, np.ceil(4.0 * s * mass / total))
 
 
@@ -698,7 +697,7 @@ def approximate_xyz_polarised(
     xyz = np.zeros(np.shape(geometry.p1) + (3,))
     for omega_low, omega_high, weight, active in piecewise_constant_boxes(geometry, s, mode_numbering, variant):
         # omega -> lambda reverses the order: the box covers [2 pi / omega_high, 2 pi / omega_low].
-        span = cmf_cumulative_at(wavelength_of(omega_low)) - cmf_cumulative_at(wavelength_of(omega_high))
+        span = colorimetry.cmf_cumulative_at(wavelength_of(omega_low)) - colorimetry.cmf_cumulative_at(wavelength_of(omega_high))
         xyz += np.where(active, weight, 0.0)[..., None] * span
     return xyz
 

@@ -24,6 +24,8 @@ import warnings
 
 import numpy as np
 
+from explorer.tables import luts
+
 with warnings.catch_warnings():
     # colour-science warns at import when matplotlib is absent; we never plot through it.
     warnings.simplefilter("ignore")
@@ -413,3 +415,60 @@ def out_of_gamut(rgb: np.ndarray, tolerance: float = 1e-6) -> np.ndarray:
     """Mask of colours outside the sRGB gamut (a negative channel, or above white)."""
     rgb = np.asarray(rgb)
     return np.any((rgb < -tolerance) | (rgb > 1.0 + tolerance), axis=-1)
+
+
+# --------------------------------------------------------------------------------------------------
+# The CMF tables of luts/ (the spectral reference and the approximations' cumulative integrals)
+
+#: First node of ``cmf_cumulative`` (nm) and its spacing.
+CUMULATIVE_START = WAVELENGTH_MIN - 0.5
+CUMULATIVE_STEP = 1.0
+
+
+def _cmf_source() -> str:
+    import colour
+
+    return f"colour-science {colour.__version__}: colour.MSDS_CMFS['{CMFS_NAME}']"
+
+
+def _generate_cmf_1nm() -> np.ndarray:
+    return colour_matching_functions().astype(np.float64)
+
+
+def _generate_cmf_cumulative() -> np.ndarray:
+    cmf = colour_matching_functions()
+    return np.concatenate([np.zeros((1, 3)), np.cumsum(cmf, axis=0)]).astype(np.float64)
+
+
+luts.register("cmf_1nm", _generate_cmf_1nm, {
+    "quantity": "CIE 1931 2 degree CMFs, normalised so that sum(ybar) = 1",
+    "range_nm": [WAVELENGTH_MIN, WAVELENGTH_MAX],
+    "resolution_nm": 1.0,
+    "shape": [471, 3],
+}, _cmf_source)
+# The cumulative integrals C(lambda) of the CMFs (Eq. 16 of Fourneau et al. 2024) at the 472 bin edges
+# 359.5 + k nm: the CMFs are constant over each 1 nm bin, so C is exactly piecewise linear between nodes
+# and a box spectrum integrates to C(hi) - C(lo) (Eq. 15).
+luts.register("cmf_cumulative", _generate_cmf_cumulative, {
+    "quantity": "cumulative integral of the normalised CMFs (Eq. 16), at 1 nm bin edges",
+    "range_nm": [CUMULATIVE_START, WAVELENGTH_MAX + 0.5],
+    "resolution_nm": CUMULATIVE_STEP,
+    "shape": [472, 3],
+}, _cmf_source)
+
+
+def cmf_cumulative_at(wavelength) -> np.ndarray:
+    """
+    ``C(lambda)`` by linear interpolation between the ``cmf_cumulative`` table's nodes, clamped outside
+    them: exactly what a linearly filtered, edge-clamped texture of the table returns.
+
+    Returns
+    -------
+    ndarray, shape ``wavelength.shape + (3,)``
+    """
+    table = luts.load("cmf_cumulative")
+    x = (np.asarray(wavelength, dtype=np.float64) - CUMULATIVE_START) / CUMULATIVE_STEP
+    x = np.clip(x, 0.0, table.shape[0] - 1.0)
+    i = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
+    f = (x - i)[..., None]
+    return table[i] * (1.0 - f) + table[i + 1] * f

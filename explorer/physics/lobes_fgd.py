@@ -1,8 +1,8 @@
 """
 The tables of Belcour's (2018) FGD term for :mod:`explorer.physics.lobes`: the Fresnel terms per polarisation,
 the nodes of the tables and their generators (``luts/lobes_fgd_correction.npy``,
-``luts/lobes_ggx_moments.npy``, registered in :mod:`explorer.tables.luts`). A module of its own so that the
-tables' generators (imported by :mod:`explorer.tables.luts`) do not import the model that loads the tables.
+``luts/lobes_ggx_moments.npy``, registered here with the table store :mod:`explorer.tables.luts`). A module
+of its own so that the tables' generators do not import the model that loads the tables.
 
 References
 ----------
@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.physics import microfacet
+from explorer.tables import luts
 
 #: The FGD tables: nodes t = k / (N_COS - 1) of the warped cosine (:func:`fgd_cos_coordinate`: the
 #: critical angle of eta < 1 on the middle node), alpha nodes k / (N_ALPHA - 1), eta nodes
@@ -182,3 +183,22 @@ def _axis(value, count: int, lo: float, hi: float):
     x = (np.clip(np.asarray(value, dtype=np.float64), lo, hi) - lo) / (hi - lo) * (count - 1)
     i = np.minimum(np.floor(x).astype(np.int64), count - 2)
     return i, x - i
+
+
+luts.register("lobes_fgd_correction", generate_fgd_correction, {
+    "quantity": "FGD - Fresnel (unpolarised) of a rough GGX dielectric interface, eta x alpha x cos theta "
+    "(explorer.physics.lobes; Belcour 2018's FGD term)",
+    "eta": "4 ** linspace(-1, 1, 33)", "alpha": "linspace(0, 1, 16)",
+    "cos_theta": "t = linspace(0, 1, 33) of explorer.physics.lobes.fgd_cos_coordinate (critical angle at t = 1/2 for eta < 1)",
+    "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+    "resolution_nm": None,  # no wavelength axis
+    "shape": [33, 16, 33],
+})
+luts.register("lobes_ggx_moments", generate_ggx_moments, {
+    "quantity": "GGX reflection lobe albedo (F = 1) and mean half-angle cosine, [E, cbar_d] x alpha x cos theta "
+    "(explorer.physics.lobes: conductors' FGD ~ E F(cbar_d))",
+    "alpha": "linspace(0, 1, 16)", "cos_theta": "linspace(0, 1, 33)",
+    "quadrature": "48 x 48 midpoints of the GGX normal distribution",
+    "resolution_nm": None,  # no wavelength axis
+    "shape": [2, 16, 33],
+})

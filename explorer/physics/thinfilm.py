@@ -47,6 +47,46 @@ from explorer.physics import colorimetry
 from explorer.tables import luts
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
+
+# The sensitivity_fourier table of luts/ (registered below, after its generator): the Fourier transform
+# S^_j(mu) of the linear sRGB sensitivities s_j of the colour convention as functions of nu = 1/lambda
+# (Eqs. 7-8), S^_j(mu) = sum_lambda s_j(lambda) exp(-2 pi i mu / lambda) over the 471 nodes of the
+# spectral reference, with s_j = (M cmf)_j and M the XYZ -> RGB matrix, so S^_j(0) = 1 (white). Being the
+# transform of the very sum the 1 nm reference computes, Eq. 10 with it converges to that reference as m
+# grows. Sampled at OPDs mu = 10 k nm, k = 0..4095, and stored demodulated, E_j(mu) = S^_j(mu)
+# exp(+2 pi i mu / carrier_j), each channel's carrier near its centroid in nu: E_j is smooth, so linear
+# interpolation between nodes is within 6e-5 of the transform (2.5e-3 without demodulation). Shape
+# (2, 4096, 3): real parts, imaginary parts (the paper's N x 2 three-channel texture, Section 5); zero
+# beyond the last node. The carriers: the sensitivities' centroids in nu, 653.2, 545.7, 440.6 nm, rounded.
+SENSITIVITY_FOURIER_STEP = 10.0
+SENSITIVITY_FOURIER_COUNT = 4096
+SENSITIVITY_FOURIER_CARRIER_NM = (653.0, 546.0, 441.0)
+
+
+def _generate_sensitivity_fourier() -> np.ndarray:
+    # Element-wise products and numpy's pairwise sums, not BLAS: the same bits on every machine.
+    cmf, matrix = colorimetry.colour_matching_functions(), colorimetry.xyz_to_rgb_matrix()
+    sensitivities = (cmf[:, None, :] * matrix[None, :, :]).sum(axis=-1)
+    mu = np.arange(SENSITIVITY_FOURIER_COUNT, dtype=np.float64) * SENSITIVITY_FOURIER_STEP
+    nu = 1.0 / colorimetry.WAVELENGTHS
+    envelope = np.empty((mu.size, 3), dtype=np.complex128)
+    for j, carrier in enumerate(SENSITIVITY_FOURIER_CARRIER_NM):
+        # exp(-2 pi i mu nu) exp(+2 pi i mu / carrier), in one phase: no large phases cancel.
+        phase = np.exp(-2j * np.pi * mu[:, None] * (nu - 1.0 / carrier)[None, :])
+        envelope[:, j] = (phase * sensitivities[None, :, j]).sum(axis=-1)
+    return np.stack([envelope.real, envelope.imag]).astype(np.float64)
+
+
+luts.register("sensitivity_fourier", _generate_sensitivity_fourier, {
+    "quantity": "Fourier transform over nu = 1/lambda of the linear sRGB sensitivities (Belcour & "
+    "Barla 2017, Eqs. 7-8), demodulated by exp(+2 pi i mu / carrier); [real, imag]",
+    "range_nm": [0.0, SENSITIVITY_FOURIER_STEP * (SENSITIVITY_FOURIER_COUNT - 1)],
+    "resolution_nm": SENSITIVITY_FOURIER_STEP,
+    "carrier_nm": list(SENSITIVITY_FOURIER_CARRIER_NM),
+    "shape": [2, SENSITIVITY_FOURIER_COUNT, 3],
+}, colorimetry._cmf_source)
+
+
 #: Cosines are kept away from exact grazing incidence, where every interface reflects totally.
 COS_THETA_MIN = 1e-6
 POLARISATIONS = ("s", "p")
@@ -576,14 +616,14 @@ def sensitivity_fourier_transform_table(mu) -> np.ndarray:
     """
     table = luts.load("sensitivity_fourier")
     mu = np.asarray(mu, dtype=np.float64)
-    x = mu / luts.SENSITIVITY_FOURIER_STEP
+    x = mu / SENSITIVITY_FOURIER_STEP
     last = table.shape[1] - 1
     inside = (x >= 0.0) & (x <= last)
     x = np.clip(x, 0.0, last)
     i = np.minimum(np.floor(x).astype(np.int64), last - 1)
     f = (x - i)[..., None]
     envelope = (table[0, i] * (1.0 - f) + table[0, i + 1] * f) + 1j * (table[1, i] * (1.0 - f) + table[1, i + 1] * f)
-    carrier = np.exp(-2j * np.pi * mu[..., None] / np.asarray(luts.SENSITIVITY_FOURIER_CARRIER_NM))
+    carrier = np.exp(-2j * np.pi * mu[..., None] / np.asarray(SENSITIVITY_FOURIER_CARRIER_NM))
     return np.where(inside[..., None], envelope * carrier, 0.0)
 
 
@@ -641,7 +681,7 @@ def D_max(epsilon: float = 0.05, sensitivity: str = "table") -> float:
     The OPD beyond which iridescence is negligible (Section 5): the least ``mu`` such that
     ``|S^_j(mu')| <= epsilon`` for every ``mu' >= mu`` and every channel, on the table's nodes.
     """
-    mu = np.arange(luts.SENSITIVITY_FOURIER_COUNT) * luts.SENSITIVITY_FOURIER_STEP
+    mu = np.arange(SENSITIVITY_FOURIER_COUNT) * SENSITIVITY_FOURIER_STEP
     above = np.any(np.abs(sensitivity_fourier_transform(mu, sensitivity)) > epsilon, axis=-1)
     return float(mu[np.nonzero(above)[0][-1] + 1]) if above.any() else 0.0
 
@@ -948,12 +988,12 @@ def _sensitivity_fourier_prefiltered() -> np.ndarray:
     Computed by the host on first use (one complex matrix product per channel, under a second).
     """
     sensitivities = sensitivities_rgb()
-    mu = np.arange(luts.SENSITIVITY_FOURIER_COUNT, dtype=np.float64) * luts.SENSITIVITY_FOURIER_STEP
+    mu = np.arange(SENSITIVITY_FOURIER_COUNT, dtype=np.float64) * SENSITIVITY_FOURIER_STEP
     wavelengths = colorimetry.WAVELENGTHS.astype(np.float64)
     sigma = np.arange(PREFILTER_LEVELS, dtype=np.float64) * PREFILTER_SIGMA_STEP
     damping = np.exp(-2.0 * np.pi**2 * (sigma[:, None] / wavelengths[None, :]) ** 2)  # (levels, 471)
     table = np.empty((2, PREFILTER_LEVELS, mu.size, 3), dtype=np.float64)
-    for j, carrier in enumerate(luts.SENSITIVITY_FOURIER_CARRIER_NM):
+    for j, carrier in enumerate(SENSITIVITY_FOURIER_CARRIER_NM):
         phase = np.exp(-2j * np.pi * (1.0 / wavelengths - 1.0 / carrier)[:, None] * mu[None, :])  # (471, mu)
         envelope = (damping * sensitivities[None, :, j]).astype(np.complex128) @ phase
         table[0, :, :, j], table[1, :, :, j] = envelope.real, envelope.imag
@@ -982,8 +1022,8 @@ def sensitivity_fourier_transform_prefiltered(mu, sigma) -> np.ndarray:
     """
     table = sensitivity_fourier_prefiltered().astype(np.float64)
     mu, sigma = np.broadcast_arrays(np.asarray(mu, dtype=np.float64), np.asarray(sigma, dtype=np.float64))
-    x = mu / luts.SENSITIVITY_FOURIER_STEP
-    last = luts.SENSITIVITY_FOURIER_COUNT - 1
+    x = mu / SENSITIVITY_FOURIER_STEP
+    last = SENSITIVITY_FOURIER_COUNT - 1
     inside = (x >= 0.0) & (x <= last)
     x = np.clip(x, 0.0, last)
     i = np.minimum(np.floor(x).astype(np.int64), last - 1)
@@ -1001,7 +1041,7 @@ def sensitivity_fourier_transform_prefiltered(mu, sigma) -> np.ndarray:
         return low * (1.0 - g) + high * g
 
     envelope = level(0) + 1j * level(PREFILTER_LEVELS)
-    carrier = np.exp(-2j * np.pi * mu[..., None] / np.asarray(luts.SENSITIVITY_FOURIER_CARRIER_NM))
+    carrier = np.exp(-2j * np.pi * mu[..., None] / np.asarray(SENSITIVITY_FOURIER_CARRIER_NM))
     return np.where(inside[..., None], envelope * carrier, 0.0)
 
 
