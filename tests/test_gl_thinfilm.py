@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
+from explorer.materials.methods import ThinFilmMethod
 from explorer.tables import luts
 from explorer.physics import microfacet, thinfilm
 from explorer.materials.brd import load_material
@@ -39,7 +40,7 @@ FUNCTION_ATOL = 1e-4
 #: W = 180: the last column at theta = 89.75 deg. The reference costs ~0.3 s per 256x256 on llvmpipe.
 VIEW_SIZES = {"gradient": (180, 1), "sphere": (32, 32)}
 SWEEP_SIZES = {"gradient": (48, 1), "sphere": (12, 12)}
-METHODS = [0, 1, 2, 3, 4, 5]
+METHODS = [int(m) for m in ThinFilmMethod]
 
 #: Films as the CLI passes values (strings) or a UI would (floats).
 FILMS = {

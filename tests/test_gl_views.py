@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 from explorer.materials.models import model_for
 from explorer.views.render import render_numpy
@@ -20,7 +21,7 @@ from twins import COLOUR_TOLERANCE, Twins, assert_black_outside, assert_twins_eq
 #: W = 180: the last column is at theta = 89.75 deg, so the gradient reaches beyond 89.5 deg.
 VIEW_SIZES = {"gradient": (180, 1), "sphere": (32, 32)}
 SWEEP_SIZES = {"gradient": (48, 1), "sphere": (12, 12)}
-METHODS = [0, 1, 2, 3, 4]
+METHODS = [int(m) for m in BraggMethod]
 #: Linear RGB of a reflectance in [0, 1] lies in the object-colour box below, up to this slack.
 OBJECT_COLOUR_SLACK = 1e-3
 

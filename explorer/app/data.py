@@ -14,13 +14,13 @@ import numpy as np
 
 from explorer.physics import bragg, colorimetry
 from explorer.materials.brd import round_integer
+from explorer.materials.methods import BraggMethod, methods_for
 
 #: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
 BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
-#: Names of the Bragg materials' methods (explorer.materials.models.METHODS), and the gradient rows of Figure 4.
-BRAGG_METHOD_NAMES = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
-BRAGG_STRIP_METHODS = (0, 1, 2, 4, 3)
-THIN_FILM_METHOD_NAMES = {0: "reference", 1: "Fourier m=1", 2: "Fourier m=2", 3: "Fourier m=3", 4: "Gaussian fits", 5: "naive RGB"}
+#: The gradient rows of Figure 4: the reference, the paper's approximations, ours, the tabulated colours.
+BRAGG_STRIP_METHODS = (BraggMethod.REFERENCE, BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED,
+                       BraggMethod.TABULATED)
 
 
 def method_names(material) -> dict[int, str]:
@@ -29,7 +29,8 @@ def method_names(material) -> dict[int, str]:
         parameter = material.parameter("method")
     except KeyError:
         return {}
-    known = BRAGG_METHOD_NAMES if material.model in BRAGG_MODELS else THIN_FILM_METHOD_NAMES if material.model == "thin_film" else {}
+    methods = methods_for(material.model)
+    known = {int(m): m.label for m in methods} if methods else {}
     return {m: known.get(m, f"method {m}") for m in range(int(parameter.min), int(parameter.max) + 1)}
 
 
@@ -90,9 +91,9 @@ def spectrum(values, theta_degrees: float, method: int | None = None, s: int = 3
             landmarks.extend(x for x in (nm_low, nm_high) if bragg.WAVELENGTH_LOW <= x <= bragg.WAVELENGTH_HIGH)
             if np.all(weight == 1.0) and high[0] > low[0]:  # the gap halves have unit weight
                 result.gaps.append((nm_low, nm_high))
-        if method in (1, 2, 4):
-            subdivisions = 0 if method == 1 else s
-            variant = "improved" if method == 4 else "paper"
+        if method in (BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED):
+            subdivisions = 0 if method == BraggMethod.BASIC else s
+            variant = "improved" if method == BraggMethod.IMPROVED else "paper"
             boxes = []
             for low, high, weight, active in bragg.piecewise_constant_boxes(geometry, subdivisions, variant=variant):
                 nm_low, nm_high = float(bragg.wavelength_of(high)[0]), float(bragg.wavelength_of(low)[0])

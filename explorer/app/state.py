@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.materials.methods import BraggMethod
 from explorer.materials.brd import Material
 
 VIEW_SIZES = (128, 256, 512, 1024)
@@ -28,7 +29,7 @@ def initial_values(material: Material, preset: str | None, is_default: bool) -> 
     """The values the app starts with: defaults, the default material's tabulated method, a preset."""
     overrides: dict = {}
     if is_default and any(p.name == "method" for p in material.parameters):
-        overrides["method"] = 3  # the default material opens on its fastest exact method
+        overrides["method"] = int(BraggMethod.TABULATED)  # the default material opens on its fastest exact method
     if preset is not None:
         from explorer.materials.presets import presets_for
 

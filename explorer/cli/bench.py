@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.materials.methods import BraggMethod, ThinFilmMethod
 from explorer.physics import bragg, colorimetry
 from explorer.materials.brd import load_material
 from explorer.files import atomic_output
@@ -53,15 +54,16 @@ def delta_E_over_theta(mirror: bragg.BraggMirror, rgb_function) -> tuple[float, 
 
 def _methods() -> list[tuple[str, int | None, dict]]:
     """(method name, s, parameter overrides) in table order."""
-    rows = [("reference", None, {"method": 0}), ("basic", None, {"method": 1})]
-    rows += [("subdivided", s, {"method": 2, "s": s}) for s in (2, 3, 4, 5)]
-    rows += [("improved", 3, {"method": 4, "s": 3})]
-    rows += [("tabulated", None, {"method": 3})]
+    B = BraggMethod
+    rows = [("reference", None, {"method": int(B.REFERENCE)}), ("basic", None, {"method": int(B.BASIC)})]
+    rows += [("subdivided", s, {"method": int(B.SUBDIVIDED), "s": s}) for s in (2, 3, 4, 5)]
+    rows += [("improved", 3, {"method": int(B.IMPROVED), "s": 3})]
+    rows += [("tabulated", None, {"method": int(B.TABULATED)})]
     return rows
 
 
 def _accuracy(mirror: bragg.BraggMirror, method: str, s: int | None, table: np.ndarray | None):
-    if method == "reference":  # the shader's method 0 at its default step: the paper's 1-nm sum
+    if method == "reference":  # the shader's reference at its default step: the paper's 1-nm sum
         return delta_E_over_theta(mirror, lambda c: bragg.reference_rgb(c, mirror, step=1.0))
     if method == "basic":
         return delta_E_over_theta(mirror, lambda c: bragg.approximate_rgb(c, mirror, 0))
@@ -263,8 +265,8 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
         cells = []
         for delta in FIGURE4_DELTAS:
             strips = []
-            for method in (0, 1, 2, 4):
-                values = material.resolve({"Lambda": Lambda, "delta": delta, "N": 20, "method": method, "s": 3})
+            for method in (BraggMethod.REFERENCE, BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED):
+                values = material.resolve({"Lambda": Lambda, "delta": delta, "N": 20, "method": int(method), "s": 3})
                 strips.append(renderer.render(material, values, "gradient", width, strip))
                 strips.append(np.ones((2, width, 3), np.float32))
             cells.append(np.concatenate(strips))
@@ -278,10 +280,8 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
 # --------------------------------------------------------------------------------------------------
 # Thin films (Belcour & Barla 2017): accuracy of each method and its cost relative to GGX + Schlick
 
-#: (name, method of thin_film.brd) in table order; method 0 is the spectral reference.
-THIN_FILM_METHODS = (
-    ("reference", 0), ("fourier m=1", 1), ("fourier m=2", 2), ("fourier m=3", 3), ("gaussian m=3", 4), ("naive rgb", 5),
-)
+#: (name, method of thin_film.brd) in table order; the first is the spectral reference.
+THIN_FILM_METHODS = tuple((m.label, int(m)) for m in ThinFilmMethod)
 
 
 def thin_film_accuracy(values: dict) -> dict[str, tuple[float, float]]:
@@ -293,10 +293,10 @@ def thin_film_accuracy(values: dict) -> dict[str, tuple[float, float]]:
     from explorer.physics import thinfilm
 
     cos_theta = np.cos(np.radians(THETA_DEGREES))
-    film = ThinFilmModel({**values, "method": 0})
+    film = ThinFilmModel({**values, "method": int(ThinFilmMethod.REFERENCE)})
     reference = thinfilm.reference_rgb(*film.film, cos_theta, film.thickness_d)
     result = {}
-    for name, method in THIN_FILM_METHODS[1:] + (("1-nm sum", 0),):
+    for name, method in THIN_FILM_METHODS[1:] + (("1-nm sum", int(ThinFilmMethod.REFERENCE)),):
         dE = colorimetry.delta_E_2000(reference, ThinFilmModel({**values, "method": method}).reflectance(cos_theta))
         result[name] = (float(np.median(dE)), float(np.max(dE)))
     return result
@@ -374,8 +374,9 @@ LAYER_ALPHAS = (0.025, 0.1, 0.4)
 FIGURE8_LAYER = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.5, "N": 20, "rho_d": "0", "s": 3}
 #: Pixels whose reference luminance Y (white = 1) is at or below this are left out (L* <= 9).
 SLICE_LUMINANCE_THRESHOLD = 0.01
-#: (name, method of bragg_layer.brd) compared with the spectral reference (method 0) by ΔE2000.
-SLICE_METHODS = (("basic", 1), ("subdivided s=3", 2), ("improved s=3", 4), ("1-nm sum", 0))
+#: (name, method of bragg_layer.brd) compared with the spectral reference by ΔE2000.
+SLICE_METHODS = (("basic", int(BraggMethod.BASIC)), ("subdivided s=3", int(BraggMethod.SUBDIVIDED)),
+                 ("improved s=3", int(BraggMethod.IMPROVED)), ("1-nm sum", int(BraggMethod.REFERENCE)))
 LAYER_GOALS = {"transmission_filter_ms": 100.0, "layer_tables_ms": 10.0}
 LAYER_PAPER = {"transmission_filter_ms": 600.0, "layer_tables_ms": 40.0}
 
@@ -531,7 +532,9 @@ def format_layers(document: dict) -> str:
 
 
 #: The methods of bragg_mirror.brd timed by ``bench --app``, fastest first.
-APP_METHODS = ((3, "tabulated"), (1, "basic"), (2, "subdivided s = 3"), (4, "improved s = 3"), (0, "reference"))
+APP_METHODS = tuple((int(m), name) for m, name in (
+    (BraggMethod.TABULATED, "tabulated"), (BraggMethod.BASIC, "basic"), (BraggMethod.SUBDIVIDED, "subdivided s = 3"),
+    (BraggMethod.IMPROVED, "improved s = 3"), (BraggMethod.REFERENCE, "reference")))
 
 
 def app_bench_script(frames: int = 60) -> list:

@@ -10,6 +10,7 @@ from typing import Mapping
 
 from explorer.materials.brd import Material, round_integer
 from explorer.materials.glsl import ShaderBuilder, ShaderError, compile_error
+from explorer.materials.methods import glsl_defines
 from explorer.resources import SHADER_DIR
 from explorer.gpu.context import GLSL_VERSION
 
@@ -27,12 +28,16 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
     The fragment shader of ``material`` in ``view`` (an :class:`explorer.materials.glsl.Program`).
 
     Each ``(name, value)`` of ``constants`` becomes ``#define SPECIALISED_name value``: the shader
-    can branch at compile time on a parameter such as ``method`` (one smaller program per value).
+    can branch at compile time on a parameter such as ``method`` (one smaller program per value). The
+    methods' names (:func:`explorer.materials.methods.glsl_defines`, ``BRAGG_TABULATED`` …) are defined
+    in every program: the one place their numbers come from.
     """
     template = SHADER_DIR / "views" / f"{view}.glsl"
     if not template.exists():
         raise ShaderError(str(template), None, f"no such view {view!r}")
     builder = ShaderBuilder(include_dirs=[SHADER_DIR], version=GLSL_VERSION)
+    for name, value in glsl_defines().items():
+        builder.define(name, value)
     for name, value in constants:
         builder.define(f"SPECIALISED_{name}", value)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")

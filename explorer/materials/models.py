@@ -17,9 +17,8 @@ from explorer.physics import bragg, colorimetry, layered, microfacet
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.lobes_model import LayeredLobesModel
+from explorer.materials.methods import BraggMethod
 from explorer.materials.thinfilm_model import ThinFilmModel
-
-METHODS = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
 
 
 def _cos_half_angle(L, V) -> np.ndarray:
@@ -46,9 +45,9 @@ class BraggMirrorModel:
             N=round_integer(values["N"]),
             nh=nh if nh >= 1.0 else None,  # below 1 the host is n1
         )
-        self.method = round_integer(values.get("method", 0))
+        self.method = BraggMethod(round_integer(values.get("method", 0)))
         self.s = round_integer(values.get("s", 3))
-        # Method 0's wavelength step (nm): 1 is the paper's 1-nm sum (bragg_layer.brd has no such parameter).
+        # The reference's wavelength step (nm): 1 is the paper's 1-nm sum (bragg_layer.brd has no such parameter).
         self.wavelength_step = float(values.get("wavelength_step", 1.0))
         self._table: np.ndarray | None = None
 
@@ -61,16 +60,7 @@ class BraggMirrorModel:
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """Linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
-        cos_theta = np.asarray(cos_theta, dtype=np.float64)
-        if self.method == 0:
-            return bragg.reference_rgb(cos_theta, self.mirror, step=self.wavelength_step)
-        if self.method == 1:
-            return bragg.approximate_rgb(cos_theta, self.mirror, 0)
-        if self.method == 2:
-            return bragg.approximate_rgb(cos_theta, self.mirror, self.s)
-        if self.method == 3:
-            return bragg.tabulated_rgb(self.table, cos_theta)
-        return bragg.approximate_rgb(cos_theta, self.mirror, self.s, variant="improved")
+        return BRAGG_REFLECTANCE[self.method](self, np.asarray(cos_theta, dtype=np.float64))
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         """The shader's ``BRDF``: the reflectance at the half-vector angle (unit vectors ``(..., 3)``)."""
@@ -79,14 +69,24 @@ class BraggMirrorModel:
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
-        return {"bragg_table": self.table if self.method == 3 else np.zeros((1, 3), np.float32)}
+        return {"bragg_table": self.table if self.method.needs_table else np.zeros((1, 3), np.float32)}
 
     def draft_textures(self) -> dict[str, np.ndarray] | None:
         """
         Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's table from the
         1-nm sum, :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
         """
-        return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method == 3 else None
+        return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method.needs_table else None
+
+
+#: The Bragg mirror's reflectance per method (the shader's branches on BRAGG_* in bragg_mirror.brd).
+BRAGG_REFLECTANCE = {
+    BraggMethod.REFERENCE: lambda model, c: bragg.reference_rgb(c, model.mirror, step=model.wavelength_step),
+    BraggMethod.BASIC: lambda model, c: bragg.approximate_rgb(c, model.mirror, 0),
+    BraggMethod.SUBDIVIDED: lambda model, c: bragg.approximate_rgb(c, model.mirror, model.s),
+    BraggMethod.TABULATED: lambda model, c: bragg.tabulated_rgb(model.table, c),
+    BraggMethod.IMPROVED: lambda model, c: bragg.approximate_rgb(c, model.mirror, model.s, variant="improved"),
+}
 
 
 @functools.lru_cache(maxsize=16)

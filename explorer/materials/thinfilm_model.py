@@ -4,15 +4,12 @@ The numpy twin of ``shaders/thin_film.brd`` (Belcour & Barla 2017; physics in :m
 The material is a GGX microfacet BRDF whose Fresnel term is a thin film's Airy reflectance at the
 half-vector angle; ``method`` picks how that reflectance becomes a colour:
 
-====== ==========================================================================================
-method what the shader computes
-====== ==========================================================================================
-0      spectral reference: the Airy reflectance at every nm from 360 to 830, both polarisations
-1-3    the paper's Fourier-space spectral integration (Eq. 10) truncated at m = method, with the
-       tabulated transform of the convention's sensitivities (``luts/sensitivity_fourier.npy``)
-4      the same at m = 3 with the paper's Gaussian fits of the XYZ sensitivities
-5      naive RGB: the Airy reflectance at :data:`explorer.physics.thinfilm.NAIVE_WAVELENGTHS`
-====== ==========================================================================================
+(:class:`explorer.materials.methods.ThinFilmMethod`): the spectral reference (the Airy reflectance at
+every nm from 360 to 830, both polarisations); the paper's Fourier-space spectral integration (Eq. 10)
+summed to m = 1, 2, 3 with the tabulated transform of the convention's sensitivities
+(``luts/sensitivity_fourier.npy``) and the series' remainder; the same at m = 3 with the paper's Gaussian
+fits of the XYZ sensitivities; naive RGB (the Airy reflectance at
+:data:`explorer.physics.thinfilm.NAIVE_WAVELENGTHS`).
 """
 
 from __future__ import annotations
@@ -23,8 +20,21 @@ import numpy as np
 
 from explorer.physics import microfacet, thinfilm
 from explorer.materials.brd import round_integer
+from explorer.materials.methods import ThinFilmMethod
 
-METHODS = {0: "reference", 1: "fourier m=1", 2: "fourier m=2", 3: "fourier m=3", 4: "gaussian m=3", 5: "naive rgb"}
+#: The methods that integrate with the tabulated sensitivities (and may be prefiltered).
+TABULATED_FOURIER = (ThinFilmMethod.FOURIER_1, ThinFilmMethod.FOURIER_2, ThinFilmMethod.FOURIER_3)
+
+
+def film_rgb(method: ThinFilmMethod, film, cos_theta, d) -> np.ndarray:
+    """The film's colour by ``method`` (the shader's branches on THIN_FILM_* in thin_film.brd)."""
+    if method == ThinFilmMethod.REFERENCE:
+        return thinfilm.reference_rgb(*film, cos_theta, d, step=1.0)  # the shader's 1-nm sum
+    if method in TABULATED_FOURIER:
+        return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=method.m_max, sensitivity="table")
+    if method == ThinFilmMethod.GAUSSIAN:
+        return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=method.m_max, sensitivity="gaussian")
+    return thinfilm.naive_rgb(*film, cos_theta, d)
 
 
 class ThinFilmModel:
@@ -40,9 +50,10 @@ class ThinFilmModel:
         self.eta_3 = float(values["eta3"])
         self.kappa_3 = float(values["kappa3"])
         self.alpha = float(values.get("alpha", 0.0))
-        self.method = round_integer(values.get("method", 0))
-        if self.method not in METHODS:
-            raise ValueError(f"method must be one of {', '.join(map(str, METHODS))}, got {self.method}")
+        method = round_integer(values.get("method", 0))
+        if method not in set(ThinFilmMethod):
+            raise ValueError(f"method must be one of {', '.join(str(int(m)) for m in ThinFilmMethod)}, got {method}")
+        self.method = ThinFilmMethod(method)
         # One-line ValueErrors on a negative thickness, kappa3 < 0, non-positive or non-finite indices.
         thinfilm.validate_film(self.eta_1, self.eta_2, self.eta_3, self.kappa_3, 1.0, self.thickness_d)
         microfacet.check_alpha(self.alpha)
@@ -54,15 +65,7 @@ class ThinFilmModel:
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth film's linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
-        cos_theta = np.asarray(cos_theta, dtype=np.float64)
-        d = self.thickness_d
-        if self.method == 0:
-            return thinfilm.reference_rgb(*self.film, cos_theta, d, step=1.0)  # the shader's 1-nm sum
-        if self.method <= 3:
-            return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=self.method, sensitivity="table")
-        if self.method == 4:
-            return thinfilm.fourier_rgb(*self.film, cos_theta, d, m_max=3, sensitivity="gaussian")
-        return thinfilm.naive_rgb(*self.film, cos_theta, d)
+        return film_rgb(self.method, self.film, np.asarray(cos_theta, dtype=np.float64), self.thickness_d)
 
     def textured_reflectance(self, cos_theta, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
         """
@@ -75,16 +78,11 @@ class ThinFilmModel:
         eta_2, d = thinfilm.film_from_D_inc(D_inc, self.eta_1, self.eta_2)
         film = (self.eta_1, eta_2, self.eta_3, self.kappa_3)
         if prefiltered:
-            if self.method not in (1, 2, 3):
-                raise ValueError(f"prefiltering needs a tabulated Fourier method (method 1, 2 or 3), not method {self.method}")
-            return thinfilm.fourier_rgb_prefiltered(*film, cos_theta, d, sigma_D_inc, m_max=self.method)
-        if self.method == 0:
-            return thinfilm.reference_rgb(*film, cos_theta, d, step=1.0)
-        if self.method <= 3:
-            return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=self.method, sensitivity="table")
-        if self.method == 4:
-            return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=3, sensitivity="gaussian")
-        return thinfilm.naive_rgb(*film, cos_theta, d)
+            if self.method not in TABULATED_FOURIER:
+                names = ", ".join(f"{int(m)} ({m.label})" for m in TABULATED_FOURIER)
+                raise ValueError(f"prefiltering needs a tabulated Fourier method ({names}), not method {int(self.method)}")
+            return thinfilm.fourier_rgb_prefiltered(*film, cos_theta, d, sigma_D_inc, m_max=self.method.m_max)
+        return film_rgb(self.method, film, cos_theta, d)
 
     def textured_brdf(self, L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`brdf` with :meth:`textured_reflectance` per sample."""

@@ -866,7 +866,7 @@ def naive_rgb(
 
 def fourier_rgb(
     eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, m_max: int = 3, sensitivity: str = "table",
-    sigma_D_inc=None,
+    sigma_D_inc=None, remainder: bool = True,
 ) -> np.ndarray:
     """
     The paper's analytic spectral integration (Eq. 10) truncated at ``m_max``, both polarisations.
@@ -882,6 +882,9 @@ def fourier_rgb(
     sigma_D_inc : array_like, optional
         Standard deviation of ``D_inc`` (nm): Eq. 10 averaged over a Gaussian distribution of thickness
         (Section 5; see :func:`fourier_rgb_prefiltered`).
+    remainder : bool
+        Add the series' terms beyond ``m_max`` in closed form (:func:`fourier_remainder`); False is the
+        paper's plain truncation (``m_max = 0``: the fringe average ``C_0``).
 
     Returns
     -------
@@ -907,7 +910,7 @@ def fourier_rgb(
     for pol in POLARISATIONS:
         terms = film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, pol)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            rgb = rgb + 0.5 * spectral_integration_fourier(terms, m_max, sensitivity, sigma_D_inc)
+            rgb = rgb + 0.5 * spectral_integration_fourier(terms, m_max, sensitivity, sigma_D_inc, remainder)
         propagates = propagates & terms.film_propagates
     propagates = np.asarray(propagates)
     if np.all(propagates):

@@ -26,6 +26,7 @@ import numpy as np
 
 from explorer.errors import LocatedError
 from explorer.resources import DEFAULT_TEXTURE
+from explorer.materials.thinfilm_model import TABULATED_FOURIER
 
 #: ``--dinc-range`` default (nm of D_inc): the paper's Figure 13 remaps its texture over [0, 1125] nm.
 DEFAULT_DINC_RANGE = (0.0, 1125.0)
@@ -33,7 +34,7 @@ DEFAULT_DINC_RANGE = (0.0, 1125.0)
 #: film shaders/thin_film.brd declares (d <= 3000 nm, eta2 <= 3); the Fourier table reaches 40950 nm.
 DINC_MAX = 18000.0
 #: Methods the prefiltering applies to: the tabulated Fourier ones (Eq. 10 with the pre-filtered table).
-PREFILTER_METHODS = (1, 2, 3)
+PREFILTER_METHODS = tuple(int(m) for m in TABULATED_FOURIER)
 MAX_FOOTPRINT_SAMPLES = 32
 
 
@@ -184,7 +185,8 @@ class ThicknessTexture:
 
 def check_prefilter(method: int, prefilter: bool) -> None:
     if prefilter and method not in PREFILTER_METHODS:
-        raise LocatedError("--prefilter", None, f"prefiltering needs a tabulated Fourier method (method 1, 2 or 3), not method {method}")
+        names = ", ".join(f"{int(m)} ({m.label})" for m in TABULATED_FOURIER)
+        raise LocatedError("--prefilter", None, f"prefiltering needs a tabulated Fourier method ({names}), not method {method}")
 
 
 if __name__ == "__main__":  # pragma: no cover
