@@ -372,8 +372,10 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--position-free", "position_free", is_flag=True,
+              help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -381,6 +383,11 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if position_free:
+        from explorer.cli.bench import run_position_free_bench
+
+        run_position_free_bench(as_json=as_json)
+        return
     if app:
         from explorer.cli.bench import run_app_bench
 

@@ -365,13 +365,14 @@ class PositionFree:
     # ----------------------------------------------------------------------------------------------
     # Estimates
 
-    def _estimate(
-        self, i_air: np.ndarray, o_air: np.ndarray | None, samples: int, seed: int,
+    def _replicates(
+        self, i_air: np.ndarray, o_air: np.ndarray | None, samples: int, seed,
         progress: Callable[[int, int], None] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    ) -> np.ndarray:
         """
-        Per query (rows of ``i_air``): mean and standard error of the albedo and BRDF tallies, from
-        ``samples`` paths in :data:`REPLICATES` independent replicates (one path each below 2 per replicate).
+        The replicates' means of the albedo and BRDF tallies per query (rows of ``i_air``): shape
+        ``(replicates, 2, Q, 3)``, from ``samples`` paths in :data:`REPLICATES` independent replicates
+        (one path each below 2 per replicate).
         """
         Q = i_air.shape[0]
         replicates = REPLICATES if samples >= 2 * REPLICATES else samples
@@ -392,6 +393,12 @@ class PositionFree:
                 done += queries.size
                 if progress is not None:
                     progress(done * per, total * per)
+        return means
+
+    @staticmethod
+    def _combine(means: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Mean and standard error over replicates: albedo mean, its error, BRDF mean, its error."""
+        replicates = means.shape[0]
         mean = means.mean(axis=0)
         if replicates > 1:
             stderr = means.std(axis=0, ddof=1) / np.sqrt(replicates)
@@ -399,7 +406,12 @@ class PositionFree:
             stderr = np.full_like(mean, np.inf)
         return mean[0], stderr[0], mean[1], stderr[1]
 
-    def albedo(self, theta_deg, samples: int = 20000, seed: int = 0, progress=None) -> PositionFreeResult:
+    def _estimate(self, i_air, o_air, samples: int, seed, progress=None):
+        """Per query: mean and standard error of the albedo and BRDF tallies from ``samples`` paths."""
+        return self._combine(self._replicates(i_air, o_air, samples, seed, progress))
+
+    def albedo(self, theta_deg, samples: int = 20000, seed: int = 0, progress=None,
+               target_stderr: float | None = None, max_seconds: float = np.inf) -> PositionFreeResult:
         """
         The directional albedo at incidence ``theta_deg`` (degrees, in air): the flux that escapes after any
         number of bounces, plus the coating's Dirac reflection ``F(theta)``, per unit incident flux.
@@ -414,11 +426,16 @@ class PositionFree:
             The generator's seed: the same seed, angles and samples give the same result.
         progress : callable, optional
             ``progress(done, total)`` (paths) after each batch.
+        target_stderr : float, optional
+            Progressive: go on by rounds of ``samples`` paths per angle (each round's own seed) until
+            every channel's standard error is at most this, or ``max_seconds`` have passed.
+        max_seconds : float
+            The progressive estimate's time budget (it ends after the round that crosses it).
 
         Returns
         -------
         PositionFreeResult
-            ``value`` and ``stderr`` of shape ``(len(theta_deg), 3)``, linear sRGB.
+            ``value`` and ``stderr`` of shape ``(len(theta_deg), 3)``, linear sRGB; ``paths`` per angle.
         """
         start = time.perf_counter()
         theta = np.radians(np.atleast_1d(np.asarray(theta_deg, dtype=np.float64)))
@@ -427,9 +444,14 @@ class PositionFree:
         if int(samples) < 1:
             raise ValueError(f"samples must be at least 1, got {samples}")
         i_air = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=-1)
-        mean, stderr, _, _ = self._estimate(i_air, None, int(samples), seed, progress)
+        rounds = [self._replicates(i_air, None, int(samples), (seed, 0), progress)]
+        while target_stderr is not None and time.perf_counter() - start < max_seconds:
+            if self._combine(np.concatenate(rounds))[1].max() <= target_stderr:
+                break
+            rounds.append(self._replicates(i_air, None, int(samples), (seed, len(rounds)), progress))
+        mean, stderr, _, _ = self._combine(np.concatenate(rounds))
         F = self._coating_F_air(np.cos(theta))
-        return PositionFreeResult(mean + F[:, None], stderr, int(samples), time.perf_counter() - start)
+        return PositionFreeResult(mean + F[:, None], stderr, int(samples) * len(rounds), time.perf_counter() - start)
 
     def brdf(self, i_air, o_air, samples: int = 256, seed: int = 0, progress=None) -> PositionFreeResult:
         """
