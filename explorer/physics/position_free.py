@@ -6,24 +6,24 @@ after Guo, Hašan & Zhao 2018): a spectral, unbiased random walk through the str
 The structure, top to bottom: a smooth coating (the interface from air to the host ``n1``, Fresnel and
 Snell; none when ``coating`` is off, or index-matched when ``n1 = 1``), rough Bragg layers in the host,
 and a Lambertian base of RGB albedo ``rho_d``. A path is traced from the light's direction ``i`` and
-carries a throughput spectrum ``beta`` (the 471 wavelengths of :mod:`explorer.physics.colorimetry`: the
-"multiplexed" walk of Section 4.2.3) and an RGB factor for the base's albedo, which has no spectrum
-(as :func:`explorer.physics.layered.single_reflection_brdf` multiplies the base's term in RGB).
+carries a few wavelengths of the 471 of :mod:`explorer.physics.colorimetry` (hero wavelength sampling,
+Wilkie et al. 2014: Section 4.2.3's "multiplexed" walk with spectral MIS) and an RGB factor for the base's
+albedo, which has no spectrum (as :func:`explorer.physics.layered.single_reflection_brdf` multiplies the
+base's term in RGB).
 
 At each event:
 
 - **coating** (from inside, going up): the part ``1 - F`` escapes (the albedo's tally), the part ``F``
   (total internal reflection included) is reflected: a deterministic split, no random choice. Entering
   from air, ``F(theta_i)`` is the coating's Dirac reflection (Eq. 34's ``f_r,0``), tallied exactly.
-- **rough Bragg layer** (from either side, its normal flipped from below, Section 4.2.2): transmission
-  is ballistic (Section 4.2.1), its weight the integrated transmissivity ``f_t cos theta`` of Eq. 28
-  (the layer's table); reflection samples a microfacet normal ``m`` from GGX's visible normals (Heitz
-  2018) and mirrors the path about it, its weight Yeh's ``R_lambda(i.m)`` times Smith's ``G1(o)`` (the
-  estimator of Eq. 17's ``f_r cos``). What neither takes, ``A`` (Eq. 30, the light that single
-  scattering among microfacets loses), is absorbed: transmission plus reflection sum to
-  ``G1(i) <T> + <R G1(o)> <= 1``. The choice is random, transmission with probability ``p_trans``
-  (Eq. 31's role, here the throughput-weighted share of the transmitted part), the weights divided by
-  the probability taken (Eqs. 32-33's role): unbiased whatever ``p_trans``.
+- **rough Bragg layer** (from either side, its normal flipped from below, Section 4.2.2): a microfacet
+  normal ``m`` is drawn from GGX's visible normals (Heitz 2018); the facet, a Bragg mirror, reflects the
+  path about ``m`` with Yeh's probability ``R_lambda(i.m)`` (weight Smith's ``G1(o)``: the estimator of
+  Eq. 17's ``f_r cos``) or lets it through, ballistically and in the same direction (Section 4.2.1), with
+  probability ``T = 1 - R`` (weight ``G1(i)``: the estimator of Eq. 22's ``f_t cos``, whose expectation
+  is Eq. 28: marginally, the path crosses with probability ``f_t cos theta / G1``, Eqs. 28 and 30). What neither keeps, ``A`` (Eq. 30: paths reflected into the layer, ``G1 < 1``), is the light
+  single scattering among microfacets loses: absorbed. A path's first events take both branches at once
+  (splitting), transmission then with Eq. 28's tabulated expectation.
 - **base**: Lambertian, cosine-sampled; the path goes on with probability ``max(rho_d)``, its RGB factor
   multiplied by ``rho_d / max(rho_d)``.
 - Russian roulette ends paths of low throughput (unbiased: survivors are divided by their probability).
@@ -32,7 +32,7 @@ The BRDF ``f(i, o)`` comes by next-event estimation toward ``o``: at every refle
 above and at every base bounce, the vertex's BRDF toward the refracted ``o'``, times the ballistic
 transmissivity of the layers above along ``o'``, the coating's ``1 - F(theta_o)`` and the radiance's
 ``1 / n1^2`` (Eq. 34's factors, here for paths of any order). The directional albedo is the escaping
-flux (plus the coating's Dirac ``F``). Both report a standard error from the paths' spread.
+flux (plus the coating's Dirac ``F``). Both report a standard error, the spread of independent replicates.
 
 References
 ----------
@@ -40,6 +40,7 @@ Fourneau, Pacanowski, Barla (2024). Interactive Exploration of Vivid Material Ir
 Mirrors. Computer Graphics Forum 43(2). Section 4.2 (Eqs. 17-19, 22, 28-33), Eq. 34, Appendix C.
 Guo, Hašan, Zhao (2018). Position-free Monte Carlo simulation for arbitrary layered BSDFs. ACM TOG 37(6).
 Heitz (2018). Sampling the GGX distribution of visible normals. JCGT 7(4).
+Wilkie, Nawaz, Droske, Weidlich, Hanika (2014). Hero wavelength spectral sampling. Computer Graphics Forum 33(4).
 """
 
 from __future__ import annotations
@@ -63,13 +64,11 @@ MAX_EVENTS = 512
 #: A path's first layer events take both branches, reflection and transmission (splitting: the first
 #: choices carry most of the variance); later events choose one.
 SPLIT_EVENTS = 3
-#: Neither branch of a layer event is rarer than this (its weight at most 1 / P_MIN times its value).
-P_MIN = 0.15
 #: Wavelengths per path (hero wavelength sampling, Wilkie et al. 2014): the first decides, all are tallied.
 HERO_WAVELENGTHS = 4
 #: Independent replicates per query: the standard error is their spread (the wavelengths are stratified
 #: within a replicate, which makes its paths negatively correlated).
-REPLICATES = 16
+REPLICATES = 32
 
 
 def _rgb_matrix() -> np.ndarray:
@@ -136,15 +135,9 @@ class PositionFree:
             raise ValueError(f"{len(tables)} layer tables for {len(stack.layers)} layers")
         self.tables = tables
         self.alphas = [float(microfacet.check_alpha(layer.alpha)) for layer in stack.layers]
-        # The layers' tables, float32 (the shader's textures): R_lambda(theta), f_t cos theta (Eq. 28) and
-        # the filtered reflectance G1 - f_t cos theta = int R F_alpha d theta_d (Eq. 28 with R for T, and
-        # Eq. 30): the expected reflection, which sets the probability of each branch.
+        # The layers' tables, float32 (the shader's textures): R_lambda(theta) and f_t cos theta (Eq. 28).
         self.reflectance = [np.ascontiguousarray(t.reflectance, dtype=np.float32) for t in tables]
         self.transmissivity = [np.ascontiguousarray(t.transmissivity, dtype=np.float32) for t in tables]
-        self.filtered_reflectance = [
-            np.maximum(layered.transmission_filter_for(layer.alpha).row_sums()[:, None].astype(np.float32) - t, 0.0)
-            for layer, t in zip(stack.layers, self.transmissivity)
-        ]
         self.rgb = _rgb_matrix()
         self.pdf = wavelength_pdf()
         self.cdf = np.cumsum(self.pdf)
@@ -292,43 +285,39 @@ class PositionFree:
                                 * microfacet.smith_G1_over_cos(oh[:, 2], alpha))
                         R = self._lookup(self.reflectance[l], microfacet.half_vector_cosine(wiu, oh), j[from_above])
                         tally(brdf, up, b[from_above] * R * E[l][pid[up]] * lobe[:, None])
-                # Each branch's probability: its expected weight at the wavelength (Eq. 31's role).
-                t = self._lookup(self.transmissivity[l], cos_in, j)
-                r = self._lookup(self.filtered_reflectance[l], cos_in, j)
-                p_t = np.clip(t / np.maximum(t + r, 1e-30), P_MIN, 1.0 - P_MIN)  # (n, K)
+                # A visible normal m (Heitz 2018), the mirror direction o about it, and Yeh's R(i.m) there.
+                m = microfacet.sample_ggx_visible_normal(wi, alpha, rng.random(at.size), rng.random(at.size))
+                cos_d = np.sum(wi * m, axis=-1)
+                o = 2.0 * cos_d[:, None] * m - wi
+                R = np.clip(self._lookup(self.reflectance[l], cos_d, j), 0.0, 1.0)  # (n, K)
+                G1_i = microfacet.smith_G1(cos_in, alpha)[:, None]
+                G1_o = microfacet.smith_G1(o[:, 2], alpha)[:, None]
+                # The first SPLIT_EVENTS events take both branches: reflection R G1(o) (Eq. 17's f_r cos / pdf)
+                # and transmission f_t cos theta (Eq. 28, its expectation over m). Later ones choose as the
+                # facet does, reflection with probability R (the hero's): weights G1(o) R and G1(i) T, each
+                # wavelength's probability R or T = 1 - R kept in pi.
                 split = splits[at] < SPLIT_EVENTS
                 splits[at[split]] += 1
-                chosen = rng.random(at.size) < p_t[:, 0]  # the hero's choice
-                transmit = split | chosen
-                reflect = split | ~chosen
-                # Reflection: a visible normal (Heitz 2018), weight R(i.m) G1(o) (Eq. 17's f_r cos / pdf).
-                if reflect.any():
-                    wir = wi[reflect]
-                    n_r = wir.shape[0]
-                    m = microfacet.sample_ggx_visible_normal(wir, alpha, rng.random(n_r), rng.random(n_r))
-                    cos_d = np.sum(wir * m, axis=-1)
-                    o = 2.0 * cos_d[:, None] * m - wir
-                    weight = self._lookup(self.reflectance[l], cos_d, j[reflect]) * microfacet.smith_G1(o[:, 2], alpha)[:, None]
-                    beta_r = b[reflect] * weight
-                    pi_r = pi[at[reflect]] * np.where(split[reflect][:, None], 1.0, 1.0 - p_t[reflect])
-                    sign = np.where(from_above[reflect], 1.0, -1.0)
-                    d_r = np.stack([o[:, 0], o[:, 1], sign * o[:, 2]], axis=-1)
-                    lost = o[:, 2] <= 0.0  # mirrored into the layer: single scattering loses it (Eq. 30's A)
-                    rows = at[reflect]
-                    spawn = split[reflect]  # a split path's reflected branch is a new path
-                    keep = ~spawn
-                    beta[rows[keep]] = beta_r[keep]
-                    pi[rows[keep]] = pi_r[keep]
-                    d[rows[keep]] = d_r[keep]
-                    alive[rows[keep & lost]] = False
-                    new = spawn & ~lost
-                    if new.any():
-                        born.append((beta_r[new], pi_r[new], d_r[new], gap[rows[new]], colour[rows[new]],
-                                     pid[rows[new]], splits[rows[new]]))
-                # Transmission: ballistic (Section 4.2.1), weight f_t cos theta (Eq. 28).
+                chosen = rng.random(at.size) < R[:, 0]
+                reflect = split | chosen
+                transmit = split | ~chosen
+                beta_r = b * R * G1_o
+                pi_r = pi[at] * np.where(split[:, None], 1.0, R)
+                beta_t = b * np.where(split[:, None], self._lookup(self.transmissivity[l], cos_in, j), (1.0 - R) * G1_i)
+                pi_t = pi[at] * np.where(split[:, None], 1.0, 1.0 - R)
+                sign = np.where(from_above, 1.0, -1.0)
+                d_r = np.stack([o[:, 0], o[:, 1], sign * o[:, 2]], axis=-1)
+                lost = o[:, 2] <= 0.0  # mirrored into the layer: single scattering loses it (Eq. 30's A)
+                # Reflection in place where chosen; a split path's reflected branch is a new path.
+                keep = reflect & ~split
+                beta[at[keep]], pi[at[keep]], d[at[keep]] = beta_r[keep], pi_r[keep], d_r[keep]
+                alive[at[keep & lost]] = False
+                new = split & ~lost
+                if new.any():
+                    born.append((beta_r[new], pi_r[new], d_r[new], gap[at[new]], colour[at[new]], pid[at[new]], splits[at[new]]))
+                # Transmission: ballistic (Section 4.2.1), the direction unchanged.
                 tr = at[transmit]
-                beta[tr] = b[transmit] * t[transmit]
-                pi[tr] *= np.where(split[transmit][:, None], 1.0, p_t[transmit])
+                beta[tr], pi[tr] = beta_t[transmit], pi_t[transmit]
                 gap[tr] = np.where(from_above[transmit], l + 1, l)
             # -- the Lambertian base
             at = np.flatnonzero(interface == L + 1)
