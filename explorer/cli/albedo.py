@@ -67,6 +67,17 @@ def progress_printer(label: str, unit: str):
     return progress
 
 
+def _load(path):
+    """A material file, or a built-in material by name, its warnings on stderr (as ``render`` loads it)."""
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    material = load_material(material_path(path))
+    for warning in material.warnings:
+        click.echo(f"{PROG}: warning: {warning}", err=True)
+    return material
+
+
 def _twin(loaded, values):
     from explorer.materials.brd import MaterialError
     from explorer.materials.models import model_for
@@ -105,8 +116,6 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
     from explorer.views import albedo as albedo_views
 
     try:
-        from explorer.cli.commands import _load
-
         angles = parse_theta(theta)
         if samples is not None and engine != "position-free":
             raise click.BadParameter("paths per angle are for --engine position-free", param_hint="--samples")
