@@ -49,6 +49,8 @@ DOCS = SOURCE_ROOT / "docs"
 FIGURES = DOCS / "figures" / "layered_validation"
 RESULTS = DOCS / "layered_validation.json"
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+#: What the JSON leaves out (the maps: megabytes; the figures show them).
+MAP_KEYS = ("map_single", "map_reference", "map_reference_stderr")
 
 
 def _write_atomic(path: Path, write) -> None:
@@ -219,7 +221,7 @@ def main(argv=None) -> int:
     for k, name in enumerate(names, start=1):
         row = compare_preset(name, args.samples, args.spp)
         plot_preset(row, FIGURES / f"{name}.png")
-        rows.append(row)
+        rows.append({key: value for key, value in row.items() if key not in MAP_KEYS})  # the maps live in the figures
         s = summary(row)
         print(f"[{k}/{len(names)}] {name}: albedo dE2000 median {s['dE_median']:.2f} max {s['dE_max']:.2f}, "
               f"dY {s['dY']:+.4f} at {s['dY_theta']:g} deg, map dE median {s['map_dE_median']:.2f} ({row['seconds']:.0f} s)",
