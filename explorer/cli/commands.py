@@ -262,7 +262,8 @@ def _errors(function):
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
-@click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
+@click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="gl", show_default=True,
+              help="The GPU shader, its numpy twin, or (bragg_stack, lit and slice) the position-free reference.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
@@ -271,7 +272,7 @@ def _errors(function):
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
-@click.option("--spp", type=click.IntRange(min=1), help="env view: Monte Carlo samples per pixel (default 64).")
+@click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
            prefilter, env_file, spp):
@@ -319,9 +320,14 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
 
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
-    elif env_file is not None or spp is not None:
+    elif env_file is not None or (spp is not None and engine != "position-free"):
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
-    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
+    if engine == "position-free":
+        from explorer.cli.albedo import render_position_free
+
+        image = render_position_free(loaded, values, view, width, height, light_angles, spp)
+    else:
+        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
@@ -388,8 +394,10 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--position-free", "position_free", is_flag=True,
+              help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -397,6 +405,11 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if position_free:
+        from explorer.cli.bench import run_position_free_bench
+
+        run_position_free_bench(as_json=as_json)
+        return
     if app:
         from explorer.cli.bench import run_app_bench
 
@@ -450,9 +463,11 @@ def default_job():
 
 
 from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  (the layered lobes' commands)
+from explorer.cli.albedo import albedo_command  # noqa: E402
 
 cli.add_command(inverse_command)
 cli.add_command(figure_command)
+cli.add_command(albedo_command)
 
 
 def main(argv: list[str] | None = None) -> None:

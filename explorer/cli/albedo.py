@@ -1,0 +1,192 @@
+"""
+``bragg-explorer albedo``: a material's directional albedo per incidence angle (:mod:`explorer.views.albedo`),
+and ``render --engine position-free`` (the lit and slice views of a layered Bragg structure by the
+position-free reference, :mod:`explorer.physics.position_free`). Registered by :mod:`explorer.cli.commands`.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+import click
+import numpy as np
+
+PROG = "bragg-explorer"
+DEFAULT_THETA = "0,15,30,45,60,75,85"
+#: Paths per angle (albedo) of the position-free engine by default.
+DEFAULT_SAMPLES = 20000
+#: The position-free render's views and its default paths per pixel.
+POSITION_FREE_VIEWS = ("lit", "slice")
+DEFAULT_SPP = 64
+
+
+def resolve_values(loaded, preset: str | None, params_file: str | None, assignments) -> dict:
+    """The material's values: its defaults, under ``--preset``, under ``--params``, under ``--set`` (as ``render``)."""
+    from explorer.materials.brd import parse_assignment
+
+    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    if params_file is not None:
+        from explorer.app.parameter_files import load_values
+
+        loaded_values = load_values(params_file, loaded)
+        for skipped in loaded_values.skipped:
+            click.echo(f"{PROG}: warning: {params_file}: skipped {skipped}", err=True)
+        overrides = {**loaded_values.values, **overrides}
+    if preset is not None:
+        from explorer.materials.presets import presets_for
+
+        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
+    return loaded.resolve(overrides)
+
+
+def parse_theta(text: str) -> np.ndarray:
+    """``--theta``: comma-separated incidence angles in degrees, each in [0, 90)."""
+    try:
+        values = [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        values = []
+    theta = np.asarray(values, dtype=np.float64)
+    if theta.size == 0 or not np.all(np.isfinite(theta) & (theta >= 0.0) & (theta < 90.0)):
+        raise click.BadParameter(f"{text!r} is not a list of angles in [0, 90) degrees (e.g. 0,30,60)", param_hint="--theta")
+    return theta
+
+
+def progress_printer(label: str, unit: str):
+    """A ``progress(done, total)`` that writes a line to stderr every 2 s (and at the end after 2 s)."""
+    start = last = time.perf_counter()
+
+    def progress(done: int, total: int) -> None:
+        nonlocal last
+        now = time.perf_counter()
+        if now - last >= 2.0 or (done == total and now - start >= 2.0):
+            last = now
+            click.echo(f"{PROG}: {label}: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
+
+    return progress
+
+
+def _load(path):
+    """A material file, or a built-in material by name, its warnings on stderr (as ``render`` loads it)."""
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    material = load_material(material_path(path))
+    for warning in material.warnings:
+        click.echo(f"{PROG}: warning: {warning}", err=True)
+    return material
+
+
+def _twin(loaded, values):
+    from explorer.materials.brd import MaterialError
+    from explorer.materials.models import model_for
+
+    try:
+        model = model_for(loaded, values)
+    except ValueError as error:
+        raise MaterialError(loaded.path, None, str(error)) from None
+    return model
+
+
+def _fail(message: str) -> None:
+    click.echo(f"{PROG}: error: {message}", err=True)
+    sys.exit(1)
+
+
+@click.command("albedo")
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
+@click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
+@click.option("--theta", default=DEFAULT_THETA, show_default=True, metavar="DEG,DEG,...", help="Incidence angles in degrees (in the outer medium).")
+@click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="numpy", show_default=True,
+              help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (bragg_stack).")
+@click.option("--samples", type=int, metavar="N", help=f"position-free: paths per angle (default {DEFAULT_SAMPLES}).")
+@click.option("--seed", type=int, default=0, show_default=True, help="position-free: the random generator's seed.")
+@click.option("--json", "as_json", is_flag=True, help='Print {"theta_deg": [...], "rgb": [[r, g, b], ...]} (plus "stderr" for position-free).')
+def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, as_json):
+    """Directional albedo of MATERIAL: BRDF x cos integrated over the outgoing hemisphere, plus its Dirac
+    reflection (a coating's Fresnel; a smooth mirror's specular reflectance), per incidence angle.
+
+    Linear sRGB as render writes it (a white reflector is 1, 1, 1); the light in the xz plane.
+    """
+    from explorer.errors import LocatedError
+    from explorer.gpu import GLUnavailable
+    from explorer.views import albedo as albedo_views
+
+    try:
+        angles = parse_theta(theta)
+        if samples is not None and engine != "position-free":
+            raise click.BadParameter("paths per angle are for --engine position-free", param_hint="--samples")
+        if samples is not None and samples < 1:
+            raise click.BadParameter(f"{samples} is not a positive number of paths", param_hint="--samples")
+        loaded = _load(material)
+        values = resolve_values(loaded, preset, params_file, assignments)
+        stderr = None
+        if engine == "gl":
+            model = _twin(loaded, values) if loaded.model else None
+            rgb = albedo_views.albedo_gl(loaded, values, angles, size=albedo_views.gl_size_for(model), model=model)
+        else:
+            from explorer.materials.brd import MaterialError
+
+            model = _twin(loaded, values)
+            if model is None:
+                raise MaterialError(loaded.path, None, "this material has no numpy twin (no known '# model:' line): use --engine gl")
+            if engine == "numpy":
+                rgb = albedo_views.albedo_numpy(model, angles)
+            else:
+                if getattr(model, "name", None) not in albedo_views.POSITION_FREE_MODELS:
+                    raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
+                                        f"({', '.join(albedo_views.POSITION_FREE_MODELS)}) only")
+                result = albedo_views.albedo_position_free(
+                    model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"))
+                rgb, stderr = result.value, result.stderr
+    except (LocatedError, GLUnavailable) as error:
+        _fail(str(error))
+    if as_json:
+        document = {"theta_deg": angles.tolist(), "rgb": rgb.tolist()}
+        if stderr is not None:
+            document["stderr"] = stderr.tolist()
+        click.echo(json.dumps(document))
+        return
+    luminance = rgb @ np.array([0.2126, 0.7152, 0.0722])
+    for k, t in enumerate(angles):
+        line = f"theta {t:6.2f} deg: rgb {rgb[k, 0]:.6f} {rgb[k, 1]:.6f} {rgb[k, 2]:.6f}  Y {luminance[k]:.6f}"
+        if stderr is not None:
+            line += f"  (stderr {stderr[k, 0]:.2g} {stderr[k, 1]:.2g} {stderr[k, 2]:.2g})"
+        click.echo(line)
+
+
+def render_position_free(loaded, values, view: str, width: int, height: int, light, spp: int | None) -> np.ndarray:
+    """
+    ``render --engine position-free``: the lit or slice view of a ``bragg_stack`` material with its BRDF
+    estimated by the position-free reference (next-event estimation, ``spp`` paths per pixel), under the
+    views' rule; progress on stderr. Small sizes: each pixel costs ``spp`` random walks.
+    """
+    from explorer.materials.brd import MaterialError
+    from explorer.physics.position_free import PositionFree
+    from explorer.views import albedo as albedo_views
+    from explorer.views.geometry import brdf_view_geometry
+
+    if view not in POSITION_FREE_VIEWS:
+        raise click.BadParameter(f"the position-free engine renders the {' and '.join(POSITION_FREE_VIEWS)} views", param_hint="--view")
+    model = _twin(loaded, values)
+    if getattr(model, "name", None) not in albedo_views.POSITION_FREE_MODELS:
+        raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
+                            f"({', '.join(albedo_views.POSITION_FREE_MODELS)}) only")
+    L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
+
+    def local(d):
+        d = np.asarray(d, dtype=np.float64)
+        return np.stack([np.sum(d * X, -1), np.sum(d * Y, -1), np.sum(d * N, -1)], axis=-1)
+
+    # The views' rule in the shaders' precision (float32): 0 unless N.L > 0 and N.V > 0.
+    shown = inside & (np.sum(N * L, -1) > 0) & (np.sum(N * V, -1) > 0)
+    image = np.zeros((height, width, 3), dtype=np.float32)
+    if shown.any():
+        walker = PositionFree(model.stack, model.tables)
+        result = walker.brdf(local(L)[shown], local(V)[shown], samples=spp or DEFAULT_SPP,
+                             progress=progress_printer("position-free", "paths"))
+        image[shown] = result.value * factor[shown][:, None]
+    return image
