@@ -126,7 +126,9 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         stderr = None
         if engine == "gl":
             model = _twin(loaded, values) if loaded.model else None
-            rgb = albedo_views.albedo_gl(loaded, values, angles, size=albedo_views.gl_size_for(model), model=model)
+            from explorer.gpu import Renderer
+
+            rgb = albedo_views.albedo_gl(loaded, values, angles, Renderer(), size=albedo_views.gl_size_for(model), model=model)
         else:
             from explorer.materials.brd import MaterialError
 

@@ -131,17 +131,15 @@ def scatter_solid_angles(width: int, height: int) -> np.ndarray:
     return np.where(r < 1.0, 0.5 * np.pi * sinc * (2.0 / width) * (2.0 / height), 0.0)
 
 
-def albedo_gl(material, values, theta_deg, size: int = GL_SIZE, renderer=None, model=None) -> np.ndarray:
+def albedo_gl(material, values, theta_deg, renderer, size: int = GL_SIZE, model=None) -> np.ndarray:
     """
     The directional albedo by the GPU: ``BRDF cos theta_o`` in the scatter view (light at ``(theta, 0)``)
     summed with :func:`scatter_solid_angles`; a material in :data:`SPECULAR_MODELS` gives its reflectance
     at the mirror pixel's angle instead (the gradient view, interpolated). ``model`` (its numpy twin, when
-    it has one) adds its ``mirror_reflection``. (n, 3).
+    it has one) adds its ``mirror_reflection``. ``renderer``: an :class:`explorer.gpu.Renderer` (views
+    come below gpu: the caller makes it). (n, 3).
     """
-    from explorer.gpu import Renderer
-
     theta = check_theta(theta_deg)
-    renderer = Renderer() if renderer is None else renderer
     if material.model in SPECULAR_MODELS:
         # The gradient's column k shows reflectance at theta = 90 (k + 0.5) / W degrees.
         width = 8192
