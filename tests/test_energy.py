@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 
 from conftest import REPO_ROOT
 from explorer.materials.brd import load_material
+from explorer.materials.methods import BraggMethod
 from explorer.materials.models import model_for
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.views.render import render_numpy
@@ -206,3 +207,68 @@ def test_numpy_gradient_of_every_material_at_its_defaults_is_passive():
     for name in MATERIALS:
         mat = material(name)
         assert_passive(render_numpy(model_for(mat, mat.resolve({})), "gradient", *SWEEP_SIZE), name)
+
+
+# --------------------------------------------------------------------------------------------------
+# Directional albedo (BRDF x cos over the outgoing hemisphere, Dirac reflections included)
+
+
+#: The albedo's quadrature error: the numpy engine's half-vector Gauss-Legendre rule resolves lobes down
+#: to alpha ~ 1e-3 to ~1e-4 (tests/test_albedo.py); the gl engine's scatter sum at its size to ~1e-3.
+ALBEDO_TOLERANCE = 3e-3
+ALBEDO_THETA = (0.0, 60.0, 85.0)
+#: The gl sweep's scatter image (256^2: a pixel spans 0.7 degree) resolves lobes of alpha >= 0.1; its
+#: sweep draws roughnesses from there up, the numpy sweep covers the whole box.
+GL_ALPHA_MIN = 0.1
+GL_ALBEDO_SIZE = 256
+ALPHAS = ("alpha", "alpha_1", "alpha_2", "alpha_3", "alpha_4")
+
+
+def _albedo_values(name: str, values: dict, alpha_min: float = 0.0) -> dict:
+    """A drawn point made cheap for an albedo: roughness floored for the gl engine, N at most 40, and the
+    Bragg reference (its spectral sum per direction: minutes) replaced by the tabulated colours. The
+    reference's own bound follows from its spectrum's (test_bragg_spectrum_is_within_0_and_1: positive
+    CMF weights, white = 1) and from the lobe's, which every method shares."""
+    values = _cheap(name, values)
+    if name in ("bragg_mirror", "bragg_layer") and round(values.get("method", 0)) == int(BraggMethod.REFERENCE):
+        values["method"] = float(BraggMethod.TABULATED)
+    for key in ALPHAS:
+        if key in values:
+            values[key] = max(values[key], alpha_min)
+    for key in ("N", "N_1", "N_2", "N_3"):
+        if key in values:  # the reference's spectral sums per direction: N up to 40 keeps an example near a second
+            values[key] = min(values[key], 40.0)
+    return values
+
+
+ALBEDO_SWEEP = settings(max_examples=4, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+@ALBEDO_SWEEP
+@given(data=st.data())
+def test_albedo_is_passive_in_numpy(name, data):
+    from explorer.views.albedo import albedo_numpy
+
+    mat, values = data.draw(parameter_sets(name))
+    values = _albedo_values(name, values)
+    rgb = albedo_numpy(model_for(mat, mat.resolve(values)), ALBEDO_THETA)
+    assert np.isfinite(rgb).all(), f"{name} {values}"
+    Y = luminance(rgb)
+    assert Y.max() <= 1.0 + ALBEDO_TOLERANCE, f"{name} numpy albedo Y = {Y.round(4)} at {ALBEDO_THETA}: {values}"
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", MATERIALS)
+@ALBEDO_SWEEP
+@given(data=st.data())
+def test_albedo_is_passive_in_gl(gl_renderer, name, data):
+    from explorer.views.albedo import albedo_gl
+
+    mat, values = data.draw(parameter_sets(name))
+    values = mat.resolve(_albedo_values(name, values, GL_ALPHA_MIN))
+    model = model_for(mat, values)
+    rgb = albedo_gl(mat, values, ALBEDO_THETA[:2], gl_renderer, size=GL_ALBEDO_SIZE, model=model)
+    assert np.isfinite(rgb).all(), f"{name} {values}"
+    Y = luminance(rgb)
+    assert Y.max() <= 1.0 + ALBEDO_TOLERANCE, f"{name} GL albedo Y = {Y.round(4)}: {values}"

@@ -16,8 +16,9 @@ Three engines:
 - ``position-free``: the Monte Carlo reference of Section 4.2 for layered Bragg structures
   (:mod:`explorer.physics.position_free`), with its standard error.
 
-A smooth mirror (``bragg_mirror``, ``schlick_fresnel``: their ``BRDF`` is their reflectance at the half
-vector, a Dirac's weight) has for albedo its specular reflectance ``reflectance(cos theta)``. The coating
+A smooth mirror (``bragg_mirror``: its ``BRDF`` is its reflectance at the half vector, a Dirac's weight)
+has for albedo its specular reflectance ``reflectance(cos theta)``. (``schlick_fresnel`` is a
+Fresnel-weighted Lambertian, ``F / pi``: integrated like any BRDF.) The coating
 of ``bragg_stack`` adds its Dirac reflection (``mirror_reflection``: Eq. 34's ``f_r,0``).
 
 References
@@ -34,7 +35,7 @@ import numpy as np
 
 #: Models whose ``BRDF`` is a smooth mirror's reflectance at the half vector (a Dirac's weight, not a
 #: density): their albedo is ``reflectance(cos theta)``.
-SPECULAR_MODELS = ("bragg_mirror", "schlick_fresnel")
+SPECULAR_MODELS = ("bragg_mirror",)
 #: The models the position-free engine simulates.
 POSITION_FREE_MODELS = ("bragg_stack",)
 #: Cell edges in theta_h (radians), graded toward the normal: lobes down to alpha ~ 1e-3 span cells.
