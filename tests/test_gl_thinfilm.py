@@ -130,8 +130,11 @@ def test_model_rejects_bad_values(thin_film_material, bad):
 
 
 def glsl_constant(name: str) -> np.ndarray:
-    """The numbers of ``const float|vec3 NAME = ...;`` in lib/thinfilm.glsl."""
-    match = re.search(rf"const\s+(?:float|vec3)\s+{name}\s*=\s*([^;]+);", THINFILM_GLSL.read_text())
+    """The numbers of ``const float|vec3 NAME = ...;`` in the block lib/thinfilm.glsl includes (generated)."""
+    from explorer.materials.shader_constants import GENERATED
+
+    assert '#include "generated/thinfilm.glsl"' in THINFILM_GLSL.read_text()
+    match = re.search(rf"const\s+(?:float|vec3)\s+{name}\s*=\s*([^;]+);", GENERATED["generated/thinfilm.glsl"]())
     assert match, f"{name} is not a constant of {THINFILM_GLSL.name}"
     return np.array([float(x) for x in re.findall(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?", match.group(1).replace("vec3", ""))])
 

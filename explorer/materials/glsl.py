@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -161,10 +161,14 @@ class ShaderBuilder:
         version: str = "330 core",
         max_depth: int = 16,
         line_stride: int = LINE_STRIDE,
+        generated: Mapping[str, Callable[[], str]] | None = None,
     ) -> None:
         if "\n" in version or "\r" in version:
             raise ValueError("version must be one line")
         self.include_dirs = [Path(d) for d in include_dirs]
+        if generated is None:  # the library's shared constants (explorer.materials.shader_constants)
+            from explorer.materials.shader_constants import GENERATED as generated
+        self.generated = dict(generated)
         self.version = version
         self.max_depth = max_depth
         self.line_stride = line_stride
@@ -298,6 +302,15 @@ class _Assembly:
         if match is None:
             raise ShaderError(name, number, 'malformed #include; expected #include "file" or #include <file>')
         target = match.group(1) or match.group(2)
+        if target in self.builder.generated:  # written from Python, not read: once per program
+            key = Path("<generated>") / target
+            if key in self.included:
+                self.out.append("")
+                return
+            self.included.add(key)
+            self.emit(_split_lines(self.builder.generated[target]()), f"<{target}>", 1, None, depth + 1)
+            self.out.append(self.line_directive(number + 1, self.source_number(name)))
+            return
         path = self.resolve(target, name, number, base)
         if not self.claim(path):
             self.out.append("")  # already included (or a cycle): keep the line count

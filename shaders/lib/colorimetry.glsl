@@ -7,10 +7,7 @@ uniform sampler2D cmf_1nm;         // 471 x 1
 uniform sampler2D cmf_cumulative;  // 472 x 1
 uniform mat3 xyz_to_rgb_matrix;
 
-const int CMF_COUNT = 471;
-const float CMF_FIRST_WAVELENGTH = 360.0;
-const float CUMULATIVE_START = 359.5;
-const float CUMULATIVE_SIZE = 472.0;
+#include "generated/colorimetry.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
 // CMFs at wavelength 360 + index nm.
 vec3 colour_matching_functions(int index) { return texelFetch(cmf_1nm, ivec2(index, 0), 0).rgb; }

@@ -7,10 +7,7 @@
 #include "lib/fresnel.glsl"
 #include "lib/colorimetry.glsl"
 
-const int MAX_LAYERS = 3;
-const int THETA_ROWS = 361;
-const float THETA_STEP = 0.25 * PI / 180.0;
-const float COS_THETA_MIN = 1e-9;
+#include "generated/layered.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
 // The polar angle of a direction above the surface, by atan2 (precise near 0, unlike acos).
 float polar_angle(vec3 v) { return atan(length(v.xy), max(v.z, 0.0)); }
@@ -34,7 +31,7 @@ vec3 refract_into_host(vec3 direction, float nh) {
 
 // The coating's Fresnel reflectance from air into nh (Eq. 34's f_r,0 weight; 0 for nh = 1).
 float coating_reflectance(float cos_theta_i, float nh) {
-    return fresnel_reflectance(clamp(cos_theta_i, COS_THETA_MIN, 1.0), 1.0, nh);
+    return fresnel_reflectance(clamp(cos_theta_i, LAYER_COS_THETA_MIN, 1.0), 1.0, nh);
 }
 
 // 1 for the layers in use, 0 beyond.

@@ -7,12 +7,7 @@
 #include "lib/complex.glsl"
 #include "lib/microfacet.glsl"
 
-const int LOBES_MAX = 4;             // explorer.physics.lobes.MAX_INTERFACES
-const int FGD_COS_COUNT = 33;
-const int FGD_ALPHA_COUNT = 16;
-const int FGD_ETA_COUNT = 33;
-const float ETA_TABLE_MAX = 4.0;
-const float LOBES_COS_MIN = 1e-4;
+#include "generated/lobes.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
 // A stack (Bati et al., Table 1): medium i has index eta[i] (eta[0] the ambient), optical depth tau[i];
 // interface i (top of medium i) roughness alpha[i]. The base (medium count) is a conductor of index
@@ -28,7 +23,6 @@ struct LobeStack {
     vec3 kappa_base;
 };
 
-const float VARIANCE_MAX = 1e6;  // explorer.physics.lobes.VARIANCE_MAX: f(1) diverges; 0 x it must stay 0
 float variance_from_roughness(float alpha) {
     float a = pow(clamp(alpha, 0.0, 1.0), 1.1);
     return min(a / max(1.0 - a, 1.0 / VARIANCE_MAX), VARIANCE_MAX);

@@ -2,7 +2,7 @@
 // Directions point away from the surface; the normal is N (n = +z in the numpy twin).
 #include "lib/complex.glsl"
 
-const float ALPHA_MIN = 1e-6;
+#include "generated/microfacet.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
 // Eq. 18: alpha^2 / (pi (alpha^2 cos^2 + sin^2)^2), with sin^2 = (1 - c)(1 + c): exact at m = n.
 float ggx_D(float cos_theta_m, float alpha) {

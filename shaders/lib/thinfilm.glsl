@@ -25,16 +25,8 @@
 uniform sampler2D sensitivity_fourier;
 
 // explorer.physics.thinfilm.COS_THETA_MIN (renamed: lib/bragg.glsl has its own COS_THETA_MIN).
-const float FILM_COS_THETA_MIN = 1e-6;
-const vec3 NAIVE_WAVELENGTHS = vec3(606.0, 539.0, 445.0);
-const float SENSITIVITY_FOURIER_STEP = 10.0;
-const vec3 SENSITIVITY_FOURIER_CARRIER_NM = vec3(653.0, 546.0, 441.0);
+#include "generated/thinfilm.glsl"  // the constants shared with explorer/physics (generated at assembly)
 // The paper's Gaussian fits of the XYZ sensitivities in Fourier space (Fig. 5(b-c)).
-const vec3 GAUSSIAN_FIT_VAL = vec3(5.4856e-13, 4.4201e-13, 5.2481e-13);
-const vec3 GAUSSIAN_FIT_POS = vec3(1.6810e06, 1.7953e06, 2.2084e06);
-const vec3 GAUSSIAN_FIT_VAR = vec3(4.3278e09, 9.3046e09, 6.6121e09);
-const vec3 GAUSSIAN_FIT_X2 = vec3(9.7470e-14, 2.2399e06, 4.5282e09);
-const float GAUSSIAN_FIT_NORM = 1.0685e-7;
 // sensitivity: 0 = 'table', 1 = 'gaussian' (the 'exact' transform is numpy's validation only).
 const int SENSITIVITY_TABLE = 0;
 const int SENSITIVITY_GAUSSIAN = 1;
@@ -42,7 +34,6 @@ const int SENSITIVITY_GAUSSIAN = 1;
 // needs the harmonic m_max + 1: the sample arrays hold SAMPLES = M_MAX_LIMIT + 2 entries.
 const int M_MAX_LIMIT = 3;
 const int SAMPLES = M_MAX_LIMIT + 2;
-const float REMAINDER_MIN = 1e-15;
 
 // ---- Complex helpers ----------------------------------------------------------------------------
 
@@ -309,8 +300,6 @@ void sensitivity_fourier_transform(float mu, int sensitivity, out vec3 re, out v
 // use: 4096 x (2 x PREFILTER_LEVELS) texels, rows k = 0..127 the real parts and rows 128 + k the imaginary
 // parts of the envelope convolved with a Gaussian of standard deviation k PREFILTER_SIGMA_STEP nm.
 uniform sampler2D sensitivity_fourier_prefiltered;
-const float PREFILTER_SIGMA_STEP = 6.25;
-const int PREFILTER_LEVELS = 128;
 
 // The envelope at OPD mean mu and standard deviation sigma, bilinear in (mu, sigma) by texelFetch as numpy
 // does; false beyond the last mu node; sigma clamped to the last level.
@@ -475,7 +464,6 @@ vec3 fourier_rgb(float eta_1, float eta_2, float eta_3, float kappa_3, float cos
 
 // ---- Parametrisation by the OPD at normal incidence (Section 5) ----------------------------------
 
-const float D_INC_BLEND = 30.0;
 
 // D_inc = 2 eta_2 d.
 float D_inc(float eta_2, float thickness_d) { return 2.0 * eta_2 * thickness_d; }
