@@ -89,21 +89,17 @@ class DisplayPass:
         self.program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=DISPLAY_SHADER)
         self._targets: dict[object, object] = {}
         self._drawn: dict[object, tuple] = {}  # what each target shows: redrawn only when that changes
-        self._blank = ctx.texture((1, 1), 4, np.zeros(4, np.float32).tobytes(), dtype="f4")
+        self.resources = renderer.resources
+        self._blank = self.resources.texture(np.zeros((1, 1, 4), np.float32))
         # Bound after each draw: moderngl rebinds its current framebuffer when it creates others, which
         # must never be the released temporary one.
-        self._parking = ctx.framebuffer(color_attachments=[ctx.texture((1, 1), 4)])
+        self._parking = self.resources.framebuffer(1, 1, dtype="f1", origin="display")
 
     def target(self, key, size):
         """The RGBA8 texture shown for ``key`` (created or resized on demand)."""
-        texture = self._targets.get(key)
-        if texture is None or texture.size != tuple(size):
-            if texture is not None:
-                texture.release()
-            texture = self._targets[key] = self.ctx.texture(tuple(size), 4)
-            import moderngl
-
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)  # shown 1:1; and cheaper to sample
+        # NEAREST: shown 1:1, and cheaper to sample.
+        texture = self._targets[key] = self.resources.replace(self._targets.get(key), size=tuple(size), components=4,
+                                                              dtype="f1", origin="display")
         return texture
 
     def _bindings(self, view: ProgressiveView, suffix: str, uniforms: dict, textures: dict) -> None:
@@ -133,8 +129,8 @@ class DisplayPass:
         self._bindings(b if b is not None else a, "b", uniforms, textures)
         # A framebuffer only for this draw: on llvmpipe, sampling a texture that is still attached to a
         # framebuffer makes every ImGui draw that shows it flush the window's whole scene (~25 ms each).
-        framebuffer = self.ctx.framebuffer(color_attachments=[texture])
+        framebuffer = self.resources.wrap([texture])
         self.renderer.draw(self.program, framebuffer, uniforms=uniforms, textures=textures, finish=False)
         self._parking.use()
-        framebuffer.release()
+        self.resources.release(framebuffer)
         return texture

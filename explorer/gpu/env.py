@@ -19,19 +19,12 @@ PASS_BUDGET_MS = 50.0
 MAX_SAMPLES_PER_PASS = 256
 
 
-def environment_texture(ctx, environment: EnvironmentMap):
-    """``environment`` as a float RGB texture of ``ctx``: LINEAR, repeat in u, clamp in v, row 0 at v = 0."""
-    import moderngl
-
-    from explorer.gpu.context import gl_limits
-
-    # Beyond GL_MAX_TEXTURE_SIZE the driver makes no texture and sampling reads zeros: refuse first.
-    gl_limits(ctx).check_texture(environment.width, environment.height, 3, environment.name)
-    texture = ctx.texture((environment.width, environment.height), 3, environment.pixels.tobytes(), dtype="f4")
-    texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
-    texture.repeat_x = True
-    texture.repeat_y = False
-    return texture
+def environment_texture(resources, environment: EnvironmentMap):
+    """``environment`` as a float RGB texture (``resources``: the renderer's :class:`explorer.gpu.resources.GLResources`):
+    LINEAR, repeat in u, clamp in v, row 0 at v = 0. Beyond GL_MAX_TEXTURE_SIZE the driver would make no
+    texture and sampling read zeros: the limits are checked first."""
+    return resources.texture(environment.pixels.reshape(environment.height, environment.width, 3), linear=True,
+                             repeat_x=True, origin=environment.name)
 
 
 #: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
@@ -92,7 +85,7 @@ class ProgressiveEnvRender:
         #: Measured cost of one sample over the whole image (ms), None before the first.
         self.sample_ms: float | None = None
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
-        self._texture = environment_texture(self.ctx, environment)
+        self._texture = environment_texture(renderer.resources, environment)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
@@ -216,10 +209,7 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self._framebuffer.release()
-        for target in self._targets:
-            target.release()
-        self._texture.release()
+        self.renderer.resources.release(self._framebuffer, self._texture)
 
 
 def render_env(

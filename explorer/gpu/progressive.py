@@ -111,20 +111,10 @@ class ProgressiveView:
         self.full = self._framebuffer(size)
 
     def _framebuffer(self, size):
-        import moderngl
+        return self.renderer.resources.framebuffer(*size, origin="view size")
 
-        from explorer.gpu.context import gl_limits
-
-        gl_limits(self.ctx).check_target(*size, origin="view size")
-        texture = self.ctx.texture(size, 4, dtype="f4")
-        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        return self.ctx.framebuffer(color_attachments=[texture])
-
-    @staticmethod
-    def _release(framebuffer) -> None:
-        for attachment in framebuffer.color_attachments:
-            attachment.release()
-        framebuffer.release()
+    def _release(self, framebuffer) -> None:
+        self.renderer.resources.release(framebuffer)
 
     # -- drawing -----------------------------------------------------------------------------------
 

@@ -19,6 +19,7 @@ from explorer.views.geometry import light_direction
 from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
+from explorer.gpu.resources import GLResources
 
 
 class Renderer:
@@ -28,6 +29,8 @@ class Renderer:
         self.ctx = ctx if ctx is not None else create_context()
         #: What this context allows, checked before every size-dependent allocation.
         self.limits: GLLimits = gl_limits(self.ctx)
+        #: The owner of every texture and framebuffer made for this context (explorer.gpu.resources).
+        self.resources = GLResources(self.ctx, self.limits)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
         self._model_textures: dict[str, object] = {}
@@ -42,13 +45,7 @@ class Renderer:
 
     def _texture(self, data: np.ndarray, linear: bool):
         """A float RGB texture of ``(height, width, 3)`` data (row 0 = texel row 0), clamped."""
-        import moderngl
-
-        data = np.ascontiguousarray(data, dtype=np.float32)
-        texture = self.ctx.texture((data.shape[1], data.shape[0]), 3, data.tobytes(), dtype="f4")
-        texture.filter = (moderngl.LINEAR, moderngl.LINEAR) if linear else (moderngl.NEAREST, moderngl.NEAREST)
-        texture.repeat_x = texture.repeat_y = False
-        return texture
+        return self.resources.texture(data, linear=linear)
 
     def _model_texture(self, name: str, table: np.ndarray):
         """
@@ -58,19 +55,12 @@ class Renderer:
         data = np.ascontiguousarray(table, dtype=np.float32)
         if data.ndim == 2:
             data = data.reshape(1, -1, 3)
-        texture = self._model_textures.get(name)
-        if texture is not None and texture.size == (data.shape[1], data.shape[0]):
-            texture.write(data.tobytes())
-            return texture
-        if texture is not None:
-            texture.release()
-        texture = self._model_textures[name] = self._texture(data, linear=True)
+        texture = self._model_textures[name] = self.resources.replace(self._model_textures.get(name), data, linear=True, origin=name)
         return texture
 
     def _library_textures(self) -> dict[str, object]:
-        fourier = self.ctx.texture(
-            (thinfilm.SENSITIVITY_FOURIER_COUNT, 2), 3, luts.load("sensitivity_fourier").astype("f4").tobytes(), dtype="f4"
-        )
+        # (2, 4096, 3) as a 4096 x 2 texture: rows 0 and 1, the real and imaginary parts.
+        fourier = self.resources.texture(luts.load("sensitivity_fourier").reshape(2, thinfilm.SENSITIVITY_FOURIER_COUNT, 3))
         return {
             "cmf_1nm": self._texture(luts.load("cmf_1nm").reshape(1, -1, 3), linear=False),
             "cmf_cumulative": self._texture(luts.load("cmf_cumulative").reshape(1, -1, 3), linear=True),
@@ -80,22 +70,12 @@ class Renderer:
 
     def _input_textures(self, inputs: Mapping[str, np.ndarray]) -> dict[str, object]:
         """A view's per-render inputs (``(h, w)`` or ``(h, w, c)`` float arrays, row 0 = texel row 0) as NEAREST textures."""
-        import moderngl
 
         for name, array in inputs.items():
             shape = np.shape(array)
             self.limits.check_texture(shape[1], shape[0], shape[2] if len(shape) > 2 else 1, name)
-        for texture in self._inputs.values():
-            texture.release()
-        self._inputs = {}
-        for name, array in inputs.items():
-            data = np.ascontiguousarray(array, dtype=np.float32)
-            if data.ndim == 2:
-                data = data[..., None]
-            texture = self.ctx.texture((data.shape[1], data.shape[0]), data.shape[2], data.tobytes(), dtype="f4")
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            texture.repeat_x = texture.repeat_y = False
-            self._inputs[name] = texture
+        self.resources.release(*self._inputs.values())
+        self._inputs = {name: self.resources.texture(array, origin=name) for name, array in inputs.items()}
         return self._inputs
 
     def program(self, material: Material, view: str, values: Mapping[str, object] | None = None):
@@ -167,10 +147,7 @@ class Renderer:
             if "sensitivity_fourier_prefiltered" not in self._library:
                 from explorer.physics.thinfilm import sensitivity_fourier_prefiltered
 
-                table = sensitivity_fourier_prefiltered()
-                self._library["sensitivity_fourier_prefiltered"] = self.ctx.texture(
-                    (table.shape[1], table.shape[0]), 3, np.ascontiguousarray(table, dtype=np.float32).tobytes(), dtype="f4"
-                )
+                self._library["sensitivity_fourier_prefiltered"] = self.resources.texture(sensitivity_fourier_prefiltered())
             textures["sensitivity_fourier_prefiltered"] = self._library["sensitivity_fourier_prefiltered"]
         if inputs:
             textures.update(self._input_textures(inputs))
@@ -273,25 +250,10 @@ class Renderer:
         A framebuffer of ``count`` float RGBA attachments (renderbuffers, or textures), checked against
         :attr:`limits` first; a driver that still finds it incomplete is a :class:`GLLimitError` too.
         """
-        import moderngl
+        return self.resources.framebuffer(width, height, count, texture=texture)
 
-        from explorer.gpu.context import GLLimitError
-
-        self.limits.check_target(width, height)
-        make = self.ctx.texture if texture else self.ctx.renderbuffer
-        attachments = [make((width, height), 4, dtype="f4") for _ in range(count)]
-        try:
-            return self.ctx.framebuffer(color_attachments=attachments)
-        except moderngl.Error as error:
-            for attachment in attachments:
-                attachment.release()
-            raise GLLimitError("--size", None, f"{width}x{height}: this GL cannot allocate it ({' '.join(str(error).split())})") from None
-
-    @staticmethod
-    def _release(framebuffer) -> None:
-        for attachment in framebuffer.color_attachments:
-            attachment.release()
-        framebuffer.release()
+    def _release(self, framebuffer) -> None:
+        self.resources.release(framebuffer)
 
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,

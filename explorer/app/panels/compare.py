@@ -76,7 +76,6 @@ class ComparePanel(Panel):
         delta_e, self.state.mean_delta_e = data.delta_e_map(a.read(), b.read(), mask)
         rgba = data.heat_map_rgba(delta_e)
         rgba[~mask] = (0, 0, 0, 255)
-        if self._heat_texture is None or self._heat_texture.size != a.size:
-            self._heat_texture = self.app.ctx.texture(a.size, 4)
-        self._heat_texture.write(np.ascontiguousarray(rgba[::-1]).tobytes())
+        self._heat_texture = self.app.renderer.resources.replace(self._heat_texture, np.ascontiguousarray(rgba[::-1]),
+                                                                 dtype="f1", linear=True, origin="ΔE map")
         self._heat_generation = generation

@@ -431,12 +431,6 @@ class InversePanel(Panel):
         if generation == self._generation:
             return texture
         image = class_image(cls)
-        size = (image.shape[1], image.shape[0])
-        if texture is None or texture.size != size:
-            if texture is not None:
-                texture.release()
-            texture = self.app.ctx.texture(size, 4)
-            texture.filter = (self.app.ctx.NEAREST, self.app.ctx.NEAREST)
-        texture.write(image.tobytes())
+        texture = self.app.renderer.resources.replace(texture, image, dtype="f1", origin="class plot")
         self._textures[k] = (self._generation, texture)
         return texture

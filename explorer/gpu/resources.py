@@ -1,0 +1,134 @@
+"""
+The one owner of the package's GL textures and framebuffers (after moderngl-window's resource owners).
+
+Every texture and framebuffer the host makes comes from a :class:`GLResources` (the renderer's, shared
+by the app's passes and panels): one factory for textures (float or 8-bit, from an array or empty,
+filtered and wrapped as asked, checked against the context's limits), one for framebuffers with their
+attachments, and one way to release both. What it made it releases: :meth:`release` frees an object
+(a framebuffer with its attachments), :meth:`replace` rewrites a texture in place or swaps it for a new
+one of another shape, and :meth:`close` (or leaving a ``with`` block) frees everything still owned.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.gpu.context import GLLimitError, GLLimits, gl_limits
+
+
+class GLResources:
+    """Textures and framebuffers of one GL context, released by whoever made them: this object."""
+
+    def __init__(self, ctx, limits: GLLimits | None = None):
+        self.ctx = ctx
+        self.limits = limits if limits is not None else gl_limits(ctx)
+        self._owned: dict[int, object] = {}  # id -> object, in creation order
+        self._wrappers: set[int] = set()  # framebuffers over textures owned elsewhere: released alone
+
+    # -- textures ----------------------------------------------------------------------------------
+
+    def texture(self, data: np.ndarray | None = None, *, size: tuple[int, int] | None = None, components: int = 3,
+                dtype: str = "f4", linear: bool = False, repeat_x: bool = False, repeat_y: bool = False,
+                origin: str = "texture"):
+        """
+        A texture of ``data`` (``(height, width)`` or ``(height, width, components)``; row 0 = texel row 0),
+        or an empty one of ``size = (width, height)`` and ``components``. ``dtype``: ``"f4"`` (float) or
+        ``"f1"`` (8 bits, ``data`` in bytes). Nearest or linear filtering, clamped unless repeated.
+        Checked against the context's limits first (``origin`` names the input in the error).
+        """
+        import moderngl
+
+        if data is not None:
+            data = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
+            if data.ndim == 2:
+                data = data[..., None]
+            size, components = (data.shape[1], data.shape[0]), data.shape[2]
+        if size is None:
+            raise ValueError("a texture needs data or a size")
+        self.limits.check_texture(int(size[0]), int(size[1]), components, origin)
+        texture = self.ctx.texture(tuple(int(s) for s in size), components, None if data is None else data.tobytes(), dtype=dtype)
+        texture.filter = (moderngl.LINEAR, moderngl.LINEAR) if linear else (moderngl.NEAREST, moderngl.NEAREST)
+        texture.repeat_x, texture.repeat_y = repeat_x, repeat_y
+        self._owned[id(texture)] = texture
+        return texture
+
+    def replace(self, texture, data: np.ndarray | None = None, **options):
+        """
+        ``texture`` rewritten with ``data`` when the shape is the same, else released and replaced by a new
+        one (:meth:`texture` with ``options``); ``texture`` may be None. Returns the texture to use.
+        """
+        dtype = options.get("dtype", "f4")
+        if data is not None:
+            array = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
+            shape = (array.shape[1], array.shape[0])
+            components = array.shape[2] if array.ndim == 3 else 1
+            if texture is not None and texture.size == shape and texture.components == components:
+                texture.write(array.tobytes())
+                return texture
+        elif texture is not None and texture.size == tuple(options.get("size", ())):
+            return texture
+        if texture is not None:
+            self.release(texture)
+        return self.texture(data, **options)
+
+    # -- framebuffers ------------------------------------------------------------------------------
+
+    def framebuffer(self, width: int, height: int, count: int = 1, *, texture: bool = True, dtype: str = "f4",
+                    origin: str = "--size"):
+        """
+        A framebuffer of ``count`` RGBA attachments (NEAREST textures, or renderbuffers), checked against
+        the limits; a driver that still finds it incomplete raises :class:`GLLimitError` too.
+        """
+        import moderngl
+
+        self.limits.check_target(width, height, origin=origin)
+        if texture:
+            attachments = [self.texture(size=(width, height), components=4, dtype=dtype, origin=origin) for _ in range(count)]
+        else:
+            attachments = [self.ctx.renderbuffer((width, height), 4, dtype=dtype) for _ in range(count)]
+            for attachment in attachments:
+                self._owned[id(attachment)] = attachment
+        try:
+            framebuffer = self.ctx.framebuffer(color_attachments=attachments)
+        except moderngl.Error as error:
+            self.release(*attachments)
+            raise GLLimitError(origin, None, f"{width}x{height}: this GL cannot allocate it ({' '.join(str(error).split())})") from None
+        self._owned[id(framebuffer)] = framebuffer
+        return framebuffer
+
+    def wrap(self, attachments):
+        """A framebuffer over textures already owned (drawn into once; :meth:`release` leaves them)."""
+        framebuffer = self.ctx.framebuffer(color_attachments=list(attachments))
+        self._owned[id(framebuffer)] = framebuffer
+        self._wrappers.add(id(framebuffer))
+        return framebuffer
+
+    # -- release -----------------------------------------------------------------------------------
+
+    def release(self, *objects) -> None:
+        """Free ``objects`` (a framebuffer with the attachments it was made with); None is skipped."""
+        for obj in objects:
+            if obj is None:
+                continue
+            if hasattr(obj, "color_attachments") and id(obj) not in self._wrappers:
+                self.release(*obj.color_attachments)
+            self._wrappers.discard(id(obj))
+            self._owned.pop(id(obj), None)
+            obj.release()
+
+    def owned(self) -> int:
+        """How many objects are still owned (tests, leak checks)."""
+        return len(self._owned)
+
+    def close(self) -> None:
+        """Release everything still owned, newest first."""
+        for obj in reversed(list(self._owned.values())):
+            obj.release()
+        self._owned.clear()
+        self._wrappers.clear()
+
+    def __enter__(self) -> GLResources:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
