@@ -364,3 +364,24 @@ def test_unexpected_error_is_one_line_unless_debug(monkeypatch):
     assert "Traceback" in run.stderr and run.returncode == 1
     monkeypatch.setenv(commands.DEBUG_ENV, "1")
     assert "Traceback" in run_cli("info", "bragg_mirror").stderr
+
+
+@pytest.mark.parametrize("material, view", [("bragg_mirror", "sphere"), ("thin_film", "lit"), ("thin_film", "textured"),
+                                            ("layered_lobes", "slice")])
+def test_numpy_views_in_chunks_are_the_same_image(monkeypatch, material, view):
+    """The numpy engine evaluates pixels in chunks (bounded memory at any --size): the same image as at once."""
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import model_for
+    from explorer.resources import builtin_materials
+    from explorer.views import render
+
+    loaded = load_material(builtin_materials()[material])
+    model = model_for(loaded, loaded.resolve())
+    whole = render.render_numpy(model, view, 24, 24)
+    monkeypatch.setattr(render, "CHUNK_PIXELS", 37)
+    np.testing.assert_array_equal(render.render_numpy(model, view, 24, 24), whole)
+
+
+def test_numpy_engine_has_the_same_image_budget(tmp_path):
+    line = one_line_error(run_cli("render", "bragg_mirror", "--engine", "numpy", "--size", "16384", "--out", tmp_path / "x.png"))
+    assert "16384x16384 is more than the 67108864 pixels" in line
