@@ -385,3 +385,10 @@ def test_numpy_views_in_chunks_are_the_same_image(monkeypatch, material, view):
 def test_numpy_engine_has_the_same_image_budget(tmp_path):
     line = one_line_error(run_cli("render", "bragg_mirror", "--engine", "numpy", "--size", "16384", "--out", tmp_path / "x.png"))
     assert "16384x16384 is more than the 67108864 pixels" in line
+
+
+def test_env_samples_are_bounded_by_the_float32_count(tmp_path):
+    from explorer.gpu.env import MAX_SPP
+
+    args = ("render", "bragg_mirror", "--view", "env", "--size", "1", "--spp", str(MAX_SPP + 1), "--out", tmp_path / "x.png")
+    assert f"at most {MAX_SPP}" in one_line_error(run_cli(*args))
