@@ -392,3 +392,28 @@ def test_env_samples_are_bounded_by_the_float32_count(tmp_path):
 
     args = ("render", "bragg_mirror", "--view", "env", "--size", "1", "--spp", str(MAX_SPP + 1), "--out", tmp_path / "x.png")
     assert f"at most {MAX_SPP}" in one_line_error(run_cli(*args))
+
+
+@pytest.mark.parametrize("name", ["p.json", "p.bparam"])
+def test_app_parameter_saves_are_atomic(tmp_path, monkeypatch, name):
+    """The app's Files tab saves through the same helper: a failed save keeps the old file, leaves nothing else."""
+    from explorer import files
+    from explorer.app.parameter_files import ParameterFileError, save_values
+    from explorer.materials.brd import load_material
+
+    material = load_material(REPO_ROOT / "shaders" / "thin_film.brd")
+    target = tmp_path / name
+    target.write_text("old")
+
+    def full_disk(*_):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(files.os, "replace", full_disk)
+    with pytest.raises(ParameterFileError, match="No space left on device"):
+        save_values(target, material, material.resolve())
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == [name]
+    monkeypatch.undo()
+    save_values(target, material, material.resolve())
+    assert target.read_text() != "old" and [p.name for p in tmp_path.iterdir()] == [name]
+    with pytest.raises(ParameterFileError, match="does not exist"):
+        save_values(tmp_path / "missing" / name, material, material.resolve())
