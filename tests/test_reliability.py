@@ -417,3 +417,11 @@ def test_app_parameter_saves_are_atomic(tmp_path, monkeypatch, name):
     assert target.read_text() != "old" and [p.name for p in tmp_path.iterdir()] == [name]
     with pytest.raises(ParameterFileError, match="does not exist"):
         save_values(tmp_path / "missing" / name, material, material.resolve())
+
+
+@pytest.mark.parametrize("first_line", ["hunter2", "root:x:0:0:root:/root:/bin/bash", "API_KEY = abc", "\u00e9t\u00e9 42"])
+def test_a_file_that_is_no_material_is_named_not_quoted(tmp_path, first_line):
+    path = tmp_path / "secret"
+    path.write_text(first_line + "\nmore\n")
+    line = one_line_error(run_cli("info", path))
+    assert "not a material file" in line and first_line.split()[0] not in line.replace(str(path), "")
