@@ -425,3 +425,14 @@ def test_a_file_that_is_no_material_is_named_not_quoted(tmp_path, first_line):
     path.write_text(first_line + "\nmore\n")
     line = one_line_error(run_cli("info", path))
     assert "not a material file" in line and first_line.split()[0] not in line.replace(str(path), "")
+
+
+def test_json_integers_stay_integers(tmp_path):
+    """A bool written 1 and an int written 3 load as before (integers are not read as floats)."""
+    from explorer.app.parameter_files import load_json
+    from explorer.materials.brd import load_material
+
+    path = tmp_path / "p.json"
+    path.write_text('{"values": {"coating": 1, "layers": 3}}')
+    loaded = load_json(path, load_material(REPO_ROOT / "shaders" / "bragg_stack.brd"))
+    assert loaded.values == {"coating": True, "layers": 3.0}
