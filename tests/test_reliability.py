@@ -6,14 +6,11 @@ confined includes, the table cache). GL rows run the CLI in a subprocess (run_cl
 
 from __future__ import annotations
 
-import json
-import os
 import signal
 import subprocess
 import sys
 import textwrap
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
