@@ -38,7 +38,3 @@ class LocatedError(Exception):
 
 class OutputError(Exception):
     """An output file cannot be written (one line naming it); raised before any work where it can be."""
-
-
-class InternalError(Exception):
-    """Marks a bug: an error that bad input should never cause (the CLI reports it as one)."""

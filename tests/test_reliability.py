@@ -361,3 +361,75 @@ def test_unexpected_error_is_one_line_unless_debug(monkeypatch):
     assert "Traceback" in run.stderr and run.returncode == 1
     monkeypatch.setenv(commands.DEBUG_ENV, "1")
     assert "Traceback" in run_cli("info", "bragg_mirror").stderr
+
+
+@pytest.mark.parametrize("material, view", [("bragg_mirror", "sphere"), ("thin_film", "lit"), ("thin_film", "textured"),
+                                            ("layered_lobes", "slice")])
+def test_numpy_views_in_chunks_are_the_same_image(monkeypatch, material, view):
+    """The numpy engine evaluates pixels in chunks (bounded memory at any --size): the same image as at once."""
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import model_for
+    from explorer.resources import builtin_materials
+    from explorer.views import render
+
+    loaded = load_material(builtin_materials()[material])
+    model = model_for(loaded, loaded.resolve())
+    whole = render.render_numpy(model, view, 24, 24)
+    monkeypatch.setattr(render, "CHUNK_PIXELS", 37)
+    np.testing.assert_array_equal(render.render_numpy(model, view, 24, 24), whole)
+
+
+def test_numpy_engine_has_the_same_image_budget(tmp_path):
+    line = one_line_error(run_cli("render", "bragg_mirror", "--engine", "numpy", "--size", "16384", "--out", tmp_path / "x.png"))
+    assert "16384x16384 is more than the 67108864 pixels" in line
+
+
+def test_env_samples_are_bounded_by_the_float32_count(tmp_path):
+    from explorer.gpu.env import MAX_SPP
+
+    args = ("render", "bragg_mirror", "--view", "env", "--size", "1", "--spp", str(MAX_SPP + 1), "--out", tmp_path / "x.png")
+    assert f"at most {MAX_SPP}" in one_line_error(run_cli(*args))
+
+
+@pytest.mark.parametrize("name", ["p.json", "p.bparam"])
+def test_app_parameter_saves_are_atomic(tmp_path, monkeypatch, name):
+    """The app's Files tab saves through the same helper: a failed save keeps the old file, leaves nothing else."""
+    from explorer import files
+    from explorer.app.parameter_files import ParameterFileError, save_values
+    from explorer.materials.brd import load_material
+
+    material = load_material(REPO_ROOT / "shaders" / "thin_film.brd")
+    target = tmp_path / name
+    target.write_text("old")
+
+    def full_disk(*_):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(files.os, "replace", full_disk)
+    with pytest.raises(ParameterFileError, match="No space left on device"):
+        save_values(target, material, material.resolve())
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == [name]
+    monkeypatch.undo()
+    save_values(target, material, material.resolve())
+    assert target.read_text() != "old" and [p.name for p in tmp_path.iterdir()] == [name]
+    with pytest.raises(ParameterFileError, match="does not exist"):
+        save_values(tmp_path / "missing" / name, material, material.resolve())
+
+
+@pytest.mark.parametrize("first_line", ["hunter2", "root:x:0:0:root:/root:/bin/bash", "API_KEY = abc", "\u00e9t\u00e9 42"])
+def test_a_file_that_is_no_material_is_named_not_quoted(tmp_path, first_line):
+    path = tmp_path / "secret"
+    path.write_text(first_line + "\nmore\n")
+    line = one_line_error(run_cli("info", path))
+    assert "not a material file" in line and first_line.split()[0] not in line.replace(str(path), "")
+
+
+def test_json_integers_stay_integers(tmp_path):
+    """A bool written 1 and an int written 3 load as before (integers are not read as floats)."""
+    from explorer.app.parameter_files import load_json
+    from explorer.materials.brd import load_material
+
+    path = tmp_path / "p.json"
+    path.write_text('{"values": {"coating": 1, "layers": 3}}')
+    loaded = load_json(path, load_material(REPO_ROOT / "shaders" / "bragg_stack.brd"))
+    assert loaded.values == {"coating": True, "layers": 3.0}

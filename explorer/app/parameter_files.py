@@ -119,13 +119,19 @@ def _apply(material: Material, raw: Mapping[str, object], where: str, lines: Map
     return result
 
 
+def _json_int(digits: str) -> int | float:
+    """
+    A JSON integer: an ``int``, or beyond Python's digit limit for ``int()`` (4300) a float, infinite: the
+    parameter's range then refuses it naming the key, as it does an int too large for a float (``1e400``).
+    """
+    return int(digits) if len(digits) <= 1000 else float(digits)
+
+
 def load_json(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
     """Read values saved by :func:`save_json` and check them against ``material``."""
     where = _display(path)
     try:
-        # Integers as floats: one too long for an int (Python's 4300-digit limit) or for a float (1e400)
-        # is then an infinite value, which the parameter's range refuses, naming the key.
-        document = json.loads(Path(path).read_text(encoding="utf-8"), parse_int=float)
+        document = json.loads(Path(path).read_text(encoding="utf-8"), parse_int=_json_int)
     except OSError as error:
         raise ParameterFileError(where, None, f"cannot read ({error.strerror or error})") from None
     except (UnicodeDecodeError, json.JSONDecodeError) as error:

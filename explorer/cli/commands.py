@@ -136,6 +136,7 @@ def render_material(
             raise MaterialError(material.path, None, "this material has no numpy twin (no known '# model:' line)")
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
+        check_numpy_size(width, height)
         return render_numpy(model, view, width, height, light=light, thickness=thickness)
     from explorer.gpu import Renderer
 
@@ -150,6 +151,16 @@ def render_material(
     return renderer.render(material, values, view, width, height, light=light)
 
 
+def check_numpy_size(width: int, height: int) -> None:
+    """The numpy engine's image budget: the GL engine's (:data:`explorer.gpu.context.MAX_IMAGE_BYTES`), without a context."""
+    from explorer.gpu.context import MAX_IMAGE_BYTES
+
+    pixels = MAX_IMAGE_BYTES // 16
+    if width * height > pixels:
+        raise LocatedError("--size", None, f"{width}x{height} is more than the {pixels} pixels of an image "
+                                           f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
+
+
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
@@ -162,6 +173,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         model = model_for(material, values)
         if model is None or not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, "its numpy twin has no brdf(): no env view with --engine numpy")
+        check_numpy_size(width, height)
     start = last = time.perf_counter()
     unit = "samples per pixel" if engine == "gl" else "pixels"
 

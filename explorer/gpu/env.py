@@ -10,6 +10,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from explorer.errors import LocatedError
 from explorer.views.env import EnvironmentMap, env_integral_numpy
 from explorer.gpu.renderer import Renderer
 
@@ -26,6 +27,10 @@ def environment_texture(resources, environment: EnvironmentMap):
     return resources.texture(environment.pixels.reshape(environment.height, environment.width, 3), linear=True,
                              repeat_x=True, origin=environment.name)
 
+
+#: The most samples per pixel: the float32 count (alpha) of the sums stops growing at 2^24, and the mean
+#: would then be silently wrong.
+MAX_SPP = 1 << 24
 
 #: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
 BAND_PROBE_ROWS = 8
@@ -223,6 +228,8 @@ def render_env(
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
     pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
     """
+    if not 1 <= spp <= MAX_SPP:
+        raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
     environment = EnvironmentMap.default() if environment is None else environment
     if engine == "numpy":
         from explorer.materials.models import model_for

@@ -137,6 +137,8 @@ _PARAMETER_USAGE = {
 COLOR_RANGE = (0.0, 1.0)
 # An int is uploaded as a float uniform holding an exact integer: shader code keeps its float arithmetic.
 _GLSL_TYPES = {"float": "float", "int": "float", "bool": "bool", "color": "vec3"}
+# BRDF Explorer's other kinds of BRDF file (BRDFBase subclasses): named when a file starts with one.
+_OTHER_KINDS = frozenset({"measured", "image", "imageslice", "merl", "lobe"})
 _TRUE_WORDS = frozenset({"1", "true", "yes", "on"})
 _FALSE_WORDS = frozenset({"0", "false", "no", "off"})
 
@@ -578,11 +580,11 @@ class _Parser:
             )
         elif kind.startswith("::"):
             raise self.error(number, f"missing 'analytic' header before {kind!r}")
-        elif _IDENTIFIER_RE.match(kind) and len(kind) <= 32:
+        elif kind in _OTHER_KINDS:
             raise self.error(
                 number, f"unsupported material kind {kind!r}; only 'analytic' materials can be loaded"
             )
-        else:  # not a word: the file is likely no material at all, and its text is not shown
+        else:  # likely no material at all: its text is not shown (it may be any file, a secret one too)
             raise self.error(number, "not a material file (expected 'analytic' on the first line)")
 
     def begin(self, number: int, tokens: list[str]) -> None:

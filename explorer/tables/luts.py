@@ -27,6 +27,7 @@ import contextlib
 import hashlib
 import io
 import json
+import os
 import sys
 from pathlib import Path
 from dataclasses import dataclass, field
@@ -142,18 +143,21 @@ def staleness(name: str, directory: Path = LUT_DIR) -> str | None:
 
 @contextlib.contextmanager
 def _manifest_lock(directory: Path):
-    """An exclusive lock on ``directory``'s manifest while it is read, updated and replaced (POSIX; none elsewhere)."""
+    """
+    An exclusive lock on ``directory`` (the folder itself: no lock file is left) while its manifest is read,
+    updated and replaced; POSIX only, none elsewhere.
+    """
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
-    with open(directory / f".{MANIFEST}.lock", "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
+    handle = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(handle)  # releases the lock
 
 
 def generate(name: str, directory: Path = LUT_DIR) -> np.ndarray:

@@ -14,6 +14,18 @@ import numpy as np
 
 from explorer.views.geometry import brdf_view_geometry, disc, view_brdf, view_cos_theta, view_named
 
+#: Pixels a model evaluates at once: a spectral model's per-wavelength arrays stay a few hundred MB
+#: whatever the image size (every model is per pixel, so the chunks change no value).
+CHUNK_PIXELS = 1 << 14
+
+
+def _chunked(function, *arrays) -> np.ndarray:
+    """``function(*arrays)`` over the first axis in chunks of :data:`CHUNK_PIXELS`, concatenated."""
+    count = len(arrays[0])
+    if count <= CHUNK_PIXELS:
+        return function(*arrays)
+    return np.concatenate([function(*(a[i:i + CHUNK_PIXELS] for a in arrays)) for i in range(0, count, CHUNK_PIXELS)])
+
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
@@ -50,7 +62,7 @@ def render_numpy(
         def textured_brdf(L, V, N, X, Y, d_inc, sigma):
             return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter)
 
-        rgb = view_brdf(textured_brdf, *vectors, d_inc[inside], sigma[inside])
+        rgb = _chunked(lambda *a: view_brdf(textured_brdf, *a), *vectors, d_inc[inside], sigma[inside])
         image[inside] = rgb * factor[inside][:, None]
         return image
     if evaluates == "brdf":
@@ -59,7 +71,7 @@ def render_numpy(
         L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
         image = np.zeros((height, width, 3), dtype=np.float32)
         vectors = [a[inside] for a in (L, V, N, X, Y)]
-        image[inside] = view_brdf(model.brdf, *vectors) * factor[inside][:, None]
+        image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]
         return image
     cos_theta, inside = view_cos_theta(view, width, height)
     image = np.zeros((height, width, 3), dtype=np.float32)
@@ -67,5 +79,5 @@ def render_numpy(
         # Every row is the same.
         image[:] = model.reflectance(cos_theta[0])[None, :, :]
     else:
-        image[inside] = model.reflectance(cos_theta[inside])
+        image[inside] = _chunked(model.reflectance, cos_theta[inside])
     return image

@@ -98,8 +98,8 @@ class ParametersPanel(Panel):
                 new = bool(v)
         else:
             changed, v = imgui.color_edit3(name, list(value), imgui.ColorEditFlags_.float | imgui.ColorEditFlags_.hdr)
-            if changed:
-                new = tuple(float(c) for c in v)
+            if changed:  # within the colour's declared range, as a slider keeps a float within its own
+                new = tuple(min(max(float(c), parameter.min), parameter.max) for c in v)
         record(state, f"param:{name}")
         if imgui.is_item_clicked() and io.key_ctrl:
             new = parameter.default
