@@ -67,6 +67,12 @@ class ScriptRobot:
         done = False
         if "wait" in action:
             done = step >= int(action["wait"])
+        elif "wait_for" in action:  # until a panel's report (state.NAME) says it is no longer running
+            report = getattr(state, str(action["wait_for"]), None)
+            done = step > 1 and isinstance(report, dict) and not report.get("running", False)
+            if step > int(action.get("timeout", 3000)):
+                script.log.append(f"wait_for {action['wait_for']}: timed out")
+                done = True
         elif "wait_complete" in action:
             done = step > 1 and app.idle()
             if step > int(action.get("timeout", 2000)):

@@ -428,6 +428,10 @@ from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  
 cli.add_command(inverse_command)
 cli.add_command(figure_command)
 
+from explorer.cli.design import design_command  # noqa: E402  (inverse design of mirrors and films)
+
+cli.add_command(design_command)
+
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point: click's usage errors too end as one line (not click's usage block)."""

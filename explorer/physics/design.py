@@ -365,6 +365,29 @@ def check_target_rgb(rgb, what: str = "colour") -> np.ndarray:
     return rgb
 
 
+def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5) -> list["Target"]:
+    """
+    ``count`` targets from a strip of linear RGB ``(H, W, 3)`` whose column ``i`` shows
+    ``theta_a + (theta_b - theta_a)(i + 0.5) / W`` degrees (as the gradient view draws 0 to 90): evenly
+    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped.
+    """
+    if not (np.isfinite(theta_a) and np.isfinite(theta_b) and 0.0 <= min(theta_a, theta_b)
+            and max(theta_a, theta_b) <= 90.0 and theta_a != theta_b):
+        raise DesignError(f"theta range {theta_a:g},{theta_b:g}: the two angles must differ, within [0, 90]")
+    width = image.shape[1]
+    columns = np.unique(np.clip(np.round((np.arange(count) + 0.5) / count * width - 0.5).astype(int), 0, width - 1))
+    targets = []
+    for i in columns:
+        theta = theta_a + (theta_b - theta_a) * (i + 0.5) / width
+        if theta >= 90.0:
+            continue
+        rgb = check_target_rgb(np.asarray(image)[:, i, :3].mean(axis=0), f"strip column {i}")
+        targets.append(Target(float(theta), tuple(float(c) for c in rgb)))
+    if not targets:
+        raise DesignError("the strip has no column below 90 degrees")
+    return targets
+
+
 # --------------------------------------------------------------------------------------------------
 # The search
 
@@ -745,7 +768,7 @@ def design(
     report(1.0, "done")
     return DesignResult(
         model=model.name,
-        values={k: (int(round(v)) if problem.box[k].integer else float(v)) for k, v in values.items()},
+        values={k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters},
         targets=list(targets),
         achieved_rgb=achieved,
         delta_e2000=problem.delta_e(achieved),
@@ -782,3 +805,41 @@ def reachable_chromaticities(model_name: str, theta_deg: float, ranges: Mapping[
     xyz = colorimetry.rgb_to_xyz(rgb)
     total = np.maximum(xyz.sum(axis=-1), 1e-12)
     return np.stack([xyz[:, 0] / total, xyz[:, 1] / total], axis=-1), xyz[:, 1]
+
+
+#: The round trip's target angles (degrees).
+ROUND_TRIP_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)
+
+
+def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]], rng: np.random.Generator) -> dict[str, float]:
+    """
+    A structure drawn from the declared ranges: uniform in each, except the parameters the search walks on
+    a log scale (``N``: log-uniform, so that thin stacks are drawn as often as thick ones) and integers
+    rounded.
+    """
+    model = design_model(model_name)
+    values = {}
+    for p in parameter_box(model, ranges):
+        value = float(p.from_unit(rng.uniform())) if p.name in model.integer_parameters else float(rng.uniform(*ranges[p.name]))
+        values[p.name] = float(round(value)) if p.integer else value
+    return values
+
+
+def round_trip(model_name: str, ranges: Mapping[str, tuple[float, float]], count: int, seed: int = 0,
+               angles: Sequence[float] = ROUND_TRIP_ANGLES, report: Callable[[int, dict, DesignResult], None] | None = None
+               ) -> list[DesignResult]:
+    """
+    Designs for ``count`` reachable targets: random structures (:func:`random_structure`, seeded), their
+    converged colours at ``angles`` as targets, each designed back from its colours alone.
+    """
+    rng = np.random.default_rng(seed)
+    results = []
+    for k in range(count):
+        truth = random_structure(model_name, ranges, rng)
+        colours = forward_rgb(model_name, truth, angles)
+        targets = [Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(angles, colours)]
+        result = design(model_name, targets, ranges, seed=seed + k)
+        results.append(result)
+        if report is not None:
+            report(k, truth, result)
+    return results
