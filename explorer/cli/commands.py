@@ -366,8 +366,10 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
+              help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app):
+def bench(as_json, size, repeats, thin_film, layers, app, design_count):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -375,6 +377,11 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if design_count is not None:
+        from explorer.cli.design import run_design_bench
+
+        run_design_bench(design_count, as_json=as_json)
+        return
     if app:
         from explorer.cli.bench import run_app_bench
 

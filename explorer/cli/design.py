@@ -192,3 +192,39 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
                    "the structure above is the closest found")
     click.echo(f"render: {render_command(name, result.values)}")
+
+
+def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None) -> None:
+    """
+    The round trip of :func:`explorer.physics.design.round_trip` on ``bragg_mirror``: per mirror the time of
+    a 5-angle design and its median / max CIEDE2000, then the acceptance figures (median of the medians,
+    share at most 1) and the median time.
+    """
+    from explorer.cli.commands import _load
+    from explorer.physics.design import round_trip
+
+    material = _load("bragg_mirror")
+    ranges = ranges_of(material)
+    draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
+    rows = []
+
+    def report(k, truth, result):
+        row = {"truth": truth, "set": result.values, "median_delta_e2000": result.median_delta_e2000,
+               "max_delta_e2000": float(result.delta_e2000.max()), "seconds": result.seconds}
+        rows.append(row)
+        if not as_json:
+            click.echo(f"{k:3d}  {' '.join(f'{n}={v:.4g}' for n, v in truth.items())}  ->  median ΔE2000 "
+                       f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s")
+
+    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw)
+    medians = np.array([r["median_delta_e2000"] for r in rows])
+    seconds = np.array([r["seconds"] for r in rows])
+    summary = {"mirrors": count, "seed": seed, "max_lambda": max_lambda,
+               "median_of_medians": float(np.median(medians)), "share_at_most_1": float(np.mean(medians <= 1.0)),
+               "median_seconds": float(np.median(seconds)), "max_seconds": float(seconds.max())}
+    if as_json:
+        click.echo(json.dumps({"summary": summary, "mirrors": rows}, indent=2))
+        return
+    click.echo(f"{count} mirrors (seed {seed}{'' if max_lambda is None else f', Lambda <= {max_lambda:g} nm'}): median of the "
+               f"per-mirror median ΔE2000 {summary['median_of_medians']:.3f}, {100 * summary['share_at_most_1']:.0f} % at most 1; "
+               f"a 5-angle design: median {summary['median_seconds']:.2f} s, max {summary['max_seconds']:.2f} s")

@@ -826,16 +826,17 @@ def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]],
 
 
 def round_trip(model_name: str, ranges: Mapping[str, tuple[float, float]], count: int, seed: int = 0,
-               angles: Sequence[float] = ROUND_TRIP_ANGLES, report: Callable[[int, dict, DesignResult], None] | None = None
-               ) -> list[DesignResult]:
+               angles: Sequence[float] = ROUND_TRIP_ANGLES, report: Callable[[int, dict, DesignResult], None] | None = None,
+               draw_ranges: Mapping[str, tuple[float, float]] | None = None) -> list[DesignResult]:
     """
-    Designs for ``count`` reachable targets: random structures (:func:`random_structure`, seeded), their
-    converged colours at ``angles`` as targets, each designed back from its colours alone.
+    Designs for ``count`` reachable targets: random structures (:func:`random_structure`, seeded, from
+    ``draw_ranges``, default ``ranges``), their converged colours at ``angles`` as targets, each designed
+    back from its colours alone over ``ranges``.
     """
     rng = np.random.default_rng(seed)
     results = []
     for k in range(count):
-        truth = random_structure(model_name, ranges, rng)
+        truth = random_structure(model_name, {**ranges, **(draw_ranges or {})}, rng)
         colours = forward_rgb(model_name, truth, angles)
         targets = [Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(angles, colours)]
         result = design(model_name, targets, ranges, seed=seed + k)
