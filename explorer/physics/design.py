@@ -57,9 +57,14 @@ FIRST_PASS_SAMPLES = 2048
 #: model's scale parameter (the period, the film's thickness), geometrically spaced over its range. A
 #: mirror's spectrum shifts by about lambda dLambda / Lambda when Lambda moves: its colour turns as fast
 #: in log Lambda everywhere, and high-order mirrors (Lambda ~ 1 um) have many narrow basins in Lambda.
-SCAN_SHAPES = 24
-SCAN_VALUES = 96
-#: Seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
+SCAN_SHAPES = 256
+SCAN_VALUES = 640
+#: The scan's spectra: samples at this relative step in s / lambda (~3 nm at 600 nm).
+SCAN_RELATIVE_STEP = 0.005
+#: Shapes per batch of the scan (memory: shapes x angles x values x 118 nodes).
+SCAN_BATCH = 8
+#: CPU seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
+#: CPU time, not wall time: a design's result must not depend on how busy the machine is.
 POLISH_SECONDS = 2.0
 #: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
 LOCAL_STARTS = 6
@@ -137,6 +142,10 @@ class DesignModel:
     host_threshold: float = 1.0
     #: The length that scales the structure (scanned densely: :data:`SCAN_VALUES`).
     scale_parameter: str | None = None
+    #: Search a mirror by its optical period and thickness share instead of ``Lambda`` and ``delta``.
+    optical: bool = False
+    #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
+    spectra: Callable | None = None
 
 
 # --------------------------------------------------------------------------------------------------
@@ -230,7 +239,7 @@ def bragg_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta, wavelengths
         # per step resolves them from ~4 per fringe, and averages them out below 1 per fringe.
         path = np.maximum(np.real(p1) + np.real(p2), 1e-9)
         fringe = wavelengths**2 / (2.0 * N * path)
-        w_point = np.clip((fringe / (smooth or step) - 1.0) / 3.0, 0.0, 1.0)
+        w_point = np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0)
     total = 0.0
     for pol in bragg.POLARISATIONS:
         r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
@@ -282,6 +291,20 @@ def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float
     return colorimetry.xyz_to_rgb(R @ weights)
 
 
+def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
+    wavelengths = np.asarray(wavelengths, dtype=np.float64)
+    return bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"], values["nh"],
+                                   cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
+
+
+def thin_film_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """The films' spectra ``(B, A, W)`` (not smoothed: a film's fringes are its colour)."""
+    col = lambda name: np.asarray(values[name], dtype=np.float64).reshape(-1, 1, 1)
+    cos = np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1)
+    return thinfilm.airy_reflectance(col("eta1"), col("eta2"), col("eta3"), col("kappa3"), cos, col("d"), np.asarray(wavelengths, float))
+
+
 def mirror_of(values: Mapping[str, float]) -> bragg.BraggMirror:
     """The :class:`explorer.physics.bragg.BraggMirror` of design values (``nh < 1``: the host is ``n1``)."""
     nh = float(values["nh"])
@@ -311,14 +334,14 @@ def thin_film_converged_rgb(values: Mapping[str, float], cos_theta, final: bool 
 
 _BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
               integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, host_parameter="nh",
-              scale_parameter="Lambda")
+              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch)
 #: Every designable material model; its specular colour is what is designed (``bragg_layer``: the smooth
 #: mirror's colour, which its gradient view shows).
 DESIGN_MODELS: dict[str, DesignModel] = {model.name: model for model in (
     DesignModel("bragg_mirror", **_BRAGG),
     DesignModel("bragg_layer", **_BRAGG),
     DesignModel("thin_film", ("d", "eta1", "eta2", "eta3", "kappa3"), (), (), thin_film_rgb_batch, thin_film_converged_rgb,
-                scale_parameter="d"),
+                scale_parameter="d", spectra=thin_film_spectra_batch),
 )}
 DESIGNABLE = tuple(DESIGN_MODELS)
 
@@ -404,8 +427,9 @@ class Target:
 class DesignResult:
     """
     The best structure found: every design value (``values``, free and fixed, ``N`` an integer), the
-    converged colour at each target and its CIEDE2000, the time taken and how many candidates were
-    evaluated.
+    converged colour at each target and its CIEDE2000, the time taken (wall and this process's CPU: on
+    a shared machine the wall time measures the load as much as the search) and how many candidates
+    were evaluated.
     """
 
     model: str
@@ -414,6 +438,7 @@ class DesignResult:
     achieved_rgb: np.ndarray
     delta_e2000: np.ndarray
     seconds: float
+    cpu_seconds: float = 0.0
     evaluations: int = 0
     stages: dict[str, float] = field(default_factory=dict)
 
@@ -463,18 +488,43 @@ class _Problem:
         self.box = {p.name: p for p in box}
         self.fixed = {k: float(v) for k, v in fixed.items()}
         self.free = [p for p in box if p.name not in self.fixed]
+        # A mirror whose period and thickness ratio are both free is searched by its optical period and
+        # the first layer's share of it (see :meth:`values`): the band positions then depend on one
+        # coordinate, and the indices move the angular shift and the contrast without moving the bands.
+        names = [p.name for p in self.free]
+        self.optical = model.optical and "Lambda" in names and "delta" in names
+        if self.optical:
+            indices = [self.box[n] if n not in self.fixed else DesignParameter(n, self.fixed[n], self.fixed[n]) for n in ("n1", "n2")]
+            n_low, n_high = min(p.low for p in indices), max(p.high for p in indices)
+            Lambda = self.box["Lambda"]
+            self.free[names.index("Lambda")] = DesignParameter("optical_period", Lambda.low * n_low, Lambda.high * n_high, log=True)
+            self.free[names.index("delta")] = DesignParameter("optical_fraction", 0.0, 1.0)
+        self.scale_parameter = "optical_period" if self.optical else model.scale_parameter
         self.targets = list(targets)
         self.cos_theta = np.cos(np.radians([t.theta_deg for t in self.targets]))
         self.target_lab = rgb_to_lab(np.array([t.rgb for t in self.targets]))
         self.cancelled = cancelled
         self.evaluations = 0
 
-    def values(self, U: np.ndarray) -> dict[str, np.ndarray]:
-        """Unit-box rows ``(B, P)`` -> every design value as ``(B,)`` arrays."""
+    def values(self, U: np.ndarray, scale_value: float | None = None) -> dict[str, np.ndarray]:
+        """
+        Unit-box rows ``(B, P)`` -> every design value as ``(B,)`` arrays. ``scale_value``: the scale
+        coordinate at this value instead, unclipped (the scale scan's reference structures).
+        """
         U = np.atleast_2d(U)
         out = {name: np.full(U.shape[0], value) for name, value in self.fixed.items()}
         for k, p in enumerate(self.free):
             out[p.name] = p.from_unit(U[:, k])
+        if scale_value is not None:
+            out[self.scale_parameter] = np.full(U.shape[0], float(scale_value))
+        if self.optical:
+            # Optical thicknesses n1 d1 = f P and n2 d2 = (1 - f) P at normal incidence (Eq. 8's phases):
+            # Lambda = P (f / n1 + (1 - f) / n2), delta = (f / n1) / (f / n1 + (1 - f) / n2).
+            f, P = out.pop("optical_fraction"), out.pop("optical_period")
+            per_period = f / out["n1"] + (1.0 - f) / out["n2"]
+            Lambda = self.box["Lambda"]
+            out["Lambda"] = P * per_period if scale_value is not None else np.clip(P * per_period, Lambda.low, Lambda.high)
+            out["delta"] = np.clip((f / out["n1"]) / per_period, 0.0, 1.0)
         return out
 
     def _check(self):
@@ -489,6 +539,48 @@ class _Problem:
             self._check()
             out[start : start + BATCH] = self.model.batch(self.values(U[start : start + BATCH]), self.cos_theta, step, smooth)
         return out
+
+    @property
+    def scale_index(self) -> int | None:
+        """The free coordinate that scales every length of the structure (None when it is fixed)."""
+        return next((k for k, p in enumerate(self.free) if p.name == self.scale_parameter), None)
+
+    def scale_profile(self, shapes: np.ndarray, grid: np.ndarray) -> np.ndarray:
+        """
+        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at each scale
+        value of ``grid`` (unit values). Without dispersion a structure's spectrum depends on ``s / lambda``
+        only (every phase is ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``), so one
+        spectrum per shape over ``x = s / lambda``, log-spaced, gives the colours at every ``s``. Values
+        that put ``Lambda`` outside its box score infinity.
+        """
+        p = self.free[self.scale_index]
+        s = np.maximum(p.from_unit(grid), 1.0)  # a film of no thickness scanned as 1 nm
+        nodes, weights = coarse_nodes(SCREEN_STEP)
+        ratio = 1.0 + SCAN_RELATIVE_STEP
+        x_low, x_high = s.min() / nodes[-1] / ratio, s.max() / nodes[0] * ratio
+        x = x_low * ratio ** np.arange(int(np.ceil(np.log(x_high / x_low) / np.log(ratio))) + 1)
+        reference = 1000.0
+        # Position of every (s, lambda_j) in the x grid.
+        q = np.log(s[:, None] / nodes[None, :] / x_low) / np.log(ratio)
+        i = np.clip(np.floor(q).astype(int), 0, x.size - 2)
+        t = q - i
+        scores = np.empty((shapes.shape[0], s.size))
+        for start in range(0, shapes.shape[0], SCAN_BATCH):
+            self._check()
+            U = shapes[start : start + SCAN_BATCH]
+            values = self.values(U, scale_value=reference)
+            R = self.model.spectra(values, self.cos_theta, reference / x, SCREEN_SMOOTH / 600.0)  # (B, A, X)
+            self.evaluations += U.shape[0] * s.size
+            R_s = R[..., i] * (1.0 - t) + R[..., i + 1] * t  # (B, A, G, J)
+            rgb = colorimetry.xyz_to_rgb(R_s @ weights).transpose(0, 2, 1, 3)  # (B, G, A, 3)
+            score = np.sum(self.residuals_of(rgb) ** 2, axis=-1)
+            if self.optical:
+                per_period = values["Lambda"] / reference
+                Lambda = s[None, :] * per_period[:, None]
+                box = self.box["Lambda"]
+                score = np.where((Lambda >= box.low) & (Lambda <= box.high), score, np.inf)
+            scores[start : start + SCAN_BATCH] = score
+        return scores
 
     def screen(self, U) -> np.ndarray:
         """Sum of squared CIEDE2000 of unit-box rows on the screening model."""
@@ -587,7 +679,7 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
     """
     The converged model with integer parameters held at the nearer of their two neighbouring integers,
     the other free parameters refined by ``least_squares`` (2-point differences) until ``deadline``
-    (``time.perf_counter()``); the best point evaluated is returned.
+    (``time.process_time()``); the best point evaluated is returned.
     """
     integer_free = [k for k, p in enumerate(problem.free) if p.integer]
     choices = [{}]
@@ -604,13 +696,13 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
             best = (values, cost, choice)
     choice = best[2]
     keep = [k for k in range(u0.size) if k not in integer_free]
-    if not keep or max_nfev <= 0 or time.perf_counter() > deadline:
+    if not keep or max_nfev <= 0 or time.process_time() > deadline:
         return best[0], best[1]
     lower, upper = _host_bounds(problem, u0)
 
     def fun(x):
         nonlocal best
-        if time.perf_counter() > deadline:
+        if time.process_time() > deadline:
             raise _OutOfTime()
         u = u0.copy()
         u[keep] = x
@@ -690,7 +782,7 @@ def design(
         Achieved colours from :func:`explorer.physics.bragg.reference_rgb` (or the film's), whatever the
         search used.
     """
-    start_time = time.perf_counter()
+    start_time, start_cpu = time.perf_counter(), time.process_time()
     model = design_model(model_name)
     fixed = dict(fixed or {})
     if not targets:
@@ -716,30 +808,31 @@ def design(
     if P == 0:
         values = problem.fine_values(np.zeros((1, 0)))
     else:
-        # 1. Space-filling first pass (Sobol) on the screening model.
         from scipy.stats import qmc
 
         report(0.0, "first pass")
-        U = qmc.Sobol(P, scramble=True, seed=seed).random(samples)
-        scores = np.empty(samples)
+        scale = problem.scale_index
         chunk = 256
-        for start in range(0, samples, chunk):
-            scores[start : start + chunk] = problem.screen(U[start : start + chunk])
-            report(0.3 * min(1.0, (start + chunk) / samples), "first pass")
-        stages["first pass"] = time.perf_counter() - start_time
-        # 2. The scale scan: the best distinct shapes at every value of the period (or thickness).
-        scale = next((k for k, p in enumerate(problem.free) if p.name == model.scale_parameter), None)
         if scale is not None:
-            shapes = _distinct(U, scores, SCAN_SHAPES)
+            # 1-2. Space-filling shapes (Sobol), each at every value of its scale (the scale scan).
+            U = qmc.Sobol(P, scramble=True, seed=seed).random(SCAN_SHAPES)
             grid = _scale_grid(problem.free[scale])
-            scanned = np.repeat(shapes, grid.size, axis=0)
-            scanned[:, scale] = np.tile(grid, len(shapes))
-            scanned_scores = np.empty(len(scanned))
-            for start in range(0, len(scanned), chunk):
-                scanned_scores[start : start + chunk] = problem.screen(scanned[start : start + chunk])
-                report(0.3 + 0.3 * min(1.0, (start + chunk) / len(scanned)), "scan")
-            U, scores = np.concatenate([U, scanned]), np.concatenate([scores, scanned_scores])
+            scores = np.empty((len(U), grid.size))
+            for start in range(0, len(U), chunk // 4):
+                scores[start : start + chunk // 4] = problem.scale_profile(U[start : start + chunk // 4], grid)
+                report(0.6 * min(1.0, (start + chunk // 4) / len(U)), "scale scan")
+            best = np.argmin(scores, axis=1)
+            U[:, scale] = grid[best]
+            scores = scores[np.arange(len(U)), best]
             stages["scan"] = time.perf_counter() - start_time
+        else:
+            # 1. Space-filling first pass (Sobol) on the screening model.
+            U = qmc.Sobol(P, scramble=True, seed=seed).random(samples)
+            scores = np.empty(samples)
+            for start in range(0, samples, chunk):
+                scores[start : start + chunk] = problem.screen(U[start : start + chunk])
+                report(0.6 * min(1.0, (start + chunk) / samples), "first pass")
+            stages["first pass"] = time.perf_counter() - start_time
         # 3. Distinct starts, refined on the coarse model.
         chosen = _distinct(U, scores, starts)
         refined = []
@@ -754,13 +847,13 @@ def design(
         stages["coarse refinement"] = time.perf_counter() - start_time
         # 4. Polish the best on the converged model, within a time budget.
         best = None
-        deadline = time.perf_counter() + POLISH_SECONDS
+        deadline = time.process_time() + POLISH_SECONDS
         for k, (_, _, u) in enumerate(refined[:POLISHED]):
             report(0.8 + 0.2 * k / POLISHED, "polish")
             values, cost = _polish(problem, u, max_nfev=12 * (P + 1), deadline=deadline)
             if best is None or cost < best[1]:
                 best = (values, cost)
-            if time.perf_counter() > deadline:
+            if time.process_time() > deadline:
                 break
         values = best[0]
         stages["polish"] = time.perf_counter() - start_time
@@ -773,6 +866,7 @@ def design(
         achieved_rgb=achieved,
         delta_e2000=problem.delta_e(achieved),
         seconds=time.perf_counter() - start_time,
+        cpu_seconds=time.process_time() - start_cpu,
         evaluations=problem.evaluations,
         stages=stages,
     )
