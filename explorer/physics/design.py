@@ -75,6 +75,13 @@ DISTINCT_STARTS = 0.08
 #: converged model's (its adaptive refinement moves colours by up to ~2e-4: a larger step).
 COARSE_DIFF_STEP = 1e-4
 FINE_DIFF_STEP = 2e-3
+#: The second scan: counts tried, perturbed shapes, their spread, and the starts refined from them.
+SECOND_COUNTS = 48
+SECOND_PERTURBED = 48
+SECOND_SPREAD = 0.05
+SECOND_STARTS = 3
+#: The polish's Jacobian: the batch model at this wavelength step (nm), fringes smoothed as the step says.
+POLISH_STEP = 1.0
 #: Above this median CIEDE2000 the coarse stage has not found the basin: more starts are refined.
 GOOD_ENOUGH = 0.05
 #: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
@@ -671,64 +678,84 @@ def _refine_level(problem: _Problem, u0: np.ndarray, max_nfev: int, step: float,
     return result.x, float(2.0 * result.cost)
 
 
-class _OutOfTime(Exception):
-    pass
-
-
 def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -> tuple[dict[str, float], float]:
     """
-    The converged model with integer parameters held at the nearer of their two neighbouring integers,
-    the other free parameters refined by ``least_squares`` (2-point differences) until ``deadline``
-    (``time.process_time()``); the best point evaluated is returned.
+    The converged model, with integer parameters held at the better of their two neighbouring integers:
+    damped Gauss-Newton steps whose residuals are the converged model's and whose Jacobian is the 1-nm
+    batch model's (smooth, all columns in one batch), until no step lowers the converged cost, after
+    ``max_nfev`` converged evaluations, or at ``deadline`` (``time.process_time()``). Finite differences
+    of the converged model itself would see its adaptive refinement's ~1e-4 steps.
     """
     integer_free = [k for k, p in enumerate(problem.free) if p.integer]
-    choices = [{}]
+    u0 = u0.copy()
+    choices = [u0.copy()]
     for k in integer_free:
         p = problem.free[k]
         value = float(p.from_unit(u0[k]))
         options = sorted({max(p.low, min(p.high, float(math.floor(value)))), max(p.low, min(p.high, float(math.ceil(value))))})
-        choices = [dict(c, **{p.name: o}) for c in choices for o in options]
-    best = None
-    for choice in choices:
-        values = problem.fine_values(u0[None], choice)
-        cost = float(np.sum(problem.residuals_of(problem.fine_rgb(values)[None]) ** 2))
-        if best is None or cost < best[1]:
-            best = (values, cost, choice)
-    choice = best[2]
-    keep = [k for k in range(u0.size) if k not in integer_free]
-    if not keep or max_nfev <= 0 or time.process_time() > deadline:
-        return best[0], best[1]
-    lower, upper = _host_bounds(problem, u0)
+        choices = [np.concatenate([c[:k], [p.to_unit(o)], c[k + 1:]]) for c in choices for o in options]
 
-    def fun(x):
-        nonlocal best
-        if time.process_time() > deadline:
-            raise _OutOfTime()
-        u = u0.copy()
-        u[keep] = x
-        values = problem.fine_values(u[None], choice)
+    def fine(u):
+        values = problem.fine_values(u[None])
         residuals = problem.residuals_of(problem.fine_rgb(values)[None])[0]
-        cost = float(np.sum(residuals**2))
-        if cost < best[1]:
-            best = (values, cost, choice)
-        return residuals
+        return values, residuals, float(np.sum(residuals**2))
 
-    from scipy.optimize import least_squares
+    best = min((fine(np.clip(c, 0.0, 1.0)) + (np.clip(c, 0.0, 1.0),) for c in choices), key=lambda item: item[2])
+    values, residuals, cost, u = best
+    keep = np.array([k for k in range(u.size) if k not in integer_free])
+    if keep.size == 0:
+        return values, cost
+    lower, upper = _host_bounds(problem, u)
+    damping = 1e-3
+    for _ in range(max_nfev):
+        if time.process_time() > deadline or cost < 1e-8:
+            break
+        h = np.where(u[keep] + COARSE_DIFF_STEP <= upper[keep], COARSE_DIFF_STEP, -COARSE_DIFF_STEP)
+        U = np.repeat(u[None], keep.size + 1, axis=0)
+        U[np.arange(1, keep.size + 1), keep] += h
+        columns = problem.residuals_of(problem.coarse_rgb(U, POLISH_STEP))
+        J = ((columns[1:] - columns[0]) / h[:, None]).T
+        JTJ, JTr = J.T @ J, J.T @ residuals
+        improved = False
+        while damping < 1e6:
+            step = -np.linalg.solve(JTJ + damping * np.diag(np.diag(JTJ) + 1e-12), JTr)
+            trial = u.copy()
+            trial[keep] = np.clip(u[keep] + step, lower[keep], upper[keep])
+            t_values, t_residuals, t_cost = fine(trial)
+            if t_cost < cost:
+                u, values, residuals, cost = trial, t_values, t_residuals, t_cost
+                damping = max(damping / 3.0, 1e-7)
+                improved = True
+                break
+            damping *= 4.0
+            if time.process_time() > deadline:
+                break
+        if not improved:
+            break
+    return values, cost
 
-    x0 = np.clip(u0[keep], lower[keep] + 1e-9, upper[keep] - 1e-9)
-    try:
-        least_squares(fun, x0, bounds=(lower[keep], upper[keep]), diff_step=FINE_DIFF_STEP, max_nfev=max_nfev,
-                      xtol=1e-8, ftol=1e-8)
-    except _OutOfTime:
-        pass
-    return best[0], best[1]
+
+def _variants(problem: _Problem, u: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """
+    Shapes near ``u``: each integer parameter on :data:`SECOND_COUNTS` log-spaced values, and
+    :data:`SECOND_PERTURBED` copies moved by a normal step of :data:`SECOND_SPREAD` in the unit box.
+    """
+    rows = []
+    for k, p in enumerate(problem.free):
+        if p.integer:
+            for value in np.unique(np.round(np.geomspace(p.low, p.high, SECOND_COUNTS))):
+                row = u.copy()
+                row[k] = p.to_unit(value)
+                rows.append(row)
+    rows += list(np.clip(u + rng.normal(0.0, SECOND_SPREAD, (SECOND_PERTURBED, u.size)), 0.0, 1.0))
+    return np.array(rows)
 
 
-def _distinct(U: np.ndarray, scores: np.ndarray, count: int) -> list[np.ndarray]:
-    """The best-scoring rows of ``U``, each farther than :data:`DISTINCT_STARTS` from those before it."""
+def _distinct(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DISTINCT_STARTS) -> list[np.ndarray]:
+    """The best-scoring rows of ``U``, each farther than ``spacing`` (max norm) from those before it."""
     chosen: list[np.ndarray] = []
     for index in np.argsort(scores):
-        if all(np.max(np.abs(U[index] - c)) > DISTINCT_STARTS for c in chosen):
+        if all(np.max(np.abs(U[index] - c)) > spacing for c in chosen):
             chosen.append(U[index])
         if len(chosen) == count:
             break
@@ -844,13 +871,27 @@ def design(
             if k >= 1 and math.sqrt(cost / len(targets)) < GOOD_ENOUGH:
                 break
         refined.sort(key=lambda item: item[0])
+        if scale is not None and math.sqrt(refined[0][0] / len(targets)) >= GOOD_ENOUGH:
+            # 3b. A second scan around the best: its integer count on a grid and perturbed shapes, each at
+            # its best scale. Fringes make the count's basins narrow: a neighbouring count rarely wins by
+            # refinement alone.
+            report(0.75, "second scan")
+            variants = _variants(problem, refined[0][2], np.random.default_rng(seed))
+            variant_scores = problem.scale_profile(variants, grid)
+            best = np.argmin(variant_scores, axis=1)
+            variants[:, scale] = grid[best]
+            variant_scores = variant_scores[np.arange(len(variants)), best]
+            for k, u0 in enumerate(_distinct(variants, variant_scores, SECOND_STARTS, spacing=0.005)):
+                u, cost = _refine_coarse(problem, u0, max_nfev=40)
+                refined.append((cost, len(refined), u))
+            refined.sort(key=lambda item: item[0])
         stages["coarse refinement"] = time.perf_counter() - start_time
         # 4. Polish the best on the converged model, within a time budget.
         best = None
         deadline = time.process_time() + POLISH_SECONDS
         for k, (_, _, u) in enumerate(refined[:POLISHED]):
             report(0.8 + 0.2 * k / POLISHED, "polish")
-            values, cost = _polish(problem, u, max_nfev=12 * (P + 1), deadline=deadline)
+            values, cost = _polish(problem, u, max_nfev=20, deadline=deadline)
             if best is None or cost < best[1]:
                 best = (values, cost)
             if time.process_time() > deadline:
