@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.cli.commands import _load
-from explorer.cli.design import ranges_of
+from explorer.cli.design import load, ranges_of
 from explorer.physics import design
 
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)
@@ -46,7 +45,7 @@ def main() -> None:
     print("| target | designed structure | ΔE2000 at 0, 15, 30, 45, 60° | time |")
     print("|---|---|---|---|")
     for title, material, targets, fixed in GALLERY:
-        result = design.design(material, targets, ranges_of(_load(material)), fixed)
+        result = design.design(material, targets, ranges_of(load(material)), fixed)
         values = ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.values.items())
         errors = ", ".join(f"{d:.2f}" for d in result.delta_e2000)
         flag = "" if result.reachable.all() else " (not reachable)"

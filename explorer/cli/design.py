@@ -28,6 +28,17 @@ def _fail(message: str) -> None:
     sys.exit(1)
 
 
+def load(path):
+    """A material file or a built-in's name (as ``render`` takes it), its warnings on stderr."""
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    material = load_material(material_path(path))
+    for warning in material.warnings:
+        click.echo(f"{PROG}: warning: {warning}", err=True)
+    return material
+
+
 def srgb_to_linear(encoded) -> np.ndarray:
     """sRGB-encoded values in [0, 1] to linear RGB (the inverse of the PNGs' encode)."""
     import colour
@@ -155,13 +166,12 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     (converged spectral) and its ΔE2000; a target no structure in the declared ranges reaches is reported
     as not reachable, with the closest structure found.
     """
-    from explorer.cli.commands import _load
     from explorer.errors import LocatedError
     from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
     from explorer.resources import display_path
 
     try:
-        loaded = _load(material)
+        loaded = load(material)
         design_model(loaded.model)
         targets = [parse_target(t) for t in target_texts]
         if target_strip is not None:
@@ -201,10 +211,9 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
     a 5-angle design and its median / max CIEDE2000, then the acceptance figures (median of the medians,
     share at most 1) and the median time.
     """
-    from explorer.cli.commands import _load
     from explorer.physics.design import round_trip
 
-    material = _load("bragg_mirror")
+    material = load("bragg_mirror")
     ranges = ranges_of(material)
     draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
     rows = []
