@@ -18,8 +18,10 @@ from explorer.app.panels.base import Panel, record
 from explorer.physics import colorimetry
 from explorer.physics import design as inverse_design
 
-#: The default targets: a green turning blue then violet with the angle, as jewel beetles do.
-DEFAULT_TARGETS = ((0.0, (0.05, 0.35, 0.08)), (30.0, (0.03, 0.2, 0.3)), (60.0, (0.08, 0.05, 0.3)))
+#: The default targets: the colours at these angles of the jewel beetle's green/blue cuticle area
+#: (Fourneau et al. 2024, Table 3 (a), smooth, in air), a gradient a mirror is known to make.
+DEFAULT_ANGLES = (0.0, 30.0, 60.0)
+DEFAULT_STRUCTURE = {"n1": 1.59, "n2": 1.67, "Lambda": 160.0, "delta": 0.51, "N": 8, "nh": 1.0}
 #: Columns of the drawn strips (θ from 0 to 90 degrees).
 STRIP_COLUMNS = 64
 #: The sRGB primaries' chromaticities (IEC 61966-2-1).
@@ -53,7 +55,8 @@ class DesignPanel(Panel):
 
     def __init__(self, app):
         super().__init__(app)
-        self.targets = [[theta, [float(c) for c in colorimetry.encode_srgb8(np.array(rgb)) / 255.0]] for theta, rgb in DEFAULT_TARGETS]
+        colours = inverse_design.forward_rgb("bragg_mirror", DEFAULT_STRUCTURE, DEFAULT_ANGLES)
+        self.targets = [[theta, [float(c) for c in colorimetry.encode_srgb8(rgb) / 255.0]] for theta, rgb in zip(DEFAULT_ANGLES, colours)]
         self.strip_path = ""
         self.strip_range = [0.0, 90.0]
         self.fixed_n1_air = False
@@ -144,7 +147,7 @@ class DesignPanel(Panel):
         state = self.state
         state.values = state.material.resolve({**state.values, **self.result.values})
         state.preset = None
-        state.status = f"Design: median ΔE2000 {self.result.median_delta_e2000:.2f} in {self.result.seconds:.1f} s"
+        state.status = f"Design: median dE2000 {self.result.median_delta_e2000:.2f} in {self.result.seconds:.1f} s"
 
     # -- the reachable colours ---------------------------------------------------------------------
 
@@ -237,7 +240,7 @@ class DesignPanel(Panel):
         if result is not None:
             unreachable = (~result.reachable).sum()
             imgui.text_wrapped(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in result.values.items()))
-            imgui.text_wrapped("ΔE2000 per target: " + ", ".join(f"{d:.2f}" for d in result.delta_e2000)
+            imgui.text_wrapped("dE2000 per target: " + ", ".join(f"{d:.2f}" for d in result.delta_e2000)
                                + (f"; {unreachable} not reachable: the closest structure found" if unreachable else ""))
         self._chromaticity(imgui)
 
