@@ -567,10 +567,16 @@ class _Problem:
         x_low, x_high = s.min() / nodes[-1] / ratio, s.max() / nodes[0] * ratio
         x = x_low * ratio ** np.arange(int(np.ceil(np.log(x_high / x_low) / np.log(ratio))) + 1)
         reference = 1000.0
-        # Position of every (s, lambda_j) in the x grid.
+        # Position of every (s, lambda_j) in the x grid, and the linear map from a spectrum over x to the
+        # XYZ at every s: XYZ(s_m) = sum_j w_j R(s_m / lambda_j), R interpolated linearly in log x.
         q = np.log(s[:, None] / nodes[None, :] / x_low) / np.log(ratio)
         i = np.clip(np.floor(q).astype(int), 0, x.size - 2)
         t = q - i
+        kernel = np.zeros((x.size, s.size, 3))
+        m = np.broadcast_to(np.arange(s.size)[:, None], i.shape)
+        np.add.at(kernel, (i, m), (1.0 - t)[..., None] * weights[None, :, :])
+        np.add.at(kernel, (i + 1, m), t[..., None] * weights[None, :, :])
+        kernel = kernel.reshape(x.size, -1)
         scores = np.empty((shapes.shape[0], s.size))
         for start in range(0, shapes.shape[0], SCAN_BATCH):
             self._check()
@@ -578,8 +584,8 @@ class _Problem:
             values = self.values(U, scale_value=reference)
             R = self.model.spectra(values, self.cos_theta, reference / x, SCREEN_SMOOTH / 600.0)  # (B, A, X)
             self.evaluations += U.shape[0] * s.size
-            R_s = R[..., i] * (1.0 - t) + R[..., i + 1] * t  # (B, A, G, J)
-            rgb = colorimetry.xyz_to_rgb(R_s @ weights).transpose(0, 2, 1, 3)  # (B, G, A, 3)
+            xyz = (R @ kernel).reshape(R.shape[:2] + (s.size, 3))  # (B, A, G, 3)
+            rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
             score = np.sum(self.residuals_of(rgb) ** 2, axis=-1)
             if self.optical:
                 per_period = values["Lambda"] / reference
