@@ -31,7 +31,8 @@ class ScriptRobot:
     Plays a :class:`ScriptState` on an app (its ``state``, and ``idle()``: nothing left to draw).
 
     Actions (dicts): ``{"wait": N}`` frames; ``{"wait_complete": true}`` until the active view is fully
-    refined; ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
+    refined; ``{"wait_for": NAME}`` until a panel's report ``state.NAME`` is a dict not ``running`` (the
+    Design window's worker); ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
