@@ -31,7 +31,8 @@ class ScriptRobot:
     Plays a :class:`ScriptState` on an app (its ``state``, and ``idle()``: nothing left to draw).
 
     Actions (dicts): ``{"wait": N}`` frames; ``{"wait_complete": true}`` until the active view is fully
-    refined; ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
+    refined; ``{"wait_for": NAME}`` until a panel's report ``state.NAME`` is a dict not ``running`` (the
+    Design window's worker); ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
@@ -67,6 +68,12 @@ class ScriptRobot:
         done = False
         if "wait" in action:
             done = step >= int(action["wait"])
+        elif "wait_for" in action:  # until a panel's report (state.NAME) says it is no longer running
+            report = getattr(state, str(action["wait_for"]), None)
+            done = step > 1 and isinstance(report, dict) and not report.get("running", False)
+            if step > int(action.get("timeout", 3000)):
+                script.log.append(f"wait_for {action['wait_for']}: timed out")
+                done = True
         elif "wait_complete" in action:
             done = step > 1 and app.idle()
             if step > int(action.get("timeout", 2000)):

@@ -408,8 +408,10 @@ def presets(material, as_json):
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
 @click.option("--position-free", "position_free", is_flag=True,
               help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
+@click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
+              help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -421,6 +423,11 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free):
         from explorer.cli.bench import run_position_free_bench
 
         run_position_free_bench(as_json=as_json)
+        return
+    if design_count is not None:
+        from explorer.cli.design import run_design_bench
+
+        run_design_bench(design_count, as_json=as_json)
         return
     if app:
         from explorer.cli.bench import run_app_bench
@@ -480,6 +487,10 @@ from explorer.cli.albedo import albedo_command  # noqa: E402
 cli.add_command(inverse_command)
 cli.add_command(figure_command)
 cli.add_command(albedo_command)
+
+from explorer.cli.design import design_command  # noqa: E402  (inverse design of mirrors and films)
+
+cli.add_command(design_command)
 
 
 def main(argv: list[str] | None = None) -> None:

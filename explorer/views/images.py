@@ -73,3 +73,31 @@ def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
         raise OSError(0, f"OpenCV: {' '.join(str(error).split())[:200]}") from None
     if not written:
         raise OSError(0, "OpenCV could not write OpenEXR")
+
+
+def read_linear_image(path) -> np.ndarray:
+    """
+    An image as linear RGB ``(H, W, 3)`` float64: a ``.npy`` as it is (linear, ``render``'s convention), any
+    other image file decoded from sRGB. ``ValueError`` (one line) when it cannot be read.
+    """
+    import colour
+
+    file = Path(path)
+    if not file.is_file():
+        raise ValueError(f"{path}: no such file")
+    try:
+        if file.suffix.lower() == ".npy":
+            image = np.load(file, allow_pickle=False).astype(np.float64)
+        else:
+            from PIL import Image
+
+            with Image.open(file) as picture:
+                encoded = np.asarray(picture.convert("RGB"), dtype=np.float64) / 255.0
+            image = np.asarray(colour.cctf_decoding(encoded, function="sRGB"))
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{path}: cannot read ({' '.join(str(error).split())[:120]})") from None
+    if image.ndim != 3 or image.shape[2] < 3 or image.shape[0] < 1 or image.shape[1] < 1:
+        raise ValueError(f"{path}: expected an H x W x 3 image, got shape {image.shape}")
+    if not np.all(np.isfinite(image[..., :3])):
+        raise ValueError(f"{path}: non-finite values")
+    return image[..., :3]

@@ -7,6 +7,7 @@ imported below and listed in :data:`PANELS`.
 from explorer.app.panels.base import Panel
 from explorer.app.panels.brdf_views import ScatterPanel, SlicePanel
 from explorer.app.panels.compare import ComparePanel
+from explorer.app.panels.design import DesignPanel
 from explorer.app.panels.files import FilesPanel
 from explorer.app.panels.inverse import InversePanel
 from explorer.app.panels.parameters import ParametersPanel
@@ -18,7 +19,7 @@ from explorer.app.panels.strips import StripsPanel
 #: The windows, in the order they are drawn (a docked window's first tab is the first of its dock here).
 PANELS: tuple[type[Panel], ...] = (
     ParametersPanel, FilesPanel, SpherePanel, ComparePanel, SlicePanel, ScatterPanel, SpectrumPanel, PolarPanel,
-    StripsPanel, InversePanel,
+    StripsPanel, InversePanel, DesignPanel,
 )
 
 

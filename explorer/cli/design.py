@@ -1,0 +1,247 @@
+"""
+``bragg-explorer design``: the structure of a Bragg mirror, rough Bragg layer or thin film from the colours
+wanted at a few angles (:mod:`explorer.physics.design`), registered by :mod:`explorer.cli.commands`.
+
+A target is ``--target THETA:COLOUR``: THETA in degrees in the outer medium, COLOUR ``#RRGGBB`` (sRGB) or
+``r,g,b`` (linear RGB, the convention of ``render``'s ``.npy``, kept as it is even outside [0, 1]). A strip
+(``--target-strip IMAGE --theta-range A,B``: a ``.png`` in sRGB or a ``.npy`` of linear RGB, column ``i`` of
+``W`` at ``A + (B - A)(i + 0.5) / W`` degrees, as the gradient view draws it) gives
+:data:`STRIP_TARGETS` targets, each the mean of its column's rows.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+import click
+import numpy as np
+
+PROG = "bragg-explorer"
+#: Targets taken from a strip, at evenly spaced columns.
+STRIP_TARGETS = 5
+
+
+def _fail(message: str) -> None:
+    click.echo(f"{PROG}: error: {message}", err=True)
+    sys.exit(1)
+
+
+def load(path):
+    """A material file or a built-in's name (as ``render`` takes it), its warnings on stderr."""
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    material = load_material(material_path(path))
+    for warning in material.warnings:
+        click.echo(f"{PROG}: warning: {warning}", err=True)
+    return material
+
+
+def srgb_to_linear(encoded) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] to linear RGB (the inverse of the PNGs' encode)."""
+    import colour
+
+    return np.asarray(colour.cctf_decoding(np.asarray(encoded, dtype=np.float64), function="sRGB"))
+
+
+def parse_colour(text: str, where: str = "--target") -> np.ndarray:
+    """``#RRGGBB`` (sRGB) or ``r,g,b`` (linear) as linear RGB; a :class:`click.UsageError` otherwise."""
+    from explorer.physics.design import DesignError, check_target_rgb
+
+    text = text.strip()
+    if text.startswith("#"):
+        digits = text[1:]
+        if len(digits) != 6 or any(c not in "0123456789abcdefABCDEF" for c in digits):
+            raise click.UsageError(f"{where}: {text!r} is not #RRGGBB")
+        rgb = srgb_to_linear([int(digits[k : k + 2], 16) / 255.0 for k in (0, 2, 4)])
+    else:
+        try:
+            rgb = np.array([float(v) for v in text.split(",")])
+        except ValueError:
+            raise click.UsageError(f"{where}: {text!r} is not #RRGGBB or r,g,b") from None
+        if rgb.size != 3:
+            raise click.UsageError(f"{where}: {text!r} is not #RRGGBB or r,g,b (three numbers)")
+    try:
+        return check_target_rgb(rgb, f"{where} {text}")
+    except DesignError as error:
+        raise click.UsageError(str(error)) from None
+
+
+def parse_target(text: str):
+    """``THETA:COLOUR`` as a :class:`explorer.physics.design.Target`."""
+    from explorer.physics.design import Target
+
+    theta_text, sep, colour_text = text.partition(":")
+    if not sep:
+        raise click.UsageError(f"--target {text!r}: expected THETA:COLOUR (e.g. 30:#3f9f4f or 30:0.1,0.4,0.1)")
+    try:
+        theta = float(theta_text)
+    except ValueError:
+        theta = float("nan")
+    if not (np.isfinite(theta) and 0.0 <= theta < 90.0):
+        raise click.UsageError(f"--target {text!r}: THETA must be a number of degrees in [0, 90)")
+    return Target(theta, tuple(float(c) for c in parse_colour(colour_text, f"--target {theta_text}")))
+
+
+def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS):
+    """Targets read from a strip image over ``theta_range`` (``A,B`` degrees)."""
+    from explorer.physics.design import DesignError, targets_from_strip
+    from explorer.views.images import read_linear_image
+
+    if theta_range is None:
+        raise click.UsageError("--target-strip needs --theta-range A,B (degrees at its left and right edges)")
+    try:
+        a, b = (float(v) for v in theta_range.split(","))
+    except ValueError:
+        raise click.UsageError(f"--theta-range {theta_range!r}: expected A,B in degrees") from None
+    try:
+        return targets_from_strip(read_linear_image(path), a, b, count)
+    except (ValueError, DesignError) as error:
+        raise click.UsageError(f"--target-strip {error}") from None
+
+
+def parse_fixes(fixes, free, material):
+    """``--fix NAME=VALUE`` and ``--free NAME,...`` as the fixed values (every design parameter not free)."""
+    from explorer.physics.design import design_model
+
+    model = design_model(material.model)
+    values = material.resolve({})
+    fixed: dict[str, float] = {}
+    for text in fixes:
+        name, sep, value_text = text.partition("=")
+        name = name.strip()
+        if not sep:
+            raise click.UsageError(f"--fix {text!r}: expected NAME=VALUE")
+        if name not in model.parameters:
+            raise click.UsageError(f"--fix {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
+        try:
+            value = float(value_text)
+        except ValueError:
+            value = float("nan")
+        if not np.isfinite(value):
+            raise click.UsageError(f"--fix {text!r}: the value must be a finite number")
+        fixed[name] = value
+    if free is not None:
+        names = [n.strip() for n in free.split(",") if n.strip()]
+        for name in names:
+            if name not in model.parameters:
+                raise click.UsageError(f"--free {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
+            if name in fixed:
+                raise click.UsageError(f"--free {name}: also fixed by --fix")
+        for name in model.parameters:
+            if name not in names and name not in fixed:
+                fixed[name] = float(values[name])  # not free: the material's default
+    return fixed
+
+
+def ranges_of(material) -> dict[str, tuple[float, float]]:
+    """The declared ``(min, max)`` of each parameter of the material file."""
+    return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
+
+
+def render_command(material_name: str, values: dict) -> str:
+    """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
+    method = "--set method=3"  # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of it)
+    return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
+
+
+@click.command("design")
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--target", "target_texts", multiple=True, metavar="THETA:COLOUR",
+              help="A colour wanted at THETA degrees: #RRGGBB (sRGB) or r,g,b (linear, as render's .npy). Repeatable.")
+@click.option("--target-strip", metavar="IMAGE", help="Targets from a strip (.png sRGB or .npy linear), theta across.")
+@click.option("--theta-range", metavar="A,B", help="--target-strip: theta (degrees) at its left and right edges.")
+@click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable).")
+@click.option("--free", metavar="NAME,...", help="Search only these parameters; the others keep the material's defaults.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
+@click.option("--seed", type=int, default=0, show_default=True, help="The first pass's Sobol scrambling.")
+def design_command(material, target_texts, target_strip, theta_range, fixes, free, as_json, seed):
+    """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
+    colours at the target angles come closest to the targets (CIEDE2000).
+
+    Prints the structure as --set values, a render command line, and per target the achieved colour
+    (converged spectral) and its ΔE2000; a target no structure in the declared ranges reaches is reported
+    as not reachable, with the closest structure found.
+    """
+    from explorer.errors import LocatedError
+    from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
+    from explorer.resources import display_path
+
+    try:
+        loaded = load(material)
+        design_model(loaded.model)
+        targets = [parse_target(t) for t in target_texts]
+        if target_strip is not None:
+            targets += strip_targets(target_strip, theta_range)
+        elif theta_range is not None:
+            raise click.UsageError("--theta-range goes with --target-strip")
+        if not targets:
+            raise click.UsageError("give at least one --target THETA:COLOUR or --target-strip IMAGE")
+        fixed = parse_fixes(fixes, free, loaded)
+        result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed)
+    except (LocatedError, DesignError) as error:
+        _fail(str(error))
+    name = display_path(loaded.path)
+    unreachable = [t for t, ok in zip(result.targets, result.reachable) if not ok]
+    if as_json:
+        click.echo(json.dumps(result.as_json(name), indent=2))
+        for t, d in zip(result.targets, result.delta_e2000):
+            if d > REACHABLE_DELTA_E:
+                click.echo(f"{PROG}: target at {t.theta_deg:g} degrees not reachable (closest: ΔE2000 {d:.2f})", err=True)
+        return
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in result.values.items())
+    click.echo(f"{name}: {sets}")
+    for t, a, d, ok in zip(result.targets, result.achieved_rgb, result.delta_e2000, result.reachable):
+        note = "" if ok else "  not reachable"
+        click.echo(f"  theta {t.theta_deg:5.1f}: target {np.round(t.rgb, 4).tolist()} achieved {np.round(a, 4).tolist()} "
+                   f"ΔE2000 {d:.2f}{note}")
+    click.echo(f"median ΔE2000 {result.median_delta_e2000:.2f}, {result.seconds:.1f} s")
+    if unreachable:
+        click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
+                   "the structure above is the closest found")
+    click.echo(f"render: {render_command(name, result.values)}")
+
+
+def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None) -> None:
+    """
+    The round trip of :func:`explorer.physics.design.round_trip` on ``bragg_mirror``: per mirror the time of
+    a 5-angle design and its median / max CIEDE2000, then the acceptance figures (median of the medians,
+    share at most 1) and the median time.
+    """
+    from explorer.physics.design import round_trip
+
+    material = load("bragg_mirror")
+    ranges = ranges_of(material)
+    draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
+    rows = []
+
+    def report(k, truth, result):
+        row = {"truth": truth, "set": result.values, "median_delta_e2000": result.median_delta_e2000,
+               "max_delta_e2000": float(result.delta_e2000.max()), "seconds": result.seconds,
+               "cpu_seconds": result.cpu_seconds}
+        rows.append(row)
+        if not as_json:
+            click.echo(f"{k:3d}  {' '.join(f'{n}={v:.4g}' for n, v in truth.items())}  ->  median ΔE2000 "
+                       f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s "
+                       f"({row['cpu_seconds']:.2f} s CPU)")
+
+    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw)
+    medians = np.array([r["median_delta_e2000"] for r in rows])
+    seconds = np.array([r["seconds"] for r in rows])
+    cpu = np.array([r["cpu_seconds"] for r in rows])
+    summary = {"mirrors": count, "seed": seed, "max_lambda": max_lambda,
+               "median_of_medians": float(np.median(medians)), "share_at_most_1": float(np.mean(medians <= 1.0)),
+               "median_seconds": float(np.median(seconds)), "max_seconds": float(seconds.max()),
+               "median_cpu_seconds": float(np.median(cpu)), "max_cpu_seconds": float(cpu.max()),
+               "load_average": list(os.getloadavg())}
+    if as_json:
+        click.echo(json.dumps({"summary": summary, "mirrors": rows}, indent=2))
+        return
+    click.echo(f"{count} mirrors (seed {seed}{'' if max_lambda is None else f', Lambda <= {max_lambda:g} nm'}): median of the "
+               f"per-mirror median ΔE2000 {summary['median_of_medians']:.3f}, {100 * summary['share_at_most_1']:.0f} % at most 1; "
+               f"a 5-angle design: median {summary['median_seconds']:.2f} s wall, {summary['median_cpu_seconds']:.2f} s CPU "
+               f"(max {summary['max_seconds']:.2f} s, {summary['max_cpu_seconds']:.2f} s CPU; load average "
+               f"{summary['load_average'][0]:.1f} on {os.cpu_count()} cores)")

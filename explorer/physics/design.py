@@ -1,0 +1,987 @@
+"""
+Inverse design of Bragg mirrors and thin films: from the colours wanted at a few angles to the structure
+that makes them, or the structure that comes closest when none does.
+
+The forward model is the converged spectral colour of the smooth structure at each target angle (what the
+tabulated method shows, :func:`explorer.physics.bragg.reference_rgb`,
+:func:`explorer.physics.thinfilm.reference_rgb`). The search minimises the sum of the squared CIEDE2000
+differences over the targets, in three stages:
+
+1. a space-filling first pass: a scrambled Sobol sequence over the free parameters' box (``N`` on a log
+   scale), every candidate evaluated at once by a vectorised coarse model (:func:`bragg_rgb_batch`,
+   :func:`thin_film_rgb_batch`: point samples every :data:`COARSE_STEP` nm, ``N`` continuous);
+2. local refinement (``scipy.optimize.least_squares``) of the best distinct candidates on the coarse model,
+   with Jacobians by finite differences evaluated in one batch;
+3. a polish of the best few on the converged model with ``N`` rounded to an integer.
+
+Residuals are the CIELAB differences scaled per target by ``dE2000 / dE76``, so that their squared norm per
+target is exactly CIEDE2000 squared while staying differentiable.
+
+References
+----------
+Fourneau, Pacanowski, Barla (2024). Interactive Exploration of Vivid Material Iridescence using Bragg
+Mirrors. CGF 43(2): Eqs. 2, 8-10 (Yeh's reflectance), Appendix D (the host), Section 7 (inverse design
+named as future work).
+Belcour & Barla (2017). A Practical Extension to Microfacet Theory for the Modeling of Varying
+Iridescence. ACM TOG 36(4): Eqs. 2-3 (the film's Airy reflectance).
+Sharma, Wu, Dalal (2005). The CIEDE2000 colour-difference formula. Color Res. Appl. 30(1).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import colour
+import numpy as np
+
+from explorer.physics import bragg, colorimetry, thinfilm
+from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
+
+#: A target whose CIEDE2000 stays above this is reported as not reachable (about twice a just
+#: noticeable difference).
+REACHABLE_DELTA_E = 2.0
+#: The coarse model's wavelength step (nm): the spectrum at these nodes, interpolated linearly, against the
+#: 1-nm CMFs.
+COARSE_STEP = 2.0
+#: The first pass's and the scan's wavelength step (nm): screening only, about 4 times cheaper.
+SCREEN_STEP = 4.0
+#: The screening averages out fringes narrower than about this (nm): their ripples make the landscape
+#: rugged where the bands' positions, which it keeps, decide the basin.
+SCREEN_SMOOTH = 12.0
+#: Candidates of the first pass (a power of two: Sobol's balance).
+FIRST_PASS_SAMPLES = 2048
+#: The scan: the best distinct candidates of the first pass, each tried at this many values of the
+#: model's scale parameter (the period, the film's thickness), geometrically spaced over its range. A
+#: mirror's spectrum shifts by about lambda dLambda / Lambda when Lambda moves: its colour turns as fast
+#: in log Lambda everywhere, and high-order mirrors (Lambda ~ 1 um) have many narrow basins in Lambda.
+SCAN_SHAPES = 256
+SCAN_VALUES = 640
+#: The scan's spectra: samples at this relative step in s / lambda (~3 nm at 600 nm).
+SCAN_RELATIVE_STEP = 0.005
+#: Shapes per batch of the scan (memory: shapes x angles x values x 118 nodes).
+SCAN_BATCH = 8
+#: CPU seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
+#: CPU time, not wall time: a design's result must not depend on how busy the machine is.
+POLISH_SECONDS = 2.0
+#: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
+LOCAL_STARTS = 6
+POLISHED = 2
+#: Two starts closer than this in the unit box (max norm) are the same basin.
+DISTINCT_STARTS = 0.08
+#: Finite-difference step in the unit box for the coarse Jacobians (the model is smooth there), and the
+#: converged model's (its adaptive refinement moves colours by up to ~2e-4: a larger step).
+COARSE_DIFF_STEP = 1e-4
+FINE_DIFF_STEP = 2e-3
+#: The second scan: counts tried, perturbed shapes, their spread, and the starts refined from them.
+SECOND_COUNTS = 48
+SECOND_PERTURBED = 48
+SECOND_SPREAD = 0.05
+SECOND_STARTS = 3
+#: The polish's Jacobian: the batch model at this wavelength step (nm), fringes smoothed as the step says.
+POLISH_STEP = 1.0
+#: Above this median CIEDE2000 the coarse stage has not found the basin: more starts are refined.
+GOOD_ENOUGH = 0.05
+#: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
+BATCH = 32
+
+
+class DesignError(ValueError):
+    """A design request that cannot be met: one line (a bad colour, an impossible fix)."""
+
+
+class DesignCancelled(Exception):
+    """The caller's ``cancelled()`` said stop."""
+
+
+# --------------------------------------------------------------------------------------------------
+# The design parameters
+
+
+@dataclass(frozen=True)
+class DesignParameter:
+    """
+    One structural parameter: its name in the material file, its box (the file's declared range unless
+    the caller narrows it), and whether the search walks it on a log scale or rounds it to an integer.
+    """
+
+    name: str
+    low: float
+    high: float
+    log: bool = False
+    integer: bool = False
+
+    def from_unit(self, u):
+        u = np.clip(np.asarray(u, dtype=np.float64), 0.0, 1.0)
+        if self.log:
+            return np.exp(math.log(self.low) + u * (math.log(self.high) - math.log(self.low)))
+        return self.low + u * (self.high - self.low)
+
+    def to_unit(self, value):
+        value = np.asarray(value, dtype=np.float64)
+        if self.high == self.low:
+            return np.zeros_like(value)
+        if self.log:
+            return (np.log(value) - math.log(self.low)) / (math.log(self.high) - math.log(self.low))
+        return (value - self.low) / (self.high - self.low)
+
+
+@dataclass(frozen=True)
+class DesignModel:
+    """
+    What can be designed of one material model: its structural parameters (the others, such as
+    ``method`` or a roughness, do not change the specular colour), the coarse batch model and the
+    converged one.
+    """
+
+    name: str
+    parameters: tuple[str, ...]
+    log_parameters: tuple[str, ...]
+    integer_parameters: tuple[str, ...]
+    #: ``batch(values: dict of (B,) arrays, cos_theta (A,)) -> (B, A, 3)`` linear RGB, coarse.
+    batch: Callable
+    #: ``converged(values: dict of floats, cos_theta (A,), final: bool) -> (A, 3)`` linear RGB.
+    converged: Callable
+    #: Parameters whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
+    host_parameter: str | None = None
+    host_threshold: float = 1.0
+    #: The length that scales the structure (scanned densely: :data:`SCAN_VALUES`).
+    scale_parameter: str | None = None
+    #: Search a mirror by its optical period and thickness share instead of ``Lambda`` and ``delta``.
+    optical: bool = False
+    #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
+    spectra: Callable | None = None
+
+
+# --------------------------------------------------------------------------------------------------
+# Forward models
+
+
+def _interpolation_weights(step: float) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Nodes every ``step`` nm over the CMFs' range and the XYZ weights that integrate the spectrum's linear
+    interpolant between them against the 1-nm CMFs: ``XYZ = R(nodes) @ weights``.
+    """
+    lo, hi = colorimetry.WAVELENGTH_MIN, colorimetry.WAVELENGTH_MAX
+    count = int(math.ceil((hi - lo) / step)) + 1
+    nodes = np.linspace(lo, hi, count)
+    fine = colorimetry.WAVELENGTHS
+    position = np.interp(fine, nodes, np.arange(count))
+    left = np.minimum(np.floor(position).astype(int), count - 2)
+    frac = position - left
+    interpolation = np.zeros((fine.size, count))
+    interpolation[np.arange(fine.size), left] = 1.0 - frac
+    interpolation[np.arange(fine.size), left + 1] += frac
+    return nodes, interpolation.T @ colorimetry.colour_matching_functions()
+
+
+_WEIGHTS: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def coarse_nodes(step: float = COARSE_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """Cached :func:`_interpolation_weights`."""
+    if step not in _WEIGHTS:
+        _WEIGHTS[step] = _interpolation_weights(step)
+    return _WEIGHTS[step]
+
+
+def chebyshev_U_real_N(a, N):
+    """
+    :func:`explorer.physics.bragg.chebyshev_U` for a real (array) ``N``: ``sin(N t) / sin t`` continues the
+    polynomials to non-integer cell counts, which lets the coarse search treat ``N`` as continuous.
+    """
+    in_band = np.abs(a) < 1.0
+    t = np.arccos(np.clip(a, -1.0, 1.0))
+    safe_sin_t = np.where(in_band, np.sin(t), 1.0)
+    U_N1_band = np.sin(N * t) / safe_sin_t
+    U_N2_band = np.sin((N - 1.0) * t) / safe_sin_t
+    x = np.maximum(np.arccosh(np.maximum(np.abs(a), 1.0)), 1e-12)
+    h = lambda y: -np.expm1(-2.0 * y)  # 1 - exp(-2y), as bragg._one_minus_exp_minus_2x
+    ratio_N2 = np.exp(-x) * h((N - 1.0) * x) / h(N * x)
+    scale_gap = np.exp(-(N - 1.0) * x) * h(x) / h(N * x)
+    # Band edges: the limits N and N - 1 (sin t -> 0) without 0/0.
+    edge = in_band & (np.abs(np.sin(t)) < 1e-9)
+    U_N1 = np.where(in_band, np.where(edge, N, U_N1_band), 1.0)
+    U_N2 = np.where(in_band, np.where(edge, N - 1.0, U_N2_band), np.sign(a) * ratio_N2)
+    return U_N1, U_N2, np.where(in_band, 1.0, scale_gap)
+
+
+def bragg_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta, wavelengths, step: float | None = None,
+                            smooth: float | None = None) -> np.ndarray:
+    """
+    Unpolarised ``R_lambda`` of many mirrors at once: parameters of shape ``(B,)`` (``nh < 1``: the host is
+    ``n1``; ``N`` may be fractional), ``cos_theta`` ``(A,)`` in the host, ``wavelengths`` ``(W,)`` nm;
+    returns ``(B, A, W)``. Appendix D's coefficient ``r_hN = (r_N + r_h1) / (1 + r_h1 r_N)`` with
+    ``r_N = r1 U_{N-1} / (U_{N-1} - U_{N-2} t1 e^{i k_1z d1})`` and the slab's ``r1, t1`` (Eq. 10);
+    ``|r_N|^2`` is Yeh's Eq. 2 when the host is ``n1`` (``r_h1 = 0``). Equals
+    :func:`explorer.physics.bragg.bragg_reflectance` at integer ``N`` (tested) when ``step`` is None.
+
+    ``step`` (nm): the spectrum is to be sampled that coarsely, so where the fringes are narrower than a
+    few steps it is blended into its average over the fringes
+    (:func:`explorer.physics.bragg.reflectance_fringe_average`, :func:`explorer.physics.bragg.fringe_average_under_host`),
+    which is what the converged colour of such a mirror integrates; point samples would alias.
+    ``smooth`` (nm, default ``step``) averages out fringes narrower than a few times it: the screening's
+    smoother landscape (the envelope's band gaps without the fringes' ripples).
+    """
+    col = lambda v: np.asarray(v, dtype=np.float64).reshape(-1, 1, 1)
+    n1, n2, Lambda, delta, N, nh = (col(v) for v in (n1, n2, Lambda, delta, N, nh))
+    host = nh >= 1.0
+    eta_h = np.where(host, nh, n1)
+    cos_h = np.maximum(np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1), bragg.COS_THETA_MIN)
+    wavelengths = np.asarray(wavelengths, dtype=np.float64).reshape(1, 1, -1)
+    omega = 2.0 * np.pi / wavelengths
+    cos_1 = cos_theta_transmitted(cos_h, eta_h, n1)
+    cos_2 = cos_theta_transmitted(cos_h, eta_h, n2)
+    p1 = n1 * cos_1 * delta * Lambda
+    p2 = n2 * cos_2 * (1.0 - delta) * Lambda
+    psi = bragg._clamp_decay(omega * p1)
+    phi = bragg._clamp_decay(omega * p2)
+    e_psi, e_phi = np.exp(1j * psi), np.exp(1j * phi)
+    cos_psi, sin_psi = (e_psi + 1.0 / e_psi) / 2.0, (e_psi - 1.0 / e_psi) / 2j
+    cos_phi, sin_phi = (e_phi + 1.0 / e_phi) / 2.0, (e_phi - 1.0 / e_phi) / 2j
+    if step is not None:
+        # Fringes lambda^2 / (2 N path) apart (path: the cell's optical thickness along z); a point sample
+        # per step resolves them from ~4 per fringe, and averages them out below 1 per fringe.
+        path = np.maximum(np.real(p1) + np.real(p2), 1e-9)
+        fringe = wavelengths**2 / (2.0 * N * path)
+        w_point = np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0)
+    total = 0.0
+    for pol in bragg.POLARISATIONS:
+        r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
+        Omega = bragg.Omega(pol, n1, cos_1, n2, cos_2)
+        a = np.real(cos_psi * cos_phi - 0.5 * Omega * sin_psi * sin_phi)  # Eq. 8
+        phase2 = e_phi * e_phi
+        r12_2 = r12 * r12
+        denominator = 1.0 - r12_2 * phase2
+        r1 = r12 * (1.0 - phase2) / denominator
+        t1 = (1.0 - r12_2) * e_phi / denominator
+        U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
+        r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
+        r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
+        R = np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
+        if step is not None:
+            average = bragg.fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), a)
+            R = w_point * R + (1.0 - w_point) * average
+        total = total + R
+    return np.clip(total / 2.0, 0.0, 1.0)
+
+
+@dataclass
+class _Geometry:
+    """What :func:`explorer.physics.bragg.fringe_average_under_host` reads of a cell (``r_h1 = 0``: no host)."""
+
+    p1: np.ndarray
+    r_h1: np.ndarray
+
+
+def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = COARSE_STEP,
+                    smooth: float | None = None) -> np.ndarray:
+    """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``) at ``cos_theta`` ``(A,)``."""
+    nodes, weights = coarse_nodes(step)
+    R = bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                values["nh"], cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = COARSE_STEP,
+                        smooth: float | None = None) -> np.ndarray:
+    """
+    The coarse colours ``(B, A, 3)`` of films ``values`` (``d``, ``eta1``, ``eta2``, ``eta3``, ``kappa3``); a
+    film's few fringes are its colour, so ``smooth`` is not used.
+    """
+    nodes, weights = coarse_nodes(step)
+    col = lambda name: np.asarray(values[name], dtype=np.float64).reshape(-1, 1, 1)
+    cos = np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1)
+    R = thinfilm.airy_reflectance(col("eta1"), col("eta2"), col("eta3"), col("kappa3"), cos, col("d"), nodes)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
+    wavelengths = np.asarray(wavelengths, dtype=np.float64)
+    return bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"], values["nh"],
+                                   cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
+
+
+def thin_film_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """The films' spectra ``(B, A, W)`` (not smoothed: a film's fringes are its colour)."""
+    col = lambda name: np.asarray(values[name], dtype=np.float64).reshape(-1, 1, 1)
+    cos = np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1)
+    return thinfilm.airy_reflectance(col("eta1"), col("eta2"), col("eta3"), col("kappa3"), cos, col("d"), np.asarray(wavelengths, float))
+
+
+def mirror_of(values: Mapping[str, float]) -> bragg.BraggMirror:
+    """The :class:`explorer.physics.bragg.BraggMirror` of design values (``nh < 1``: the host is ``n1``)."""
+    nh = float(values["nh"])
+    return bragg.BraggMirror(n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]),
+                             delta=float(values["delta"]), N=max(1, int(round(float(values["N"])))),
+                             nh=nh if nh >= 1.0 else None)
+
+
+def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours of a mirror (``N`` rounded): :func:`explorer.physics.bragg.reference_rgb` when
+    ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped),
+    which the polish calls many times.
+    """
+    mirror = mirror_of(values)
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final:
+        return bragg.reference_rgb(cos_theta, mirror)
+    return bragg._converged_rgb(cos_theta, mirror)
+
+
+def thin_film_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+    """The film's converged colours (:func:`explorer.physics.thinfilm.reference_rgb`)."""
+    return thinfilm.reference_rgb(float(values["eta1"]), float(values["eta2"]), float(values["eta3"]),
+                                  float(values["kappa3"]), np.asarray(cos_theta, dtype=np.float64), float(values["d"]))
+
+
+_BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+              integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, host_parameter="nh",
+              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch)
+#: Every designable material model; its specular colour is what is designed (``bragg_layer``: the smooth
+#: mirror's colour, which its gradient view shows).
+DESIGN_MODELS: dict[str, DesignModel] = {model.name: model for model in (
+    DesignModel("bragg_mirror", **_BRAGG),
+    DesignModel("bragg_layer", **_BRAGG),
+    DesignModel("thin_film", ("d", "eta1", "eta2", "eta3", "kappa3"), (), (), thin_film_rgb_batch, thin_film_converged_rgb,
+                scale_parameter="d", spectra=thin_film_spectra_batch),
+)}
+DESIGNABLE = tuple(DESIGN_MODELS)
+
+
+def design_model(name: str | None) -> DesignModel:
+    """The :class:`DesignModel` of a material model name, or a :class:`DesignError`."""
+    if name not in DESIGN_MODELS:
+        raise DesignError(f"model {name or '(none)'} cannot be designed (designable: {', '.join(DESIGNABLE)})")
+    return DESIGN_MODELS[name]
+
+
+# --------------------------------------------------------------------------------------------------
+# Colours
+
+
+def _white_xy() -> np.ndarray:
+    return colour.XYZ_to_xy(colorimetry.white_xyz())
+
+
+def rgb_to_lab(rgb) -> np.ndarray:
+    """CIELAB of linear RGB colours of this convention, relative to the flat reflectance of 1 (as ΔE2000)."""
+    return colour.XYZ_to_Lab(colorimetry.rgb_to_xyz(np.asarray(rgb, dtype=np.float64)), _white_xy())
+
+
+def delta_E_2000_lab(lab_a, lab_b) -> np.ndarray:
+    """CIEDE2000 between CIELAB colours (colour-science)."""
+    return np.asarray(colour.delta_E(lab_a, lab_b, method="CIE 2000"))
+
+
+def check_target_rgb(rgb, what: str = "colour") -> np.ndarray:
+    """
+    A target colour as linear RGB, or a :class:`DesignError`: non-finite values, or a luminance no passive
+    reflector has (``Y > 1``: brighter than the flat reflectance of 1; ``Y < 0``). Channels outside [0, 1]
+    are kept (vivid Bragg colours lie outside sRGB).
+    """
+    rgb = np.asarray(rgb, dtype=np.float64)
+    if rgb.shape != (3,) or not np.all(np.isfinite(rgb)):
+        raise DesignError(f"{what}: expected three finite numbers")
+    Y = float(colorimetry.rgb_to_xyz(rgb)[1])
+    if Y > 1.0 + 1e-6:
+        raise DesignError(f"{what}: luminance Y = {Y:.4g} > 1, brighter than a perfect mirror: no passive reflector has it")
+    if Y < -1e-6:
+        raise DesignError(f"{what}: luminance Y = {Y:.4g} < 0: no colour has it")
+    return rgb
+
+
+def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5) -> list["Target"]:
+    """
+    ``count`` targets from a strip of linear RGB ``(H, W, 3)`` whose column ``i`` shows
+    ``theta_a + (theta_b - theta_a)(i + 0.5) / W`` degrees (as the gradient view draws 0 to 90): evenly
+    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped.
+    """
+    if not (np.isfinite(theta_a) and np.isfinite(theta_b) and 0.0 <= min(theta_a, theta_b)
+            and max(theta_a, theta_b) <= 90.0 and theta_a != theta_b):
+        raise DesignError(f"theta range {theta_a:g},{theta_b:g}: the two angles must differ, within [0, 90]")
+    width = image.shape[1]
+    columns = np.unique(np.clip(np.round((np.arange(count) + 0.5) / count * width - 0.5).astype(int), 0, width - 1))
+    targets = []
+    for i in columns:
+        theta = theta_a + (theta_b - theta_a) * (i + 0.5) / width
+        if theta >= 90.0:
+            continue
+        rgb = check_target_rgb(np.asarray(image)[:, i, :3].mean(axis=0), f"strip column {i}")
+        targets.append(Target(float(theta), tuple(float(c) for c in rgb)))
+    if not targets:
+        raise DesignError("the strip has no column below 90 degrees")
+    return targets
+
+
+# --------------------------------------------------------------------------------------------------
+# The search
+
+
+@dataclass(frozen=True)
+class Target:
+    """A wanted colour (linear RGB of this convention) at an angle (degrees, in the outer medium)."""
+
+    theta_deg: float
+    rgb: tuple[float, float, float]
+
+
+@dataclass
+class DesignResult:
+    """
+    The best structure found: every design value (``values``, free and fixed, ``N`` an integer), the
+    converged colour at each target and its CIEDE2000, the time taken (wall and this process's CPU: on
+    a shared machine the wall time measures the load as much as the search) and how many candidates
+    were evaluated.
+    """
+
+    model: str
+    values: dict[str, float]
+    targets: list[Target]
+    achieved_rgb: np.ndarray
+    delta_e2000: np.ndarray
+    seconds: float
+    cpu_seconds: float = 0.0
+    evaluations: int = 0
+    stages: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def median_delta_e2000(self) -> float:
+        return float(np.median(self.delta_e2000))
+
+    @property
+    def reachable(self) -> np.ndarray:
+        """Per target: whether the design reaches it (CIEDE2000 at most :data:`REACHABLE_DELTA_E`)."""
+        return self.delta_e2000 <= REACHABLE_DELTA_E
+
+    def as_json(self, material: str) -> dict:
+        """The ``design --json`` object; colours are linear RGB."""
+        return {
+            "material": material,
+            "set": dict(self.values),
+            "targets": [
+                {"theta_deg": t.theta_deg, "target_rgb": [float(c) for c in t.rgb],
+                 "achieved_rgb": [float(c) for c in a], "delta_e2000": float(d)}
+                for t, a, d in zip(self.targets, self.achieved_rgb, self.delta_e2000)
+            ],
+            "median_delta_e2000": self.median_delta_e2000,
+            "seconds": self.seconds,
+        }
+
+
+def parameter_box(model: DesignModel, ranges: Mapping[str, tuple[float, float]]) -> list[DesignParameter]:
+    """The design parameters of ``model`` over ``ranges`` (name -> (low, high), the material's declared ranges)."""
+    box = []
+    for name in model.parameters:
+        if name not in ranges:
+            raise DesignError(f"the material declares no range for {name}")
+        low, high = (float(v) for v in ranges[name])
+        if name in model.log_parameters:
+            low = max(low, 1.0)
+        box.append(DesignParameter(name, low, high, log=name in model.log_parameters, integer=name in model.integer_parameters))
+    return box
+
+
+class _Problem:
+    """The free parameters, the fixed values and the targets, with the residuals of both models."""
+
+    def __init__(self, model: DesignModel, box: list[DesignParameter], fixed: Mapping[str, float],
+                 targets: Sequence[Target], cancelled: Callable[[], bool] | None):
+        self.model = model
+        self.box = {p.name: p for p in box}
+        self.fixed = {k: float(v) for k, v in fixed.items()}
+        self.free = [p for p in box if p.name not in self.fixed]
+        # A mirror whose period and thickness ratio are both free is searched by its optical period and
+        # the first layer's share of it (see :meth:`values`): the band positions then depend on one
+        # coordinate, and the indices move the angular shift and the contrast without moving the bands.
+        names = [p.name for p in self.free]
+        self.optical = model.optical and "Lambda" in names and "delta" in names
+        if self.optical:
+            indices = [self.box[n] if n not in self.fixed else DesignParameter(n, self.fixed[n], self.fixed[n]) for n in ("n1", "n2")]
+            n_low, n_high = min(p.low for p in indices), max(p.high for p in indices)
+            Lambda = self.box["Lambda"]
+            self.free[names.index("Lambda")] = DesignParameter("optical_period", Lambda.low * n_low, Lambda.high * n_high, log=True)
+            self.free[names.index("delta")] = DesignParameter("optical_fraction", 0.0, 1.0)
+        self.scale_parameter = "optical_period" if self.optical else model.scale_parameter
+        self.targets = list(targets)
+        self.cos_theta = np.cos(np.radians([t.theta_deg for t in self.targets]))
+        self.target_lab = rgb_to_lab(np.array([t.rgb for t in self.targets]))
+        self.cancelled = cancelled
+        self.evaluations = 0
+
+    def values(self, U: np.ndarray, scale_value: float | None = None) -> dict[str, np.ndarray]:
+        """
+        Unit-box rows ``(B, P)`` -> every design value as ``(B,)`` arrays. ``scale_value``: the scale
+        coordinate at this value instead, unclipped (the scale scan's reference structures).
+        """
+        U = np.atleast_2d(U)
+        out = {name: np.full(U.shape[0], value) for name, value in self.fixed.items()}
+        for k, p in enumerate(self.free):
+            out[p.name] = p.from_unit(U[:, k])
+        if scale_value is not None:
+            out[self.scale_parameter] = np.full(U.shape[0], float(scale_value))
+        if self.optical:
+            # Optical thicknesses n1 d1 = f P and n2 d2 = (1 - f) P at normal incidence (Eq. 8's phases):
+            # Lambda = P (f / n1 + (1 - f) / n2), delta = (f / n1) / (f / n1 + (1 - f) / n2).
+            f, P = out.pop("optical_fraction"), out.pop("optical_period")
+            per_period = f / out["n1"] + (1.0 - f) / out["n2"]
+            Lambda = self.box["Lambda"]
+            out["Lambda"] = P * per_period if scale_value is not None else np.clip(P * per_period, Lambda.low, Lambda.high)
+            out["delta"] = np.clip((f / out["n1"]) / per_period, 0.0, 1.0)
+        return out
+
+    def _check(self):
+        if self.cancelled is not None and self.cancelled():
+            raise DesignCancelled()
+
+    def coarse_rgb(self, U, step: float = COARSE_STEP, smooth: float | None = None) -> np.ndarray:
+        U = np.atleast_2d(U)
+        self.evaluations += U.shape[0]
+        out = np.empty((U.shape[0], self.cos_theta.size, 3))
+        for start in range(0, U.shape[0], BATCH):
+            self._check()
+            out[start : start + BATCH] = self.model.batch(self.values(U[start : start + BATCH]), self.cos_theta, step, smooth)
+        return out
+
+    @property
+    def scale_index(self) -> int | None:
+        """The free coordinate that scales every length of the structure (None when it is fixed)."""
+        return next((k for k, p in enumerate(self.free) if p.name == self.scale_parameter), None)
+
+    def scale_profile(self, shapes: np.ndarray, grid: np.ndarray) -> np.ndarray:
+        """
+        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at each scale
+        value of ``grid`` (unit values). Without dispersion a structure's spectrum depends on ``s / lambda``
+        only (every phase is ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``), so one
+        spectrum per shape over ``x = s / lambda``, log-spaced, gives the colours at every ``s``. Values
+        that put ``Lambda`` outside its box score infinity.
+        """
+        p = self.free[self.scale_index]
+        s = np.maximum(p.from_unit(grid), 1.0)  # a film of no thickness scanned as 1 nm
+        nodes, weights = coarse_nodes(SCREEN_STEP)
+        ratio = 1.0 + SCAN_RELATIVE_STEP
+        x_low, x_high = s.min() / nodes[-1] / ratio, s.max() / nodes[0] * ratio
+        x = x_low * ratio ** np.arange(int(np.ceil(np.log(x_high / x_low) / np.log(ratio))) + 1)
+        reference = 1000.0
+        # Position of every (s, lambda_j) in the x grid, and the linear map from a spectrum over x to the
+        # XYZ at every s: XYZ(s_m) = sum_j w_j R(s_m / lambda_j), R interpolated linearly in log x.
+        q = np.log(s[:, None] / nodes[None, :] / x_low) / np.log(ratio)
+        i = np.clip(np.floor(q).astype(int), 0, x.size - 2)
+        t = q - i
+        kernel = np.zeros((x.size, s.size, 3))
+        m = np.broadcast_to(np.arange(s.size)[:, None], i.shape)
+        np.add.at(kernel, (i, m), (1.0 - t)[..., None] * weights[None, :, :])
+        np.add.at(kernel, (i + 1, m), t[..., None] * weights[None, :, :])
+        kernel = kernel.reshape(x.size, -1)
+        scores = np.empty((shapes.shape[0], s.size))
+        for start in range(0, shapes.shape[0], SCAN_BATCH):
+            self._check()
+            U = shapes[start : start + SCAN_BATCH]
+            values = self.values(U, scale_value=reference)
+            R = self.model.spectra(values, self.cos_theta, reference / x, SCREEN_SMOOTH / 600.0)  # (B, A, X)
+            self.evaluations += U.shape[0] * s.size
+            xyz = (R @ kernel).reshape(R.shape[:2] + (s.size, 3))  # (B, A, G, 3)
+            rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
+            score = np.sum(self.residuals_of(rgb) ** 2, axis=-1)
+            if self.optical:
+                per_period = values["Lambda"] / reference
+                Lambda = s[None, :] * per_period[:, None]
+                box = self.box["Lambda"]
+                score = np.where((Lambda >= box.low) & (Lambda <= box.high), score, np.inf)
+            scores[start : start + SCAN_BATCH] = score
+        return scores
+
+    def screen(self, U) -> np.ndarray:
+        """Sum of squared CIEDE2000 of unit-box rows on the screening model."""
+        return np.sum(self.residuals_of(self.coarse_rgb(U, SCREEN_STEP, SCREEN_SMOOTH)) ** 2, axis=-1)
+
+    def residuals_of(self, rgb: np.ndarray) -> np.ndarray:
+        """``(..., A, 3)`` colours -> ``(..., 3 A)`` residuals whose squared norm per target is CIEDE2000^2."""
+        lab = rgb_to_lab(np.maximum(rgb, -1.0))
+        difference = lab - self.target_lab
+        e76 = np.linalg.norm(difference, axis=-1)
+        e00 = delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+        scale = np.where(e76 > 1e-9, e00 / np.maximum(e76, 1e-300), 1.0)
+        return (difference * scale[..., None]).reshape(rgb.shape[:-2] + (-1,))
+
+    def delta_e(self, rgb) -> np.ndarray:
+        lab = rgb_to_lab(rgb)
+        return delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+
+    def fine_values(self, u: np.ndarray, fixed_extra: Mapping[str, float] = {}) -> dict[str, float]:
+        values = {k: float(v[0]) for k, v in self.values(u).items()}
+        values.update(fixed_extra)
+        for p in self.box.values():
+            if p.integer:
+                values[p.name] = float(max(round(values[p.name]), p.low))
+        return values
+
+    def fine_rgb(self, values: Mapping[str, float], final: bool = False) -> np.ndarray:
+        self._check()
+        self.evaluations += 1
+        return self.model.converged(values, self.cos_theta, final=final)
+
+
+def _least_squares(fun, jac, x0, lower, upper, max_nfev):
+    from scipy.optimize import least_squares
+
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
+    return least_squares(fun, x0, jac=jac, bounds=(lower, upper), max_nfev=max_nfev, x_scale=1.0, method="dogbox",
+                         xtol=1e-10, ftol=1e-10, gtol=1e-10)
+
+
+def _host_bounds(problem: _Problem, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The unit box of a local refinement: a host parameter stays on the start's side of its threshold
+    (below it the host is ``n1``, a branch, not a slope: there it is held).
+    """
+    lower, upper = np.zeros(u.size), np.ones(u.size)
+    name = problem.model.host_parameter
+    for k, p in enumerate(problem.free):
+        if p.name == name:
+            threshold = float(np.clip(p.to_unit(problem.model.host_threshold), 0.0, 1.0))
+            if p.from_unit(u[k]) < problem.model.host_threshold:
+                lower[k], upper[k] = max(u[k] - 1e-6, 0.0), min(u[k] + 1e-6, 1.0)
+            else:
+                lower[k] = threshold
+    return lower, upper
+
+
+def _refine_coarse(problem: _Problem, u0: np.ndarray, max_nfev: int) -> tuple[np.ndarray, float]:
+    """The screening model's refinement, then the coarse model's (a continuation: smooth landscape first)."""
+    u, _ = _refine_level(problem, u0, max_nfev, SCREEN_STEP, SCREEN_SMOOTH)
+    return _refine_level(problem, u, max_nfev, COARSE_STEP, None)
+
+
+def _refine_level(problem: _Problem, u0: np.ndarray, max_nfev: int, step: float, smooth) -> tuple[np.ndarray, float]:
+    """Trust-region refinement (dogbox) on one batch model; Jacobian columns in one batch."""
+    lower, upper = _host_bounds(problem, u0)
+    P = u0.size
+    cache: dict[bytes, np.ndarray] = {}
+
+    def batch_residuals(U):
+        return problem.residuals_of(problem.coarse_rgb(U, step, smooth))
+
+    def fun(u):
+        key = u.tobytes()
+        if key not in cache:
+            cache.clear()
+            cache[key] = batch_residuals(u[None])[0]
+        return cache[key]
+
+    def jac(u):
+        h = np.where(u + COARSE_DIFF_STEP <= upper, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)
+        U = np.repeat(u[None], P, axis=0) + np.diag(h)
+        columns = batch_residuals(U)
+        return ((columns - fun(u)[None]) / h[:, None]).T
+
+    result = _least_squares(fun, jac, u0, lower, upper, max_nfev)
+    return result.x, float(2.0 * result.cost)
+
+
+def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -> tuple[dict[str, float], float]:
+    """
+    The converged model, with integer parameters held at the better of their two neighbouring integers:
+    damped Gauss-Newton steps whose residuals are the converged model's and whose Jacobian is the 1-nm
+    batch model's (smooth, all columns in one batch), until no step lowers the converged cost, after
+    ``max_nfev`` converged evaluations, or at ``deadline`` (``time.process_time()``). Finite differences
+    of the converged model itself would see its adaptive refinement's ~1e-4 steps.
+    """
+    integer_free = [k for k, p in enumerate(problem.free) if p.integer]
+    u0 = u0.copy()
+    choices = [u0.copy()]
+    for k in integer_free:
+        p = problem.free[k]
+        value = float(p.from_unit(u0[k]))
+        options = sorted({max(p.low, min(p.high, float(math.floor(value)))), max(p.low, min(p.high, float(math.ceil(value))))})
+        choices = [np.concatenate([c[:k], [p.to_unit(o)], c[k + 1:]]) for c in choices for o in options]
+
+    def fine(u):
+        values = problem.fine_values(u[None])
+        residuals = problem.residuals_of(problem.fine_rgb(values)[None])[0]
+        return values, residuals, float(np.sum(residuals**2))
+
+    best = min((fine(np.clip(c, 0.0, 1.0)) + (np.clip(c, 0.0, 1.0),) for c in choices), key=lambda item: item[2])
+    values, residuals, cost, u = best
+    keep = np.array([k for k in range(u.size) if k not in integer_free])
+    if keep.size == 0:
+        return values, cost
+    lower, upper = _host_bounds(problem, u)
+    damping = 1e-3
+    for _ in range(max_nfev):
+        if time.process_time() > deadline or cost < 1e-8:
+            break
+        h = np.where(u[keep] + COARSE_DIFF_STEP <= upper[keep], COARSE_DIFF_STEP, -COARSE_DIFF_STEP)
+        U = np.repeat(u[None], keep.size + 1, axis=0)
+        U[np.arange(1, keep.size + 1), keep] += h
+        columns = problem.residuals_of(problem.coarse_rgb(U, POLISH_STEP))
+        J = ((columns[1:] - columns[0]) / h[:, None]).T
+        JTJ, JTr = J.T @ J, J.T @ residuals
+        improved = False
+        while damping < 1e6:
+            step = -np.linalg.solve(JTJ + damping * np.diag(np.diag(JTJ) + 1e-12), JTr)
+            trial = u.copy()
+            trial[keep] = np.clip(u[keep] + step, lower[keep], upper[keep])
+            t_values, t_residuals, t_cost = fine(trial)
+            if t_cost < cost:
+                u, values, residuals, cost = trial, t_values, t_residuals, t_cost
+                damping = max(damping / 3.0, 1e-7)
+                improved = True
+                break
+            damping *= 4.0
+            if time.process_time() > deadline:
+                break
+        if not improved:
+            break
+    return values, cost
+
+
+def _variants(problem: _Problem, u: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """
+    Shapes near ``u``: each integer parameter on :data:`SECOND_COUNTS` log-spaced values, and
+    :data:`SECOND_PERTURBED` copies moved by a normal step of :data:`SECOND_SPREAD` in the unit box.
+    """
+    rows = []
+    for k, p in enumerate(problem.free):
+        if p.integer:
+            for value in np.unique(np.round(np.geomspace(p.low, p.high, SECOND_COUNTS))):
+                row = u.copy()
+                row[k] = p.to_unit(value)
+                rows.append(row)
+    rows += list(np.clip(u + rng.normal(0.0, SECOND_SPREAD, (SECOND_PERTURBED, u.size)), 0.0, 1.0))
+    return np.array(rows)
+
+
+def _distinct(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DISTINCT_STARTS) -> list[np.ndarray]:
+    """The best-scoring rows of ``U``, each farther than ``spacing`` (max norm) from those before it."""
+    chosen: list[np.ndarray] = []
+    for index in np.argsort(scores):
+        if all(np.max(np.abs(U[index] - c)) > spacing for c in chosen):
+            chosen.append(U[index])
+        if len(chosen) == count:
+            break
+    return chosen
+
+
+def _scale_grid(p: DesignParameter) -> np.ndarray:
+    """:data:`SCAN_VALUES` unit-box values of a scale parameter, geometrically spaced (and its low end)."""
+    if p.log:
+        return np.linspace(0.0, 1.0, SCAN_VALUES)
+    values = np.geomspace(max(p.low, 1.0), p.high, SCAN_VALUES - 1)
+    return np.clip(p.to_unit(np.concatenate([[p.low], values])), 0.0, 1.0)
+
+
+def design(
+    model_name: str,
+    targets: Sequence[Target],
+    ranges: Mapping[str, tuple[float, float]],
+    fixed: Mapping[str, float] | None = None,
+    seed: int = 0,
+    samples: int = FIRST_PASS_SAMPLES,
+    starts: int = LOCAL_STARTS,
+    progress: Callable[[float, str], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
+) -> DesignResult:
+    """
+    The structure whose converged colours come closest (least squares of CIEDE2000) to ``targets``.
+
+    Parameters
+    ----------
+    model_name : str
+        A key of :data:`DESIGN_MODELS` (the material's ``# model:``).
+    targets : sequence of Target
+        Colours at angles in [0, 90) degrees.
+    ranges : mapping
+        Each design parameter's box (the material's declared ``min``, ``max``).
+    fixed : mapping, optional
+        Parameters held at a value inside their range; the others are searched.
+    seed : int
+        The first pass's Sobol scrambling: the same seed gives the same design.
+    samples, starts : int
+        Candidates of the first pass; distinct starts refined on the coarse model.
+    progress : callable, optional
+        ``progress(fraction, stage)``, for a UI.
+    cancelled : callable, optional
+        Polled between batches; ``True`` raises :class:`DesignCancelled`.
+
+    Returns
+    -------
+    DesignResult
+        Achieved colours from :func:`explorer.physics.bragg.reference_rgb` (or the film's), whatever the
+        search used.
+    """
+    start_time, start_cpu = time.perf_counter(), time.process_time()
+    model = design_model(model_name)
+    fixed = dict(fixed or {})
+    if not targets:
+        raise DesignError("give at least one target colour")
+    for t in targets:
+        if not (np.isfinite(t.theta_deg) and 0.0 <= t.theta_deg < 90.0):
+            raise DesignError(f"target angle {t.theta_deg:g}: must be in [0, 90) degrees")
+        check_target_rgb(t.rgb, f"target at {t.theta_deg:g} degrees")
+    box = parameter_box(model, ranges)
+    names = {p.name for p in box}
+    for name, value in fixed.items():
+        if name not in names:
+            raise DesignError(f"cannot fix {name}: not a design parameter of {model.name} ({', '.join(model.parameters)})")
+        p = next(p for p in box if p.name == name)
+        low = float(ranges[name][0])
+        if not (np.isfinite(value) and low <= value <= p.high):
+            raise DesignError(f"cannot fix {name} = {value:g}: outside its range [{low:g}, {p.high:g}]")
+    problem = _Problem(model, box, fixed, targets, cancelled)
+    report = progress or (lambda fraction, stage: None)
+    stages: dict[str, float] = {}
+    P = len(problem.free)
+
+    if P == 0:
+        values = problem.fine_values(np.zeros((1, 0)))
+    else:
+        from scipy.stats import qmc
+
+        report(0.0, "first pass")
+        scale = problem.scale_index
+        chunk = 256
+        if scale is not None:
+            # 1-2. Space-filling shapes (Sobol), each at every value of its scale (the scale scan).
+            U = qmc.Sobol(P, scramble=True, seed=seed).random(SCAN_SHAPES)
+            grid = _scale_grid(problem.free[scale])
+            scores = np.empty((len(U), grid.size))
+            for start in range(0, len(U), chunk // 4):
+                scores[start : start + chunk // 4] = problem.scale_profile(U[start : start + chunk // 4], grid)
+                report(0.6 * min(1.0, (start + chunk // 4) / len(U)), "scale scan")
+            best = np.argmin(scores, axis=1)
+            U[:, scale] = grid[best]
+            scores = scores[np.arange(len(U)), best]
+            stages["scan"] = time.perf_counter() - start_time
+        else:
+            # 1. Space-filling first pass (Sobol) on the screening model.
+            U = qmc.Sobol(P, scramble=True, seed=seed).random(samples)
+            scores = np.empty(samples)
+            for start in range(0, samples, chunk):
+                scores[start : start + chunk] = problem.screen(U[start : start + chunk])
+                report(0.6 * min(1.0, (start + chunk) / samples), "first pass")
+            stages["first pass"] = time.perf_counter() - start_time
+        # 3. Distinct starts, refined on the coarse model.
+        chosen = _distinct(U, scores, starts)
+        refined = []
+        for k, u0 in enumerate(chosen):
+            report(0.6 + 0.2 * k / len(chosen), "local refinement")
+            u, cost = _refine_coarse(problem, u0, max_nfev=40)
+            refined.append((cost, k, u))
+            # A start that already matches every target to a small fraction of a unit needs no others.
+            if k >= 1 and math.sqrt(cost / len(targets)) < GOOD_ENOUGH:
+                break
+        refined.sort(key=lambda item: item[0])
+        if scale is not None and math.sqrt(refined[0][0] / len(targets)) >= GOOD_ENOUGH:
+            # 3b. A second scan around the best: its integer count on a grid and perturbed shapes, each at
+            # its best scale. Fringes make the count's basins narrow: a neighbouring count rarely wins by
+            # refinement alone.
+            report(0.75, "second scan")
+            variants = _variants(problem, refined[0][2], np.random.default_rng(seed))
+            variant_scores = problem.scale_profile(variants, grid)
+            best = np.argmin(variant_scores, axis=1)
+            variants[:, scale] = grid[best]
+            variant_scores = variant_scores[np.arange(len(variants)), best]
+            for k, u0 in enumerate(_distinct(variants, variant_scores, SECOND_STARTS, spacing=0.005)):
+                u, cost = _refine_coarse(problem, u0, max_nfev=40)
+                refined.append((cost, len(refined), u))
+            refined.sort(key=lambda item: item[0])
+        stages["coarse refinement"] = time.perf_counter() - start_time
+        # 4. Polish the best on the converged model, within a time budget.
+        best = None
+        deadline = time.process_time() + POLISH_SECONDS
+        for k, (_, _, u) in enumerate(refined[:POLISHED]):
+            report(0.8 + 0.2 * k / POLISHED, "polish")
+            values, cost = _polish(problem, u, max_nfev=20, deadline=deadline)
+            if best is None or cost < best[1]:
+                best = (values, cost)
+            if time.process_time() > deadline:
+                break
+        values = best[0]
+        stages["polish"] = time.perf_counter() - start_time
+    achieved = problem.fine_rgb(values, final=True)
+    report(1.0, "done")
+    return DesignResult(
+        model=model.name,
+        values={k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters},
+        targets=list(targets),
+        achieved_rgb=achieved,
+        delta_e2000=problem.delta_e(achieved),
+        seconds=time.perf_counter() - start_time,
+        cpu_seconds=time.process_time() - start_cpu,
+        evaluations=problem.evaluations,
+        stages=stages,
+    )
+
+
+def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg) -> np.ndarray:
+    """The converged colours of a structure at angles (degrees): what :func:`design` reports as achieved."""
+    model = design_model(model_name)
+    return model.converged(values, np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), final=True)
+
+
+def reachable_chromaticities(model_name: str, theta_deg: float, ranges: Mapping[str, tuple[float, float]],
+                             fixed: Mapping[str, float] | None = None, samples: int = 4096, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The chromaticities ``(x, y)`` and luminances ``Y`` of structures spread over the box (Sobol, coarse
+    model) at one angle: the colours a Bragg mirror (or film) can make there.
+
+    Returns
+    -------
+    xy : ndarray (M, 2)
+    Y : ndarray (M,)
+    """
+    from scipy.stats import qmc
+
+    model = design_model(model_name)
+    box = parameter_box(model, ranges)
+    problem = _Problem(model, box, dict(fixed or {}), [Target(float(theta_deg), (0.5, 0.5, 0.5))], None)
+    U = qmc.Sobol(max(len(problem.free), 1), scramble=True, seed=seed).random(samples)[:, : len(problem.free)]
+    rgb = problem.coarse_rgb(U)[:, 0]
+    xyz = colorimetry.rgb_to_xyz(rgb)
+    total = np.maximum(xyz.sum(axis=-1), 1e-12)
+    return np.stack([xyz[:, 0] / total, xyz[:, 1] / total], axis=-1), xyz[:, 1]
+
+
+#: The round trip's target angles (degrees).
+ROUND_TRIP_ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)
+
+
+def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]], rng: np.random.Generator) -> dict[str, float]:
+    """
+    A structure drawn from the declared ranges: uniform in each, except the parameters the search walks on
+    a log scale (``N``: log-uniform, so that thin stacks are drawn as often as thick ones) and integers
+    rounded.
+    """
+    model = design_model(model_name)
+    values = {}
+    for p in parameter_box(model, ranges):
+        value = float(p.from_unit(rng.uniform())) if p.name in model.integer_parameters else float(rng.uniform(*ranges[p.name]))
+        values[p.name] = float(round(value)) if p.integer else value
+    return values
+
+
+def round_trip(model_name: str, ranges: Mapping[str, tuple[float, float]], count: int, seed: int = 0,
+               angles: Sequence[float] = ROUND_TRIP_ANGLES, report: Callable[[int, dict, DesignResult], None] | None = None,
+               draw_ranges: Mapping[str, tuple[float, float]] | None = None) -> list[DesignResult]:
+    """
+    Designs for ``count`` reachable targets: random structures (:func:`random_structure`, seeded, from
+    ``draw_ranges``, default ``ranges``), their converged colours at ``angles`` as targets, each designed
+    back from its colours alone over ``ranges``.
+    """
+    rng = np.random.default_rng(seed)
+    results = []
+    for k in range(count):
+        truth = random_structure(model_name, {**ranges, **(draw_ranges or {})}, rng)
+        colours = forward_rgb(model_name, truth, angles)
+        targets = [Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(angles, colours)]
+        result = design(model_name, targets, ranges, seed=seed + k)
+        results.append(result)
+        if report is not None:
+            report(k, truth, result)
+    return results
