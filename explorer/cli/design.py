@@ -144,7 +144,11 @@ def ranges_of(material) -> dict[str, tuple[float, float]]:
 def render_command(material_name: str, values: dict) -> str:
     """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
     sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
-    method = "--set method=3"  # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of it)
+    from explorer.materials.methods import BraggMethod, ThinFilmMethod
+
+    # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of the reference).
+    best = ThinFilmMethod.FOURIER_3 if "thin_film" in material_name else BraggMethod.TABULATED
+    method = f"--set method={int(best)}"
     return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
 
 
