@@ -497,7 +497,7 @@ class PositionFree:
 
 
 #: Jobs of at least this many paths are traced by :func:`_workers` processes (forked; below, in this one).
-PARALLEL_PATHS = 1 << 18
+PARALLEL_PATHS = 1 << 16
 _WORKER: PositionFree | None = None
 
 
