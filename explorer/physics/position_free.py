@@ -113,9 +113,10 @@ class PositionFree:
     """
     The random walk through one layered Bragg structure (see the module docstring).
 
-    Each path carries one wavelength of the 471-nm grid, drawn with :func:`wavelength_pdf` (stratified
-    over the paths of a replicate), so that every choice follows that wavelength's own probabilities
-    and the weights stay near 1; its RGB is ``beta M(lambda) / p(lambda)``, an unbiased estimate of the
+    Each path carries :data:`HERO_WAVELENGTHS` wavelengths of the 471-nm grid (:meth:`sample_wavelengths`:
+    drawn with :func:`wavelength_pdf`, stratified over the paths of a replicate); the first decides every
+    choice with its own probabilities, and each adds ``f_k M(lambda_k) / (K p(lambda_k))`` divided by
+    the mean of the wavelengths' path probabilities (:meth:`trace`): an unbiased estimate of the
     spectrum's colour (:func:`explorer.physics.colorimetry.spectrum_to_rgb`).
 
     Parameters
