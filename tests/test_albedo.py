@@ -105,7 +105,8 @@ def test_cli_json_and_errors():
     document = json.loads(run.stdout)
     assert np.shape(document["rgb"]) == (1, 3) and np.shape(document["stderr"]) == (1, 3)
     for args in (("--theta", "90"), ("--theta", "x"), ("--samples", "10"), ("--engine", "position-free", "--samples", "0"),
-                 ("--set", "alpha_1=2"), ("--preset", "nonexistent")):
+                 ("--set", "alpha_1=2"), ("--preset", "nonexistent"),
+                 ("--engine", "position-free", "--seed", "-1")):
         one_line_error(run_cli("albedo", "bragg_stack", *args))
     one_line_error(run_cli("albedo", "ggx_schlick", "--engine", "position-free"))
     one_line_error(run_cli("albedo", str(BRDF_DATA / "lambert.brdf"), "--engine", "numpy"))

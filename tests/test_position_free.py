@@ -160,3 +160,14 @@ def test_bad_input():
         position_free.directional_albedo(stack, [95.0], samples=8)
     with pytest.raises(ValueError, match="samples"):
         position_free.directional_albedo(stack, [10.0], samples=0)
+
+
+def test_processes_do_not_change_the_result(monkeypatch):
+    stack = LayeredBragg(layers=(RoughBraggLayer(alpha=0.2),), n1=1.3, rho_d=0.4)
+    walker = position_free.PositionFree(stack)
+    sequential = walker.albedo([0.0, 60.0], samples=256, seed=3)
+    monkeypatch.setattr(position_free, "PARALLEL_PATHS", 1)
+    monkeypatch.setattr(position_free, "_workers", lambda: 2)
+    parallel = walker.albedo([0.0, 60.0], samples=256, seed=3)
+    np.testing.assert_array_equal(parallel.value, sequential.value)
+    np.testing.assert_array_equal(parallel.stderr, sequential.stderr)

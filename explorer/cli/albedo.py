@@ -103,7 +103,7 @@ def _fail(message: str) -> None:
 @click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="numpy", show_default=True,
               help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (bragg_stack).")
 @click.option("--samples", type=int, metavar="N", help=f"position-free: paths per angle (default {DEFAULT_SAMPLES}).")
-@click.option("--seed", type=int, default=0, show_default=True, help="position-free: the random generator's seed.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="position-free: the random generator's seed (>= 0).")
 @click.option("--json", "as_json", is_flag=True, help='Print {"theta_deg": [...], "rgb": [[r, g, b], ...]} (plus "stderr" for position-free).')
 def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, as_json):
     """Directional albedo of MATERIAL: BRDF x cos integrated over the outgoing hemisphere, plus its Dirac

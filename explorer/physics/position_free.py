@@ -45,6 +45,7 @@ Wilkie, Nawaz, Droske, Weidlich, Hanika (2014). Hero wavelength spectral samplin
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -112,9 +113,10 @@ class PositionFree:
     """
     The random walk through one layered Bragg structure (see the module docstring).
 
-    Each path carries one wavelength of the 471-nm grid, drawn with :func:`wavelength_pdf` (stratified
-    over the paths of a replicate), so that every choice follows that wavelength's own probabilities
-    and the weights stay near 1; its RGB is ``beta M(lambda) / p(lambda)``, an unbiased estimate of the
+    Each path carries :data:`HERO_WAVELENGTHS` wavelengths of the 471-nm grid (:meth:`sample_wavelengths`:
+    drawn with :func:`wavelength_pdf`, stratified over the paths of a replicate); the first decides every
+    choice with its own probabilities, and each adds ``f_k M(lambda_k) / (K p(lambda_k))`` divided by
+    the mean of the wavelengths' path probabilities (:meth:`trace`): an unbiased estimate of the
     spectrum's colour (:func:`explorer.physics.colorimetry.spectrum_to_rgb`).
 
     Parameters
@@ -354,6 +356,24 @@ class PositionFree:
     # ----------------------------------------------------------------------------------------------
     # Estimates
 
+    def replicate(self, i_air: np.ndarray, o_air: np.ndarray | None, per: int, key: tuple) -> np.ndarray:
+        """
+        One replicate: ``per`` paths per query (rows of ``i_air``), its generator seeded by ``key``; the
+        means of its albedo and BRDF tallies, shape ``(2, Q, 3)``.
+        """
+        Q = i_air.shape[0]
+        rng = np.random.default_rng(key)
+        means = np.zeros((2, Q, 3))
+        queries_per_batch = max(1, BATCH_PATHS // per)
+        for start in range(0, Q, queries_per_batch):
+            queries = np.arange(start, min(Q, start + queries_per_batch))
+            rows = np.repeat(queries, per)
+            wavelength = self.sample_wavelengths(per, queries.size, rng)
+            a, f = self.trace(i_air[rows], None if o_air is None else o_air[rows], wavelength, rng)
+            for k, tally in enumerate((a, f)):
+                means[k, queries] = tally.reshape(queries.size, per, 3).mean(axis=1)
+        return means
+
     def _replicates(
         self, i_air: np.ndarray, o_air: np.ndarray | None, samples: int, seed,
         progress: Callable[[int, int], None] | None = None,
@@ -361,27 +381,33 @@ class PositionFree:
         """
         The replicates' means of the albedo and BRDF tallies per query (rows of ``i_air``): shape
         ``(replicates, 2, Q, 3)``, from ``samples`` paths in :data:`REPLICATES` independent replicates
-        (one path each below 2 per replicate).
+        (one path each below 2 per replicate), each seeded by ``(seed, its index)`` so that the result
+        does not depend on how many processes trace them (:data:`PARALLEL_PATHS`).
         """
         Q = i_air.shape[0]
         replicates = REPLICATES if samples >= 2 * REPLICATES else samples
         per = samples // replicates
         replicates = samples // per
-        rng = np.random.default_rng(seed)
+        keys = [tuple(np.atleast_1d(seed).tolist()) + (rep,) for rep in range(replicates)]
+        workers = _workers() if replicates * per * Q >= PARALLEL_PATHS else 1
         means = np.zeros((replicates, 2, Q, 3))
-        queries_per_batch = max(1, BATCH_PATHS // per)
-        total, done = replicates * Q, 0
-        for rep in range(replicates):
-            for start in range(0, Q, queries_per_batch):
-                queries = np.arange(start, min(Q, start + queries_per_batch))
-                rows = np.repeat(queries, per)
-                wavelength = self.sample_wavelengths(per, queries.size, rng)
-                a, f = self.trace(i_air[rows], None if o_air is None else o_air[rows], wavelength, rng)
-                for k, tally in enumerate((a, f)):
-                    means[rep, k, queries] = tally.reshape(queries.size, per, 3).mean(axis=1)
-                done += queries.size
-                if progress is not None:
-                    progress(done * per, total * per)
+        if workers > 1:
+            import concurrent.futures
+            import multiprocessing
+
+            with concurrent.futures.ProcessPoolExecutor(
+                workers, mp_context=multiprocessing.get_context("fork"), initializer=_set_worker, initargs=(self,)
+            ) as pool:
+                futures = {pool.submit(_worker_replicate, i_air, o_air, per, key): rep for rep, key in enumerate(keys)}
+                for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
+                    means[futures[future]] = future.result()
+                    if progress is not None:
+                        progress(done * per * Q, replicates * per * Q)
+            return means
+        for rep, key in enumerate(keys):
+            means[rep] = self.replicate(i_air, o_air, per, key)
+            if progress is not None:
+                progress((rep + 1) * per * Q, replicates * per * Q)
         return means
 
     @staticmethod
@@ -469,6 +495,28 @@ class PositionFree:
                                              int(samples), seed, progress)
             value[above], stderr[above] = mean, err
         return PositionFreeResult(value, stderr, int(samples), time.perf_counter() - start)
+
+
+#: Jobs of at least this many paths are traced by :func:`_workers` processes (forked; below, in this one).
+PARALLEL_PATHS = 1 << 16
+_WORKER: PositionFree | None = None
+
+
+def _workers() -> int:
+    """The processes a large job uses: the CPUs this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _set_worker(walker: PositionFree) -> None:
+    global _WORKER
+    _WORKER = walker
+
+
+def _worker_replicate(i_air, o_air, per, key):
+    return _WORKER.replicate(i_air, o_air, per, key)
 
 
 def directional_albedo(stack: layered.LayeredBragg, theta_deg, samples: int = 20000, seed: int = 0,
