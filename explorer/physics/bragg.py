@@ -796,10 +796,13 @@ def approximate_xyz_polarised(
     ``w_j (C(omega_{j+1}) - C(omega_j))`` from the cumulative CMF table (Eq. 16).
     """
     xyz = np.zeros(np.shape(geometry.p1) + (3,))
-    for omega_low, omega_high, weight, active in piecewise_constant_boxes(geometry, s, mode_numbering, variant):
-        # omega -> lambda reverses the order: the box covers [2 pi / omega_high, 2 pi / omega_low].
-        span = cmf_cumulative_at(wavelength_of(omega_low)) - cmf_cumulative_at(wavelength_of(omega_high))
-        xyz += np.where(active, weight, 0.0)[..., None] * span
+    # Finished elements' extra boxes (masked by active) may lie at negative omega, where the exact
+    # reflectance of the improved variant overflows: their warnings are noise.
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for omega_low, omega_high, weight, active in piecewise_constant_boxes(geometry, s, mode_numbering, variant):
+            # omega -> lambda reverses the order: the box covers [2 pi / omega_high, 2 pi / omega_low].
+            span = cmf_cumulative_at(wavelength_of(omega_low)) - cmf_cumulative_at(wavelength_of(omega_high))
+            xyz += np.where(active, weight, 0.0)[..., None] * span
     return xyz
 
 

@@ -250,6 +250,21 @@ float reflectance_envelope(float omega, CellGeometry g) {
     return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
+// R_h1 = |r_h1|^2, the host interface's reflectance (0 when the host is n1), at most 1.
+float host_reflectance(CellGeometry g) { return g.host_is_n1 ? 0.0 : min(cabs2(g.r_h1), 1.0); }
+
+// The paper's weight w~ R^e (Section 3.2.2, Appendix B); under a host, under_host(w~ R^e): w~ corrects the
+// mirror's fringes, not the host interface's own reflection.
+float paper_weight(float omega, CellGeometry g) {
+    if (g.host_is_n1) return g.correction * reflectance_envelope(omega, g);
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    float r1_2 = cabs2(r1);
+    float denominator = r1_2 + cabs2(t1) * max(1.0 - a * a, 0.0);
+    return under_host(g.correction * (denominator > 0.0 ? r1_2 / denominator : 0.0), g);
+}
+
 // |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
 // spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
 // <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/bragg.py has the derivation).
@@ -337,6 +352,51 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
     return max(1.0, ceil(4.0 * s * dot(C_low - C_high, vec3(1.0)) / total));
 }
 
+// The improved variant (ours) resolves fringes wider than FRINGE_RESOLVE_NM / s nm with SAMPLES_PER_FRINGE
+// sub-boxes per fringe feature, weighted by the exact reflectance (explorer/bragg.py has the reasoning).
+const float FRINGE_RESOLVE_NM = 24.0;
+const float SAMPLES_PER_FRINGE = 3.0;
+const float MAX_RESOLVED_PIECES = 64.0;
+
+// Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
+float fringe_count(float omega_low, float omega_high, CellGeometry g) {
+    float t_low = acos(clamp(cos_K_Lambda(omega_low, g), -1.0, 1.0));
+    float t_high = acos(clamp(cos_K_Lambda(omega_high, g), -1.0, 1.0));
+    return g.N * abs(t_high - t_low) / PI;
+}
+
+// The share of a fringe its dip fills at most: min(1, 2 / (pi sqrt(k))), k >= 4 r12^2 / (1 - r12^2)^2 and R_h1 / (1 - R_h1).
+float fringe_sharpness(CellGeometry g) {
+    float r12_2 = min(cabs2(g.r12), 1.0 - 1e-7);
+    float k = 4.0 * r12_2 / ((1.0 - r12_2) * (1.0 - r12_2));
+    float R_h1 = min(host_reflectance(g), 1.0 - 1e-7);
+    k = max(k, R_h1 / (1.0 - R_h1));
+    return min(1.0, 2.0 / (PI * sqrt(max(k, 1e-30))));
+}
+
+float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, out bool resolved) {
+    float by_mass = subdivisions_by_mass(C_low, C_high, s);
+    resolved = false;
+    if (s <= 0.0) return by_mass;
+    float fringes = max(fringe_count(omega_low, omega_high, g), 1e-9);
+    float width_nm = wavelength_of(omega_low) - wavelength_of(omega_high);
+    float feature = fringe_sharpness(g);
+    float pieces = ceil(SAMPLES_PER_FRINGE * fringes / feature);
+    resolved = width_nm * feature * s > FRINGE_RESOLVE_NM * fringes && pieces <= MAX_RESOLVED_PIECES;
+    return resolved ? max(pieces, by_mass) : by_mass;
+}
+
+
+// The exact reflectance where fringes are resolved, their closed-form average otherwise.
+float pass_band_weight(float omega, CellGeometry g, bool resolved) {
+    return resolved ? clamp(reflectance_polarised(omega, g), 0.0, 1.0) : reflectance_fringe_average(omega, g);
+}
+
+// A half band gap's weight (ours): the exact reflectance at its middle (the paper's 1 is its large-N limit).
+float gap_weight(float omega_low, float omega_high, CellGeometry g) {
+    return clamp(reflectance_polarised(0.5 * (omega_low + omega_high), g), 0.0, 1.0);
+}
+
 // Sub-box j of pieces in [lo, hi]: equal (edge 0), or graded quadratically toward a band edge at lo
 // (edge -1) or hi (edge +1) and sampled at its centroid (ours).
 void sub_box(float lo, float hi, float j, float pieces, int edge, out float sub_lo, out float centre, out float sub_hi) {
@@ -371,28 +431,30 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
 
         vec3 C_previous = cmf_cumulative_at(wavelength_of(omega_m));
         vec3 C_next = cmf_cumulative_at(wavelength_of(edge_low));
-        xyz += C_previous - C_next;  // upper half of the gap around mode m: w = 1
+        // upper half of the gap around mode m: w = 1 (the paper), its finite-N reflectance (ours)
+        xyz += (improved ? gap_weight(omega_m, edge_low, g) : 1.0) * (C_previous - C_next);
         C_previous = C_next;
         float pieces = subdivisions(m, m_first, s, absolute_numbering);
+        bool resolved = false;
         for (int box = 0; box < 3; ++box) {
             float lo = box == 0 ? edge_low : (box == 1 ? x1 : x2);
             float hi = box == 0 ? x1 : (box == 1 ? x2 : edge_high);
             if (hi <= lo) continue;
             int edge = improved ? box - 1 : 0;
             vec3 C_high = cmf_cumulative_at(wavelength_of(hi));
-            if (improved) pieces = subdivisions_by_mass(C_previous, C_high, s);
+            if (improved) pieces = subdivisions_resolving_fringes(lo, hi, C_previous, C_high, s, g, resolved);
             for (float k = 0.0; k < pieces; k += 1.0) {
                 float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
                 float sub_lo, centre, sub_hi;
                 sub_box(lo, hi, j, pieces, edge, sub_lo, centre, sub_hi);
-                float weight = improved ? reflectance_fringe_average(centre, g)
-                                        : g.correction * reflectance_envelope(centre, g);
+                float weight = improved ? pass_band_weight(centre, g, resolved) : paper_weight(centre, g);
                 C_next = k + 1.0 < pieces ? cmf_cumulative_at(wavelength_of(sub_hi)) : C_high;
                 xyz += weight * (C_previous - C_next);
                 C_previous = C_next;
             }
         }
-        xyz += C_previous - cmf_cumulative_at(wavelength_of(omega_next));  // lower half of the next gap
+        // lower half of the next gap
+        xyz += (improved ? gap_weight(edge_high, omega_next, g) : 1.0) * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
     }
     return xyz;
 }
