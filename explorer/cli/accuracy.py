@@ -56,7 +56,7 @@ class PresetMirror:
 
 def preset_mirrors(preset_files=None) -> list[PresetMirror]:
     """Every distinct Bragg mirror of the shipped presets (see the module docstring), in file order."""
-    from explorer.materials.models import model_for
+    from explorer.materials.models import BraggStackModel, model_for
     from explorer.materials.presets import all_preset_files
 
     found: dict[bragg.BraggMirror, PresetMirror] = {}
@@ -72,7 +72,7 @@ def preset_mirrors(preset_files=None) -> list[PresetMirror]:
             if kind in ("bragg_mirror", "bragg_layer"):
                 add(model_for(preset_file.material, preset.resolve()).mirror, name, kind)
             elif kind == "bragg_stack":
-                stack = model_for(preset_file.material, preset.resolve()).stack
+                stack = BraggStackModel.stack_of(preset_file.material.physical_values(preset.resolve()))
                 for k, layer in enumerate(stack.layers, start=1):
                     add(layer.mirror(stack.n1), f"{name}/layer {k}", kind)
     return list(found.values())
