@@ -21,8 +21,8 @@ from explorer.materials.accuracy import ACCURACY_LIMIT, accuracy_badge, gradient
 from explorer.materials.brd import load_material
 from explorer.physics import bragg, colorimetry
 
-#: Gradient columns of the per-preset sweep in the tests (the command uses 256).
-TEST_WIDTH = 32
+#: Gradient columns of the per-preset sweep in the tests (the badge's; the command uses 256).
+TEST_WIDTH = 90
 
 
 @pytest.fixture(scope="module")

@@ -625,15 +625,17 @@ def subdivisions_by_mass(omega_low, omega_high, s):
     return np.maximum(1.0, np.ceil(4.0 * s * mass / total))
 
 
-#: The improved variant resolves a fringe wider than ``FRINGE_RESOLVE_NM / s`` nm (8 nm at s = 3): its
-#: sub-boxes sample the exact reflectance (:func:`subdivisions_resolving_fringes`); narrower fringes are
-#: averaged in closed form. On the shipped presets the worst median ΔE2000 goes 2.3 -> 1.5 from 12 nm to
-#: 8 nm, at 3.7 times the boxes of the unresolved variant on average (docs/accuracy.md).
+#: The improved variant resolves a pass band's fringes where a fringe feature is wider than
+#: ``FRINGE_RESOLVE_NM / s`` nm (8 nm at s = 3) and N <= 10 (:func:`fringes_resolved`): its sub-boxes then
+#: sample the exact reflectance; elsewhere the fringes are averaged in closed form (docs/accuracy.md).
 FRINGE_RESOLVE_NM = 24.0
 #: Sub-boxes per resolved fringe (each rises from a zero of R to a peak and back; 2 alias).
 SAMPLES_PER_FRINGE = 3.0
-#: At most this many sub-boxes per box; a box that would need more keeps the fringe average.
-MAX_RESOLVED_PIECES = 64.0
+#: Fringes are resolved only while ``SAMPLES_PER_FRINGE N`` is at most this (N <= 10): beyond, they are
+#: narrow enough for their average, and the method keeps the cost of the paper's (Figure 4's N = 20).
+RESOLVE_BUDGET = 32.0
+#: At most this many sub-boxes per box (sharp dips at grazing angles ask for more).
+MAX_RESOLVED_PIECES = 48.0
 
 
 def fringe_count(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
@@ -647,31 +649,35 @@ def fringe_count(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
     return geometry.N * np.abs(t_high - t_low) / np.pi
 
 
-def subdivisions_resolving_fringes(omega_low, omega_high, s, geometry: CellGeometry):
+def fringes_resolved(edge_low, edge_high, s, geometry: CellGeometry) -> np.ndarray:
     """
-    Sub-boxes of the improved variant (ours) in a pass-band box, and whether its fringes are resolved.
+    Whether the improved variant (ours) resolves the fringes of the pass band ``[edge_low, edge_high]``.
 
     Eq. 2 has ``N`` fringes per pass band; the fringe average (:func:`reflectance_fringe_average`)
-    replaces them by their mean, which is right when they are narrower than the CMFs vary: large ``N``.
-    For a few cells (the jewel beetles of Table 3, ``N = 6-8``; Figure 12, ``N = 3``) a fringe spans tens of
-    nm and where it lies is the colour. Where a fringe's feature (:func:`fringe_sharpness`) is wider than
-    ``FRINGE_RESOLVE_NM / s`` nm, the box gets :data:`SAMPLES_PER_FRINGE` sub-boxes per feature width,
-    weighted by the exact reflectance (:func:`pass_band_weight`); elsewhere :func:`subdivisions_by_mass`.
+    replaces them by their mean, right when they are narrower than the CMFs vary: large ``N``. For a few
+    cells (the jewel beetles of Table 3, ``N = 6-8``; Figure 12, ``N = 3``) a fringe spans tens of nm and
+    where it lies is the colour. They are resolved where a fringe's feature (:func:`fringe_sharpness`)
+    is wider than ``FRINGE_RESOLVE_NM / s`` nm and ``SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET`` (``N <= 10``).
+    """
+    if s <= 0:
+        return np.zeros(np.shape(edge_low), dtype=bool)
+    feature = fringe_sharpness(geometry)
+    width_nm = wavelength_of(edge_low) - wavelength_of(edge_high)
+    return (width_nm * feature * s > FRINGE_RESOLVE_NM * geometry.N) & (SAMPLES_PER_FRINGE * geometry.N <= RESOLVE_BUDGET)
 
-    Returns
-    -------
-    pieces : ndarray
-    resolved : ndarray of bool
+
+def subdivisions_resolving_fringes(omega_low, omega_high, s, geometry: CellGeometry, resolved):
+    """
+    Sub-boxes of the improved variant (ours) in a pass-band box: :func:`subdivisions_by_mass`, and where
+    the fringes are resolved (:func:`fringes_resolved`) at least :data:`SAMPLES_PER_FRINGE` per fringe
+    feature (:func:`fringe_count`, :func:`fringe_sharpness`), at most :data:`MAX_RESOLVED_PIECES`.
     """
     by_mass = subdivisions_by_mass(omega_low, omega_high, s)
-    if s <= 0:
-        return by_mass, np.zeros(np.shape(by_mass), dtype=bool)
-    fringes = np.maximum(fringe_count(omega_low, omega_high, geometry), 1e-9)
-    width_nm = wavelength_of(omega_low) - wavelength_of(omega_high)
-    feature = fringe_sharpness(geometry)
-    pieces = np.ceil(SAMPLES_PER_FRINGE * fringes / feature)
-    resolved = (width_nm * feature * s > FRINGE_RESOLVE_NM * fringes) & (pieces <= MAX_RESOLVED_PIECES)
-    return np.where(resolved, np.maximum(pieces, by_mass), by_mass), resolved
+    if not np.any(resolved):
+        return by_mass
+    pieces = np.ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, geometry) / fringe_sharpness(geometry))
+    pieces = np.minimum(pieces, MAX_RESOLVED_PIECES)
+    return np.where(resolved, np.maximum(pieces, by_mass), by_mass)
 
 
 def fringe_sharpness(geometry: CellGeometry) -> np.ndarray:
@@ -772,10 +778,17 @@ def piecewise_constant_boxes(
         z = np.where(has_zero, omega_z, omega_a)
         x1 = np.minimum(z, omega_a)
         x2 = np.maximum(z, omega_a)
-        yield omega_m, edge_low, gap_weight(omega_m, edge_low, geometry) if improved else ones, active
-        for lo, hi, edge in ((edge_low, x1, -1), (x1, x2, 0), (x2, edge_high, 1)):
+        boxes = ((edge_low, x1, -1), (x1, x2, 0), (x2, edge_high, 1))
+        if improved:
+            resolved = fringes_resolved(edge_low, edge_high, s, geometry)
+            # Resolved fringes: the gaps take their finite-N reflectance too (the fringe average and
+            # w = 1 are both the large-N limit, consistent only together).
+            gap_low = np.where(resolved, gap_weight(omega_m, edge_low, geometry), 1.0)
+            gap_high = np.where(resolved, gap_weight(edge_high, omega_next, geometry), 1.0)
+        yield omega_m, edge_low, gap_low if improved else ones, active
+        for lo, hi, edge in boxes:
             if improved:
-                pieces, resolved = subdivisions_resolving_fringes(lo, hi, s, geometry)
+                pieces = subdivisions_resolving_fringes(lo, hi, s, geometry, resolved)
             else:
                 pieces = subdivisions(m, m_first, s, mode_numbering)
             for j in range(int(np.max(np.where(active, pieces, 1.0)))):
@@ -785,7 +798,7 @@ def piecewise_constant_boxes(
                 else:
                     weight = paper_weight(centre, geometry)
                 yield sub_lo, sub_hi, weight, active & (j < pieces)
-        yield edge_high, omega_next, gap_weight(edge_high, omega_next, geometry) if improved else ones, active
+        yield edge_high, omega_next, gap_high if improved else ones, active
 
 
 def approximate_xyz_polarised(

@@ -352,11 +352,13 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
     return max(1.0, ceil(4.0 * s * dot(C_low - C_high, vec3(1.0)) / total));
 }
 
-// The improved variant (ours) resolves fringes wider than FRINGE_RESOLVE_NM / s nm with SAMPLES_PER_FRINGE
-// sub-boxes per fringe feature, weighted by the exact reflectance (explorer/bragg.py has the reasoning).
+// The improved variant (ours) resolves a pass band's fringes where a fringe feature is wider than
+// FRINGE_RESOLVE_NM / s nm and N <= 10 (SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET), with SAMPLES_PER_FRINGE
+// sub-boxes per feature weighted by the exact reflectance (explorer/bragg.py has the reasoning).
 const float FRINGE_RESOLVE_NM = 24.0;
 const float SAMPLES_PER_FRINGE = 3.0;
-const float MAX_RESOLVED_PIECES = 64.0;
+const float RESOLVE_BUDGET = 32.0;
+const float MAX_RESOLVED_PIECES = 48.0;
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
 float fringe_count(float omega_low, float omega_high, CellGeometry g) {
@@ -374,18 +376,18 @@ float fringe_sharpness(CellGeometry g) {
     return min(1.0, 2.0 / (PI * sqrt(max(k, 1e-30))));
 }
 
-float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, out bool resolved) {
-    float by_mass = subdivisions_by_mass(C_low, C_high, s);
-    resolved = false;
-    if (s <= 0.0) return by_mass;
-    float fringes = max(fringe_count(omega_low, omega_high, g), 1e-9);
-    float width_nm = wavelength_of(omega_low) - wavelength_of(omega_high);
-    float feature = fringe_sharpness(g);
-    float pieces = ceil(SAMPLES_PER_FRINGE * fringes / feature);
-    resolved = width_nm * feature * s > FRINGE_RESOLVE_NM * fringes && pieces <= MAX_RESOLVED_PIECES;
-    return resolved ? max(pieces, by_mass) : by_mass;
+bool fringes_resolved(float edge_low, float edge_high, float s, CellGeometry g) {
+    if (s <= 0.0) return false;
+    float width_nm = wavelength_of(edge_low) - wavelength_of(edge_high);
+    return width_nm * fringe_sharpness(g) * s > FRINGE_RESOLVE_NM * g.N && SAMPLES_PER_FRINGE * g.N <= RESOLVE_BUDGET;
 }
 
+float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, bool resolved) {
+    float by_mass = subdivisions_by_mass(C_low, C_high, s);
+    if (!resolved) return by_mass;
+    float pieces = min(ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, g) / fringe_sharpness(g)), MAX_RESOLVED_PIECES);
+    return max(pieces, by_mass);
+}
 
 // The exact reflectance where fringes are resolved, their closed-form average otherwise.
 float pass_band_weight(float omega, CellGeometry g, bool resolved) {
@@ -431,11 +433,11 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
 
         vec3 C_previous = cmf_cumulative_at(wavelength_of(omega_m));
         vec3 C_next = cmf_cumulative_at(wavelength_of(edge_low));
-        // upper half of the gap around mode m: w = 1 (the paper), its finite-N reflectance (ours)
-        xyz += (improved ? gap_weight(omega_m, edge_low, g) : 1.0) * (C_previous - C_next);
+        // Resolved fringes (ours): the gaps take their finite-N reflectance too, else w = 1 (the paper).
+        bool resolved = improved && fringes_resolved(edge_low, edge_high, s, g);
+        xyz += (resolved ? gap_weight(omega_m, edge_low, g) : 1.0) * (C_previous - C_next);  // upper half of the gap around mode m
         C_previous = C_next;
         float pieces = subdivisions(m, m_first, s, absolute_numbering);
-        bool resolved = false;
         for (int box = 0; box < 3; ++box) {
             float lo = box == 0 ? edge_low : (box == 1 ? x1 : x2);
             float hi = box == 0 ? x1 : (box == 1 ? x2 : edge_high);
@@ -454,7 +456,7 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
             }
         }
         // lower half of the next gap
-        xyz += (improved ? gap_weight(edge_high, omega_next, g) : 1.0) * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
+        xyz += (resolved ? gap_weight(edge_high, omega_next, g) : 1.0) * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
     }
     return xyz;
 }
