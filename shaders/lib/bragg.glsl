@@ -389,14 +389,32 @@ float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_l
     return max(pieces, by_mass);
 }
 
-// The exact reflectance where fringes are resolved, their closed-form average otherwise.
+// The exact reflectance where fringes are resolved (Eqs. 2, 9; Appendix D under a host), their closed-form
+// average otherwise: one airy_slab_coefficients and cos_K_Lambda for both, so that the exact branch adds
+// little code to the loop (llvmpipe pays for a branch's code even where no pixel takes it).
 float pass_band_weight(float omega, CellGeometry g, bool resolved) {
-    return resolved ? clamp(reflectance_polarised(omega, g), 0.0, 1.0) : reflectance_fringe_average(omega, g);
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    if (resolved) {
+        float U_N1, U_N2, scale;
+        chebyshev_U(a, g.N, U_N1, U_N2, scale);
+        if (g.host_is_n1) {
+            float numerator = cabs2(r1) * U_N1 * U_N1;
+            return numerator / max(numerator + cabs2(t1) * scale * scale, 1e-30);
+        }
+        vec2 r_N = cdiv(r1 * U_N1, vec2(U_N1, 0.0) - U_N2 * cmul(t1, cexpi(omega * g.p1)));
+        return clamp(cabs2(reflection_coefficient_host(r_N, g.r_h1)), 0.0, 1.0);
+    }
+    if (!g.host_is_n1) return fringe_average_under_host(r1, t1, omega, g, a);
+    float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
+    float denominator = cabs2(r1) + t1_2_sin2;
+    return denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0;
 }
 
 // A half band gap's weight (ours): the exact reflectance at its middle (the paper's 1 is its large-N limit).
 float gap_weight(float omega_low, float omega_high, CellGeometry g) {
-    return clamp(reflectance_polarised(0.5 * (omega_low + omega_high), g), 0.0, 1.0);
+    return pass_band_weight(0.5 * (omega_low + omega_high), g, true);
 }
 
 // Sub-box j of pieces in [lo, hi]: equal (edge 0), or graded quadratically toward a band edge at lo
@@ -435,7 +453,9 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
         vec3 C_next = cmf_cumulative_at(wavelength_of(edge_low));
         // Resolved fringes (ours): the gaps take their finite-N reflectance too, else w = 1 (the paper).
         bool resolved = improved && fringes_resolved(edge_low, edge_high, s, g);
-        xyz += (resolved ? gap_weight(omega_m, edge_low, g) : 1.0) * (C_previous - C_next);  // upper half of the gap around mode m
+        float gap = 1.0;
+        if (resolved) gap = gap_weight(omega_m, edge_low, g);
+        xyz += gap * (C_previous - C_next);  // upper half of the gap around mode m
         C_previous = C_next;
         float pieces = subdivisions(m, m_first, s, absolute_numbering);
         for (int box = 0; box < 3; ++box) {
@@ -449,14 +469,18 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
                 float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
                 float sub_lo, centre, sub_hi;
                 sub_box(lo, hi, j, pieces, edge, sub_lo, centre, sub_hi);
-                float weight = improved ? pass_band_weight(centre, g, resolved) : paper_weight(centre, g);
+                float weight;
+                if (improved) weight = pass_band_weight(centre, g, resolved);
+                else weight = paper_weight(centre, g);
                 C_next = k + 1.0 < pieces ? cmf_cumulative_at(wavelength_of(sub_hi)) : C_high;
                 xyz += weight * (C_previous - C_next);
                 C_previous = C_next;
             }
         }
         // lower half of the next gap
-        xyz += (resolved ? gap_weight(edge_high, omega_next, g) : 1.0) * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
+        gap = 1.0;
+        if (resolved) gap = gap_weight(edge_high, omega_next, g);
+        xyz += gap * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
     }
     return xyz;
 }
