@@ -27,8 +27,6 @@ import json
 import sys
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from explorer.materials.accuracy import ACCURACY_LIMIT, METHOD_NAMES, gradient_cos_theta, mirror_accuracy
 from explorer.physics import bragg
 

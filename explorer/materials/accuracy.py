@@ -37,10 +37,9 @@ SUGGESTION_ORDER = (3, 4, 2, 1, 0)
 
 
 def gradient_cos_theta(width: int = BADGE_WIDTH) -> np.ndarray:
-    """The gradient view's ``cos theta`` per column (:func:`explorer.views.geometry.view_cos_theta`)."""
-    from explorer.views.geometry import view_cos_theta
-
-    return view_cos_theta("gradient", width, 1)[0][0]
+    """The gradient view's ``cos theta`` per column, ``theta = 90 deg (i + 0.5) / width``
+    (:func:`explorer.views.geometry.view_cos_theta`, which rounds it to float32 as the shader does)."""
+    return np.cos(0.5 * np.pi * (np.arange(width) + 0.5) / width)
 
 
 def method_rgb(mirror: bragg.BraggMirror, method: int, cos_theta, s: int = 3, wavelength_step: float = 1.0,
