@@ -139,8 +139,8 @@ def mirror_accuracy(mirror: bragg.BraggMirror, methods=(1, 2, 3, 4), s: int = 3,
 def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | None:
     """
     The badge of ``material`` at ``values`` (None unless its model is a Bragg mirror's with a ``method``):
-    every closed-form method and the tabulated one, plus the current method whatever it is (method 0 at
-    its ``wavelength_step``: the paper's 1-nm sum is not converged for N of a few tens and more).
+    the current method (method 0 at its ``wavelength_step``: the paper's 1-nm sum is not converged for N
+    of a few tens and more) and, when it is off, every closed-form method and the tabulated one.
     """
     if getattr(material, "model", None) not in BRAGG_METHOD_MODELS or "method" not in values:
         return None
@@ -149,5 +149,9 @@ def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | No
     model = model_for(material, values)
     if model.method not in METHOD_NAMES:
         return None
-    methods = sorted({1, 2, 3, 4, model.method})
-    return AccuracyBadge(model.method, mirror_accuracy(model.mirror, methods, s=model.s, wavelength_step=model.wavelength_step))
+    options = dict(s=model.s, wavelength_step=model.wavelength_step)
+    accuracies = mirror_accuracy(model.mirror, (model.method,), **options)
+    if not accuracies[model.method].accurate:  # only then are the others needed (render's note, the app's hint)
+        others = tuple(m for m in (1, 2, 3, 4) if m != model.method)
+        accuracies.update(mirror_accuracy(model.mirror, others, **options))
+    return AccuracyBadge(model.method, accuracies)
