@@ -521,6 +521,7 @@ def paper_weight(omega, geometry: CellGeometry) -> np.ndarray:
     envelope = np.divide(r1_2, denominator, out=np.zeros_like(r1_2), where=denominator > 0.0)
     return under_host(geometry.correction * envelope, geometry)
 
+
 def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:
     """
     The angular correction ``w~(theta_1) = w~0 + (1 - w~0)(1 - cos theta_1)^5`` (Appendix B), with
@@ -749,7 +750,10 @@ def piecewise_constant_boxes(
     ``variant='improved'`` (ours): ``w =`` :func:`reflectance_fringe_average` at the sub-box's
     centroid, sub-boxes graded toward band edges (:func:`_sub_box`), their number set by the box's
     share of the CMF mass (:func:`subdivisions_by_mass`; ``mode_numbering`` is then unused). Same
-    landmarks, same lookups per box.
+    landmarks, same lookups per box. Where a pass band's fringes are wide and few (:func:`fringes_resolved`,
+    N <= 10) they are resolved instead: sub-boxes per fringe weighted by the exact reflectance
+    (:func:`pass_band_weight`), and the pass band's half-gaps by theirs (:func:`gap_weight`); the
+    paper's weights under a host are :func:`paper_weight`.
 
     Yields
     ------
