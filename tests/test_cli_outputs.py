@@ -90,7 +90,9 @@ def test_params_files_then_set(tmp_path):
     base = ["--engine", "numpy", "--view", "gradient", "--size", "24x4", "--set", "method=1"]
     runs = {name: cli("render", MATERIAL, *base, *extra, "--out", tmp_path / name) for name, extra in jobs.items()}
     for name, run in runs.items():
-        assert run.returncode == 0 and run.stderr == "", f"{name}: {run.stderr}"
+        # The basic method is off here: render's one-line accuracy note is the only stderr allowed.
+        unexpected = [line for line in run.stderr.splitlines() if ": note: method 1 basic is off here" not in line]
+        assert run.returncode == 0 and not unexpected, f"{name}: {run.stderr}"
     image = {name: np.load(tmp_path / name) for name in jobs}
     np.testing.assert_allclose(image["json.npy"], image["set.npy"], rtol=0, atol=1e-6)
     np.testing.assert_allclose(image["bparam.npy"], image["set.npy"], rtol=0, atol=1e-6)

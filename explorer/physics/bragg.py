@@ -626,15 +626,20 @@ def subdivisions_by_mass(omega_low, omega_high, s):
     return np.maximum(1.0, np.ceil(4.0 * s * mass / total))
 
 
-#: The improved variant resolves a pass band's fringes where a fringe feature is wider than
-#: ``FRINGE_RESOLVE_NM / s`` nm (8 nm at s = 3) and N <= 10 (:func:`fringes_resolved`): its sub-boxes then
-#: sample the exact reflectance; elsewhere the fringes are averaged in closed form (docs/accuracy.md).
+#: The improved variant resolves a pass band's fringes where, in its visible part, a fringe feature is
+#: wider than ``FRINGE_RESOLVE_NM / s`` nm (8 nm at s = 3), times ``(N / N_RESOLVE)^GROW_EXPONENT`` beyond
+#: ``N_RESOLVE`` cells (:func:`fringes_resolved`): its sub-boxes then sample the exact reflectance;
+#: elsewhere the fringes are averaged in closed form (docs/accuracy.md).
 FRINGE_RESOLVE_NM = 24.0
 #: Sub-boxes per resolved fringe (each rises from a zero of R to a peak and back; 2 alias).
 SAMPLES_PER_FRINGE = 3.0
-#: Fringes are resolved only while ``SAMPLES_PER_FRINGE N`` is at most this (N <= 10): beyond, they are
-#: narrow enough for their average, and the method keeps the cost of the paper's (Figure 4's N = 20).
-RESOLVE_BUDGET = 32.0
+#: Fringes are resolved only while ``SAMPLES_PER_FRINGE N`` is at most this (N <= 21).
+RESOLVE_BUDGET = 64.0
+#: Beyond this many cells the width a fringe must have to be resolved grows like ``N^GROW_EXPONENT``:
+#: Figure 4's N = 20 mirrors (fringes of 10-25 nm) keep their fringe average and their cost, while the
+#: weak-contrast mirrors of up to ~20 cells (a fringe of ~40 nm) are resolved.
+N_RESOLVE = 10.0
+GROW_EXPONENT = 2.0
 #: At most this many sub-boxes per box (sharp dips at grazing angles ask for more).
 MAX_RESOLVED_PIECES = 48.0
 
@@ -657,14 +662,22 @@ def fringes_resolved(edge_low, edge_high, s, geometry: CellGeometry) -> np.ndarr
     Eq. 2 has ``N`` fringes per pass band; the fringe average (:func:`reflectance_fringe_average`)
     replaces them by their mean, right when they are narrower than the CMFs vary: large ``N``. For a few
     cells (the jewel beetles of Table 3, ``N = 6-8``; Figure 12, ``N = 3``) a fringe spans tens of nm and
-    where it lies is the colour. They are resolved where a fringe's feature (:func:`fringe_sharpness`)
-    is wider than ``FRINGE_RESOLVE_NM / s`` nm and ``SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET`` (``N <= 10``).
+    where it lies is the colour. They are resolved where, in the pass band's visible part, a fringe's
+    feature (:func:`fringe_sharpness`) is wider than ``FRINGE_RESOLVE_NM / s`` nm, a width that grows like
+    ``(N / N_RESOLVE)^GROW_EXPONENT`` beyond :data:`N_RESOLVE` cells, and ``SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET``.
     """
     if s <= 0:
         return np.zeros(np.shape(edge_low), dtype=bool)
-    feature = fringe_sharpness(geometry)
-    width_nm = wavelength_of(edge_low) - wavelength_of(edge_high)
-    return (width_nm * feature * s > FRINGE_RESOLVE_NM * geometry.N) & (SAMPLES_PER_FRINGE * geometry.N <= RESOLVE_BUDGET)
+    # The pass band's visible part: its fringes there, and their mean width in nm.
+    low, high = np.maximum(edge_low, OMEGA_LOW), np.minimum(edge_high, OMEGA_HIGH)
+    visible = high > low
+    high = np.where(visible, high, low)
+    fringes = np.maximum(fringe_count(low, high, geometry), 1e-9)
+    width_nm = wavelength_of(low) - wavelength_of(high)
+    # The width (nm) to resolve grows beyond N_RESOLVE cells, as the cost of resolving them does.
+    grow = max(1.0, geometry.N / N_RESOLVE) ** GROW_EXPONENT
+    wide = width_nm * fringe_sharpness(geometry) * s > FRINGE_RESOLVE_NM * grow * fringes
+    return visible & wide & (SAMPLES_PER_FRINGE * geometry.N <= RESOLVE_BUDGET)
 
 
 def subdivisions_resolving_fringes(omega_low, omega_high, s, geometry: CellGeometry, resolved):
@@ -750,8 +763,8 @@ def piecewise_constant_boxes(
     ``variant='improved'`` (ours): ``w =`` :func:`reflectance_fringe_average` at the sub-box's
     centroid, sub-boxes graded toward band edges (:func:`_sub_box`), their number set by the box's
     share of the CMF mass (:func:`subdivisions_by_mass`; ``mode_numbering`` is then unused). Same
-    landmarks, same lookups per box. Where a pass band's fringes are wide and few (:func:`fringes_resolved`,
-    N <= 10) they are resolved instead: sub-boxes per fringe weighted by the exact reflectance
+    landmarks, same lookups per box. Where a pass band's fringes are wide (:func:`fringes_resolved`) they
+    are resolved instead: sub-boxes per fringe weighted by the exact reflectance
     (:func:`pass_band_weight`), and the pass band's half-gaps by theirs (:func:`gap_weight`); the
     paper's weights under a host are :func:`paper_weight`.
 

@@ -352,12 +352,15 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
     return max(1.0, ceil(4.0 * s * dot(C_low - C_high, vec3(1.0)) / total));
 }
 
-// The improved variant (ours) resolves a pass band's fringes where a fringe feature is wider than
-// FRINGE_RESOLVE_NM / s nm and N <= 10 (SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET), with SAMPLES_PER_FRINGE
-// sub-boxes per feature weighted by the exact reflectance (explorer/bragg.py has the reasoning).
+// The improved variant (ours) resolves a pass band's fringes where, in its visible part, a fringe feature
+// is wider than FRINGE_RESOLVE_NM / s nm (times (N / N_RESOLVE)^GROW_EXPONENT beyond N_RESOLVE cells) and
+// SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET, with SAMPLES_PER_FRINGE sub-boxes per feature weighted by the
+// exact reflectance (explorer/bragg.py has the reasoning).
 const float FRINGE_RESOLVE_NM = 24.0;
 const float SAMPLES_PER_FRINGE = 3.0;
-const float RESOLVE_BUDGET = 32.0;
+const float RESOLVE_BUDGET = 64.0;
+const float N_RESOLVE = 10.0;
+const float GROW_EXPONENT = 2.0;
 const float MAX_RESOLVED_PIECES = 48.0;
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
@@ -377,9 +380,13 @@ float fringe_sharpness(CellGeometry g) {
 }
 
 bool fringes_resolved(float edge_low, float edge_high, float s, CellGeometry g) {
-    if (s <= 0.0) return false;
-    float width_nm = wavelength_of(edge_low) - wavelength_of(edge_high);
-    return width_nm * fringe_sharpness(g) * s > FRINGE_RESOLVE_NM * g.N && SAMPLES_PER_FRINGE * g.N <= RESOLVE_BUDGET;
+    if (s <= 0.0 || SAMPLES_PER_FRINGE * g.N > RESOLVE_BUDGET) return false;
+    float low = max(edge_low, OMEGA_LOW), high = min(edge_high, OMEGA_HIGH);  // the pass band's visible part
+    if (high <= low) return false;
+    float fringes = max(fringe_count(low, high, g), 1e-9);
+    float width_nm = wavelength_of(low) - wavelength_of(high);
+    float grow = pow(max(1.0, g.N / N_RESOLVE), GROW_EXPONENT);
+    return width_nm * fringe_sharpness(g) * s > FRINGE_RESOLVE_NM * grow * fringes;
 }
 
 float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, bool resolved) {
