@@ -53,7 +53,7 @@ def test_improved_method_median_within_limit_on_every_shipped_preset(shipped_mir
     assert not too_far, f"improved method, median ΔE2000 above {ACCURACY_LIMIT}: {too_far}"
 
 
-@pytest.mark.parametrize("N", [2, 3, 5, 8])
+@pytest.mark.parametrize("N", [2, 3, 5, 8, 15])
 @pytest.mark.parametrize("nh", [None, 1.0, 1.33])
 def test_improved_method_at_low_N_under_a_host(N, nh):
     """Low N (>= 2) and hosts beyond the presets: weak and moderate contrast, median ΔE2000 <= 2."""
