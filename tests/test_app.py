@@ -391,3 +391,20 @@ def test_inverse_panel_opens_the_lobes_material(x_display, tmp_path):
     stack = invert_lobes([Lobe(lobe["R"], lobe["sigma"], lobe["layers"], lobe["base"])], inverse["choices"])
     material = load_material(LOBES_MATERIAL)
     assert same_values(material.resolve(report["values"]), material.resolve(values_from_stack(stack)))
+
+
+def test_accuracy_badge_names_the_accurate_method(x_display, tmp_path, bragg_material):
+    """Table 3's jewel beetle with the basic method: the Parameters window says it is off and names method 4."""
+    from explorer.materials.accuracy import accuracy_badge
+
+    actions = [{"wait": 2}, {"set": {"method": 1}}, {"wait": 2}, {"wait_accuracy": True, "timeout": 1500},
+               {"set": {"method": 4}}, {"wait": 2}, {"wait_accuracy": True, "timeout": 1500}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path, "--preset", "table3_green_blue")
+    log = report["script_log"]
+    assert not any("timed out" in line for line in log), log
+    shown = [line for line in log if line.startswith("accuracy: ")]
+    assert len(shown) == 2, log
+    assert shown[0].startswith("accuracy: method 1 basic") and "OFF" in shown[0] and "4 improved" in shown[0], shown[0]
+    assert report["accuracy"].startswith("method 4 improved") and "accurate" in report["accuracy"], report["accuracy"]
+    off = accuracy_badge(bragg_material, bragg_material.resolve({**report["values"], "method": 1}))
+    assert not off.accurate and 4 in off.accurate_methods()

@@ -90,7 +90,9 @@ def test_params_files_then_set(tmp_path):
     base = ["--engine", "numpy", "--view", "gradient", "--size", "24x4", "--set", "method=1"]
     runs = {name: cli("render", MATERIAL, *base, *extra, "--out", tmp_path / name) for name, extra in jobs.items()}
     for name, run in runs.items():
-        assert run.returncode == 0 and run.stderr == "", f"{name}: {run.stderr}"
+        # The basic method is off here: render's one-line accuracy note is the only stderr allowed.
+        unexpected = [line for line in run.stderr.splitlines() if ": note: method 1 basic is off here" not in line]
+        assert run.returncode == 0 and not unexpected, f"{name}: {run.stderr}"
     image = {name: np.load(tmp_path / name) for name in jobs}
     np.testing.assert_allclose(image["json.npy"], image["set.npy"], rtol=0, atol=1e-6)
     np.testing.assert_allclose(image["bparam.npy"], image["set.npy"], rtol=0, atol=1e-6)
@@ -104,7 +106,8 @@ def test_params_names_another_material_has_are_skipped_with_a_warning(tmp_path):
     save_values(tmp_path / "other.json", material, material.resolve({}))
     run = cli("render", MATERIAL, *GRADIENT, "--params", tmp_path / "other.json", "--out", tmp_path / "x.npy")
     assert run.returncode == 0, run.stderr
-    warnings = run.stderr.strip().splitlines()
+    # render's one-line accuracy note (the chosen Bragg method off here) is not a warning.
+    warnings = [line for line in run.stderr.strip().splitlines() if not line.startswith("bragg-explorer: note: ")]
     assert warnings and all(line.startswith("bragg-explorer: warning: ") and "skipped" in line for line in warnings)
 
 

@@ -33,6 +33,9 @@ MIRRORS = {
     "jewel beetle (nh=1)": {"n1": 1.59, "n2": 1.67, "Lambda": 160.0, "delta": 0.51, "N": 8.0, "nh": 1.0},
     "nh>n1": {"nh": 1.6, "n1": 1.0, "n2": 1.5},
     "Lambda=988": {"Lambda": "988"},
+    # Few cells: the improved method resolves the fringes (exact reflectance per sub-box).
+    "N=3 (Figure 12)": {"Lambda": 470.0, "delta": 0.3, "N": 3.0},
+    "N=5 weak contrast": {"n1": 1.35, "n2": 1.5, "Lambda": 440.0, "delta": 0.3, "N": 5.0},
 }
 
 

@@ -32,7 +32,8 @@ class ScriptRobot:
 
     Actions (dicts): ``{"wait": N}`` frames; ``{"wait_complete": true}`` until the active view is fully
     refined; ``{"wait_for": NAME}`` until a panel's report ``state.NAME`` is a dict not ``running`` (the
-    Design window's worker); ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
+    Design window's worker); ``{"wait_accuracy": true}`` until the accuracy badge shows the current values;
+    ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
@@ -78,6 +79,13 @@ class ScriptRobot:
             done = step > 1 and app.idle()
             if step > int(action.get("timeout", 2000)):
                 script.log.append("wait_complete: timed out")
+                done = True
+        elif "wait_accuracy" in action:  # the Parameters window's accuracy badge shows the current values
+            done = step > 1 and bool(state.accuracy) and not state.accuracy.endswith("(updating)")
+            if done:
+                script.log.append(f"accuracy: {state.accuracy}")
+            if step > int(action.get("timeout", 2000)):
+                script.log.append("wait_accuracy: timed out")
                 done = True
         elif "mark" in action:
             script.mark = action["mark"]

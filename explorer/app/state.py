@@ -66,6 +66,7 @@ class AppState:
     exposure: float = 1.0
     gamut: bool = False
     mean_delta_e: float | None = None
+    accuracy: str = ""  # the Parameters window's accuracy badge (a Bragg mirror's method vs the converged table)
     spectrum_theta: float = 0.0
     spectrum_show: dict = field(default_factory=lambda: dict.fromkeys(
         ("s", "p", "average", "envelope", "gaps", "landmarks", "boxes"), True))

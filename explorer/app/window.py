@@ -223,7 +223,7 @@ class App:
             "light": s.light, "camera": s.camera, "view_size": s.view_size, "exposure": s.exposure,
             "frames": s.frame_times, "screenshots": s.screenshots, "screenshot_info": s.screenshot_info,
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
-            "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design,
+            "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
         }
         from explorer.files import write_text_atomic
 

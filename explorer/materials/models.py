@@ -173,6 +173,12 @@ class BraggStackModel:
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
+        self.stack = self.stack_of(values)
+        self.tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+
+    @staticmethod
+    def stack_of(values: Mapping[str, object]) -> layered.LayeredBragg:
+        """The structure the values describe (no tables built)."""
         count = round_integer(values["layers"])
         if not 1 <= count <= layered.MAX_LAYERS:
             raise ValueError(f"layers must be 1 to {layered.MAX_LAYERS}, got {values['layers']}")
@@ -185,10 +191,9 @@ class BraggStackModel:
                 delta=_number(values, f"delta_{k}"), N=round_integer(values[f"N_{k}"]),
                 alpha=_number(values, f"alpha_{k}"), n1=None if n1_k == nh else n1_k,
             ))
-        self.stack = layered.LayeredBragg(
+        return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
         )
-        self.tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""

@@ -504,6 +504,23 @@ def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.nd
     return np.clip(np.where(fringes, average, limit), 0.0, 1.0)
 
 
+def paper_weight(omega, geometry: CellGeometry) -> np.ndarray:
+    """
+    The paper's box weight ``w = w~(theta) R^e`` (Section 3.2.2, Appendix B). Under a host ``nh != n1`` the
+    host interface's own reflection is no fringe: the correction ``w~`` (a fringe average) applies to the
+    mirror's envelope only, and the host interface is added after it, ``under_host(w~ R^e)`` (Appendix D;
+    applying ``w~`` to the host's Fresnel reflection halved it).
+    """
+    if geometry.host_is_n1:
+        return geometry.correction * reflectance_envelope(omega, geometry)
+    r1, t1 = airy_slab_coefficients(omega, geometry)
+    a = cos_K_Lambda(omega, geometry)
+    r1_2 = np.abs(r1) ** 2
+    denominator = r1_2 + np.abs(t1) ** 2 * np.maximum(1.0 - a * a, 0.0)
+    envelope = np.divide(r1_2, denominator, out=np.zeros_like(r1_2), where=denominator > 0.0)
+    return under_host(geometry.correction * envelope, geometry)
+
+
 def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:
     """
     The angular correction ``w~(theta_1) = w~0 + (1 - w~0)(1 - cos theta_1)^5`` (Appendix B), with
@@ -608,6 +625,109 @@ def subdivisions_by_mass(omega_low, omega_high, s):
     return np.maximum(1.0, np.ceil(4.0 * s * mass / total))
 
 
+#: The improved variant resolves a pass band's fringes where, in its visible part, a fringe feature is
+#: wider than ``FRINGE_RESOLVE_NM / s`` nm (8 nm at s = 3), times ``(N / N_RESOLVE)^GROW_EXPONENT`` beyond
+#: ``N_RESOLVE`` cells (:func:`fringes_resolved`): its sub-boxes then sample the exact reflectance;
+#: elsewhere the fringes are averaged in closed form (docs/accuracy.md).
+FRINGE_RESOLVE_NM = 24.0
+#: Sub-boxes per resolved fringe (each rises from a zero of R to a peak and back; 2 alias).
+SAMPLES_PER_FRINGE = 3.0
+#: Fringes are resolved only while ``SAMPLES_PER_FRINGE N`` is at most this (N <= 21).
+RESOLVE_BUDGET = 64.0
+#: Beyond this many cells the width a fringe must have to be resolved grows like ``N^GROW_EXPONENT``:
+#: Figure 4's N = 20 mirrors (fringes of 10-25 nm) keep their fringe average and their cost, while the
+#: weak-contrast mirrors of up to ~20 cells (a fringe of ~40 nm) are resolved.
+N_RESOLVE = 10.0
+GROW_EXPONENT = 2.0
+#: At most this many sub-boxes per box (sharp dips at grazing angles ask for more).
+MAX_RESOLVED_PIECES = 48.0
+
+
+def fringe_count(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
+    """
+    How many fringes of Eq. 2 lie in a pass-band box: ``N |Delta K Lambda| / pi``. Between zeros of
+    ``sin N K Lambda`` the Bloch phase ``K Lambda`` advances by ``pi / N``, and it is monotone across a
+    pass band (Eq. 8 with ``|cos K Lambda| <= 1``).
+    """
+    t_low = np.arccos(np.clip(cos_K_Lambda(omega_low, geometry), -1.0, 1.0))
+    t_high = np.arccos(np.clip(cos_K_Lambda(omega_high, geometry), -1.0, 1.0))
+    return geometry.N * np.abs(t_high - t_low) / np.pi
+
+
+def fringes_resolved(edge_low, edge_high, s, geometry: CellGeometry) -> np.ndarray:
+    """
+    Whether the improved variant (ours) resolves the fringes of the pass band ``[edge_low, edge_high]``.
+
+    Eq. 2 has ``N`` fringes per pass band; the fringe average (:func:`reflectance_fringe_average`)
+    replaces them by their mean, right when they are narrower than the CMFs vary: large ``N``. For a few
+    cells (the jewel beetles of Table 3, ``N = 6-8``; Figure 12, ``N = 3``) a fringe spans tens of nm and
+    where it lies is the colour. They are resolved where, in the pass band's visible part, a fringe's
+    feature (:func:`fringe_sharpness`) is wider than ``FRINGE_RESOLVE_NM / s`` nm, a width that grows like
+    ``(N / N_RESOLVE)^GROW_EXPONENT`` beyond :data:`N_RESOLVE` cells, and ``SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET``.
+    """
+    if s <= 0:
+        return np.zeros(np.shape(edge_low), dtype=bool)
+    # The pass band's visible part: its fringes there, and their mean width in nm.
+    low, high = np.maximum(edge_low, OMEGA_LOW), np.minimum(edge_high, OMEGA_HIGH)
+    visible = high > low
+    high = np.where(visible, high, low)
+    fringes = np.maximum(fringe_count(low, high, geometry), 1e-9)
+    width_nm = wavelength_of(low) - wavelength_of(high)
+    # The width (nm) to resolve grows beyond N_RESOLVE cells, as the cost of resolving them does.
+    grow = max(1.0, geometry.N / N_RESOLVE) ** GROW_EXPONENT
+    wide = width_nm * fringe_sharpness(geometry) * s > FRINGE_RESOLVE_NM * grow * fringes
+    return visible & wide & (SAMPLES_PER_FRINGE * geometry.N <= RESOLVE_BUDGET)
+
+
+def subdivisions_resolving_fringes(omega_low, omega_high, s, geometry: CellGeometry, resolved):
+    """
+    Sub-boxes of the improved variant (ours) in a pass-band box: :func:`subdivisions_by_mass`, and where
+    the fringes are resolved (:func:`fringes_resolved`) at least :data:`SAMPLES_PER_FRINGE` per fringe
+    feature (:func:`fringe_count`, :func:`fringe_sharpness`), at most :data:`MAX_RESOLVED_PIECES`.
+    """
+    by_mass = subdivisions_by_mass(omega_low, omega_high, s)
+    if not np.any(resolved):
+        return by_mass
+    pieces = np.ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, geometry) / fringe_sharpness(geometry))
+    pieces = np.minimum(pieces, MAX_RESOLVED_PIECES)
+    return np.where(resolved, np.maximum(pieces, by_mass), by_mass)
+
+
+def fringe_sharpness(geometry: CellGeometry) -> np.ndarray:
+    """
+    The share of a fringe its feature (a dip of Eq. 2) fills at most: ``min(1, 2 / (pi sqrt(k)))``, Eq. 2
+    written ``R = k sin^2 u / (1 + k sin^2 u)`` with ``u = N K Lambda`` and ``k = |r1|^2 / (|t1|^2 sin^2 K Lambda)
+    >= 4 r12^2 / (1 - r12^2)^2`` (Eq. 10 at ``sin phi = 1``). Where ``k >> 1`` (strong contrast, grazing
+    angles) ``R ~ 1`` but for dips of width ``~ 2 / sqrt(k)`` in ``u``, which samples must resolve. Under a
+    host ``nh != n1`` its interface sharpens them alike: ``k >= R_h1 / (1 - R_h1)``.
+    """
+    r12_2 = np.minimum(np.abs(geometry.r12) ** 2, 1.0 - 1e-12)
+    k = 4.0 * r12_2 / (1.0 - r12_2) ** 2
+    R_h1 = np.minimum(host_reflectance(geometry), 1.0 - 1e-12)
+    k = np.maximum(k, R_h1 / (1.0 - R_h1))
+    return np.minimum(1.0, 2.0 / (np.pi * np.sqrt(np.maximum(k, 1e-300))))
+
+
+def pass_band_weight(omega, geometry: CellGeometry, resolved) -> np.ndarray:
+    """The improved variant's weight in a pass band: the exact reflectance (Eqs. 2, 9, 10; Appendix D)
+    where the fringes are resolved, their closed-form average otherwise."""
+    average = reflectance_fringe_average(omega, geometry)
+    if not np.any(resolved):
+        return average
+    return np.where(resolved, np.clip(reflectance_polarised(omega, geometry), 0.0, 1.0), average)
+
+
+def gap_weight(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
+    """
+    The improved variant's weight of a half band gap: the exact reflectance at its middle. The paper
+    gives gaps ``w = 1``, the limit of Eq. 9 for large ``N``: ``R = 1 - O(e^{-2 N Im[K] Lambda})``. A mirror
+    of a few cells or weak contrast (Table 3: ``n2 - n1 = 0.08``, ``N = 8``) reflects far less in its gaps,
+    and under a host (Appendix D) the host interface adds to it in phase; without fringes in a gap, one
+    sample suffices.
+    """
+    return np.clip(reflectance_polarised(0.5 * (omega_low + omega_high), geometry), 0.0, 1.0)
+
+
 def _sub_box(lo, hi, j, pieces, edge):
     """
     Sub-box ``j`` of ``pieces`` in ``[lo, hi]`` and the point where its weight is sampled.
@@ -642,7 +762,10 @@ def piecewise_constant_boxes(
     ``variant='improved'`` (ours): ``w =`` :func:`reflectance_fringe_average` at the sub-box's
     centroid, sub-boxes graded toward band edges (:func:`_sub_box`), their number set by the box's
     share of the CMF mass (:func:`subdivisions_by_mass`; ``mode_numbering`` is then unused). Same
-    landmarks, same lookups per box.
+    landmarks, same lookups per box. Where a pass band's fringes are wide (:func:`fringes_resolved`) they
+    are resolved instead: sub-boxes per fringe weighted by the exact reflectance
+    (:func:`pass_band_weight`), and the pass band's half-gaps by theirs (:func:`gap_weight`); the
+    paper's weights under a host are :func:`paper_weight`.
 
     Yields
     ------
@@ -671,20 +794,27 @@ def piecewise_constant_boxes(
         z = np.where(has_zero, omega_z, omega_a)
         x1 = np.minimum(z, omega_a)
         x2 = np.maximum(z, omega_a)
-        yield omega_m, edge_low, ones, active
-        for lo, hi, edge in ((edge_low, x1, -1), (x1, x2, 0), (x2, edge_high, 1)):
+        boxes = ((edge_low, x1, -1), (x1, x2, 0), (x2, edge_high, 1))
+        if improved:
+            resolved = fringes_resolved(edge_low, edge_high, s, geometry)
+            # Resolved fringes: the gaps take their finite-N reflectance too (the fringe average and
+            # w = 1 are both the large-N limit, consistent only together).
+            gap_low = np.where(resolved, gap_weight(omega_m, edge_low, geometry), 1.0)
+            gap_high = np.where(resolved, gap_weight(edge_high, omega_next, geometry), 1.0)
+        yield omega_m, edge_low, gap_low if improved else ones, active
+        for lo, hi, edge in boxes:
             if improved:
-                pieces = subdivisions_by_mass(lo, hi, s)
+                pieces = subdivisions_resolving_fringes(lo, hi, s, geometry, resolved)
             else:
                 pieces = subdivisions(m, m_first, s, mode_numbering)
             for j in range(int(np.max(np.where(active, pieces, 1.0)))):
                 sub_lo, centre, sub_hi = _sub_box(lo, hi, j, pieces, edge if improved else 0)
                 if improved:
-                    weight = reflectance_fringe_average(centre, geometry)
+                    weight = pass_band_weight(centre, geometry, resolved)
                 else:
-                    weight = geometry.correction * reflectance_envelope(centre, geometry)
+                    weight = paper_weight(centre, geometry)
                 yield sub_lo, sub_hi, weight, active & (j < pieces)
-        yield edge_high, omega_next, ones, active
+        yield edge_high, omega_next, gap_high if improved else ones, active
 
 
 def approximate_xyz_polarised(
@@ -695,10 +825,13 @@ def approximate_xyz_polarised(
     ``w_j (C(omega_{j+1}) - C(omega_j))`` from the cumulative CMF table (Eq. 16).
     """
     xyz = np.zeros(np.shape(geometry.p1) + (3,))
-    for omega_low, omega_high, weight, active in piecewise_constant_boxes(geometry, s, mode_numbering, variant):
-        # omega -> lambda reverses the order: the box covers [2 pi / omega_high, 2 pi / omega_low].
-        span = colorimetry.cmf_cumulative_at(wavelength_of(omega_low)) - colorimetry.cmf_cumulative_at(wavelength_of(omega_high))
-        xyz += np.where(active, weight, 0.0)[..., None] * span
+    # Finished elements' extra boxes (masked by active) may lie at negative omega, where the exact
+    # reflectance of the improved variant overflows: their warnings are noise.
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for omega_low, omega_high, weight, active in piecewise_constant_boxes(geometry, s, mode_numbering, variant):
+            # omega -> lambda reverses the order: the box covers [2 pi / omega_high, 2 pi / omega_low].
+            span = colorimetry.cmf_cumulative_at(wavelength_of(omega_low)) - colorimetry.cmf_cumulative_at(wavelength_of(omega_high))
+            xyz += np.where(active, weight, 0.0)[..., None] * span
     return xyz
 
 

@@ -250,6 +250,21 @@ float reflectance_envelope(float omega, CellGeometry g) {
     return under_host(denominator > 0.0 ? r1_2 / denominator : 0.0, g);  // delta = 1: no cell, no gap
 }
 
+// R_h1 = |r_h1|^2, the host interface's reflectance (0 when the host is n1), at most 1.
+float host_reflectance(CellGeometry g) { return g.host_is_n1 ? 0.0 : min(cabs2(g.r_h1), 1.0); }
+
+// The paper's weight w~ R^e (Section 3.2.2, Appendix B); under a host, under_host(w~ R^e): w~ corrects the
+// mirror's fringes, not the host interface's own reflection.
+float paper_weight(float omega, CellGeometry g) {
+    if (g.host_is_n1) return g.correction * reflectance_envelope(omega, g);
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    float r1_2 = cabs2(r1);
+    float denominator = r1_2 + cabs2(t1) * max(1.0 - a * a, 0.0);
+    return under_host(g.correction * (denominator > 0.0 ? r1_2 / denominator : 0.0), g);
+}
+
 // |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
 // spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
 // <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/physics/bragg.py has the derivation).
@@ -337,6 +352,78 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
     return max(1.0, ceil(4.0 * s * dot(C_low - C_high, vec3(1.0)) / total));
 }
 
+// The improved variant (ours) resolves a pass band's fringes where, in its visible part, a fringe feature
+// is wider than FRINGE_RESOLVE_NM / s nm (times (N / N_RESOLVE)^GROW_EXPONENT beyond N_RESOLVE cells) and
+// SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET, with SAMPLES_PER_FRINGE sub-boxes per feature weighted by the
+// exact reflectance (explorer/bragg.py has the reasoning).
+const float FRINGE_RESOLVE_NM = 24.0;
+const float SAMPLES_PER_FRINGE = 3.0;
+const float RESOLVE_BUDGET = 64.0;
+const float N_RESOLVE = 10.0;
+const float GROW_EXPONENT = 2.0;
+const float MAX_RESOLVED_PIECES = 48.0;
+
+// Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
+float fringe_count(float omega_low, float omega_high, CellGeometry g) {
+    float t_low = acos(clamp(cos_K_Lambda(omega_low, g), -1.0, 1.0));
+    float t_high = acos(clamp(cos_K_Lambda(omega_high, g), -1.0, 1.0));
+    return g.N * abs(t_high - t_low) / PI;
+}
+
+// The share of a fringe its dip fills at most: min(1, 2 / (pi sqrt(k))), k >= 4 r12^2 / (1 - r12^2)^2 and R_h1 / (1 - R_h1).
+float fringe_sharpness(CellGeometry g) {
+    float r12_2 = min(cabs2(g.r12), 1.0 - 1e-7);
+    float k = 4.0 * r12_2 / ((1.0 - r12_2) * (1.0 - r12_2));
+    float R_h1 = min(host_reflectance(g), 1.0 - 1e-7);
+    k = max(k, R_h1 / (1.0 - R_h1));
+    return min(1.0, 2.0 / (PI * sqrt(max(k, 1e-30))));
+}
+
+bool fringes_resolved(float edge_low, float edge_high, float s, CellGeometry g) {
+    if (s <= 0.0 || SAMPLES_PER_FRINGE * g.N > RESOLVE_BUDGET) return false;
+    float low = max(edge_low, OMEGA_LOW), high = min(edge_high, OMEGA_HIGH);  // the pass band's visible part
+    if (high <= low) return false;
+    float fringes = max(fringe_count(low, high, g), 1e-9);
+    float width_nm = wavelength_of(low) - wavelength_of(high);
+    float grow = pow(max(1.0, g.N / N_RESOLVE), GROW_EXPONENT);
+    return width_nm * fringe_sharpness(g) * s > FRINGE_RESOLVE_NM * grow * fringes;
+}
+
+float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, bool resolved) {
+    float by_mass = subdivisions_by_mass(C_low, C_high, s);
+    if (!resolved) return by_mass;
+    float pieces = min(ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, g) / fringe_sharpness(g)), MAX_RESOLVED_PIECES);
+    return max(pieces, by_mass);
+}
+
+// The exact reflectance where fringes are resolved (Eqs. 2, 9; Appendix D under a host), their closed-form
+// average otherwise: one airy_slab_coefficients and cos_K_Lambda for both, so that the exact branch adds
+// little code to the loop (llvmpipe pays for a branch's code even where no pixel takes it).
+float pass_band_weight(float omega, CellGeometry g, bool resolved) {
+    vec2 r1, t1;
+    airy_slab_coefficients(omega, g, r1, t1);
+    float a = cos_K_Lambda(omega, g);
+    if (resolved) {
+        float U_N1, U_N2, scale;
+        chebyshev_U(a, g.N, U_N1, U_N2, scale);
+        if (g.host_is_n1) {
+            float numerator = cabs2(r1) * U_N1 * U_N1;
+            return numerator / max(numerator + cabs2(t1) * scale * scale, 1e-30);
+        }
+        vec2 r_N = cdiv(r1 * U_N1, vec2(U_N1, 0.0) - U_N2 * cmul(t1, cexpi(omega * g.p1)));
+        return clamp(cabs2(reflection_coefficient_host(r_N, g.r_h1)), 0.0, 1.0);
+    }
+    if (!g.host_is_n1) return fringe_average_under_host(r1, t1, omega, g, a);
+    float t1_2_sin2 = cabs2(t1) * max(1.0 - a * a, 0.0);
+    float denominator = cabs2(r1) + t1_2_sin2;
+    return denominator > 0.0 ? 1.0 - sqrt(t1_2_sin2 / denominator) : 0.0;
+}
+
+// A half band gap's weight (ours): the exact reflectance at its middle (the paper's 1 is its large-N limit).
+float gap_weight(float omega_low, float omega_high, CellGeometry g) {
+    return pass_band_weight(0.5 * (omega_low + omega_high), g, true);
+}
+
 // Sub-box j of pieces in [lo, hi]: equal (edge 0), or graded quadratically toward a band edge at lo
 // (edge -1) or hi (edge +1) and sampled at its centroid (ours).
 void sub_box(float lo, float hi, float j, float pieces, int edge, out float sub_lo, out float centre, out float sub_hi) {
@@ -371,7 +458,11 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
 
         vec3 C_previous = cmf_cumulative_at(wavelength_of(omega_m));
         vec3 C_next = cmf_cumulative_at(wavelength_of(edge_low));
-        xyz += C_previous - C_next;  // upper half of the gap around mode m: w = 1
+        // Resolved fringes (ours): the gaps take their finite-N reflectance too, else w = 1 (the paper).
+        bool resolved = improved && fringes_resolved(edge_low, edge_high, s, g);
+        float gap = 1.0;
+        if (resolved) gap = gap_weight(omega_m, edge_low, g);
+        xyz += gap * (C_previous - C_next);  // upper half of the gap around mode m
         C_previous = C_next;
         float pieces = subdivisions(m, m_first, s, absolute_numbering);
         for (int box = 0; box < 3; ++box) {
@@ -380,19 +471,23 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
             if (hi <= lo) continue;
             int edge = improved ? box - 1 : 0;
             vec3 C_high = cmf_cumulative_at(wavelength_of(hi));
-            if (improved) pieces = subdivisions_by_mass(C_previous, C_high, s);
+            if (improved) pieces = subdivisions_resolving_fringes(lo, hi, C_previous, C_high, s, g, resolved);
             for (float k = 0.0; k < pieces; k += 1.0) {
                 float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
                 float sub_lo, centre, sub_hi;
                 sub_box(lo, hi, j, pieces, edge, sub_lo, centre, sub_hi);
-                float weight = improved ? reflectance_fringe_average(centre, g)
-                                        : g.correction * reflectance_envelope(centre, g);
+                float weight;
+                if (improved) weight = pass_band_weight(centre, g, resolved);
+                else weight = paper_weight(centre, g);
                 C_next = k + 1.0 < pieces ? cmf_cumulative_at(wavelength_of(sub_hi)) : C_high;
                 xyz += weight * (C_previous - C_next);
                 C_previous = C_next;
             }
         }
-        xyz += C_previous - cmf_cumulative_at(wavelength_of(omega_next));  // lower half of the next gap
+        // lower half of the next gap
+        gap = 1.0;
+        if (resolved) gap = gap_weight(edge_high, omega_next, g);
+        xyz += gap * (C_previous - cmf_cumulative_at(wavelength_of(omega_next)));
     }
     return xyz;
 }

@@ -5,12 +5,17 @@ from __future__ import annotations
 from explorer.materials.brd import round_integer
 from explorer.app.parameter_files import slider_format, widget_kind
 from explorer.app.state import VIEW_SIZES
+from explorer.app.badge import BadgeWorker
 from explorer.app.panels.base import Panel, record
 
 
 class ParametersPanel(Panel):
     title = "Parameters"
     dock = "left"
+
+    def __init__(self, app):
+        super().__init__(app)
+        self.badge = BadgeWorker()
 
     def draw(self, imgui) -> None:
         state, app = self.state, self.app
@@ -37,6 +42,7 @@ class ParametersPanel(Panel):
         io = imgui.get_io()
         for parameter in state.material.parameters:
             self._parameter_widget(imgui, io, parameter)
+        self._accuracy_badge(imgui)
         imgui.separator()
         self._light_and_camera(imgui)
         imgui.separator()
@@ -52,6 +58,23 @@ class ParametersPanel(Panel):
         imgui.text(state.frame_label())
         if state.status:
             imgui.text_wrapped(state.status)
+
+    def _accuracy_badge(self, imgui) -> None:
+        """A Bragg mirror's method against the converged table (explorer.materials.accuracy), when it has one."""
+        state = self.state
+        badge, current = self.badge.request(state.material, state.values, bool(self.app.dragging))
+        if badge is None:
+            state.accuracy = self.badge.error
+            if self.badge.error:
+                imgui.text_wrapped(self.badge.error)
+            return
+        text = badge.text() + ("" if current else " (updating)")
+        colour = imgui.ImVec4(0.45, 0.9, 0.45, 1.0) if badge.accurate else imgui.ImVec4(1.0, 0.65, 0.2, 1.0)
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text_colored(colour, f"method {badge.current.label()}: {text}")
+        imgui.pop_text_wrap_pos()
+        record(state, "accuracy_badge")
+        state.accuracy = f"method {badge.current.label()}: {text}"
 
     def _light_and_camera(self, imgui) -> None:
         state = self.state
