@@ -11,6 +11,7 @@ import numpy as np
 
 from explorer.physics import lobes
 from explorer.tables import luts
+from explorer.materials.twins import twin
 from explorer.materials.brd import round_integer
 from explorer.errors import LocatedError
 
@@ -53,6 +54,7 @@ def moments_texture() -> np.ndarray:
     return np.stack([table[0], table[1], np.zeros_like(table[0])], axis=-1).astype(np.float32)
 
 
+@twin
 class LayeredLobesModel:
     """Twin of ``shaders/layered_lobes.brd``: ``reflectance(cos_theta)`` (sum of the lobes' energies) and Eq. 3."""
 

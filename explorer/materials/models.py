@@ -7,7 +7,7 @@ A material names its model in a comment line ``# model: NAME``.
 
 from __future__ import annotations
 
-from typing import Callable, Mapping
+from typing import Mapping
 
 import functools
 
@@ -16,9 +16,11 @@ import numpy as np
 from explorer.physics import bragg, colorimetry, layered, microfacet
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
-from explorer.materials.lobes_model import LayeredLobesModel
 from explorer.materials.methods import BraggMethod
-from explorer.materials.thinfilm_model import ThinFilmModel
+from explorer.materials.twins import TWINS, twin
+# The other materials' twins register themselves on import (explorer.materials.twins).
+from explorer.materials.lobes_model import LayeredLobesModel  # noqa: F401
+from explorer.materials.thinfilm_model import ThinFilmModel  # noqa: F401
 
 
 def _cos_half_angle(L, V) -> np.ndarray:
@@ -29,6 +31,7 @@ def _cos_half_angle(L, V) -> np.ndarray:
     return np.clip(np.sum(H * L, axis=-1), 0.0, 1.0)
 
 
+@twin
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
@@ -106,6 +109,7 @@ def _transmission_rgb_table(mirror: bragg.BraggMirror, alpha: float, size: int) 
     return table
 
 
+@twin
 class BraggLayerModel(BraggMirrorModel):
     """
     Twin of ``shaders/bragg_layer.brd``: one rough Bragg layer (Eq. 17, GGX microfacets that are Bragg
@@ -159,6 +163,7 @@ def _number(values: Mapping[str, object], name: str) -> float:
     return float(values[name])
 
 
+@twin
 class BraggStackModel:
     """
     Twin of ``shaders/bragg_stack.brd``: the single-reflection BRDF (Eq. 34) of 1 to 3 rough Bragg layers
@@ -233,6 +238,7 @@ class BraggStackModel:
         }
 
 
+@twin
 class SchlickFresnelModel:
     """Twin of ``shaders/schlick_fresnel.brd``."""
 
@@ -253,6 +259,7 @@ class SchlickFresnelModel:
         return {}
 
 
+@twin
 class GGXSchlickModel:
     """
     Twin of ``shaders/ggx_schlick.brd``: a GGX microfacet BRDF (:mod:`explorer.physics.microfacet`) with Schlick's
@@ -281,15 +288,9 @@ class GGXSchlickModel:
         return {}
 
 
-MODELS: dict[str, Callable[[Mapping[str, object]], object]] = {
-    BraggMirrorModel.name: BraggMirrorModel,
-    BraggLayerModel.name: BraggLayerModel,
-    BraggStackModel.name: BraggStackModel,
-    SchlickFresnelModel.name: SchlickFresnelModel,
-    ThinFilmModel.name: ThinFilmModel,
-    GGXSchlickModel.name: GGXSchlickModel,
-    LayeredLobesModel.name: LayeredLobesModel,
-}
+#: Every numpy twin by ``# model:`` name (the registry of :mod:`explorer.materials.twins`; the thin film's
+#: and the layered lobes' register on import, above).
+MODELS = TWINS
 
 
 def model_for(material, values: Mapping[str, object]):

@@ -19,6 +19,7 @@ from typing import Mapping
 import numpy as np
 
 from explorer.physics import microfacet, thinfilm
+from explorer.materials.twins import twin
 from explorer.materials.brd import round_integer
 from explorer.materials.methods import ThinFilmMethod
 
@@ -37,6 +38,7 @@ def film_rgb(method: ThinFilmMethod, film, cos_theta, d) -> np.ndarray:
     return thinfilm.naive_rgb(*film, cos_theta, d)
 
 
+@twin
 class ThinFilmModel:
     """Twin of ``shaders/thin_film.brd``: ``reflectance(cos_theta)`` and ``brdf(L, V, N, X, Y)``, every method."""
 
