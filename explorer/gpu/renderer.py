@@ -152,14 +152,12 @@ class Renderer:
         if inputs:
             textures.update(self._input_textures(inputs))
         start = time.perf_counter()
-        key, entry = self.models.entry(material, values)
+        key, entry = self.models.entry(material, values, normalised=True)  # values normalised once, above
         if entry is not None:
-            if entry[1] is None:
-                entry[1] = entry[0].textures()
-            for name, table in entry[1].items():
+            for name, table in entry.ensure_tables().items():
                 if name in program:
                     # A draft and the real tables share the values' key: the texture's key tells them apart.
-                    texture_key = None if key is None else (key, entry[2])
+                    texture_key = None if key is None else (key, entry.draft)
                     if texture_key is None or self._model_texture_keys.get(name) != texture_key or name not in self._model_textures:
                         self._model_texture(name, table)
                         self._model_texture_keys[name] = texture_key

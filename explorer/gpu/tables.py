@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from dataclasses import dataclass
 from typing import Mapping
 
 from explorer.materials.brd import Material
@@ -18,16 +19,30 @@ from explorer.materials.models import MODELS, model_for
 MODEL_CACHE_SIZE = 8
 
 
+@dataclass
+class CacheEntry:
+    """A cached model: the numpy twin, its tables (``textures()``; None until asked), and whether those
+    are its quick ``draft_textures()`` (shown while a slider moves, replaced on :meth:`ModelCache.prepare`)."""
+
+    model: object
+    tables: dict | None = None
+    draft: bool = False
+
+    def ensure_tables(self) -> dict:
+        """The tables, built from the model on first use."""
+        if self.tables is None:
+            self.tables = self.model.textures()
+        return self.tables
+
+
 class ModelCache:
     """
-    ``(material path, model, values) -> [model, its textures() or None, draft]``, least recently used
-    first; ``draft``: the textures are the model's ``draft_textures()``, quick stand-ins shown while a
-    slider moves, replaced by the real ones on :meth:`prepare`.
+    ``(material path, model, values) ->`` :class:`CacheEntry`, least recently used first.
     """
 
     def __init__(self, size: int = MODEL_CACHE_SIZE):
         self.size = size
-        self._models: OrderedDict[tuple, list] = OrderedDict()
+        self._models: OrderedDict[tuple, CacheEntry] = OrderedDict()
         self._lock = threading.Lock()  # prepare() may fill the cache from another thread
 
     @staticmethod
@@ -40,27 +55,29 @@ class ModelCache:
             return None
         return key
 
-    def entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, list | None]:
+    def entry(self, material: Material, values: Mapping[str, object], normalised: bool = False) -> tuple[tuple | None, CacheEntry | None]:
         """
-        ``(key, [model, tables, draft])`` of ``material`` at ``values`` (None: it has no model), from the
-        cache or built here; key None: uncached. ``tables`` is None until someone asks the model for them.
+        ``(key, entry)`` of ``material`` at ``values`` (entry None: it has no model), from the cache or
+        built here; key None: uncached. The entry's tables are None until someone asks for them.
+        ``normalised``: ``values`` are already :meth:`Material.physical_values` (the renderer's bind).
         """
-        values = material.physical_values(values)
+        if not normalised:
+            values = material.physical_values(values)
         key = self.key(material, values)
         if key is None:
-            model = model_for(material, values)
-            return None, ([model, None, False] if model is not None else None)
+            model = model_for(material, values, normalised=True)
+            return None, (CacheEntry(model) if model is not None else None)
         with self._lock:
             entry = self._models.get(key)
             if entry is not None:
                 self._models.move_to_end(key)
                 return key, entry
-        model = model_for(material, values)
+        model = model_for(material, values, normalised=True)
         if model is None:
             return key, None
-        return key, self._store(key, [model, None, False])
+        return key, self._store(key, CacheEntry(model))
 
-    def _store(self, key: tuple, entry: list) -> list:
+    def _store(self, key: tuple, entry: CacheEntry) -> CacheEntry:
         with self._lock:
             self._models[key] = entry
             self._models.move_to_end(key)
@@ -75,7 +92,7 @@ class ModelCache:
         key = self.key(material, material.physical_values(values))
         with self._lock:
             entry = self._models.get(key) if key is not None else None
-        return entry is not None and entry[1] is not None and not entry[2]
+        return entry is not None and entry.tables is not None and not entry.draft
 
     def drawable(self, material: Material, values: Mapping[str, object]) -> bool:
         """Whether ``material`` at ``values`` can be drawn without numpy work, its draft tables accepted."""
@@ -84,7 +101,7 @@ class ModelCache:
         key = self.key(material, material.physical_values(values))
         with self._lock:
             entry = self._models.get(key) if key is not None else None
-        return entry is not None and entry[1] is not None
+        return entry is not None and entry.tables is not None
 
     def prepare(self, material: Material, values: Mapping[str, object]) -> None:
         """Build ``material``'s model at ``values`` and its tables into the cache; safe on a worker thread."""
@@ -95,7 +112,7 @@ class ModelCache:
         model = model_for(material, values)
         if model is None or key is None:
             return
-        self._store(key, [model, model.textures(), False])
+        self._store(key, CacheEntry(model, model.textures(), False))
 
     def prepare_draft(self, material: Material, values: Mapping[str, object]) -> bool:
         """
@@ -110,11 +127,11 @@ class ModelCache:
             return False
         with self._lock:
             entry = self._models.get(key)
-        if entry is not None and entry[2]:
+        if entry is not None and entry.draft:
             return True
-        model = entry[0] if entry is not None else model_for(material, values)
+        model = entry.model if entry is not None else model_for(material, values)
         draft = getattr(model, "draft_textures", lambda: None)() if model is not None else None
         if draft is None:
             return False
-        self._store(key, [model, draft, True])
+        self._store(key, CacheEntry(model, draft, True))
         return True

@@ -293,10 +293,13 @@ class GGXSchlickModel:
 MODELS = TWINS
 
 
-def model_for(material, values: Mapping[str, object]):
+def model_for(material, values: Mapping[str, object], normalised: bool = False):
     """
     The numpy twin of ``material`` with parameter ``values`` (None when it names no known model), its
-    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.materials.brd.Material.physical_values`).
+    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.materials.brd.Material.physical_values`;
+    ``normalised``: they already are, once per bind).
     """
     factory = MODELS.get(material.model or "")
-    return factory(material.physical_values(values)) if factory else None
+    if factory is None:
+        return None
+    return factory(values if normalised else material.physical_values(values))
