@@ -66,81 +66,12 @@ class ScriptRobot:
         action = script.actions[script.index]
         step = script.frame_in_action
         script.frame_in_action += 1
-        done = False
-        if "wait" in action:
-            done = step >= int(action["wait"])
-        elif "wait_for" in action:  # until a panel's report (state.NAME) says it is no longer running
-            report = getattr(state, str(action["wait_for"]), None)
-            done = step > 1 and isinstance(report, dict) and not report.get("running", False)
-            if step > int(action.get("timeout", 3000)):
-                script.log.append(f"wait_for {action['wait_for']}: timed out")
-                done = True
-        elif "wait_complete" in action:
-            done = step > 1 and app.idle()
-            if step > int(action.get("timeout", 2000)):
-                script.log.append("wait_complete: timed out")
-                done = True
-        elif "wait_accuracy" in action:  # the Parameters window's accuracy badge shows the current values
-            done = step > 1 and bool(state.accuracy) and not state.accuracy.endswith("(updating)")
-            if done:
-                script.log.append(f"accuracy: {state.accuracy}")
-            if step > int(action.get("timeout", 2000)):
-                script.log.append("wait_accuracy: timed out")
-                done = True
-        elif "mark" in action:
-            script.mark = action["mark"]
-            done = True
-        elif "set" in action:
-            state.values = state.material.resolve({**state.values, **action["set"]})
-            done = True
-        elif "drag" in action:
-            done = self._drag(state, io, action, step)
-        elif "click" in action:
-            done = self._click(state, io, action, step)
-        elif "type" in action:
-            done = self._type(state, io, action, step)
-        elif "screenshot" in action:
-            if step == 0:
-                state.pending_screenshot = str(action["screenshot"])
-            done = state.pending_screenshot is None
-            if step > int(action.get("timeout", 3000)):
-                script.log.append("screenshot: timed out")
-                done = True
-        elif "key" in action:
-            from imgui_bundle import imgui
-
-            if step <= 1:
-                io.add_key_event(getattr(imgui.Key, str(action["key"]).lower()), step == 0)
-            else:
-                done = state.pending_screenshot is None
-                if step > int(action.get("timeout", 3000)):
-                    script.log.append(f"key {action['key']}: timed out")
-                    done = True
-                if done:
-                    script.log.append(f"pressed {action['key']}")
-        elif "window_screenshot" in action:
-            if step == 0:
-                state.pending_window_shot = str(action["window_screenshot"])
-            done = step > 0 and state.pending_window_shot is None
-        elif "file_path" in action:
-            state.file_path = str(action["file_path"])
-            done = True
-        elif "view_size" in action:
-            state.view_size = int(action["view_size"])
-            done = True
-        elif "focus" in action:  # bring a docked window's tab to the front, as a click on its tab does
-            state.focus_request = str(action["focus"])
-            done = True
-        elif "write" in action:  # what a user's editor does to the material file between two reloads
-            Path(action["write"]).write_text(str(action["text"]))
-            script.log.append(f"wrote {action['write']}")
-            done = True
-        elif "quit" in action:
-            state.quit = True
-            done = True
-        else:
+        kind = next((k for k in ACTIONS if k in action), None)
+        if kind is None:
             script.log.append(f"unknown action {action!r}")
             done = True
+        else:
+            done = bool(ACTIONS[kind](self, app, io, action, step))
         if done:
             script.index += 1
             script.frame_in_action = 0
@@ -225,3 +156,116 @@ class ScriptRobot:
             self.script.log.append(f"typed {action['type']}")
             return True
         return False
+
+
+# -- the actions: {"KIND": ...} -> handler(robot, app, io, action, step) -> done ----------------------
+
+
+def _timed_out(robot, action, step: int, what: str, default: int) -> bool:
+    if step > int(action.get("timeout", default)):
+        robot.script.log.append(f"{what}: timed out")
+        return True
+    return False
+
+
+def _wait(robot, app, io, action, step):
+    return step >= int(action["wait"])
+
+
+def _wait_for(robot, app, io, action, step):  # until a panel's report (state.NAME) says it is no longer running
+    report = getattr(app.state, str(action["wait_for"]), None)
+    done = step > 1 and isinstance(report, dict) and not report.get("running", False)
+    return done or _timed_out(robot, action, step, f"wait_for {action['wait_for']}", 3000)
+
+
+def _wait_complete(robot, app, io, action, step):
+    return (step > 1 and app.idle()) or _timed_out(robot, action, step, "wait_complete", 2000)
+
+
+def _wait_accuracy(robot, app, io, action, step):  # the Parameters window's badge shows the current values
+    state = app.state
+    done = step > 1 and bool(state.accuracy) and not state.accuracy.endswith("(updating)")
+    if done:
+        robot.script.log.append(f"accuracy: {state.accuracy}")
+    return done or _timed_out(robot, action, step, "wait_accuracy", 2000)
+
+
+def _mark(robot, app, io, action, step):
+    robot.script.mark = action["mark"]
+    return True
+
+
+def _set(robot, app, io, action, step):
+    state = app.state
+    state.values = state.material.resolve({**state.values, **action["set"]})
+    return True
+
+
+def _screenshot(robot, app, io, action, step):
+    state = app.state
+    if step == 0:
+        state.pending_screenshot = str(action["screenshot"])
+    return state.pending_screenshot is None or _timed_out(robot, action, step, "screenshot", 3000)
+
+
+def _key(robot, app, io, action, step):
+    from imgui_bundle import imgui
+
+    state = app.state
+    if step <= 1:
+        io.add_key_event(getattr(imgui.Key, str(action["key"]).lower()), step == 0)
+        return False
+    done = state.pending_screenshot is None or _timed_out(robot, action, step, f"key {action['key']}", 3000)
+    if done:
+        robot.script.log.append(f"pressed {action['key']}")
+    return done
+
+
+def _window_screenshot(robot, app, io, action, step):
+    state = app.state
+    if step == 0:
+        state.pending_window_shot = str(action["window_screenshot"])
+    return step > 0 and state.pending_window_shot is None
+
+
+def _assign(name: str, convert):
+    def handler(robot, app, io, action, step):
+        setattr(app.state, name, convert(action[ACTION_OF_FIELD[name]]))
+        return True
+    return handler
+
+
+ACTION_OF_FIELD = {"file_path": "file_path", "view_size": "view_size", "focus_request": "focus"}
+
+
+def _write(robot, app, io, action, step):  # what a user's editor does to the material file between two reloads
+    Path(action["write"]).write_text(str(action["text"]))
+    robot.script.log.append(f"wrote {action['write']}")
+    return True
+
+
+def _quit(robot, app, io, action, step):
+    app.state.quit = True
+    return True
+
+
+#: Each action kind, in the order a script's dict is matched (the first key found decides).
+ACTIONS = {
+    "wait": _wait,
+    "wait_for": _wait_for,
+    "wait_complete": _wait_complete,
+    "wait_accuracy": _wait_accuracy,
+    "mark": _mark,
+    "set": _set,
+    "drag": lambda robot, app, io, action, step: robot._drag(app.state, io, action, step),
+    "click": lambda robot, app, io, action, step: robot._click(app.state, io, action, step),
+    "type": lambda robot, app, io, action, step: robot._type(app.state, io, action, step),
+    "screenshot": _screenshot,
+    "key": _key,
+    "window_screenshot": _window_screenshot,
+    "file_path": _assign("file_path", str),
+    "view_size": _assign("view_size", int),
+    "focus": _assign("focus_request", str),  # bring a docked window's tab to the front, as a click on it does
+    "write": _write,
+    "quit": _quit,
+}
