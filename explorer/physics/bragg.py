@@ -811,28 +811,29 @@ def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.
 #: fraction of the brightest channel (estimated from the entries' second differences), the midpoint is
 #: computed, and the table doubles its resolution, up to :data:`TABLE_MAX_SIZE` entries.
 TABLE_TOLERANCE = 5e-4
-#: 256 entries refined four times.
-TABLE_MAX_SIZE = 16 * (TABLE_SIZE - 1) + 1
+#: Entries computed first: the refinement adds the midpoints where the colour needs them (most of a
+#: 256-entry table's entries are linear interpolations of their neighbours' to the tolerance).
+TABLE_FIRST_SIZE = 65
+#: 65 entries refined six times.
+TABLE_MAX_SIZE = 64 * (TABLE_FIRST_SIZE - 1) + 1
 #: At most this many midpoints computed in all: mirrors whose colour the table cannot follow anyway
 #: (fringes unresolved at any sampling, e.g. N = 1000 and Lambda = 1500 nm) stop refining early.
 TABLE_MAX_REFINED = 2 * (TABLE_SIZE - 1)
 
 
-#: The table's finest sampling (samples per nm): N ~ 100 mirrors converge well before it; at N = 1000 the
-#: reference goes to 1/1024 nm, and the table stops here (within ~2e-3 of it) to stay within seconds.
-TABLE_MAX_SUBSTEPS = 128
-
-
-#: Under a host nh != n1 every sample takes the complex path, ~10 times slower: the table stops at
-#: 1/32 nm and at the first halving under the tolerance (N = 20: within 3e-4 of the reference).
-TABLE_MAX_SUBSTEPS_HOST = 32
+#: The table's finest sampling (samples per nm). Its integrand (:mod:`explorer.physics.fringes`) has fringes
+#: only within a few of a band edge: 1/128 nm keeps every N within ~3e-4 of the reference (1/1024 nm).
+TABLE_MAX_SUBSTEPS = 1024
 
 
 def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
-    if mirror.eta_h == mirror.n1:
-        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, substeps_max=TABLE_MAX_SUBSTEPS)
-    else:
-        spectra, _ = converged_reflectance_spectra(cos_theta, mirror, passes=1, substeps_max=TABLE_MAX_SUBSTEPS_HOST)
+    """
+    The converged reference's colours (:func:`reference_rgb`) from the fringe average plus the fringes
+    near band edges (:func:`explorer.physics.fringes.converged_spectra`), at a cost that does not grow with ``N``.
+    """
+    from explorer.physics import fringes  # it builds on this module
+
+    spectra, _ = fringes.converged_spectra(cos_theta, mirror, substeps_max=TABLE_MAX_SUBSTEPS)
     return colorimetry.spectrum_to_rgb(spectra)
 
 
@@ -854,30 +855,31 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
     The converged spectral reference (:func:`reference_rgb`) over ``cos theta`` in [0, 1], entry ``k`` of
     ``n`` at ``cos theta = k / (n - 1)``, for the host to upload as a 1D texture.
 
-    ``size`` entries first; then, while some interval's interpolation error may exceed
-    :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), every interval is halved: its
-    midpoint computed where the estimate says so, interpolated linearly elsewhere (which leaves the
-    texture's lookups unchanged there). The resolution so follows the colour, which varies fastest
-    near Brewster's and the critical angles for large ``N``, within :data:`TABLE_MAX_REFINED` computed
-    midpoints. Cached per mirror (32 of them).
+    :data:`TABLE_FIRST_SIZE` entries first; then, while some interval's interpolation error may exceed
+    :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate`), or while the table has fewer than
+    ``size`` entries, every interval is halved: its midpoint computed where the estimate says so,
+    interpolated linearly elsewhere (which leaves the texture's lookups unchanged there). The resolution
+    so follows the colour, which varies fastest near Brewster's and the critical angles for large ``N``,
+    within :data:`TABLE_MAX_REFINED` computed midpoints. Cached per mirror (32 of them).
     """
-    cos_theta = np.linspace(0.0, 1.0, size)
+    cos_theta = np.linspace(0.0, 1.0, min(TABLE_FIRST_SIZE, size))
     table = _converged_rgb(cos_theta, mirror)
     budget = TABLE_MAX_REFINED
     while 2 * table.shape[0] - 1 <= max_size:
         refine = _interpolation_error_estimate(table) > TABLE_TOLERANCE
-        if not refine.any() or refine.sum() > budget:
+        if refine.sum() > budget or not (refine.any() or table.shape[0] < size):
             break
         budget -= int(refine.sum())
         midpoints = 0.5 * (cos_theta[:-1] + cos_theta[1:])
         values = 0.5 * (table[:-1] + table[1:])
-        values[refine] = _converged_rgb(midpoints[refine], mirror)
+        if refine.any():
+            values[refine] = _converged_rgb(midpoints[refine], mirror)
         finer = np.empty((2 * table.shape[0] - 1, 3))
         finer[0::2], finer[1::2] = table, values
         table = finer
         cos_theta = np.linspace(0.0, 1.0, table.shape[0])
     table = table.astype(np.float32)
-    table.setflags(write=False)  # cached (a mirror's table is rebuilt in seconds for large N): read-only
+    table.setflags(write=False)  # cached: read-only
     return table
 
 
