@@ -588,3 +588,97 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
               f"{row['fps']:6.1f} {row['sphere_updates_per_s']:9.1f}  {row['gl_ms']:7.1f}ms {row['ui_ms']:5.1f}ms  {row['while_dragging']}")
     print("fps: frames while the slider moves; sphere/s: frames that show new parameter values on the sphere")
     return rows
+
+
+# --------------------------------------------------------------------------------------------------
+# bench --tables: host table rebuilds and the tabulated method's per-pixel cost (issue 22)
+
+#: The mirror of the table timings (n1 = 1, n2 = 1.5, delta = 0.5) at Lambda = 500 nm, and its N values.
+TABLES_MIRROR = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.5}
+TABLES_N = (20, 100, 1000)
+#: Lambda offsets (nm) per repeat: each repeat is a new mirror, so the cached table is rebuilt, as when a
+#: slider moves; small enough that the timed mirror is Lambda = 500 nm to 1e-3.
+TABLES_LAMBDA_STEP = 1e-4
+
+
+def _timed_ms(build) -> float:
+    start = time.perf_counter()
+    build()
+    return 1e3 * (time.perf_counter() - start)
+
+
+def table_timings(repeats: int = 5) -> dict:
+    """
+    Medians (ms) over ``repeats`` interleaved rounds, after a warm-up round, of rebuilding the tabulated
+    method's converged table (:func:`explorer.physics.bragg.tabulated_rgb_table`, through its cache, as the
+    app does) at each N of :data:`TABLES_N`, and of one rough layer's tables (Figure 7's layer A,
+    :func:`explorer.physics.layered.layer_tables`, its ``F_alpha`` cached as in the app): Lambda moves by
+    :data:`TABLES_LAMBDA_STEP` every round, so every round rebuilds.
+    """
+    from explorer.physics import layered
+
+    layer, n1 = layered.figure7_layers()["A (n1=1, d1=d2=250 nm, N=10, alpha=0.1)"]
+    F = layered.transmission_filter_for(layer.alpha)
+    times: dict[str, list[float]] = {str(N): [] for N in TABLES_N}
+    times["layer"] = []
+    for round_ in range(repeats + 1):
+        Lambda = TABLES_MIRROR["Lambda"] + TABLES_LAMBDA_STEP * (round_ + 1)
+        for N in TABLES_N:
+            mirror = bragg.BraggMirror(**{**TABLES_MIRROR, "Lambda": Lambda}, N=N)
+            ms = _timed_ms(lambda: bragg.tabulated_rgb_table(mirror))
+            if round_:
+                times[str(N)].append(ms)
+        moved = layered.RoughBraggLayer(layer.n2, layer.Lambda + TABLES_LAMBDA_STEP * (round_ + 1), layer.delta, layer.N, layer.alpha)
+        ms = _timed_ms(lambda: layered.layer_tables(moved, n1, F))
+        if round_:
+            times["layer"].append(ms)
+        _progress(f"bench --tables: round {round_}/{repeats} done")
+    return {
+        "table_ms": {str(N): float(np.median(times[str(N)])) for N in TABLES_N},
+        "layer_tables_ms": float(np.median(times["layer"])),
+    }
+
+
+def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, str]:
+    """
+    Per Lambda of :data:`BENCH_LAMBDAS`: the median frame time of a ``size``-square sphere of
+    ``bragg_mirror.brd``'s tabulated method (N = 20) over that of ``schlick_fresnel.brd`` in the same run
+    (interleaved repeats, finish-bounded, tables built and programs compiled before timing). Returns the
+    ratios and the renderer's name.
+    """
+    from explorer.gpu import Renderer
+
+    renderer = Renderer()
+    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    schlick_values = schlick_material.resolve({})
+    ratios = {}
+    for Lambda in BENCH_LAMBDAS:
+        values = mirror_material.resolve({**TABLES_MIRROR, "Lambda": Lambda, "N": 20, "method": 3})
+        cases = [(mirror_material, values), (schlick_material, schlick_values)]
+        for material, v in cases:  # compile, build the table, warm up
+            renderer.time_frame(material, v, "sphere", size, size)
+        times: list[list[float]] = [[], []]
+        for _ in range(repeats):
+            for i, (material, v) in enumerate(cases):
+                times[i].append(renderer.time_frame(material, v, "sphere", size, size))
+        ratios[f"{Lambda:g}"] = float(np.median(times[0]) / np.median(times[1]))
+        _progress(f"bench --tables: tabulated / schlick at Lambda = {Lambda:g} nm: {ratios[f'{Lambda:g}']:.2f}")
+    return ratios, renderer.ctx.info.get("GL_RENDERER", "unknown")
+
+
+def run_tables_bench(as_json: bool = False, size: int = 512, repeats: int = 5) -> dict:
+    """``bragg-explorer bench --tables``: :func:`table_timings` and :func:`tabulated_over_schlick` from one run."""
+    document = table_timings(repeats)
+    document["tabulated_over_schlick"], device = tabulated_over_schlick(size, repeats)
+    if as_json:
+        print(json.dumps(document, indent=2))
+    else:
+        print(f"Host tables (wall-clock medians of {repeats} interleaved rebuilds; Lambda = 500 nm, n1 = 1, n2 = 1.5, delta = 0.5):")
+        for N, ms in document["table_ms"].items():
+            print(f"  converged table, N = {N:>4}: {ms:8.1f} ms")
+        print(f"  one rough layer's tables (Figure 7's A, N = 10): {document['layer_tables_ms']:8.1f} ms")
+        print(f"Tabulated method over Schlick's Fresnel, {size}x{size} sphere on {device}:")
+        for Lambda, ratio in document["tabulated_over_schlick"].items():
+            print(f"  Lambda = {Lambda:>3} nm: x{ratio:.2f}")
+    return document

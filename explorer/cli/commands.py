@@ -366,8 +366,10 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--tables", "tables", is_flag=True,
+              help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app):
+def bench(as_json, size, repeats, thin_film, layers, app, tables):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -375,6 +377,12 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if tables:
+        from explorer.cli.bench import run_tables_bench
+
+        source = click.get_current_context().get_parameter_source("repeats")
+        run_tables_bench(as_json=as_json, size=size, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
+        return
     if app:
         from explorer.cli.bench import run_app_bench
 
