@@ -464,6 +464,7 @@ def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> lis
             layered._reflectance_at_theta_nodes.cache_clear()
             start = time.perf_counter()
             model = BraggStackModel(values)
+            model.tables  # built on first use
             rebuilds.append(1e3 * (time.perf_counter() - start))
         renderer.render(material, values, "lit", 8, 8)  # compile and upload once
         frames = [renderer.time_frame(material, values, "lit", size, size) for _ in range(repeats)]
