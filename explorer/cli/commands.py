@@ -368,8 +368,11 @@ def presets(material, as_json):
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
 @click.option("--tables", "tables", is_flag=True,
               help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
+@click.option("--scaling", "scaling", is_flag=True,
+              help="Instead: table cost against N and table size, frame time against sphere size (with --plot PNG).")
+@click.option("--plot", type=click.Path(dir_okay=False, writable=True), default=None, help="With --scaling: write the plot here.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, tables):
+def bench(as_json, size, repeats, thin_film, layers, app, tables, scaling, plot):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -377,6 +380,11 @@ def bench(as_json, size, repeats, thin_film, layers, app, tables):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if scaling:
+        from explorer.cli.bench import run_scaling_bench
+
+        run_scaling_bench(as_json=as_json, repeats=repeats, plot=Path(plot) if plot else None)
+        return
     if tables:
         from explorer.cli.bench import run_tables_bench
 
