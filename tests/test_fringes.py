@@ -94,3 +94,19 @@ def test_cost_is_bounded_in_N(monkeypatch):
         samples[N] = count
     assert max(samples.values()) <= 4.0 * samples[20], samples
     assert samples[3000] < samples[1000] < samples[300], samples
+
+
+#: The draft table (bragg.draft_rgb_table) against the converged reference, of the brightest channel.
+DRAFT_RTOL = 1.5e-2
+
+
+def test_draft_table_is_close_at_any_N_and_closer_than_the_1nm_sum():
+    rng = np.random.default_rng(9)
+    cos_theta = rng.uniform(0.0, 1.0, 24)
+    for N in (20, 300, 1000):
+        mirror = bragg.BraggMirror(N=N)
+        reference = bragg.reference_rgb(cos_theta, mirror)
+        draft = relative_error(bragg.tabulated_rgb(bragg.draft_rgb_table(mirror), cos_theta), reference)
+        one_nm = relative_error(bragg.reference_rgb(cos_theta, mirror, step=1.0), reference)
+        assert draft.max() <= DRAFT_RTOL, (N, draft.max())
+        assert draft.max() < one_nm.max(), (N, draft.max(), one_nm.max())

@@ -83,8 +83,8 @@ class BraggMirrorModel:
 
     def draft_textures(self) -> dict[str, np.ndarray] | None:
         """
-        Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's table from the
-        1-nm sum, :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
+        Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's draft table,
+        :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
         """
         return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method == 3 else None
 

@@ -255,7 +255,6 @@ def converged_spectra(
     tolerance: float = CONVERGENCE_TOLERANCE,
     passes: int = CONVERGENCE_PASSES,
     substeps_max: int = MAX_SUBSTEPS,
-    pooled: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """
     Hat-averaged spectra (:func:`hat_average`) refined, nm cell by nm cell, until their colour has converged.
@@ -290,11 +289,6 @@ def converged_spectra(
     row_count : int
     substeps_min, substeps_max : int
         Powers of 2, samples per nm.
-    pooled : bool
-        Share half of a row's tolerance among the cells still refining after the first comparison, instead
-        of giving each 1/472 of it (the other cells' changes were already under that). For spectra whose
-        only fine structure is a few cells beside band edges (:mod:`explorer.physics.fringes`): those
-        cells stop several halvings earlier, and the row's error stays within 1.5 ``tolerance``.
 
     Returns
     -------
@@ -360,8 +354,6 @@ def converged_spectra(
         done |= stopped
     # The active (row, cell) pairs, flat.
     pair = np.flatnonzero(~done.ravel())
-    # Pooled budgets: each row's remaining cells share half its tolerance (at least one cell's share).
-    share = np.maximum(0.5 * cells / np.maximum((~done).sum(axis=-1), 1), 1.0) if pooled else np.ones(row_count)
     trap_l, trap_r = trap[0].ravel()[pair], trap[1].ravel()[pair]
     simp_l, simp_r = result[0].ravel()[pair], result[1].ravel()[pair]
     result_l, result_r = result[0].reshape(-1), result[1].reshape(-1)
@@ -369,7 +361,7 @@ def converged_spectra(
     needed = max(1, int(passes) - 1)
     row_colour = xyz_to_rgb((result[0][:, 1:] + result[1][:, :-1]) @ colour_matching_functions())
     while pair.size and K < substeps_max:
-        budget = budgets() * share
+        budget = budgets()
         pair_row, pair_cell = np.divmod(pair, cells)
         t = (np.arange(K) + 0.5) / K
         values = _evaluate_points(spectrum, (HAT_LOW + pair_cell)[:, None] + t, pair_row)

@@ -181,7 +181,6 @@ def windowed_spectrum_function(cos_theta, mirror: bragg.BraggMirror, float64: bo
 def converged_spectra(
     cos_theta, mirror: bragg.BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
     passes: int = colorimetry.CONVERGENCE_PASSES, float64: bool = False, substeps_max: int = colorimetry.MAX_SUBSTEPS,
-    pooled: bool = True,
 ):
     """
     Hat-averaged spectra whose colours equal those of
@@ -209,7 +208,6 @@ def converged_spectra(
         tolerance=tolerance,
         passes=passes,
         substeps_max=substeps_max,
-        pooled=pooled,
     )
     return spectra[inverse.ravel()], substeps[inverse.ravel()]
 
