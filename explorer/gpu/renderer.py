@@ -130,7 +130,7 @@ class Renderer:
         return self.models.drawable(material, values)
 
     def prepare_draft(self, material: Material, values: Mapping[str, object]) -> bool:
-        """Quick draft tables of ``material`` at ``values`` (~10 ms), True when it can be drawn with them now."""
+        """Quick draft tables of ``material`` at ``values`` (tens of ms), True when it can be drawn with them now."""
         return self.models.prepare_draft(material, values)
 
     # -- bindings and the draw primitive ------------------------------------------------------------
