@@ -29,7 +29,8 @@ def test_bench_scaling_document_and_plot(gl_renderer, monkeypatch, tmp_path, cap
     monkeypatch.setattr(bench, "SCALING_ANGLES", (17, 33))
     monkeypatch.setattr(bench, "SCALING_SPHERES", (16, 32))
     plot = tmp_path / "scaling.png"
-    document = bench.run_scaling_bench(as_json=True, repeats=1, plot=plot)
+    # The session's renderer: a second GL context made current here would leave the other tests' one stale.
+    document = bench.run_scaling_bench(as_json=True, repeats=1, plot=plot, renderer=gl_renderer)
     assert json.loads(capsys.readouterr().out) == document
     assert [r["N"] for r in document["N"]] == [1, 20] and [r["size"] for r in document["spheres"]] == [16, 32]
     assert {(r["N"], r["angles"]) for r in document["angles"]} == {(20, 17), (20, 33), (1000, 17), (1000, 33)}

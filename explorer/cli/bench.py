@@ -723,13 +723,14 @@ def _converged_rule_rgb(cos_theta, mirror: bragg.BraggMirror) -> np.ndarray:
     return colorimetry.spectrum_to_rgb(spectra)
 
 
-def scaling_study(repeats: int = 3) -> dict:
+def scaling_study(repeats: int = 3, renderer=None) -> dict:
     """
     Medians (ms, interleaved repeats after a warm-up; wall-clock and CPU time) of: the converged table
     (:func:`explorer.physics.bragg.tabulated_rgb_table`, Lambda moved each round) and, for comparison, the
     converged reference's own rule at the table's 65 first angles, against N; the table's node function at
     :data:`SCALING_ANGLES` angles (N = 20 and 1000); frame times of the tabulated method and of Schlick's
-    Fresnel on spheres of :data:`SCALING_SPHERES` pixels a side (GL). Lambda = 500 nm, n1 = 1, n2 = 1.5, delta = 0.5.
+    Fresnel on spheres of :data:`SCALING_SPHERES` pixels a side (GL; ``renderer``, a new one by default).
+    Lambda = 500 nm, n1 = 1, n2 = 1.5, delta = 0.5.
     """
     from explorer.gpu import Renderer
 
@@ -753,7 +754,7 @@ def scaling_study(repeats: int = 3) -> dict:
                 if round_:
                     times.setdefault(("angles", N, n), []).append(measured)
         _progress(f"bench --scaling: table against its size, round {round_}/{repeats}")
-    renderer = Renderer()
+    renderer = Renderer() if renderer is None else renderer
     mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
     schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
     cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": 3})),
@@ -822,13 +823,13 @@ def plot_scaling(document: dict, path: Path) -> None:
         plt.close(figure)
 
 
-def run_scaling_bench(as_json: bool = False, repeats: int = 3, plot: Path | None = None) -> dict:
+def run_scaling_bench(as_json: bool = False, repeats: int = 3, plot: Path | None = None, renderer=None) -> dict:
     """``bragg-explorer bench --scaling [--plot PNG]``: :func:`scaling_study`, printed (and plotted)."""
     if plot is not None:
         from explorer.views.images import check_output
 
         check_output(plot)  # a bad path fails now, not after the study
-    document = scaling_study(repeats)
+    document = scaling_study(repeats, renderer)
     if plot is not None:
         plot_scaling(document, plot)
         _progress(f"bench --scaling: wrote {plot}")
