@@ -1,5 +1,5 @@
 """
-The fast converged table (explorer/physics/fringes.py): the fringe average plus the fringes near band edges
+The fast converged table (explorer/physics/bragg.py's windowed_converged_spectra): the fringe average plus the fringes near band edges
 integrates to the converged reference's colours at any N, under a host and with n2 < n1, and its cost does
 not grow with N (counted in samples, not timed: timings are ``bench --tables``).
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer.physics import bragg, colorimetry, fringes
+from explorer.physics import bragg, colorimetry
 
 #: Of the brightest linear RGB channel (at least colorimetry.CONVERGENCE_FLOOR, as the integrator's own
 #: tolerance): the table's nodes against the converged reference (bragg.reference_rgb without a step).
@@ -60,7 +60,7 @@ def test_window_covers_small_N_and_only_edges_for_large_N():
     wavelengths = np.linspace(360.0, 830.0, 941)
     for N, exact_everywhere in ((4, True), (1000, False)):
         mirror = bragg.BraggMirror(N=N)
-        windowed = fringes.windowed_spectrum_function(cos_theta, mirror, float64=True)(wavelengths, np.arange(3))
+        windowed = bragg.windowed_spectrum_function(cos_theta, mirror, float64=True)(wavelengths, np.arange(3))
         exact = bragg.bragg_reflectance(cos_theta[:, None], wavelengths, mirror)
         if exact_everywhere:
             np.testing.assert_allclose(windowed, exact, atol=1e-9)

@@ -790,7 +790,7 @@ def plot_scaling(document: dict, path: Path) -> None:
     figure, axes = plt.subplots(1, 3, figsize=(14, 4))
     rows = document["N"]
     axes[0].loglog([r["N"] for r in rows], [r["table_cpu_ms"] for r in rows], "o-", label="converged table, refined")
-    axes[0].loglog([r["N"] for r in rows], [r["table_rule_65_cpu_ms"] for r in rows], "^-", label="its rule (fringes.py), 65 angles")
+    axes[0].loglog([r["N"] for r in rows], [r["table_rule_65_cpu_ms"] for r in rows], "^-", label="its rule (windowed), 65 angles")
     axes[0].loglog([r["N"] for r in rows], [r["reference_rule_65_cpu_ms"] for r in rows], "s--", label="reference's rule, 65 angles")
     axes[0].set(xlabel="N (cells)", ylabel="CPU ms", title="Table rebuild against N (Λ = 500 nm)")
     for N in sorted({r["N"] for r in document["angles"]}):
