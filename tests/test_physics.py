@@ -636,7 +636,7 @@ def test_table_nodes_equal_reference(mirror):
     table = bragg.tabulated_rgb_table(mirror)
     size = table.shape[0]
     assert bragg.TABLE_SIZE <= size <= bragg.TABLE_MAX_SIZE and table.dtype == np.float32
-    assert (size - 1) % (bragg.TABLE_SIZE - 1) == 0  # refined by halving its intervals
+    assert (size - 1) % (bragg.TABLE_FIRST_SIZE - 1) == 0  # refined by halving its intervals
     nodes = np.linspace(0.0, 1.0, size)
     # The first 256 entries' nodes, every 15th (the converged reference costs seconds at N = 1000).
     checked = np.arange(0, size, 15 * (size - 1) // (bragg.TABLE_SIZE - 1))

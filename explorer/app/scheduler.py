@@ -30,8 +30,9 @@ class TablePrefetcher:
     The parameter values the sphere shows. While a slider is dragged the host's tables (the tabulated
     method's converged table, a stack's layers) are built on a worker thread as the frame draws, and the
     sphere shows the current values with the model's quick draft tables where it has them (the tabulated
-    method's 1-nm table, ~10 ms), else the newest values whose tables are ready. Once the slider is
-    released the real tables are built on the spot, so a released slider always shows its own values.
+    method's draft table, a stack's 1-nm layer tables; 20-30 ms), else the newest values whose tables are
+    ready. Once the slider is released the real tables are built on the spot, so a released slider always
+    shows its own values.
     """
 
     def __init__(self, renderer):

@@ -480,6 +480,7 @@ def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> lis
             layered._reflectance_at_theta_nodes.cache_clear()
             start = time.perf_counter()
             model = BraggStackModel(values)
+            model.tables  # built on first use
             rebuilds.append(1e3 * (time.perf_counter() - start))
         renderer.render(material, values, "lit", 8, 8)  # compile and upload once
         frames = [renderer.time_frame(material, values, "lit", size, size) for _ in range(repeats)]
@@ -670,3 +671,261 @@ def run_position_free_bench(as_json: bool = False, target: float = POSITION_FREE
         print(f"{row['configuration']:<78} {row['paths_per_angle']:>11} {row['max_stderr']:>10.2e} {row['seconds']:>8.1f} "
               f"{row['cpu_seconds']:>6.1f}  {'met' if ok else 'missed'} (<= {POSITION_FREE_GOAL_S:g} s wall)")
     return rows
+# --------------------------------------------------------------------------------------------------
+# bench --tables: host table rebuilds and the tabulated method's per-pixel cost (issue 22)
+
+#: The mirror of the table timings (n1 = 1, n2 = 1.5, delta = 0.5) at Lambda = 500 nm, and its N values.
+TABLES_MIRROR = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.5}
+TABLES_N = (20, 100, 1000)
+#: Lambda offsets (nm) per repeat: each repeat is a new mirror, so the cached table is rebuilt, as when a
+#: slider moves; small enough that the timed mirror is Lambda = 500 nm to 1e-3.
+TABLES_LAMBDA_STEP = 1e-4
+
+
+def _timed_ms(build) -> tuple[float, float]:
+    """Wall-clock and CPU time (ms; the process's, all threads) of ``build()``."""
+    start, cpu = time.perf_counter(), time.process_time()
+    build()
+    return 1e3 * (time.perf_counter() - start), 1e3 * (time.process_time() - cpu)
+
+
+def _timed_frame(renderer, material, values, size: int) -> tuple[float, float]:
+    """A sphere frame's finish-bounded wall-clock time and the CPU time around it (llvmpipe: the rendering)."""
+    cpu = time.process_time()
+    wall = renderer.time_frame(material, values, "sphere", size, size)
+    return wall, 1e3 * (time.process_time() - cpu)
+
+
+def _medians(times: dict) -> dict:
+    """``{key: [(wall, cpu), ...]}`` -> ``{key: median wall}``, ``{key: median cpu}``."""
+    return ({k: float(np.median([t[0] for t in v])) for k, v in times.items()},
+            {k: float(np.median([t[1] for t in v])) for k, v in times.items()})
+
+
+def table_timings(repeats: int = 5) -> dict:
+    """
+    Medians (ms) over ``repeats`` interleaved rounds, after a warm-up round, of rebuilding the tabulated
+    method's converged table (:func:`explorer.physics.bragg.tabulated_rgb_table`, through its cache, as the
+    app does) at each N of :data:`TABLES_N`, and of one rough layer's tables (Figure 7's layer A,
+    :func:`explorer.physics.layered.layer_tables`, its ``F_alpha`` cached as in the app): Lambda moves by
+    :data:`TABLES_LAMBDA_STEP` every round, so every round rebuilds. Wall-clock, and CPU time (``*_cpu_ms``:
+    what the machine's other processes do not inflate).
+    """
+    from explorer.physics import layered
+
+    layer, n1 = layered.figure7_layers()["A (n1=1, d1=d2=250 nm, N=10, alpha=0.1)"]
+    F = layered.transmission_filter_for(layer.alpha)
+    times: dict[str, list] = {str(N): [] for N in TABLES_N}
+    times["layer"] = []
+    for round_ in range(repeats + 1):
+        Lambda = TABLES_MIRROR["Lambda"] + TABLES_LAMBDA_STEP * (round_ + 1)
+        for N in TABLES_N:
+            mirror = bragg.BraggMirror(**{**TABLES_MIRROR, "Lambda": Lambda}, N=N)
+            measured = _timed_ms(lambda: bragg.tabulated_rgb_table(mirror))
+            if round_:
+                times[str(N)].append(measured)
+        moved = layered.RoughBraggLayer(layer.n2, layer.Lambda + TABLES_LAMBDA_STEP * (round_ + 1), layer.delta, layer.N, layer.alpha)
+        measured = _timed_ms(lambda: layered.layer_tables(moved, n1, F))
+        if round_:
+            times["layer"].append(measured)
+        _progress(f"bench --tables: round {round_}/{repeats} done")
+    wall, cpu = _medians(times)
+    return {
+        "table_ms": {str(N): wall[str(N)] for N in TABLES_N},
+        "layer_tables_ms": wall["layer"],
+        "table_cpu_ms": {str(N): cpu[str(N)] for N in TABLES_N},
+        "layer_tables_cpu_ms": cpu["layer"],
+    }
+
+
+def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, dict, str]:
+    """
+    Per Lambda of :data:`BENCH_LAMBDAS`: the median frame time of a ``size``-square sphere of
+    ``bragg_mirror.brd``'s tabulated method (N = 20) over that of ``schlick_fresnel.brd`` in the same run
+    (interleaved repeats, finish-bounded, tables built and programs compiled before timing). Returns the
+    wall-clock ratios, the CPU-time ratios (llvmpipe renders on the CPU: robust to other processes) and
+    the renderer's name.
+    """
+    from explorer.gpu import Renderer
+
+    renderer = Renderer()
+    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    schlick_values = schlick_material.resolve({})
+    ratios, cpu_ratios = {}, {}
+    for Lambda in BENCH_LAMBDAS:
+        values = mirror_material.resolve({**TABLES_MIRROR, "Lambda": Lambda, "N": 20, "method": 3})
+        cases = [(mirror_material, values), (schlick_material, schlick_values)]
+        for material, v in cases:  # compile, build the table, warm up
+            renderer.time_frame(material, v, "sphere", size, size)
+        times: dict[int, list] = {0: [], 1: []}
+        for _ in range(repeats):
+            for i, (material, v) in enumerate(cases):
+                times[i].append(_timed_frame(renderer, material, v, size))
+        wall, cpu = _medians(times)
+        ratios[f"{Lambda:g}"] = wall[0] / wall[1]
+        cpu_ratios[f"{Lambda:g}"] = cpu[0] / cpu[1]
+        _progress(f"bench --tables: tabulated / schlick at Lambda = {Lambda:g} nm: x{ratios[f'{Lambda:g}']:.2f} "
+                  f"(CPU time x{cpu_ratios[f'{Lambda:g}']:.2f})")
+    return ratios, cpu_ratios, renderer.ctx.info.get("GL_RENDERER", "unknown")
+
+
+def run_tables_bench(as_json: bool = False, size: int = 512, repeats: int = 5) -> dict:
+    """``bragg-explorer bench --tables``: :func:`table_timings` and :func:`tabulated_over_schlick` from one run."""
+    document = table_timings(repeats)
+    document["tabulated_over_schlick"], document["tabulated_over_schlick_cpu"], device = tabulated_over_schlick(size, repeats)
+    if as_json:
+        print(json.dumps(document, indent=2))
+    else:
+        print(f"Host tables (wall-clock medians of {repeats} interleaved rebuilds; Lambda = 500 nm, n1 = 1, n2 = 1.5, delta = 0.5):")
+        for N, ms in document["table_ms"].items():
+            print(f"  converged table, N = {N:>4}: {ms:8.1f} ms  (CPU {document['table_cpu_ms'][N]:.1f} ms)")
+        print(f"  one rough layer's tables (Figure 7's A, N = 10): {document['layer_tables_ms']:8.1f} ms  "
+              f"(CPU {document['layer_tables_cpu_ms']:.1f} ms)")
+        print(f"Tabulated method over Schlick's Fresnel, {size}x{size} sphere on {device}:")
+        for Lambda, ratio in document["tabulated_over_schlick"].items():
+            print(f"  Lambda = {Lambda:>3} nm: x{ratio:.2f}  (CPU time x{document['tabulated_over_schlick_cpu'][Lambda]:.2f})")
+    return document
+
+
+# --------------------------------------------------------------------------------------------------
+# bench --scaling: how the table and the shading cost grow (issue 22)
+
+SCALING_N = (1, 2, 5, 10, 20, 50, 100, 200, 300, 500, 1000)
+#: Entries (angles) of the converged table computed at once: its first size is 65.
+SCALING_ANGLES = (17, 33, 65, 129, 257, 513)
+SCALING_SPHERES = (128, 256, 512, 1024, 2048)
+
+
+def _converged_rule_rgb(cos_theta, mirror: bragg.BraggMirror) -> np.ndarray:
+    """The converged reference's own rule (Yeh's R sampled from its fringe floor), as the tables used before."""
+    spectra, _ = bragg.converged_reflectance_spectra(cos_theta, mirror, substeps_max=bragg.TABLE_MAX_SUBSTEPS)
+    return colorimetry.spectrum_to_rgb(spectra)
+
+
+def scaling_study(repeats: int = 3, renderer=None) -> dict:
+    """
+    Medians (ms, interleaved repeats after a warm-up; wall-clock and CPU time) of: the converged table
+    (:func:`explorer.physics.bragg.tabulated_rgb_table`, Lambda moved each round) and, for comparison, the
+    converged reference's own rule at the table's 65 first angles, against N; the table's node function at
+    :data:`SCALING_ANGLES` angles (N = 20 and 1000); frame times of the tabulated method and of Schlick's
+    Fresnel on spheres of :data:`SCALING_SPHERES` pixels a side (GL; ``renderer``, a new one by default).
+    Lambda = 500 nm, n1 = 1, n2 = 1.5, delta = 0.5.
+    """
+    from explorer.gpu import Renderer
+
+    document: dict = {"repeats": repeats}
+    times: dict = {}
+    first = np.linspace(0.0, 1.0, bragg.TABLE_FIRST_SIZE)
+    for round_ in range(repeats + 1):
+        Lambda = TABLES_MIRROR["Lambda"] + TABLES_LAMBDA_STEP * (round_ + 1)
+        for N in SCALING_N:
+            mirror = bragg.BraggMirror(**{**TABLES_MIRROR, "Lambda": Lambda}, N=N)
+            measured = [_timed_ms(lambda: bragg.tabulated_rgb_table(mirror)), _timed_ms(lambda: _converged_rule_rgb(first, mirror)),
+                        _timed_ms(lambda: bragg._converged_rgb(first, mirror))]
+            if round_:
+                for key, value in zip(("table", "rule", "nodes"), measured):
+                    times.setdefault((key, N), []).append(value)
+        _progress(f"bench --scaling: table against N, round {round_}/{repeats}")
+    for round_ in range(repeats + 1):
+        for N in (20, 1000):
+            for n in SCALING_ANGLES:
+                measured = _timed_ms(lambda: bragg._converged_rgb(np.linspace(0.0, 1.0, n), bragg.BraggMirror(**TABLES_MIRROR, N=N)))
+                if round_:
+                    times.setdefault(("angles", N, n), []).append(measured)
+        _progress(f"bench --scaling: table against its size, round {round_}/{repeats}")
+    renderer = Renderer() if renderer is None else renderer
+    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": 3})),
+             ("schlick", schlick_material, schlick_material.resolve({}))]
+    for _, material, values in cases:
+        renderer.time_frame(material, values, "sphere", 16, 16)
+    for round_ in range(repeats + 1):
+        for size in SCALING_SPHERES:
+            for name, material, values in cases:
+                measured = _timed_frame(renderer, material, values, size)
+                if round_:
+                    times.setdefault((name, size), []).append(measured)
+        _progress(f"bench --scaling: spheres, round {round_}/{repeats}")
+    wall, cpu = _medians(times)
+    document["N"] = [{"N": N, "table_ms": wall[("table", N)], "table_cpu_ms": cpu[("table", N)],
+                      "table_rule_65_ms": wall[("nodes", N)], "table_rule_65_cpu_ms": cpu[("nodes", N)],
+                      "reference_rule_65_ms": wall[("rule", N)], "reference_rule_65_cpu_ms": cpu[("rule", N)]} for N in SCALING_N]
+    document["angles"] = [{"N": N, "angles": n, "wavelengths": colorimetry.WAVELENGTHS.size, "ms": wall[("angles", N, n)],
+                           "cpu_ms": cpu[("angles", N, n)]} for N in (20, 1000) for n in SCALING_ANGLES]
+    document["device"] = renderer.ctx.info.get("GL_RENDERER", "unknown")
+    document["spheres"] = [{"size": size, **{name: wall[(name, size)] for name, _, _ in cases},
+                            **{f"{name}_cpu": cpu[(name, size)] for name, _, _ in cases}} for size in SCALING_SPHERES]
+    return document
+
+
+def plot_scaling(document: dict, path: Path) -> None:
+    """The three curves of :func:`scaling_study` (log-log), as a PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, 3, figsize=(14, 4))
+    rows = document["N"]
+    axes[0].loglog([r["N"] for r in rows], [r["table_cpu_ms"] for r in rows], "o-", label="converged table, refined")
+    axes[0].loglog([r["N"] for r in rows], [r["table_rule_65_cpu_ms"] for r in rows], "^-", label="its rule (windowed), 65 angles")
+    axes[0].loglog([r["N"] for r in rows], [r["reference_rule_65_cpu_ms"] for r in rows], "s--", label="reference's rule, 65 angles")
+    axes[0].set(xlabel="N (cells)", ylabel="CPU ms", title="Table rebuild against N (Λ = 500 nm)")
+    for N in sorted({r["N"] for r in document["angles"]}):
+        rows = [r for r in document["angles"] if r["N"] == N]
+        axes[1].loglog([r["angles"] for r in rows], [r["cpu_ms"] for r in rows], "o-", label=f"N = {N}")
+    axes[1].set(xlabel="angles (× 471 wavelengths)", ylabel="CPU ms", title="Converged colours against table size")
+    rows = document["spheres"]
+    for name in ("tabulated", "schlick"):
+        axes[2].loglog([r["size"] ** 2 for r in rows], [r[f"{name}_cpu"] for r in rows], "o-", label=name)
+    axes[2].set(xlabel="pixels", ylabel="CPU ms / frame", title=f"Sphere frame ({document['device'][:24]})")
+    from matplotlib.ticker import LogLocator, NullFormatter
+
+    for axis in axes:
+        axis.xaxis.set_minor_formatter(NullFormatter())
+        axis.xaxis.set_major_locator(LogLocator(base=10.0, numticks=6))
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(fontsize=8)
+    figure.tight_layout()
+    # Atomically: a temporary file beside the plot, renamed over it.
+    import os
+    import tempfile
+
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            figure.savefig(stream, dpi=110, format="png")
+        os.replace(temporary, path)
+    finally:
+        Path(temporary).unlink(missing_ok=True)
+        plt.close(figure)
+
+
+def run_scaling_bench(as_json: bool = False, repeats: int = 3, plot: Path | None = None, renderer=None) -> dict:
+    """``bragg-explorer bench --scaling [--plot PNG]``: :func:`scaling_study`, printed (and plotted)."""
+    if plot is not None:
+        from explorer.views.images import check_output
+
+        check_output(plot)  # a bad path fails now, not after the study
+    document = scaling_study(repeats, renderer)
+    if plot is not None:
+        plot_scaling(document, plot)
+        _progress(f"bench --scaling: wrote {plot}")
+    if as_json:
+        print(json.dumps(document, indent=2))
+        return document
+    print(f"Converged table against N (medians of {repeats} interleaved repeats; wall-clock / CPU time):")
+    for r in document["N"]:
+        print(f"  N = {r['N']:>4}: table {r['table_ms']:8.1f} / {r['table_cpu_ms']:7.1f} ms   at 65 angles: its rule "
+              f"{r['table_rule_65_ms']:8.1f} / {r['table_rule_65_cpu_ms']:7.1f} ms, the reference's "
+              f"{r['reference_rule_65_ms']:8.1f} / {r['reference_rule_65_cpu_ms']:7.1f} ms")
+    print("Converged colours against the number of angles (471 wavelengths each):")
+    for r in document["angles"]:
+        print(f"  N = {r['N']:>4}, {r['angles']:>4} angles: {r['ms']:8.1f} / {r['cpu_ms']:7.1f} ms")
+    print(f"Sphere frame times on {document['device']} (wall-clock / CPU time):")
+    for r in document["spheres"]:
+        print(f"  {r['size']:>4}^2: tabulated {r['tabulated']:8.2f} / {r['tabulated_cpu']:7.2f} ms   schlick {r['schlick']:8.2f} / "
+              f"{r['schlick_cpu']:7.2f} ms   CPU x{r['tabulated_cpu'] / r['schlick_cpu']:.2f}")
+    return document

@@ -415,8 +415,13 @@ def presets(material, as_json):
               help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
               help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
+@click.option("--tables", "tables", is_flag=True,
+              help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
+@click.option("--scaling", "scaling", is_flag=True,
+              help="Instead: table cost against N and table size, frame time against sphere size (with --plot PNG).")
+@click.option("--plot", type=click.Path(dir_okay=False, writable=True), default=None, help="With --scaling: write the plot here.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -433,6 +438,17 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
         from explorer.cli.design import run_design_bench
 
         run_design_bench(design_count, as_json=as_json)
+        return
+    if scaling:
+        from explorer.cli.bench import run_scaling_bench
+
+        run_scaling_bench(as_json=as_json, repeats=repeats, plot=Path(plot) if plot else None)
+        return
+    if tables:
+        from explorer.cli.bench import run_tables_bench
+
+        source = click.get_current_context().get_parameter_source("repeats")
+        run_tables_bench(as_json=as_json, size=size, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
         return
     if app:
         from explorer.cli.bench import run_app_bench

@@ -76,8 +76,8 @@ class BraggMirrorModel:
 
     def draft_textures(self) -> dict[str, np.ndarray] | None:
         """
-        Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's table from the
-        1-nm sum, :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
+        Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's draft table,
+        :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
         """
         return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method.needs_table else None
 
@@ -199,6 +199,14 @@ class BraggStackModel:
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
         )
+        self._tables: tuple | None = None
+
+    @property
+    def tables(self) -> tuple:
+        """Every layer's tables (:func:`explorer.physics.layered.layer_tables`, cached per layer), built on first use."""
+        if self._tables is None:
+            self._tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+        return self._tables
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
@@ -225,10 +233,21 @@ class BraggStackModel:
         columns the wavelengths, channel l layer l (zeros beyond the used layers); ``stack_sampling``:
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator).
         """
+        return self._textures_of(self.tables)
+
+    def draft_textures(self) -> dict[str, np.ndarray]:
+        """
+        Quick stand-ins for :meth:`textures` while a slider moves: the layers' tables from ``R_lambda`` at
+        every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
+        """
+        return self._textures_of(tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers))
+
+    @staticmethod
+    def _textures_of(tables) -> dict[str, np.ndarray]:
         shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
         reflectance = np.zeros(shape, np.float32)
         transmissivity = np.zeros(shape, np.float32)
-        for l, table in enumerate(self.tables):
+        for l, table in enumerate(tables):
             reflectance[..., l] = table.reflectance
             transmissivity[..., l] = table.transmissivity
         return {

@@ -292,7 +292,9 @@ def _reflectance_at_theta_nodes(mirror: bragg.BraggMirror) -> np.ndarray:
     return table
 
 
-def layer_tables(layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=None, cached: bool = True) -> LayerTables:
+def layer_tables(
+    layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=None, cached: bool = True, draft: bool = False
+) -> LayerTables:
     """
     Build a layer's tables: ``R_lambda`` over angle and the integrated transmissivity (Eq. 28).
 
@@ -306,6 +308,10 @@ def layer_tables(layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=No
     cached : bool
         Reuse ``R_lambda`` of a mirror seen before (it depends on the mirror only, not on ``alpha``);
         ``False`` computes it afresh (timings).
+    draft : bool
+        ``R_lambda`` sampled at every nm (the paper's 1-nm sum, :func:`explorer.physics.bragg.reflectance_spectra`)
+        instead of converged hat averages: several times quicker, for an interactive host to show while a
+        slider moves; not converged near band edges (never a reference).
 
     Returns
     -------
@@ -321,7 +327,9 @@ def layer_tables(layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=No
     start = time.perf_counter()
     theta = F.theta
     mirror = layer.mirror(float(n1))
-    if cached and np.array_equal(theta, microfacet.theta_nodes()):
+    if draft:
+        reflectance = bragg.reflectance_spectra(np.cos(theta), mirror).astype(np.float32)
+    elif cached and np.array_equal(theta, microfacet.theta_nodes()):
         reflectance = _reflectance_at_theta_nodes(mirror)
     else:
         reflectance = reflectance_table(mirror, np.cos(theta)).astype(np.float32)

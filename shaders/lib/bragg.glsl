@@ -500,7 +500,11 @@ vec3 approximate_rgb(float cos_theta, BraggMirror mirror, float s, bool absolute
 }
 
 // The tabulated method: exact RGB over cos theta in [0, 1], table entry k at cos theta = k / (size - 1).
+// Two texel fetches interpolated in float: the numpy twin's arithmetic (hardware filtering may round its
+// weights to 8 bits), and cheaper than a filtered fetch on llvmpipe (bench --tables).
 vec3 tabulated_rgb(sampler2D table, float cos_theta) {
-    float size = float(textureSize(table, 0).x);
-    return texture(table, vec2((clamp(cos_theta, 0.0, 1.0) * (size - 1.0) + 0.5) / size, 0.5)).rgb;
+    int last = textureSize(table, 0).x - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, max(last - 1, 0));  // a 1-texel placeholder reads its texel
+    return mix(texelFetch(table, ivec2(i, 0), 0).rgb, texelFetch(table, ivec2(min(i + 1, last), 0), 0).rgb, x - float(i));
 }
