@@ -179,7 +179,7 @@ class BraggStackModel:
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.stack = self.stack_of(values)
-        self.tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+        self._tables: tuple | None = None
 
     @staticmethod
     def stack_of(values: Mapping[str, object]) -> layered.LayeredBragg:
@@ -199,7 +199,6 @@ class BraggStackModel:
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
         )
-        self._tables: tuple | None = None
 
     @property
     def tables(self) -> tuple:
