@@ -111,10 +111,10 @@ def test_stack_drafts_its_layer_tables_then_builds_the_real_ones(monkeypatch):
     cache = tables.ModelCache()
     assert cache.prepare_draft(material, values) and not cache.ready(material, values) and cache.drawable(material, values)
     assert built == [], "drafting built the converged layer tables"
-    draft = cache.entry(material, values)[1][1]
+    draft = cache.entry(material, values)[1].tables
     cache.prepare(material, values)
     assert cache.ready(material, values) and len(built) == int(values["layers"])
-    real = cache.entry(material, values)[1][1]
+    real = cache.entry(material, values)[1].tables
     assert draft.keys() == real.keys() and all(draft[k].shape == real[k].shape for k in real)
     # The colour of each layer's R_lambda table: the draft (1-nm samples) within 2e-2 of the converged one.
     used = int(values["layers"])
