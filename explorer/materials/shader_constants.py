@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from explorer.physics import colorimetry, layered, lobes, lobes_fgd, microfacet, thinfilm
+from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, thinfilm
 
 
 def declaration(name: str, value) -> str:
@@ -45,6 +45,23 @@ def _block(constants: Mapping[str, object], source: str) -> str:
 
 #: ``{include name: the block's text}``, each from the physics module the library file twins.
 GENERATED: dict[str, Callable[[], str]] = {
+    "generated/bragg.glsl": lambda: _block({
+        "BISECTION_STEPS": bragg.BISECTION_STEPS,
+        "WAVELENGTH_LOW": bragg.WAVELENGTH_LOW,
+        "WAVELENGTH_HIGH": bragg.WAVELENGTH_HIGH,
+        "OMEGA_LOW": bragg.OMEGA_LOW,
+        "OMEGA_HIGH": bragg.OMEGA_HIGH,
+        "COS_THETA_MIN": bragg.COS_THETA_MIN,
+        "MAX_DECAY": bragg.MAX_DECAY,
+        "FRINGE_B_MIN": bragg.FRINGE_B_MIN,
+        "FRINGE_Q_MIN": bragg.FRINGE_Q_MIN,
+        "FRINGE_RESOLVE_NM": bragg.FRINGE_RESOLVE_NM,
+        "SAMPLES_PER_FRINGE": bragg.SAMPLES_PER_FRINGE,
+        "RESOLVE_BUDGET": bragg.RESOLVE_BUDGET,
+        "N_RESOLVE": bragg.N_RESOLVE,
+        "GROW_EXPONENT": bragg.GROW_EXPONENT,
+        "MAX_RESOLVED_PIECES": bragg.MAX_RESOLVED_PIECES,
+    }, "explorer/physics/bragg.py"),
     "generated/colorimetry.glsl": lambda: _block({
         "CMF_COUNT": colorimetry.WAVELENGTHS.size,
         "CMF_FIRST_WAVELENGTH": float(colorimetry.WAVELENGTH_MIN),

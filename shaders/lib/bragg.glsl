@@ -7,13 +7,7 @@
 #include "lib/fresnel.glsl"
 #include "lib/colorimetry.glsl"
 
-const int BISECTION_STEPS = 12;
-const float WAVELENGTH_LOW = 359.5;
-const float WAVELENGTH_HIGH = 830.5;
-const float OMEGA_LOW = 2.0 * PI / WAVELENGTH_HIGH;
-const float OMEGA_HIGH = 2.0 * PI / WAVELENGTH_LOW;
-const float COS_THETA_MIN = 1e-6;
-const float MAX_DECAY = 40.0;
+#include "generated/bragg.glsl"  // the constants shared with explorer/physics (generated at assembly)
 const int CHEBYSHEV_BITS = 10;  // binary powering up to N = 1023
 
 struct BraggMirror {
@@ -268,8 +262,6 @@ float paper_weight(float omega, CellGeometry g) {
 // |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
 // spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
 // <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/physics/bragg.py has the derivation).
-const float FRINGE_B_MIN = 1e-12;
-const float FRINGE_Q_MIN = 1e-6;
 float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
     vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
     float sin_t = sqrt(max(1.0 - a * a, 0.0));
@@ -356,12 +348,6 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
 // is wider than FRINGE_RESOLVE_NM / s nm (times (N / N_RESOLVE)^GROW_EXPONENT beyond N_RESOLVE cells) and
 // SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET, with SAMPLES_PER_FRINGE sub-boxes per feature weighted by the
 // exact reflectance (explorer/bragg.py has the reasoning).
-const float FRINGE_RESOLVE_NM = 24.0;
-const float SAMPLES_PER_FRINGE = 3.0;
-const float RESOLVE_BUDGET = 64.0;
-const float N_RESOLVE = 10.0;
-const float GROW_EXPONENT = 2.0;
-const float MAX_RESOLVED_PIECES = 48.0;
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
 float fringe_count(float omega_low, float omega_high, CellGeometry g) {
