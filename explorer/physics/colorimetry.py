@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import functools
 import warnings
+from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.tables import luts
 
@@ -150,7 +152,7 @@ CHUNK_SAMPLES = 1 << 18
 MAX_BLOCK_SAMPLES = 1 << 24
 
 
-def colour_matching_functions_at(wavelength) -> np.ndarray:
+def colour_matching_functions_at(wavelength: ArrayLike) -> np.ndarray:
     """
     The CMFs (:func:`colour_matching_functions`) interpolated linearly between their 1-nm nodes, zero
     from :data:`HAT_LOW` and :data:`HAT_HIGH` outwards: ``sum_i c_i h_i(lambda)``.
@@ -189,7 +191,7 @@ def _power_of_two_at_least(x: float) -> int:
     return int(2 ** np.ceil(np.log2(max(float(x), 1.0))))
 
 
-def substeps_for_fringes(optical_path) -> int:
+def substeps_for_fringes(optical_path: float) -> int:
     """
     The coarsest sampling (samples per nm, a power of 2) that puts four samples in every fringe of a
     spectrum whose phase is ``2 pi optical_path / lambda`` (nm): fringes are ``lambda^2 / optical_path``
@@ -208,7 +210,7 @@ def _evaluate(spectrum, wavelengths: np.ndarray, rows: np.ndarray) -> np.ndarray
     )
 
 
-def fixed_step_spectra(spectrum, row_count: int, step: float) -> np.ndarray:
+def fixed_step_spectra(spectrum: Callable[[np.ndarray, np.ndarray], np.ndarray], row_count: int, step: float) -> np.ndarray:
     """
     Hat-averaged spectra from samples every ``1 / K`` nm, ``K = round(1 / step)``, without refinement
     (``step = 1``: the 1-nm point samples themselves). ``spectrum`` as in :func:`converged_spectra`.
@@ -251,7 +253,7 @@ def _padded_cmfs() -> np.ndarray:
 
 
 def converged_spectra(
-    spectrum,
+    spectrum: Callable[[np.ndarray, np.ndarray], np.ndarray],
     row_count: int,
     substeps_min: int = 1,
     tolerance: float = CONVERGENCE_TOLERANCE,
@@ -457,7 +459,7 @@ luts.register("cmf_cumulative", _generate_cmf_cumulative, {
 }, _cmf_source)
 
 
-def cmf_cumulative_at(wavelength) -> np.ndarray:
+def cmf_cumulative_at(wavelength: ArrayLike) -> np.ndarray:
     """
     ``C(lambda)`` by linear interpolation between the ``cmf_cumulative`` table's nodes, clamped outside
     them: exactly what a linearly filtered, edge-clamped texture of the table returns.
