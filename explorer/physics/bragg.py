@@ -25,9 +25,10 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Iterator
+from typing import Callable, Iterator
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import colorimetry
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
@@ -107,7 +108,7 @@ class CellGeometry:
     host_is_n1: bool
 
 
-def Omega(polarisation: str, n1, cos_theta_1, n2, cos_theta_2) -> np.ndarray:
+def Omega(polarisation: str, n1: ArrayLike, cos_theta_1: ArrayLike, n2: ArrayLike, cos_theta_2: ArrayLike) -> np.ndarray:
     """The polarisation term of the dispersion relation (Eqs. 6-7); ``Omega >= 2`` for real angles."""
     if polarisation == "s":
         x = (n2 * cos_theta_2) / (n1 * cos_theta_1)
@@ -117,7 +118,7 @@ def Omega(polarisation: str, n1, cos_theta_1, n2, cos_theta_2) -> np.ndarray:
     return x + 1.0 / x
 
 
-def cell_geometry(cos_theta_h, mirror: BraggMirror, polarisation: str) -> CellGeometry:
+def cell_geometry(cos_theta_h: ArrayLike, mirror: BraggMirror, polarisation: str) -> CellGeometry:
     """Snell's law into both layers, and the cell's angular terms, for one polarisation."""
     cos_theta_h = np.maximum(np.asarray(cos_theta_h, dtype=np.float64), COS_THETA_MIN)
     eta_h, n1, n2 = mirror.eta_h, mirror.n1, mirror.n2
@@ -141,7 +142,7 @@ def cell_geometry(cos_theta_h, mirror: BraggMirror, polarisation: str) -> CellGe
 # Yeh's reflectance (Section 3.1)
 
 
-def airy_slab_coefficients(omega, geometry: CellGeometry) -> tuple[np.ndarray, np.ndarray]:
+def airy_slab_coefficients(omega: ArrayLike, geometry: CellGeometry) -> tuple[np.ndarray, np.ndarray]:
     """
     Reflection and transmission coefficients ``(r1, t1)`` of one slab of ``n2`` in ``n1`` (Eq. 10).
 
@@ -155,7 +156,7 @@ def airy_slab_coefficients(omega, geometry: CellGeometry) -> tuple[np.ndarray, n
     return geometry.r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * phase / denominator
 
 
-def cos_K_Lambda(omega, geometry: CellGeometry) -> np.ndarray:
+def cos_K_Lambda(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     The dispersion relation (Eq. 8): ``cos k1z d1 cos k2z d2 - Omega/2 sin k1z d1 sin k2z d2``.
 
@@ -181,7 +182,7 @@ def _one_minus_exp_minus_2x(x):
     return -np.expm1(-2.0 * x)
 
 
-def chebyshev_U(cos_K_Lambda, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def chebyshev_U(cos_K_Lambda: ArrayLike, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Chebyshev polynomials ``(U_{N-1}, U_{N-2})`` of ``cos K Lambda``, scaled to stay finite.
 
@@ -214,7 +215,7 @@ def chebyshev_U(cos_K_Lambda, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return U_N1, U_N2, scale
 
 
-def reflectance_yeh(r1, t1, cos_K_Lambda, N: int) -> np.ndarray:
+def reflectance_yeh(r1: ArrayLike, t1: ArrayLike, cos_K_Lambda: ArrayLike, N: int) -> np.ndarray:
     """
     Yeh's reflectance of ``N`` cells in ``n1`` (Eqs. 2 and 9): ``|C|^2 / (|C|^2 + (sin K/sin NK)^2)``.
 
@@ -226,7 +227,9 @@ def reflectance_yeh(r1, t1, cos_K_Lambda, N: int) -> np.ndarray:
     return numerator / (numerator + np.abs(t1) ** 2 * scale**2)
 
 
-def reflection_coefficient_bragg(r1, t1, omega, geometry: CellGeometry, cos_K_Lambda) -> np.ndarray:
+def reflection_coefficient_bragg(
+    r1: ArrayLike, t1: ArrayLike, omega: ArrayLike, geometry: CellGeometry, cos_K_Lambda: ArrayLike,
+) -> np.ndarray:
     """
     The mirror's amplitude coefficient ``r_N = U(C) / V(A)`` (Appendix D), seen from ``n1``.
 
@@ -238,12 +241,12 @@ def reflection_coefficient_bragg(r1, t1, omega, geometry: CellGeometry, cos_K_La
     return r1 * U_N1 / (U_N1 - U_N2 * t_cell)
 
 
-def reflection_coefficient_host(r_N, r_h1) -> np.ndarray:
+def reflection_coefficient_host(r_N: ArrayLike, r_h1: ArrayLike) -> np.ndarray:
     """``r_hN = (r_N + r_h1) / (1 + r_h1 r_N)``: the mirror under a host medium ``nh`` (Appendix D)."""
     return (r_N + r_h1) / (1.0 + r_h1 * r_N)
 
 
-def reflectance_polarised(omega, geometry: CellGeometry) -> np.ndarray:
+def reflectance_polarised(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """Exact reflectance of the mirror for one polarisation (Eqs. 2, 9, 10; Appendix D if nh != n1)."""
     r1, t1 = airy_slab_coefficients(omega, geometry)
     a = cos_K_Lambda(omega, geometry)
@@ -253,7 +256,7 @@ def reflectance_polarised(omega, geometry: CellGeometry) -> np.ndarray:
     return np.abs(reflection_coefficient_host(r_N, geometry.r_h1)) ** 2
 
 
-def bragg_reflectance(cos_theta, wavelength, mirror: BraggMirror, polarisation: str | None = None) -> np.ndarray:
+def bragg_reflectance(cos_theta: ArrayLike, wavelength: ArrayLike, mirror: BraggMirror, polarisation: str | None = None) -> np.ndarray:
     """
     Spectral reflectance ``R_lambda`` of a Bragg mirror.
 
@@ -285,7 +288,7 @@ def _spectra(cos_theta, mirror: BraggMirror, wavelengths, fast: bool) -> np.ndar
     return reflectance_spectra(cos_theta, mirror, wavelengths, float64=not fast)
 
 
-def substeps_for(mirror: BraggMirror, cos_theta) -> int:
+def substeps_for(mirror: BraggMirror, cos_theta: ArrayLike) -> int:
     """
     The coarsest sampling (samples per nm) that resolves the mirror's fringes: ``N`` fringes per band,
     bands ``pi / n_+`` apart in ``omega``, so fringes as if from an optical path ``2 N n_+``
@@ -296,9 +299,9 @@ def substeps_for(mirror: BraggMirror, cos_theta) -> int:
 
 
 def converged_reflectance_spectra(
-    cos_theta, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
+    cos_theta: ArrayLike, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
     passes: int = colorimetry.CONVERGENCE_PASSES, fast: bool = True, substeps_max: int = colorimetry.MAX_SUBSTEPS,
-):
+) -> tuple[np.ndarray, np.ndarray]:
     """
     The unpolarised ``R_lambda`` averaged over each nm's hat function (:func:`explorer.physics.colorimetry.hat_average`),
     sampled finely enough that the colour has converged (:func:`explorer.physics.colorimetry.converged_spectra`).
@@ -373,7 +376,7 @@ def _spectrum_function(cos_theta, mirror: BraggMirror, float64: bool):
     return spectrum
 
 
-def reference_rgb(cos_theta, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
+def reference_rgb(cos_theta: ArrayLike, mirror: BraggMirror, step: float | None = None) -> np.ndarray:
     """
     The spectral reference: exact ``R_lambda`` (both polarisations averaged) integrated against the CMFs
     (Section 3.2.2), in linear sRGB.
@@ -414,7 +417,7 @@ def host_reflectance(geometry: CellGeometry) -> np.ndarray:
     return np.minimum(np.abs(geometry.r_h1) ** 2, 1.0)
 
 
-def under_host(R_mirror, geometry: CellGeometry) -> np.ndarray:
+def under_host(R_mirror: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     A mirror reflectance seen through the host interface ``nh -> n1``, added incoherently (our
     extension for the approximations when ``nh != n1``): ``R_h1 + (1 - R_h1)^2 R / (1 - R_h1 R)``,
@@ -426,7 +429,7 @@ def under_host(R_mirror, geometry: CellGeometry) -> np.ndarray:
     return 1.0 - (1.0 - R_h1) * (1.0 - R_mirror) / np.maximum(1.0 - R_h1 * R_mirror, 1e-300)
 
 
-def reflectance_envelope(omega, geometry: CellGeometry) -> np.ndarray:
+def reflectance_envelope(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     The envelope ``R^e = |C|^2 / (|C|^2 + sin^2 K Lambda)`` (Eq. 11); 1 inside band gaps.
 
@@ -441,7 +444,7 @@ def reflectance_envelope(omega, geometry: CellGeometry) -> np.ndarray:
     return under_host(np.divide(r1_2, denominator, out=np.zeros_like(r1_2), where=denominator > 0.0), geometry)
 
 
-def reflectance_fringe_average(omega, geometry: CellGeometry) -> np.ndarray:
+def reflectance_fringe_average(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     Yeh's reflectance averaged over its fringes: ``1 - |sin K Lambda| / sqrt(|C|^2 + sin^2 K Lambda)``.
 
@@ -468,7 +471,7 @@ FRINGE_B_MIN = 1e-12
 FRINGE_Q_MIN = 1e-6
 
 
-def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.ndarray:
+def fringe_average_under_host(r1: ArrayLike, t1: ArrayLike, omega: ArrayLike, geometry: CellGeometry, a: ArrayLike) -> np.ndarray:
     """
     ``|r_hN|^2`` (Appendix D) averaged over the fringes, coherently: the host's interface reflects in
     phase with the mirror, and the incoherent :func:`under_host` misses a slow modulation of up to
@@ -504,7 +507,7 @@ def fringe_average_under_host(r1, t1, omega, geometry: CellGeometry, a) -> np.nd
     return np.clip(np.where(fringes, average, limit), 0.0, 1.0)
 
 
-def paper_weight(omega, geometry: CellGeometry) -> np.ndarray:
+def paper_weight(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     The paper's box weight ``w = w~(theta) R^e`` (Section 3.2.2, Appendix B). Under a host ``nh != n1`` the
     host interface's own reflection is no fringe: the correction ``w~`` (a fringe average) applies to the
@@ -521,7 +524,7 @@ def paper_weight(omega, geometry: CellGeometry) -> np.ndarray:
     return under_host(geometry.correction * envelope, geometry)
 
 
-def angular_correction(cos_theta_1, n1, n2) -> np.ndarray:
+def angular_correction(cos_theta_1: ArrayLike, n1: ArrayLike, n2: ArrayLike) -> np.ndarray:
     """
     The angular correction ``w~(theta_1) = w~0 + (1 - w~0)(1 - cos theta_1)^5`` (Appendix B), with
     ``w~0 = 0.735 R12 + 0.532`` and ``R12`` the normal-incidence reflectance between ``n1`` and ``n2``.
@@ -537,7 +540,7 @@ def optical_thickness(geometry: CellGeometry) -> np.ndarray:
     return np.maximum(np.real(geometry.p1) + np.real(geometry.p2), 1e-9)
 
 
-def mode_frequency(m, n_plus) -> np.ndarray:
+def mode_frequency(m: ArrayLike, n_plus: ArrayLike) -> np.ndarray:
     """Spectral modes ``omega_m = m pi / n_+`` (Eq. 13): inside a band gap for every ``m >= 1``."""
     return m * np.pi / n_plus
 
@@ -553,19 +556,19 @@ def _bisect(f, lo, hi, positive_at_lo):
     return 0.5 * (lo + hi)
 
 
-def airy_point(geometry: CellGeometry, omega_m, omega_next, m) -> np.ndarray:
+def airy_point(geometry: CellGeometry, omega_m: ArrayLike, omega_next: ArrayLike, m: ArrayLike) -> np.ndarray:
     """The zero of ``cos K Lambda`` between modes ``m`` and ``m + 1``, where ``R^e = |r1|^2``.
 
     ``cos K Lambda`` has the sign ``(-1)^m`` at ``omega_m`` (Appendix A)."""
     return _bisect(lambda w: cos_K_Lambda(w, geometry), omega_m, omega_next, (m % 2) == 0)
 
 
-def band_edge(geometry: CellGeometry, lo, hi, gap_at_lo: bool) -> np.ndarray:
+def band_edge(geometry: CellGeometry, lo: ArrayLike, hi: ArrayLike, gap_at_lo: bool) -> np.ndarray:
     """The band-gap edge ``|cos K Lambda| = 1`` between a mode and an Airy point, in either order."""
     return _bisect(lambda w: np.abs(cos_K_Lambda(w, geometry)) - 1.0, lo, hi, gap_at_lo)
 
 
-def zero_point_after(geometry: CellGeometry, omega) -> tuple[np.ndarray, np.ndarray]:
+def zero_point_after(geometry: CellGeometry, omega: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """
     The first zero point ``omega_z = z pi / (n2 cos theta_2 d2)`` (Eq. 12) above ``omega``.
 
@@ -581,7 +584,7 @@ def zero_point_after(geometry: CellGeometry, omega) -> tuple[np.ndarray, np.ndar
 # --------------------------------------------------------------------------------------------------
 # The piecewise-constant approximation (Section 3.2.2)
 
-def wavelength_of(omega) -> np.ndarray:
+def wavelength_of(omega: ArrayLike) -> np.ndarray:
     """``lambda = 2 pi / omega`` in nm; ``omega = 0`` (mode 0) maps past the visible range."""
     return 2.0 * np.pi / np.maximum(omega, 1e-9)
 
@@ -590,14 +593,14 @@ OMEGA_LOW = 2.0 * np.pi / WAVELENGTH_HIGH
 OMEGA_HIGH = 2.0 * np.pi / WAVELENGTH_LOW
 
 
-def mode_range(n_plus) -> tuple[np.ndarray, np.ndarray]:
+def mode_range(n_plus: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """First and last intervals ``[omega_m, omega_{m+1}]`` that overlap the visible range."""
     m_first = np.floor(OMEGA_LOW * n_plus / np.pi)
     m_last = np.floor(OMEGA_HIGH * n_plus / np.pi)
     return m_first, m_last
 
 
-def subdivisions(m, m_first, s, mode_numbering: str = "relative"):
+def subdivisions(m: ArrayLike, m_first: ArrayLike, s: int, mode_numbering: str = "relative") -> np.ndarray:
     """
     Sub-boxes per box outside band gaps: ``max(1, s - m)`` (Section 3.2.2); ``s = 0`` is the basic
     approximation (one box). The paper leaves open how ``m`` is counted: ``'relative'`` counts from
@@ -610,7 +613,7 @@ def subdivisions(m, m_first, s, mode_numbering: str = "relative"):
     return np.maximum(1.0, s - index)
 
 
-def subdivisions_by_mass(omega_low, omega_high, s):
+def subdivisions_by_mass(omega_low: ArrayLike, omega_high: ArrayLike, s: int) -> np.ndarray:
     """
     Sub-boxes of the improved variant (ours): ``ceil(4 s mu)``, with ``mu`` the box's share of the
     visible CMF mass (X + Y + Z), i.e. ``s`` sub-boxes per quarter of it. Boxes where the eye is most
@@ -643,7 +646,7 @@ GROW_EXPONENT = 2.0
 MAX_RESOLVED_PIECES = 48.0
 
 
-def fringe_count(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
+def fringe_count(omega_low: ArrayLike, omega_high: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     How many fringes of Eq. 2 lie in a pass-band box: ``N |Delta K Lambda| / pi``. Between zeros of
     ``sin N K Lambda`` the Bloch phase ``K Lambda`` advances by ``pi / N``, and it is monotone across a
@@ -654,7 +657,7 @@ def fringe_count(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
     return geometry.N * np.abs(t_high - t_low) / np.pi
 
 
-def fringes_resolved(edge_low, edge_high, s, geometry: CellGeometry) -> np.ndarray:
+def fringes_resolved(edge_low: ArrayLike, edge_high: ArrayLike, s: int, geometry: CellGeometry) -> np.ndarray:
     """
     Whether the improved variant (ours) resolves the fringes of the pass band ``[edge_low, edge_high]``.
 
@@ -679,7 +682,9 @@ def fringes_resolved(edge_low, edge_high, s, geometry: CellGeometry) -> np.ndarr
     return visible & wide & (SAMPLES_PER_FRINGE * geometry.N <= RESOLVE_BUDGET)
 
 
-def subdivisions_resolving_fringes(omega_low, omega_high, s, geometry: CellGeometry, resolved):
+def subdivisions_resolving_fringes(
+    omega_low: ArrayLike, omega_high: ArrayLike, s: int, geometry: CellGeometry, resolved: ArrayLike,
+) -> np.ndarray:
     """
     Sub-boxes of the improved variant (ours) in a pass-band box: :func:`subdivisions_by_mass`, and where
     the fringes are resolved (:func:`fringes_resolved`) at least :data:`SAMPLES_PER_FRINGE` per fringe
@@ -708,7 +713,7 @@ def fringe_sharpness(geometry: CellGeometry) -> np.ndarray:
     return np.minimum(1.0, 2.0 / (np.pi * np.sqrt(np.maximum(k, 1e-300))))
 
 
-def pass_band_weight(omega, geometry: CellGeometry, resolved) -> np.ndarray:
+def pass_band_weight(omega: ArrayLike, geometry: CellGeometry, resolved: ArrayLike) -> np.ndarray:
     """The improved variant's weight in a pass band: the exact reflectance (Eqs. 2, 9, 10; Appendix D)
     where the fringes are resolved, their closed-form average otherwise."""
     average = reflectance_fringe_average(omega, geometry)
@@ -717,7 +722,7 @@ def pass_band_weight(omega, geometry: CellGeometry, resolved) -> np.ndarray:
     return np.where(resolved, np.clip(reflectance_polarised(omega, geometry), 0.0, 1.0), average)
 
 
-def gap_weight(omega_low, omega_high, geometry: CellGeometry) -> np.ndarray:
+def gap_weight(omega_low: ArrayLike, omega_high: ArrayLike, geometry: CellGeometry) -> np.ndarray:
     """
     The improved variant's weight of a half band gap: the exact reflectance at its middle. The paper
     gives gaps ``w = 1``, the limit of Eq. 9 for large ``N``: ``R = 1 - O(e^{-2 N Im[K] Lambda})``. A mirror
@@ -836,7 +841,7 @@ def approximate_xyz_polarised(
 
 
 def approximate_rgb(
-    cos_theta, mirror: BraggMirror, s: int = 0, mode_numbering: str = "relative", variant: str = "paper"
+    cos_theta: ArrayLike, mirror: BraggMirror, s: int = 0, mode_numbering: str = "relative", variant: str = "paper"
 ) -> np.ndarray:
     """
     The RGB approximation of Section 3.2: ``s = 0`` the basic one, ``s >= 1`` the subdivided one
@@ -907,7 +912,9 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
 ROW_BLOCK = 32
 
 
-def reflectance_spectra(cos_theta, mirror: BraggMirror, wavelengths=colorimetry.WAVELENGTHS, float64: bool = False) -> np.ndarray:
+def reflectance_spectra(
+    cos_theta: ArrayLike, mirror: BraggMirror, wavelengths: ArrayLike = colorimetry.WAVELENGTHS, float64: bool = False,
+) -> np.ndarray:
     """
     Unpolarised ``R_lambda`` at every angle of ``cos_theta`` and every wavelength (nm; by default every nm
     of :data:`explorer.physics.colorimetry.WAVELENGTHS`): shape ``(n_angles, n_wavelengths)``. A 2D
@@ -1038,7 +1045,7 @@ def _rows(geometry: CellGeometry) -> CellGeometry:
     return CellGeometry(**fields)
 
 
-def tabulated_rgb(table: np.ndarray, cos_theta) -> np.ndarray:
+def tabulated_rgb(table: np.ndarray, cos_theta: ArrayLike) -> np.ndarray:
     """Linear interpolation in the table, as a linearly filtered texture fetch does."""
     size = table.shape[0]
     x = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0) * (size - 1)
@@ -1084,7 +1091,7 @@ EDGE_FRINGES = 8.0
 WINDOW_SUBSTEPS_MIN = 4
 
 
-def edge_window(a, N: int, fringes: float = EDGE_FRINGES):
+def edge_window(a: np.ndarray, N: int, fringes: float = EDGE_FRINGES) -> np.ndarray:
     """
     The window ``W`` of the fringe part: 1 within ``fringes`` fringes of a band edge, a cos^2 taper to 0
     over as many more, from ``a = cos K Lambda`` (Eq. 8): ``s = N min(u, pi - u) / pi`` with ``u = acos a``
@@ -1185,7 +1192,9 @@ def _windowed_complex(omega, geometry: CellGeometry) -> np.ndarray:
     return mean
 
 
-def windowed_spectrum_function(cos_theta, mirror: BraggMirror, float64: bool = False):
+def windowed_spectrum_function(
+    cos_theta: ArrayLike, mirror: BraggMirror, float64: bool = False,
+) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """
     ``spectrum(wavelengths, rows)`` for :func:`explorer.physics.colorimetry.converged_spectra`: the unpolarised
     ``Rbar + W (R - Rbar)`` (the section's comment above) at the angles ``cos_theta[rows]``, as
@@ -1218,9 +1227,9 @@ def windowed_spectrum_function(cos_theta, mirror: BraggMirror, float64: bool = F
 
 
 def windowed_converged_spectra(
-    cos_theta, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
+    cos_theta: ArrayLike, mirror: BraggMirror, tolerance: float = colorimetry.CONVERGENCE_TOLERANCE,
     passes: int = colorimetry.CONVERGENCE_PASSES, float64: bool = False, substeps_max: int = colorimetry.MAX_SUBSTEPS,
-):
+) -> tuple[np.ndarray, np.ndarray]:
     """
     Hat-averaged spectra whose colours equal those of
     :func:`explorer.physics.converged_reflectance_spectra`, from ``Rbar + W (R - Rbar)`` (module
@@ -1251,7 +1260,7 @@ def windowed_converged_spectra(
     return spectra[inverse.ravel()], substeps[inverse.ravel()]
 
 
-def windowed_converged_rgb(cos_theta, mirror: BraggMirror, **kwargs) -> np.ndarray:
+def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: float) -> np.ndarray:
     """Linear sRGB of :func:`windowed_converged_spectra`, shape ``cos_theta.shape + (3,)``."""
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     spectra, _ = windowed_converged_spectra(cos_theta, mirror, **kwargs)
