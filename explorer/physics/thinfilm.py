@@ -42,6 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import colorimetry
 from explorer.tables import luts
@@ -121,7 +122,9 @@ def _real_array(name: str, value) -> np.ndarray:
     return array
 
 
-def validate_film(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d) -> tuple[np.ndarray, ...]:
+def validate_film(
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+) -> tuple[np.ndarray, ...]:
     """
     The film's parameters as float arrays, or a ``ValueError`` with a one-line message.
 
@@ -153,7 +156,7 @@ def _validate_wavelength(wavelength) -> np.ndarray:
 # Snell and Fresnel with a conducting base (explorer.physics.fresnel is dielectric-only)
 
 
-def cos_theta_transmitted_conductor(cos_theta_1, eta_1, eta_3, kappa_3) -> np.ndarray:
+def cos_theta_transmitted_conductor(cos_theta_1: ArrayLike, eta_1: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike) -> np.ndarray:
     """
     Cosine of the complex refraction angle into a base of index ``eta_3 + i kappa_3``.
 
@@ -172,7 +175,7 @@ def cos_theta_transmitted_conductor(cos_theta_1, eta_1, eta_3, kappa_3) -> np.nd
     return q_3 / n_3
 
 
-def fresnel_t(polarisation: str, eta_i, cos_theta_i, eta_t, cos_theta_t) -> np.ndarray:
+def fresnel_t(polarisation: str, eta_i: ArrayLike, cos_theta_i: ArrayLike, eta_t: ArrayLike, cos_theta_t: ArrayLike) -> np.ndarray:
     """
     Amplitude transmission coefficient (the ``tmm`` convention, as :func:`explorer.physics.fresnel.fresnel_r`):
     ``t_s = 2 a / (a + b)`` with ``a = eta_i cos_i``, ``b = eta_t cos_t``; ``t_p = 2 a / (eta_t cos_i + eta_i cos_t)``.
@@ -288,17 +291,20 @@ class FilmTerms:
         return factor * np.abs(self.t12 * self.t23) ** 2
 
 
-def optical_path_difference(eta_2, cos_theta_2, thickness_d) -> np.ndarray:
+def optical_path_difference(eta_2: ArrayLike, cos_theta_2: ArrayLike, thickness_d: ArrayLike) -> np.ndarray:
     """``D = 2 eta_2 d cos theta_2`` (Section 3), in nm; the order-``k`` path difference is ``k D``."""
     return 2.0 * np.asarray(eta_2) * np.asarray(cos_theta_2) * np.asarray(thickness_d)
 
 
-def phase_shift(D, wavelength) -> np.ndarray:
+def phase_shift(D: ArrayLike, wavelength: ArrayLike) -> np.ndarray:
     """``Delta phi = 2 pi nu D`` with ``nu = 1 / lambda`` (Section 3): the OPD's phase."""
     return 2.0 * np.pi * np.asarray(D) / np.asarray(wavelength)
 
 
-def film_terms(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, polarisation: str) -> FilmTerms:
+def film_terms(
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    polarisation: str,
+) -> FilmTerms:
     """
     Snell's law into the film and the base, and the Fresnel coefficients of both interfaces.
 
@@ -369,13 +375,13 @@ def _complex_phase(terms: FilmTerms, wavelength) -> np.ndarray:
     return np.exp(2j * np.pi * 2.0 * terms.eta_2 * terms.thickness_d * terms.cos_theta_2 / wavelength)
 
 
-def airy_reflection_coefficient_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
+def airy_reflection_coefficient_from_terms(terms: FilmTerms, wavelength: ArrayLike) -> np.ndarray:
     """Airy summation (Eq. 3): ``r = r12 + t12 r23 t21 e^{i Dphi} / (1 - r21 r23 e^{i Dphi})``."""
     e = _complex_phase(terms, wavelength)
     return terms.r12 + terms.t12 * terms.r23 * terms.t21 * e / (1.0 - terms.r21 * terms.r23 * e)
 
 
-def airy_transmission_coefficient_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
+def airy_transmission_coefficient_from_terms(terms: FilmTerms, wavelength: ArrayLike) -> np.ndarray:
     """Airy summation for transmission (Appendix): ``t = t12 t23 e^{i Dphi/2} / (1 - r21 r23 e^{i Dphi})``
     (``e^{i Dphi / 2}`` is the one crossing, the Appendix's ``delta phi``)."""
     e = _complex_phase(terms, wavelength)
@@ -401,7 +407,7 @@ def _airy_denominator(terms: FilmTerms, Phi) -> np.ndarray:
     return one_minus_R_l**2 + 4.0 * R_l * np.sin(0.5 * Phi) ** 2
 
 
-def airy_reflectance_appendix_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
+def airy_reflectance_appendix_from_terms(terms: FilmTerms, wavelength: ArrayLike) -> np.ndarray:
     """
     The Appendix's closed form, literally:
     ``R = R12 + R* + 2 (R_l cos Phi - R_l^2) / (1 - 2 R_l cos Phi + R_l^2) (R* - sqrt(T12 T21))``.
@@ -415,7 +421,7 @@ def airy_reflectance_appendix_from_terms(terms: FilmTerms, wavelength) -> np.nda
     )
 
 
-def airy_reflectance_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
+def airy_reflectance_from_terms(terms: FilmTerms, wavelength: ArrayLike) -> np.ndarray:
     """
     The spectral Airy reflectance for one polarisation: the Appendix's closed form, rearranged.
 
@@ -435,7 +441,7 @@ def airy_reflectance_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
     return np.where(propagates, closed, evanescent)
 
 
-def airy_transmittance_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
+def airy_transmittance_from_terms(terms: FilmTerms, wavelength: ArrayLike) -> np.ndarray:
     """
     The spectral Airy transmittance for one polarisation (Appendix):
     ``T = T* (1 + 2 (R_l cos Phi - R_l^2) / (1 - 2 R_l cos Phi + R_l^2))`` with
@@ -454,7 +460,8 @@ def airy_transmittance_from_terms(terms: FilmTerms, wavelength) -> np.ndarray:
 
 
 def airy_reflection_coefficient(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, wavelength, polarisation: str
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    wavelength: ArrayLike, polarisation: str,
 ) -> np.ndarray:
     """
     The film's complex amplitude reflection coefficient ``r`` by Airy summation (Eqs. 2-3).
@@ -485,7 +492,8 @@ def _polarisation_average(of_terms, film, wavelength, polarisation: str | None) 
 
 
 def airy_reflectance(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, wavelength, polarisation: str | None = None
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    wavelength: ArrayLike, polarisation: str | None = None,
 ) -> np.ndarray:
     """
     The spectral Airy reflectance ``R`` of a thin film (Eqs. 2-3; the Appendix's closed form).
@@ -531,7 +539,8 @@ def airy_reflectance(
 
 
 def airy_transmittance(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, wavelength, polarisation: str | None = None
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    wavelength: ArrayLike, polarisation: str | None = None,
 ) -> np.ndarray:
     """
     The spectral Airy transmittance ``T`` into the base (Appendix, "The case of transmission").
@@ -589,7 +598,7 @@ def sensitivities_rgb() -> np.ndarray:
     return colorimetry.colour_matching_functions() @ colorimetry.xyz_to_rgb_matrix().T
 
 
-def sensitivity_fourier_transform_exact(mu) -> np.ndarray:
+def sensitivity_fourier_transform_exact(mu: ArrayLike) -> np.ndarray:
     """
     ``S^_j(mu) = sum_lambda s_j(lambda) exp(-2 pi i mu / lambda)``: the Fourier transform over
     ``nu = 1/lambda`` (Eqs. 7-8) of the discrete measure the 1 nm reference integrates against, so
@@ -604,7 +613,7 @@ def sensitivity_fourier_transform_exact(mu) -> np.ndarray:
     return np.exp(-2j * np.pi * mu[..., None] * nu) @ sensitivities_rgb().astype(np.complex128)
 
 
-def sensitivity_fourier_transform_table(mu) -> np.ndarray:
+def sensitivity_fourier_transform_table(mu: ArrayLike) -> np.ndarray:
     """
     ``S^_j(mu)`` from the ``sensitivity_fourier`` table (:mod:`explorer.tables.luts`): the demodulated envelope
     ``E_j`` interpolated linearly between nodes, as a linearly filtered texture fetch does, times the
@@ -627,7 +636,7 @@ def sensitivity_fourier_transform_table(mu) -> np.ndarray:
     return np.where(inside[..., None], envelope * carrier, 0.0)
 
 
-def sensitivity_fourier_transform_gaussian_xyz(mu) -> np.ndarray:
+def sensitivity_fourier_transform_gaussian_xyz(mu: ArrayLike) -> np.ndarray:
     """
     The paper's Gaussian fits of the XYZ sensitivities in Fourier space (Section 5, Fig. 5(b-c)):
     ``S^(mu) = sum val sqrt(2 pi var) exp(-var phase^2) exp(-i pos phase) / norm``,
@@ -646,7 +655,7 @@ def sensitivity_fourier_transform_gaussian_xyz(mu) -> np.ndarray:
     return xyz / GAUSSIAN_FIT_NORM
 
 
-def sensitivity_fourier_transform(mu, sensitivity: str = "table") -> np.ndarray:
+def sensitivity_fourier_transform(mu: ArrayLike, sensitivity: str = "table") -> np.ndarray:
     """
     The Fourier transform ``S^_j(mu)`` of the linear sRGB sensitivities at OPD ``mu`` (nm), Eq. 8.
 
@@ -691,7 +700,7 @@ def D_max(epsilon: float = 0.05, sensitivity: str = "table") -> float:
 
 
 def spectral_integration_fourier(
-    terms: FilmTerms, m_max: int = 3, sensitivity: str = "table", sigma_D_inc=None, remainder: bool = True
+    terms: FilmTerms, m_max: int = 3, sensitivity: str = "table", sigma_D_inc: ArrayLike | None = None, remainder: bool = True
 ) -> np.ndarray:
     """
     Eq. 10 for one polarisation: ``R_j = C_0 S^_j(0) + 2 sum_{m=1}^{m_max} C_m [cos(m phi_2) Re S^_j(mD)
@@ -739,7 +748,7 @@ def spectral_integration_fourier(
 REMAINDER_MIN = 1e-15
 
 
-def fourier_remainder(terms: FilmTerms, m_max: int, z_M, z_next) -> np.ndarray:
+def fourier_remainder(terms: FilmTerms, m_max: int, z_M: ArrayLike, z_next: ArrayLike) -> np.ndarray:
     """
     The terms of Eq. 10 beyond ``m_max``, summed in closed form.
 
@@ -787,7 +796,10 @@ def _with_axis(*arrays):
     return tuple(np.asarray(a, dtype=np.float64)[..., None] for a in arrays)
 
 
-def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, step: float | None = None) -> np.ndarray:
+def reference_rgb(
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    step: float | None = None,
+) -> np.ndarray:
     """
     The spectral reference: the exact Airy reflectance, both polarisations averaged, integrated against
     the CMFs (:mod:`explorer.physics.colorimetry`), in linear sRGB.
@@ -828,7 +840,8 @@ def reference_rgb(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, step: 
 
 
 def naive_rgb(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, wavelengths=NAIVE_WAVELENGTHS, space: str = "rgb"
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    wavelengths: ArrayLike = NAIVE_WAVELENGTHS, space: str = "rgb",
 ) -> np.ndarray:
     """
     The naive RGB method: the exact Airy reflectance at one wavelength per channel (Section 4, Fig. 7(a)).
@@ -865,8 +878,8 @@ def naive_rgb(
 
 
 def fourier_rgb(
-    eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, m_max: int = 3, sensitivity: str = "table",
-    sigma_D_inc=None, remainder: bool = True,
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    m_max: int = 3, sensitivity: str = "table", sigma_D_inc: ArrayLike | None = None, remainder: bool = True,
 ) -> np.ndarray:
     """
     The paper's analytic spectral integration (Eq. 10) truncated at ``m_max``, both polarisations.
@@ -923,12 +936,12 @@ def fourier_rgb(
 # Parametrisation by the optical path difference at normal incidence (Section 5)
 
 
-def D_inc(eta_2, thickness_d) -> np.ndarray:
+def D_inc(eta_2: ArrayLike, thickness_d: ArrayLike) -> np.ndarray:
     """``D_inc = 2 eta_2 d``: the OPD at normal incidence (Section 5); then ``D = D_inc cos theta_2``."""
     return 2.0 * np.asarray(eta_2, dtype=np.float64) * np.asarray(thickness_d, dtype=np.float64)
 
 
-def film_from_D_inc(D_inc, eta_1, eta_2) -> tuple[np.ndarray, np.ndarray]:
+def film_from_D_inc(D_inc: ArrayLike, eta_1: ArrayLike, eta_2: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """
     The film ``(eta_2', thickness_d)`` an artist's ``D_inc`` stands for (Section 5).
 
@@ -1013,7 +1026,7 @@ def sensitivity_fourier_prefiltered() -> np.ndarray:
     return _PREFILTERED[0]
 
 
-def sensitivity_fourier_transform_prefiltered(mu, sigma) -> np.ndarray:
+def sensitivity_fourier_transform_prefiltered(mu: ArrayLike, sigma: ArrayLike) -> np.ndarray:
     """
     ``S^_j`` averaged over OPDs distributed as a Gaussian of mean ``mu`` and standard deviation ``sigma``
     (nm): the pre-filtered table interpolated bilinearly in ``(mu, sigma)``, as ``lib/thinfilm.glsl``
@@ -1048,7 +1061,10 @@ def sensitivity_fourier_transform_prefiltered(mu, sigma) -> np.ndarray:
     return np.where(inside[..., None], envelope * carrier, 0.0)
 
 
-def fourier_rgb_prefiltered(eta_1, eta_2, eta_3, kappa_3, cos_theta_1, thickness_d, sigma_D_inc, m_max: int = 3) -> np.ndarray:
+def fourier_rgb_prefiltered(
+    eta_1: ArrayLike, eta_2: ArrayLike, eta_3: ArrayLike, kappa_3: ArrayLike, cos_theta_1: ArrayLike, thickness_d: ArrayLike,
+    sigma_D_inc: ArrayLike, m_max: int = 3,
+) -> np.ndarray:
     """
     Eq. 10 integrated against a Gaussian distribution of thickness (Section 5, Multi-scale Rendering):
 
