@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 #: ``alpha = 0`` is a smooth layer: ``D`` is then a Dirac, evaluated with this roughness instead.
@@ -65,7 +66,7 @@ def theta_cell_edges() -> np.ndarray:
     return np.concatenate([[0.0], (np.arange(THETA_COUNT - 1) + 0.5) * THETA_STEP, [0.5 * np.pi]])
 
 
-def check_alpha(alpha) -> np.ndarray:
+def check_alpha(alpha: ArrayLike) -> np.ndarray:
     """
     Validate a GGX roughness (Eq. 18: ``alpha`` in [0, 1]).
 
@@ -90,7 +91,7 @@ def check_alpha(alpha) -> np.ndarray:
 # GGX and Smith (Eqs. 18-19)
 
 
-def ggx_D(cos_theta_m, alpha) -> np.ndarray:
+def ggx_D(cos_theta_m: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """
     The isotropic GGX (Trowbridge-Reitz) distribution of microfacet normals (Eq. 18).
 
@@ -123,7 +124,7 @@ def ggx_D(cos_theta_m, alpha) -> np.ndarray:
     return np.where(cos_theta_m > 0.0, a2 / (np.pi * denominator * denominator), 0.0)
 
 
-def smith_G1(cos_theta_i, alpha, i_dot_m=None) -> np.ndarray:
+def smith_G1(cos_theta_i: ArrayLike, alpha: ArrayLike, i_dot_m: ArrayLike | None = None) -> np.ndarray:
     """
     Smith's masking function for GGX (Eq. 19): ``chi+(i.m / i.n) 2 / (1 + sqrt(1 + alpha^2 tan^2 theta_i))``.
 
@@ -157,7 +158,7 @@ def smith_G1(cos_theta_i, alpha, i_dot_m=None) -> np.ndarray:
     return G1
 
 
-def smith_G1_over_cos(cos_theta_i, alpha) -> np.ndarray:
+def smith_G1_over_cos(cos_theta_i: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """
     ``G1(theta_i) / cos theta_i = 2 / (cos + sqrt(cos^2 + alpha^2 sin^2))`` (Eq. 19 over Eq. 17's
     cosine): finite at grazing incidence, where both vanish. 0 below the horizon.
@@ -173,7 +174,7 @@ def smith_G1_over_cos(cos_theta_i, alpha) -> np.ndarray:
 # The microfacet Bragg BRDF (Eq. 17)
 
 
-def half_vector(i, o) -> np.ndarray:
+def half_vector(i: ArrayLike, o: ArrayLike) -> np.ndarray:
     """``h = (i + o) / |i + o|`` (Eq. 17); ``+z`` where ``i = -o`` (both on the horizon, opposite)."""
     s = np.asarray(i, dtype=np.float64) + np.asarray(o, dtype=np.float64)
     norm = np.linalg.norm(s, axis=-1, keepdims=True)
@@ -182,7 +183,7 @@ def half_vector(i, o) -> np.ndarray:
     return np.where(norm > 1e-12, s / np.maximum(norm, 1e-300), fallback)
 
 
-def half_vector_cosine(i, o) -> np.ndarray:
+def half_vector_cosine(i: ArrayLike, o: ArrayLike) -> np.ndarray:
     """
     ``cos theta_d = i.h = o.h = |i + o| / 2`` for unit ``i, o``: symmetric in ``i`` and ``o`` to the last
     bit, so that Eq. 17 is exactly reciprocal even where Yeh's reflectance varies fast with angle.
@@ -191,7 +192,7 @@ def half_vector_cosine(i, o) -> np.ndarray:
     return np.clip(0.5 * np.linalg.norm(s, axis=-1), 0.0, 1.0)
 
 
-def microfacet_lobe(i, o, n, alpha) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def microfacet_lobe(i: ArrayLike, o: ArrayLike, n: ArrayLike, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Eq. 17 without its reflectance, about any normal ``n``: ``D(h) G1(i) G1(o) / (4 |i.n| |o.n|)``, the
     twin of ``microfacet_lobe`` in ``shaders/lib/microfacet.glsl``.
@@ -220,7 +221,7 @@ def microfacet_lobe(i, o, n, alpha) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return np.where(above, lobe, 0.0), np.clip(0.5 * norm, 0.0, 1.0), above
 
 
-def microfacet_brdf(i, o, alpha, reflectance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+def microfacet_brdf(i: ArrayLike, o: ArrayLike, alpha: float, reflectance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     """
     A GGX microfacet BRDF with a given microfacet reflectance (Eq. 17):
     ``f_r(i, o) = D(h) G1(i) G1(o) R(i.h) / (4 |i.n| |o.n|)``.
@@ -252,7 +253,7 @@ def microfacet_brdf(i, o, alpha, reflectance: Callable[[np.ndarray], np.ndarray]
 # Sampling the visible normals (Heitz 2018), for the env view's Monte Carlo estimator
 
 
-def sample_ggx_visible_normal(v, alpha, u1, u2) -> np.ndarray:
+def sample_ggx_visible_normal(v: ArrayLike, alpha: float, u1: ArrayLike, u2: ArrayLike) -> np.ndarray:
     """
     Sample a microfacet normal from GGX's distribution of normals visible from ``v`` (Heitz 2018).
 
@@ -302,7 +303,7 @@ def sample_ggx_visible_normal(v, alpha, u1, u2) -> np.ndarray:
     return m / np.linalg.norm(m, axis=-1, keepdims=True)
 
 
-def ggx_visible_normal_pdf(v, m, alpha) -> np.ndarray:
+def ggx_visible_normal_pdf(v: ArrayLike, m: ArrayLike, alpha: float) -> np.ndarray:
     """
     The density (1/sr) of :func:`sample_ggx_visible_normal`: Heitz's distribution of visible normals
     ``D_v(m) = G1(v) max(0, v.m) D(m) / v.n`` (Eqs. 18-19 of Fourneau et al. 2024 for ``D`` and ``G1``),
@@ -325,7 +326,7 @@ def ggx_visible_normal_pdf(v, m, alpha) -> np.ndarray:
     return smith_G1_over_cos(cos_v, alpha) * v_dot_m * ggx_D(m[..., 2], alpha)
 
 
-def ggx_reflection_pdf(l, v, alpha) -> np.ndarray:
+def ggx_reflection_pdf(l: ArrayLike, v: ArrayLike, alpha: float) -> np.ndarray:
     """
     The density (1/sr) of ``l = reflect(-v, m)`` for ``m`` drawn by :func:`sample_ggx_visible_normal`:
     ``D_v(h) / (4 v.h) = G1(v) D(h) / (4 v.n)`` with ``h = (l + v) / |l + v|`` (the Jacobian of the
@@ -349,7 +350,7 @@ def ggx_reflection_pdf(l, v, alpha) -> np.ndarray:
 # The GGX transmission filter (Section 4.2.2, Eqs. 24-29)
 
 
-def cos_theta_m(theta_i, theta_d, psi_d) -> np.ndarray:
+def cos_theta_m(theta_i: ArrayLike, theta_d: ArrayLike, psi_d: ArrayLike) -> np.ndarray:
     """
     ``cos theta_m = cos theta_i cos theta_d + sin theta_i sin theta_d cos psi_d`` (Eq. 24): the
     microfacet normal at angle ``theta_d`` from ``i`` and azimuth ``psi_d`` around it (Figure 5).
@@ -358,7 +359,7 @@ def cos_theta_m(theta_i, theta_d, psi_d) -> np.ndarray:
     return np.cos(theta_i) * np.cos(theta_d) + np.sin(theta_i) * np.sin(theta_d) * np.cos(psi_d)
 
 
-def psi_d_max(theta_i, theta_d) -> np.ndarray:
+def psi_d_max(theta_i: ArrayLike, theta_d: ArrayLike) -> np.ndarray:
     """
     The bound of the ``psi_d`` integral where the microfacet normal reaches the horizon (Eq. 26):
     ``acos(-1 / (tan theta_i tan theta_d))`` if ``theta_i + theta_d >= pi/2``, else ``pi``.
@@ -432,7 +433,7 @@ def _G1_squared_over_cos(cos_theta_i, alpha) -> np.ndarray:
     return 4.0 * c / (root * root)
 
 
-def transmission_filter(theta_i, theta_d, alpha) -> np.ndarray:
+def transmission_filter(theta_i: ArrayLike, theta_d: ArrayLike, alpha: float) -> np.ndarray:
     """
     The GGX transmission filter (Eq. 29), pointwise:
     ``F_alpha(theta_i, theta_d) = 2 G1^2(theta_i) (cos theta_d / cos theta_i) int_0^psi_d_max D~(theta_m) sin theta_d d psi_d``,
@@ -509,7 +510,7 @@ _GL2 = np.polynomial.legendre.leggauss(2)
 _GL_PIECE = np.polynomial.legendre.leggauss(PIECE_NODES)
 
 
-def transmission_filter_table(alpha) -> TransmissionFilter:
+def transmission_filter_table(alpha: float) -> TransmissionFilter:
     """
     Tabulate ``F_alpha`` (Eq. 29) for one roughness at 0.25 degrees in ``theta_i`` and ``theta_d``
     (Figure 7), as the integral of ``F_alpha`` over each ``theta_d`` cell.
