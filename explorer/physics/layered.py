@@ -32,8 +32,10 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import dataclass, field
+from typing import Mapping, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import bragg, colorimetry, microfacet
 from explorer.physics.fresnel import fresnel_reflectance
@@ -148,7 +150,9 @@ class LayeredBragg:
 # Eqs. 28 and 30
 
 
-def rough_bragg_brdf(i, o, mirror: bragg.BraggMirror, alpha, wavelength=None) -> np.ndarray:
+def rough_bragg_brdf(
+    i: ArrayLike, o: ArrayLike, mirror: bragg.BraggMirror, alpha: float, wavelength: ArrayLike | None = None,
+) -> np.ndarray:
     """
     The BRDF of a rough Bragg layer (Eq. 17): GGX microfacets that are Bragg mirrors, reflecting with
     Yeh's exact unpolarised reflectance ``R_lambda`` at the half-vector angle ``theta_d = acos(i.h)``
@@ -179,7 +183,7 @@ def rough_bragg_brdf(i, o, mirror: bragg.BraggMirror, alpha, wavelength=None) ->
     )
 
 
-def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter, transmissivity) -> np.ndarray:
+def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter, transmissivity: ArrayLike) -> np.ndarray:
     """
     The integrated transmissivity of a rough Bragg layer (Eq. 28), per wavelength:
     ``f_t(theta_i) cos theta_i = int_0^{pi/2} T_lambda(theta_d) F_alpha(theta_i, theta_d) d theta_d``.
@@ -204,7 +208,7 @@ def integrated_transmissivity(transmission_filter: microfacet.TransmissionFilter
     return transmission_filter.weights @ np.asarray(transmissivity, dtype=np.float64)
 
 
-def absorption(cos_theta_i, alpha) -> np.ndarray:
+def absorption(cos_theta_i: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """
     The part of the light a rough Bragg layer absorbs (Eq. 30): ``A(theta_i) = 1 - G1(theta_i)``, the
     paths that would scatter more than once among its microfacets (Eq. 28 with ``T = 1``, Appendix C).
@@ -212,7 +216,7 @@ def absorption(cos_theta_i, alpha) -> np.ndarray:
     return 1.0 - microfacet.smith_G1(cos_theta_i, alpha)
 
 
-def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
+def coating_reflectance(cos_theta_i: ArrayLike, n1: ArrayLike) -> np.ndarray:
     """
     The weight of the coating's specular reflection ``f_r,0`` of Eq. 34 (a Dirac in the mirror
     direction): the unpolarised Fresnel reflectance from air into the host ``n1`` (0 for ``n1 = 1``).
@@ -232,7 +236,7 @@ def coating_reflectance(cos_theta_i, n1) -> np.ndarray:
 LAYER_MAX_SUBSTEPS = 64
 
 
-def reflectance_table(mirror: bragg.BraggMirror, cos_theta) -> np.ndarray:
+def reflectance_table(mirror: bragg.BraggMirror, cos_theta: ArrayLike) -> np.ndarray:
     """
     Yeh's unpolarised reflectance ``R_lambda`` of ``mirror`` at every angle of ``cos_theta``, averaged
     over each nm of :data:`explorer.physics.colorimetry.WAVELENGTHS` (its hat function), sampled finely enough
@@ -250,7 +254,7 @@ def _cached_filter(alpha: float) -> microfacet.TransmissionFilter:
     return microfacet.transmission_filter_table(alpha)
 
 
-def transmission_filter_for(alpha) -> microfacet.TransmissionFilter:
+def transmission_filter_for(alpha: float) -> microfacet.TransmissionFilter:
     """The transmission filter ``F_alpha`` (Eq. 29), built once per ``alpha`` and cached (8 of them)."""
     return _cached_filter(float(microfacet.check_alpha(alpha)))
 
@@ -293,7 +297,8 @@ def _reflectance_at_theta_nodes(mirror: bragg.BraggMirror) -> np.ndarray:
 
 
 def layer_tables(
-    layer: RoughBraggLayer, n1: float = 1.0, transmission_filter=None, cached: bool = True, draft: bool = False
+    layer: RoughBraggLayer, n1: float = 1.0, transmission_filter: microfacet.TransmissionFilter | None = None, cached: bool = True,
+    draft: bool = False,
 ) -> LayerTables:
     """
     Build a layer's tables: ``R_lambda`` over angle and the integrated transmissivity (Eq. 28).
@@ -346,7 +351,7 @@ def stack_tables(stack: LayeredBragg) -> tuple[LayerTables, ...]:
     return tuple(layer_tables(layer, stack.n1) for layer in stack.layers)
 
 
-def lookup(table: np.ndarray, theta) -> np.ndarray:
+def lookup(table: np.ndarray, theta: ArrayLike) -> np.ndarray:
     """
     Linear interpolation of a per-angle table (rows at ``k * 0.25 deg``) at ``theta`` (radians), as a
     linearly filtered texture fetch does: shape ``theta.shape + table.shape[1:]``.
@@ -361,7 +366,7 @@ def lookup(table: np.ndarray, theta) -> np.ndarray:
 # The single-reflection BRDF (Eq. 34)
 
 
-def refract_into_host(direction, n1: float) -> np.ndarray:
+def refract_into_host(direction: ArrayLike, n1: float) -> np.ndarray:
     """
     Snell's law through the smooth coating, from air into the host ``n1 >= 1``: the direction keeps its
     azimuth, ``sin theta' = sin theta / n1`` (Eq. 34's refracted ``i`` and ``o``), and stays above.
@@ -394,7 +399,7 @@ class SingleReflectionSpectra:
 
 
 def single_reflection_spectra(
-    stack: LayeredBragg, i, o, tables=None, exact_reflectance: bool = False
+    stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False
 ) -> SingleReflectionSpectra:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34), spectrally:
@@ -469,7 +474,9 @@ def single_reflection_spectra(
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
 
 
-def single_reflection_brdf(stack: LayeredBragg, i, o, tables=None, exact_reflectance: bool = False) -> np.ndarray:
+def single_reflection_brdf(
+    stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False,
+) -> np.ndarray:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34) in linear sRGB (1/sr): the Bragg
     layers' spectral term integrated against the CMFs, plus the base's spectral transmission factor
@@ -508,7 +515,7 @@ def _host_angle(cos_theta, n1: float, coating: bool) -> tuple[np.ndarray, np.nda
     return np.arctan2(s, np.sqrt(np.maximum(1.0 - s * s, 0.0))), F
 
 
-def stack_specular_rgb(stack: LayeredBragg, cos_theta, tables=None) -> np.ndarray:
+def stack_specular_rgb(stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequence[LayerTables] | None = None) -> np.ndarray:
     """
     The smooth limit's specular colour of a stack at incidence ``cos_theta`` (in air), in linear sRGB: the
     weight of the mirror reflection, ``F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2``,
@@ -535,7 +542,7 @@ def stack_specular_rgb(stack: LayeredBragg, cos_theta, tables=None) -> np.ndarra
     return colorimetry.spectrum_to_rgb(spectrum) + F[..., None]  # F is flat: white is (1, 1, 1)
 
 
-def transmission_probability(mean_transmissivity, cos_theta, alpha) -> np.ndarray:
+def transmission_probability(mean_transmissivity: ArrayLike, cos_theta: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """
     The probability of transmission through a rough Bragg layer (Eq. 31), with the numerator averaged
     over wavelengths (the "multiplexed" form of Section 4.2.3): ``2 <f_t cos theta>_lambda / (1 + G1)``.
@@ -544,7 +551,9 @@ def transmission_probability(mean_transmissivity, cos_theta, alpha) -> np.ndarra
     return np.clip(p, 0.0, 1.0)
 
 
-def layer_choice_probabilities(stack: LayeredBragg, cos_theta, tables=None) -> tuple[np.ndarray, np.ndarray]:
+def layer_choice_probabilities(
+    stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequence[LayerTables] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """
     The probability that a path entering at ``cos_theta`` (in air) reflects on Bragg layer ``l`` (Eq. 35),
     ``p_refl,l = (1 - p_trans,l) prod_{k<l} p_trans,k`` with ``p_trans,0 = 1 - F`` through the coating,
@@ -580,7 +589,9 @@ def figure7_layers() -> dict[str, tuple[RoughBraggLayer, float]]:
     }
 
 
-def measure_timings(alphas=(0.025, 0.1, 0.4), layers=None, repeats: int = 5) -> dict:
+def measure_timings(
+    alphas: Sequence[float] = (0.025, 0.1, 0.4), layers: Mapping[str, tuple[RoughBraggLayer, float]] | None = None, repeats: int = 5,
+) -> dict:
     """
     Median wall-clock times (ms) of building ``F_alpha`` for each of ``alphas`` and each layer's tables
     (``layers``: the Figure 7 configurations A, B and A' by default), over ``repeats`` interleaved
