@@ -41,6 +41,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import microfacet
 from explorer.physics.lobes_fgd import (  # the Fresnel terms and table coordinates the model reads
@@ -64,19 +65,19 @@ COS_MIN = 1e-4
 VARIANCE_MAX = 1e6
 
 
-def variance_from_roughness(alpha) -> np.ndarray:
+def variance_from_roughness(alpha: ArrayLike) -> np.ndarray:
     """Belcour's roughness-to-variance mapping ``f(alpha) = alpha^1.1 / (1 - alpha^1.1)`` (Bati et al., Sec. 4), at most :data:`VARIANCE_MAX`."""
     a = np.clip(np.asarray(alpha, dtype=np.float64), 0.0, 1.0) ** 1.1
     return np.minimum(a / np.maximum(1.0 - a, 1.0 / VARIANCE_MAX), VARIANCE_MAX)
 
 
-def roughness_from_variance(sigma) -> np.ndarray:
+def roughness_from_variance(sigma: ArrayLike) -> np.ndarray:
     """``f^{-1}(sigma) = (sigma / (1 + sigma))^(1 / 1.1)``; 0 for ``sigma <= 0``, 1 from :data:`VARIANCE_MAX` on."""
     s = np.clip(np.asarray(sigma, dtype=np.float64), 0.0, VARIANCE_MAX)
     return np.where(s >= VARIANCE_MAX, 1.0, (s / (1.0 + s)) ** (1.0 / 1.1))
 
 
-def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
+def fgd_dielectric(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike) -> np.ndarray:
     """
     ``FGD_{s,p}`` of a rough dielectric interface of relative index ``eta`` (achromatic or per channel):
     the exact Fresnel term plus the (unpolarised) tabulated correction, interpolated trilinearly in
@@ -105,7 +106,7 @@ def fgd_dielectric(cos_theta, alpha, eta) -> np.ndarray:
     return np.clip(np.where(mean > 1e-9, F * scale, target), 0.0, 1.0)
 
 
-def fgd_conductor(cos_theta, alpha, eta, kappa) -> np.ndarray:
+def fgd_conductor(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike, kappa: ArrayLike) -> np.ndarray:
     """``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices)."""
     from explorer.tables import luts
 
@@ -184,7 +185,10 @@ def _rgb(value) -> np.ndarray:
     return np.broadcast_to(np.asarray(value, dtype=np.float64), (3,)).copy()
 
 
-def make_stack(eta, alpha, tau=None, base_kappa=None, eta_0=1.0, tir=False) -> Stack:
+def make_stack(
+    eta: ArrayLike, alpha: ArrayLike, tau: ArrayLike | None = None, base_kappa: ArrayLike | None = None, eta_0: float = 1.0,
+    tir: bool = False,
+) -> Stack:
     """
     A stack from its interfaces, top first: ``eta[i - 1]`` (a number, or RGB for a conducting base),
     ``alpha[i - 1]``, ``tau[i - 1]`` the optical depth below interface ``i`` (RGB; ``n - 1`` entries, or
@@ -256,7 +260,7 @@ def _safe_divide(a, b):
     return np.where(b > 0.0, a / np.where(b > 0.0, b, 1.0), 0.0)
 
 
-def interface_fgd(stack: Stack, i: int, cos_theta, alpha) -> np.ndarray:
+def interface_fgd(stack: Stack, i: int, cos_theta: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """``FGD_{s,p}`` of interface ``i`` seen from medium ``i - 1`` (conductor or dielectric), ``(2, ..., 3)``."""
     ratio = stack.eta[i] / stack.eta[i - 1].mean()
     if i == stack.count and stack.conductor:
@@ -264,7 +268,7 @@ def interface_fgd(stack: Stack, i: int, cos_theta, alpha) -> np.ndarray:
     return fgd_dielectric(cos_theta, alpha, ratio)
 
 
-def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
+def lobes_and_statistics(stack: Stack, cos_theta: ArrayLike, count: int | None = None) -> tuple[np.ndarray, np.ndarray, StackStatistics]:
     """
     The adding equations (Bati et al., Eqs. 2, 4-6; Belcour 2018) down to interface ``count``
     (default: all): the lobes' energies ``R_k`` and variances ``sigma_k``, ``(..., count, 3)`` each, and
@@ -345,13 +349,13 @@ def lobes_and_statistics(stack: Stack, cos_theta, count: int | None = None):
     return np.stack(energies, axis=-2), np.stack(variances, axis=-2), statistics
 
 
-def lobes(stack: Stack, cos_theta):
+def lobes(stack: Stack, cos_theta: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``(R_k, sigma_k)`` of every lobe at incidence ``cos_theta``: arrays ``(..., n, 3)``."""
     energies, variances, _ = lobes_and_statistics(stack, cos_theta)
     return energies, variances
 
 
-def stack_statistics(stack: Stack, count: int, cos_theta=1.0) -> StackStatistics:
+def stack_statistics(stack: Stack, count: int, cos_theta: float = 1.0) -> StackStatistics:
     """The statistics of the top ``count`` interfaces (Algorithm 3's input, normal incidence by default)."""
     if count == 0:
         shape = np.shape(cos_theta) + (3,)
@@ -360,12 +364,12 @@ def stack_statistics(stack: Stack, count: int, cos_theta=1.0) -> StackStatistics
     return lobes_and_statistics(stack, cos_theta, count)[2]
 
 
-def reflectance(stack: Stack, cos_theta) -> np.ndarray:
+def reflectance(stack: Stack, cos_theta: ArrayLike) -> np.ndarray:
     """The stack's total reflected energy ``sum_k R_k`` at incidence ``cos_theta``, ``(..., 3)``."""
     return lobes(stack, cos_theta)[0].sum(axis=-2)
 
 
-def brdf(stack: Stack, L, V, N) -> np.ndarray:
+def brdf(stack: Stack, L: ArrayLike, V: ArrayLike, N: ArrayLike) -> np.ndarray:
     """
     Eq. 3: ``sum_k R_k(theta_0) D(h; alpha_k) G1(L; alpha_k) G1(V; alpha_k) / (4 cos theta_L cos theta_V)``,
     ``alpha_k = f^{-1}(sigma_k(theta_0))`` per channel and ``theta_0`` the light's angle (unit vectors
