@@ -15,6 +15,7 @@ appearance. ACM TOG 40(4). Section 4.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import microfacet
 from explorer.tables import luts
@@ -34,7 +35,7 @@ FGD_COS_FLOOR = 1e-3
 # Fresnel terms per polarisation
 
 
-def fresnel_sp(cos_theta, eta, kappa=0.0) -> np.ndarray:
+def fresnel_sp(cos_theta: ArrayLike, eta: ArrayLike, kappa: float = 0.0) -> np.ndarray:
     """
     Fresnel reflectances ``[R_s, R_p]`` of a smooth interface towards a medium of relative index
     ``eta + i kappa`` (relative to the medium of incidence), at incidence ``cos_theta``.
@@ -67,7 +68,7 @@ def _fresnel_dielectric_mean(cos_theta, eta) -> np.ndarray:
     return np.where((q2 <= 0.0) | ~np.isfinite(value), 1.0, value)
 
 
-def normal_reflectance(eta_0, eta_1, kappa_1=0.0) -> np.ndarray:
+def normal_reflectance(eta_0: ArrayLike, eta_1: ArrayLike, kappa_1: float = 0.0) -> np.ndarray:
     """Eq. 1: ``R_01 = ((eta_0 - eta_1)^2 + kappa_1^2) / ((eta_0 + eta_1)^2 + kappa_1^2)``."""
     eta_0, eta_1, kappa_1 = (np.asarray(v, dtype=np.float64) for v in (eta_0, eta_1, kappa_1))
     return ((eta_0 - eta_1) ** 2 + kappa_1**2) / ((eta_0 + eta_1) ** 2 + kappa_1**2)
@@ -87,7 +88,7 @@ def _critical_cos(eta):
     return np.sqrt(np.maximum(1.0 - eta * eta, 0.0))
 
 
-def fgd_cos_coordinate(cos_theta, eta) -> np.ndarray:
+def fgd_cos_coordinate(cos_theta: ArrayLike, eta: ArrayLike) -> np.ndarray:
     """
     The FGD table's coordinate ``t`` of ``cos theta``: ``cos theta`` itself for ``eta >= 1``; below 1,
     piecewise linear with the critical angle (``cos theta_c = sqrt(1 - eta^2)``) at ``t = 1/2``, so that the
@@ -102,7 +103,7 @@ def fgd_cos_coordinate(cos_theta, eta) -> np.ndarray:
     return np.where(c_c > 0.0, np.where(c <= c_c, below, above), c)
 
 
-def fgd_cos_from_coordinate(t, eta) -> np.ndarray:
+def fgd_cos_from_coordinate(t: ArrayLike, eta: ArrayLike) -> np.ndarray:
     """The inverse of :func:`fgd_cos_coordinate`."""
     t = np.asarray(t, dtype=np.float64)
     c_c = _critical_cos(eta)
