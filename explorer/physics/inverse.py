@@ -28,8 +28,10 @@ appearance. ACM TOG 40(4). Sections 5-6, Algorithms 1-5.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Mapping, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import lobes
 from explorer.physics.lobes import ETA_MAX, roughness_from_variance, variance_from_roughness
@@ -63,7 +65,7 @@ def _mean(F) -> np.ndarray:
     return np.asarray(F).mean(axis=0)
 
 
-def fgd_normal(alpha, eta_ratio) -> np.ndarray:
+def fgd_normal(alpha: ArrayLike, eta_ratio: ArrayLike) -> np.ndarray:
     """The forward model's dielectric FGD at normal incidence (s = p there), for relative index ``eta_ratio``."""
     return _mean(lobes.fgd_dielectric(1.0, alpha, eta_ratio))
 
@@ -79,7 +81,7 @@ def _bisect(function, lo, hi, target):
     return 0.5 * (lo + hi)
 
 
-def dielectric_roots(R, alpha, eta_0=1.0):
+def dielectric_roots(R: ArrayLike, alpha: ArrayLike, eta_0: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """
     The indices ``eta_1`` (lower, upper) with ``FGD(0, alpha, eta_1 / eta_0) = R`` (Eq. 7 when smooth; the
     FGD term inverted numerically when rough, Sec. 5.1.1); NaN where a root leaves the table's range.
@@ -92,11 +94,11 @@ def dielectric_roots(R, alpha, eta_0=1.0):
     return np.where(R <= bottom, eta_0 * lower, np.nan), np.where(R <= top, eta_0 * upper, np.nan)
 
 
-def conductor_fgd_normal(alpha, eta, kappa) -> np.ndarray:
+def conductor_fgd_normal(alpha: ArrayLike, eta: ArrayLike, kappa: ArrayLike) -> np.ndarray:
     return _mean(lobes.fgd_conductor(1.0, alpha, eta, kappa))
 
 
-def conductor_bounds(R, eta_0=1.0):
+def conductor_bounds(R: ArrayLike, eta_0: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Eqs. 9-10: ``(eta_min^c, eta_max^c)`` of a conductor of normal reflectance ``R`` under ``eta_0`` (NaN max below 3 - 2 sqrt 2)."""
     R = np.asarray(R, dtype=np.float64)
     with np.errstate(invalid="ignore"):
@@ -104,7 +106,7 @@ def conductor_bounds(R, eta_0=1.0):
     return eta_0 * (1 - R) / (1 + R), eta_max
 
 
-def conductor_kappa(R, alpha, eta, eta_0=1.0):
+def conductor_kappa(R: ArrayLike, alpha: ArrayLike, eta: ArrayLike, eta_0: float = 1.0) -> np.ndarray:
     """
     ``kappa`` with the forward model's conductor FGD at normal incidence equal to ``R`` (Eq. 8 when
     smooth), for ``eta`` under ``eta_0``; NaN where no ``kappa`` reaches it.
@@ -136,7 +138,9 @@ class OneLayerClass:
     bounds: tuple
 
 
-def one_layer_class(energy, variance, eta_0=1.0, base="dielectric", samples=64, eta_max=ETA_MAX) -> OneLayerClass:
+def one_layer_class(
+    energy: ArrayLike, variance: ArrayLike, eta_0: float = 1.0, base: str = "dielectric", samples: int = 64, eta_max: float = ETA_MAX,
+) -> OneLayerClass:
     energy = np.broadcast_to(np.asarray(energy, float), (3,))
     alpha = float(roughness_from_variance(variance))
     if base == "dielectric":
@@ -177,7 +181,7 @@ class TwoLayerClass:
         return self.eta_2[self.valid[i]]
 
 
-def two_layer_energy_bounds(variance, eta_0=1.0, samples=48, eta_max=ETA_MAX) -> tuple[float, float]:
+def two_layer_energy_bounds(variance: ArrayLike, eta_0: float = 1.0, samples: int = 48, eta_max: float = ETA_MAX) -> tuple[float, float]:
     """
     ``[R_min, R_max]``: the achromatic energies a 2-layer lobe of ``variance`` reaches under ``eta_0``
     with ``eta_1, eta_2`` in ``[1, eta_max]`` and no absorption (Sec. 5.2.1: the adding equation on the
@@ -193,7 +197,7 @@ def two_layer_energy_bounds(variance, eta_0=1.0, samples=48, eta_max=ETA_MAX) ->
     return float(R_02.min()), float(R_02.max())
 
 
-def tau_0_range(energy, variance, eta_0=1.0, eta_max=ETA_MAX) -> tuple[float, float]:
+def tau_0_range(energy: ArrayLike, variance: ArrayLike, eta_0: float = 1.0, eta_max: float = ETA_MAX) -> tuple[float, float]:
     """
     Eq. 16: ``T_0 = 1/2 log([R_min, R_max] / R_02)`` intersected with ``tau_0 >= 0``: the optical depths of
     the medium above a 2-layer lobe (a lobe under others) that leave its energy achievable. Coloured
@@ -225,7 +229,9 @@ def _lobe_terms(statistics, energy, variance, eta_0, eta_n):
     return R_prime, sigma_R
 
 
-def two_layer_class(energy, variance, eta_0=1.0, samples=48, eta_max=ETA_MAX) -> TwoLayerClass:
+def two_layer_class(
+    energy: ArrayLike, variance: ArrayLike, eta_0: float = 1.0, samples: int = 48, eta_max: float = ETA_MAX,
+) -> TwoLayerClass:
     """Algorithm 1 (``tau_0 = 0``) on a ``samples x samples`` grid of ``[1, eta_max]^2``."""
     energy = np.broadcast_to(np.asarray(energy, float), (3,))
     alpha_1 = float(roughness_from_variance(variance))
@@ -294,7 +300,7 @@ def _least_variance(statistics, R_prime, c: int, eta_n: float) -> float:
     return float(s.sigma_T_n0[c] + eta_n * (s.sigma_T_0n[c] + x * s.sigma_R_n0[c] / (1.0 - x)))
 
 
-def conductor_albedo(alpha) -> float:
+def conductor_albedo(alpha: ArrayLike) -> float:
     """``E(0, alpha)``: the forward model's rough conductor FGD at normal incidence is ``E F(cbar_d)``."""
     return float(_mean(lobes.fgd_conductor(1.0, alpha, 1.0, 1e9)))
 
@@ -414,7 +420,7 @@ def _two_layer(partial: _Partial, k, lobe_energy, variance, statistics_above, ch
     _one_layer(partial, k, R_prime_2, sigma_R_2, statistics, base, {} if probe else {key: v for key, v in choice.items() if key in ("eta", "t", "tau")}, probe)
 
 
-def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
+def invert_lobes(lobe_list: Sequence[Lobe], choices: Sequence[Mapping[str, float]] | None = None, tir: bool = False) -> lobes.Stack:
     """
     Algorithm 2: the stack whose lobes at normal incidence are ``lobe_list`` (top first; :class:`Lobe`),
     each 1- or 2-layer, the last one possibly on a conductor base.
@@ -459,7 +465,7 @@ def invert_lobes(lobe_list, choices=None, tir: bool = False) -> lobes.Stack:
     return partial.stack()
 
 
-def forward_lobes(stack: lobes.Stack, layers) -> tuple[np.ndarray, np.ndarray]:
+def forward_lobes(stack: lobes.Stack, layers: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     """The stack's lobes at normal incidence merged as ``layers`` (1 or 2 interfaces each): energies ``(K, 3)``, variances ``(K, 3)``."""
     energies, variances = lobes.lobes(stack, 1.0)
     out_e, out_v, i = [], [], 0
@@ -498,7 +504,9 @@ class LobeClass:
     valid: np.ndarray
 
 
-def lobe_class(lobe_list, k: int, choices=None, samples: int = 48, tir: bool = False) -> LobeClass:
+def lobe_class(
+    lobe_list: Sequence[Lobe], k: int, choices: Sequence[Mapping[str, float]] | None = None, samples: int = 48, tir: bool = False,
+) -> LobeClass:
     """The class of lobe ``k`` (1-based) of ``lobe_list`` once lobes ``1..k-1`` are set (by ``choices``)."""
     choices = list(choices or [{}] * len(lobe_list))
     above = invert_lobes(lobe_list[: k - 1], choices[: k - 1], tir=tir) if k > 1 else None
