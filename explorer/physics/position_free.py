@@ -48,9 +48,10 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import colorimetry, layered, microfacet
 from explorer.physics.fresnel import fresnel_reflectance
@@ -519,13 +520,17 @@ def _worker_replicate(i_air, o_air, per, key):
     return _WORKER.replicate(i_air, o_air, per, key)
 
 
-def directional_albedo(stack: layered.LayeredBragg, theta_deg, samples: int = 20000, seed: int = 0,
-                       tables=None, progress=None) -> PositionFreeResult:
+def directional_albedo(
+    stack: layered.LayeredBragg, theta_deg: ArrayLike, samples: int = 20000, seed: int = 0,
+    tables: Sequence[layered.LayerTables] | None = None, progress: Callable[[int, int], None] | None = None,
+) -> PositionFreeResult:
     """The position-free directional albedo of ``stack`` (:meth:`PositionFree.albedo`)."""
     return PositionFree(stack, tables).albedo(theta_deg, samples, seed, progress)
 
 
-def brdf(stack: layered.LayeredBragg, i_air, o_air, samples: int = 256, seed: int = 0, tables=None,
-         progress=None) -> PositionFreeResult:
+def brdf(
+    stack: layered.LayeredBragg, i_air: ArrayLike, o_air: ArrayLike, samples: int = 256, seed: int = 0,
+    tables: Sequence[layered.LayerTables] | None = None, progress: Callable[[int, int], None] | None = None,
+) -> PositionFreeResult:
     """The position-free BRDF of ``stack`` by next-event estimation (:meth:`PositionFree.brdf`)."""
     return PositionFree(stack, tables).brdf(i_air, o_air, samples, seed, progress)
