@@ -36,6 +36,7 @@ from typing import Callable, Mapping, Sequence
 
 import colour
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
@@ -187,7 +188,7 @@ def coarse_nodes(step: float = COARSE_STEP) -> tuple[np.ndarray, np.ndarray]:
     return _WEIGHTS[step]
 
 
-def chebyshev_U_real_N(a, N):
+def chebyshev_U_real_N(a: ArrayLike, N: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     :func:`explorer.physics.bragg.chebyshev_U` for a real (array) ``N``: ``sin(N t) / sin t`` continues the
     polynomials to non-integer cell counts, which lets the coarse search treat ``N`` as continuous.
@@ -208,8 +209,10 @@ def chebyshev_U_real_N(a, N):
     return U_N1, U_N2, np.where(in_band, 1.0, scale_gap)
 
 
-def bragg_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta, wavelengths, step: float | None = None,
-                            smooth: float | None = None) -> np.ndarray:
+def bragg_reflectance_batch(
+    n1: ArrayLike, n2: ArrayLike, Lambda: ArrayLike, delta: ArrayLike, N: ArrayLike, nh: ArrayLike, cos_theta: ArrayLike,
+    wavelengths: ArrayLike, step: float | None = None, smooth: float | None = None,
+) -> np.ndarray:
     """
     Unpolarised ``R_lambda`` of many mirrors at once: parameters of shape ``(B,)`` (``nh < 1``: the host is
     ``n1``; ``N`` may be fractional), ``cos_theta`` ``(A,)`` in the host, ``wavelengths`` ``(W,)`` nm;
@@ -276,7 +279,7 @@ class _Geometry:
     r_h1: np.ndarray
 
 
-def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = COARSE_STEP,
+def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta: ArrayLike, step: float = COARSE_STEP,
                     smooth: float | None = None) -> np.ndarray:
     """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``) at ``cos_theta`` ``(A,)``."""
     nodes, weights = coarse_nodes(step)
@@ -285,7 +288,7 @@ def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = C
     return colorimetry.xyz_to_rgb(R @ weights)
 
 
-def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = COARSE_STEP,
+def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta: ArrayLike, step: float = COARSE_STEP,
                         smooth: float | None = None) -> np.ndarray:
     """
     The coarse colours ``(B, A, 3)`` of films ``values`` (``d``, ``eta1``, ``eta2``, ``eta3``, ``kappa3``); a
@@ -298,14 +301,18 @@ def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float
     return colorimetry.xyz_to_rgb(R @ weights)
 
 
-def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+def bragg_spectra_batch(
+    values: Mapping[str, np.ndarray], cos_theta: ArrayLike, wavelengths: ArrayLike, smooth_relative: float,
+) -> np.ndarray:
     """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
     wavelengths = np.asarray(wavelengths, dtype=np.float64)
     return bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"], values["nh"],
                                    cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
 
 
-def thin_film_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+def thin_film_spectra_batch(
+    values: Mapping[str, np.ndarray], cos_theta: ArrayLike, wavelengths: ArrayLike, smooth_relative: float,
+) -> np.ndarray:
     """The films' spectra ``(B, A, W)`` (not smoothed: a film's fringes are its colour)."""
     col = lambda name: np.asarray(values[name], dtype=np.float64).reshape(-1, 1, 1)
     cos = np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1)
@@ -320,7 +327,7 @@ def mirror_of(values: Mapping[str, float]) -> bragg.BraggMirror:
                              nh=nh if nh >= 1.0 else None)
 
 
-def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+def bragg_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, final: bool = True) -> np.ndarray:
     """
     The converged colours of a mirror (``N`` rounded): :func:`explorer.physics.bragg.reference_rgb` when
     ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped),
@@ -333,7 +340,7 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     return bragg._converged_rgb(cos_theta, mirror)
 
 
-def thin_film_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+def thin_film_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, final: bool = True) -> np.ndarray:
     """The film's converged colours (:func:`explorer.physics.thinfilm.reference_rgb`)."""
     return thinfilm.reference_rgb(float(values["eta1"]), float(values["eta2"]), float(values["eta3"]),
                                   float(values["kappa3"]), np.asarray(cos_theta, dtype=np.float64), float(values["d"]))
@@ -368,17 +375,17 @@ def _white_xy() -> np.ndarray:
     return colour.XYZ_to_xy(colorimetry.white_xyz())
 
 
-def rgb_to_lab(rgb) -> np.ndarray:
+def rgb_to_lab(rgb: ArrayLike) -> np.ndarray:
     """CIELAB of linear RGB colours of this convention, relative to the flat reflectance of 1 (as ΔE2000)."""
     return colour.XYZ_to_Lab(colorimetry.rgb_to_xyz(np.asarray(rgb, dtype=np.float64)), _white_xy())
 
 
-def delta_E_2000_lab(lab_a, lab_b) -> np.ndarray:
+def delta_E_2000_lab(lab_a: ArrayLike, lab_b: ArrayLike) -> np.ndarray:
     """CIEDE2000 between CIELAB colours (colour-science)."""
     return np.asarray(colour.delta_E(lab_a, lab_b, method="CIE 2000"))
 
 
-def check_target_rgb(rgb, what: str = "colour") -> np.ndarray:
+def check_target_rgb(rgb: ArrayLike, what: str = "colour") -> np.ndarray:
     """
     A target colour as linear RGB, or a :class:`DesignError`: non-finite values, or a luminance no passive
     reflector has (``Y > 1``: brighter than the flat reflectance of 1; ``Y < 0``). Channels outside [0, 1]
@@ -919,7 +926,7 @@ def design(
     )
 
 
-def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg) -> np.ndarray:
+def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg: ArrayLike) -> np.ndarray:
     """The converged colours of a structure at angles (degrees): what :func:`design` reports as achieved."""
     model = design_model(model_name)
     return model.converged(values, np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), final=True)
