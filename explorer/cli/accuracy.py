@@ -28,10 +28,11 @@ import sys
 from dataclasses import dataclass, field
 
 from explorer.materials.accuracy import ACCURACY_LIMIT, METHOD_NAMES, gradient_cos_theta, mirror_accuracy
+from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg
 
 #: The methods of the study, in table order (3 last: a check, exact by construction).
-PRESET_METHODS = (1, 2, 4, 3)
+PRESET_METHODS = tuple(int(m) for m in (BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED, BraggMethod.TABULATED))
 #: The subdivided and improved methods' quality, the material's default.
 PRESET_S = 3
 #: Columns of the gradient view (its default width): θ = 90° (i + 0.5) / W.

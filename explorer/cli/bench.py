@@ -754,7 +754,7 @@ def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, dic
     schlick_values = schlick_material.resolve({})
     ratios, cpu_ratios = {}, {}
     for Lambda in BENCH_LAMBDAS:
-        values = mirror_material.resolve({**TABLES_MIRROR, "Lambda": Lambda, "N": 20, "method": 3})
+        values = mirror_material.resolve({**TABLES_MIRROR, "Lambda": Lambda, "N": 20, "method": int(BraggMethod.TABULATED)})
         cases = [(mirror_material, values), (schlick_material, schlick_values)]
         for material, v in cases:  # compile, build the table, warm up
             renderer.time_frame(material, v, "sphere", size, size)
@@ -837,7 +837,7 @@ def scaling_study(repeats: int = 3, renderer=None) -> dict:
     renderer = Renderer() if renderer is None else renderer
     mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
     schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
-    cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": 3})),
+    cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": int(BraggMethod.TABULATED)})),
              ("schlick", schlick_material, schlick_material.resolve({}))]
     for _, material, values in cases:
         renderer.time_frame(material, values, "sphere", 16, 16)

@@ -22,6 +22,7 @@ from typing import Mapping
 
 import numpy as np
 
+from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 
 #: A method is accurate for the current parameters when its median ΔE2000 over θ is at most this.
@@ -32,7 +33,7 @@ BADGE_WIDTH = 90
 BRAGG_METHOD_MODELS = ("bragg_mirror", "bragg_layer")
 #: The methods' names (``shaders/bragg_mirror.brd``), and the order in which accurate ones are suggested:
 #: the exact table first (one texture fetch per pixel), then the closed forms, the spectral sum last.
-METHOD_NAMES = {0: "reference", 1: "basic", 2: "subdivided", 3: "tabulated", 4: "improved"}
+METHOD_NAMES = {int(m): m.label for m in BraggMethod}
 SUGGESTION_ORDER = (3, 4, 2, 1, 0)
 
 
@@ -45,15 +46,15 @@ def gradient_cos_theta(width: int = BADGE_WIDTH) -> np.ndarray:
 def method_rgb(mirror: bragg.BraggMirror, method: int, cos_theta, s: int = 3, wavelength_step: float = 1.0,
                table: np.ndarray | None = None) -> np.ndarray:
     """What ``shaders/bragg_mirror.brd`` shows for ``method`` at ``cos_theta`` (the numpy twin's reflectance)."""
-    if method == 0:
+    if method == BraggMethod.REFERENCE:
         return bragg.reference_rgb(cos_theta, mirror, step=wavelength_step)
-    if method == 1:
+    if method == BraggMethod.BASIC:
         return bragg.approximate_rgb(cos_theta, mirror, 0)
-    if method == 2:
+    if method == BraggMethod.SUBDIVIDED:
         return bragg.approximate_rgb(cos_theta, mirror, s)
-    if method == 3:
+    if method == BraggMethod.TABULATED:
         return bragg.tabulated_rgb(bragg.tabulated_rgb_table(mirror) if table is None else table, cos_theta)
-    if method == 4:
+    if method == BraggMethod.IMPROVED:
         return bragg.approximate_rgb(cos_theta, mirror, s, variant="improved")
     raise ValueError(f"unknown method {method} (methods: {', '.join(f'{k} {v}' for k, v in METHOD_NAMES.items())})")
 

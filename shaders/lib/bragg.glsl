@@ -347,7 +347,7 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
 // The improved variant (ours) resolves a pass band's fringes where, in its visible part, a fringe feature
 // is wider than FRINGE_RESOLVE_NM / s nm (times (N / N_RESOLVE)^GROW_EXPONENT beyond N_RESOLVE cells) and
 // SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET, with SAMPLES_PER_FRINGE sub-boxes per feature weighted by the
-// exact reflectance (explorer/bragg.py has the reasoning).
+// exact reflectance (explorer/physics/bragg.py has the reasoning).
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
 float fringe_count(float omega_low, float omega_high, CellGeometry g) {
