@@ -46,16 +46,15 @@ def gradient_cos_theta(width: int = BADGE_WIDTH) -> np.ndarray:
 def method_rgb(mirror: bragg.BraggMirror, method: int, cos_theta, s: int = 3, wavelength_step: float = 1.0,
                table: np.ndarray | None = None) -> np.ndarray:
     """What ``shaders/bragg_mirror.brd`` shows for ``method`` at ``cos_theta`` (the numpy twin's reflectance)."""
-    if method == BraggMethod.REFERENCE:
-        return bragg.reference_rgb(cos_theta, mirror, step=wavelength_step)
-    if method == BraggMethod.BASIC:
-        return bragg.approximate_rgb(cos_theta, mirror, 0)
-    if method == BraggMethod.SUBDIVIDED:
-        return bragg.approximate_rgb(cos_theta, mirror, s)
-    if method == BraggMethod.TABULATED:
-        return bragg.tabulated_rgb(bragg.tabulated_rgb_table(mirror) if table is None else table, cos_theta)
-    if method == BraggMethod.IMPROVED:
-        return bragg.approximate_rgb(cos_theta, mirror, s, variant="improved")
+    compute = {
+        BraggMethod.REFERENCE: lambda: bragg.reference_rgb(cos_theta, mirror, step=wavelength_step),
+        BraggMethod.BASIC: lambda: bragg.approximate_rgb(cos_theta, mirror, 0),
+        BraggMethod.SUBDIVIDED: lambda: bragg.approximate_rgb(cos_theta, mirror, s),
+        BraggMethod.TABULATED: lambda: bragg.tabulated_rgb(bragg.tabulated_rgb_table(mirror) if table is None else table, cos_theta),
+        BraggMethod.IMPROVED: lambda: bragg.approximate_rgb(cos_theta, mirror, s, variant="improved"),
+    }.get(method)
+    if compute is not None:
+        return compute()
     raise ValueError(f"unknown method {method} (methods: {', '.join(f'{k} {v}' for k, v in METHOD_NAMES.items())})")
 
 

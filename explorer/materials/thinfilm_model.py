@@ -27,15 +27,20 @@ from explorer.materials.methods import ThinFilmMethod
 TABULATED_FOURIER = (ThinFilmMethod.FOURIER_1, ThinFilmMethod.FOURIER_2, ThinFilmMethod.FOURIER_3)
 
 
+#: The film's colour per method (the shader's branches on THIN_FILM_* in thin_film.brd).
+FILM_RGB = {
+    ThinFilmMethod.REFERENCE: lambda film, c, d: thinfilm.reference_rgb(*film, c, d, step=1.0),  # the shader's 1-nm sum
+    **{m: (lambda film, c, d, m=m: thinfilm.fourier_rgb(*film, c, d, m_max=m.m_max, sensitivity="table"))
+       for m in TABULATED_FOURIER},
+    ThinFilmMethod.GAUSSIAN: lambda film, c, d: thinfilm.fourier_rgb(
+        *film, c, d, m_max=ThinFilmMethod.GAUSSIAN.m_max, sensitivity="gaussian"),
+    ThinFilmMethod.NAIVE: lambda film, c, d: thinfilm.naive_rgb(*film, c, d),
+}
+
+
 def film_rgb(method: ThinFilmMethod, film, cos_theta, d) -> np.ndarray:
-    """The film's colour by ``method`` (the shader's branches on THIN_FILM_* in thin_film.brd)."""
-    if method == ThinFilmMethod.REFERENCE:
-        return thinfilm.reference_rgb(*film, cos_theta, d, step=1.0)  # the shader's 1-nm sum
-    if method in TABULATED_FOURIER:
-        return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=method.m_max, sensitivity="table")
-    if method == ThinFilmMethod.GAUSSIAN:
-        return thinfilm.fourier_rgb(*film, cos_theta, d, m_max=method.m_max, sensitivity="gaussian")
-    return thinfilm.naive_rgb(*film, cos_theta, d)
+    """The film's colour by ``method`` (:data:`FILM_RGB`)."""
+    return FILM_RGB[method](film, cos_theta, d)
 
 
 @twin
