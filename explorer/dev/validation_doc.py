@@ -68,10 +68,26 @@ def _quiet(function, *args, **kwargs):
 
 
 def _app() -> str:
-    from explorer.cli.bench import run_app_bench
-    from explorer.cli.markdown_tables import app_markdown
+    import json
+    import subprocess
 
-    return app_markdown(_quiet(run_app_bench, as_json=True, size=512, frames=APP_FRAMES))
+    from explorer.cli.markdown_tables import app_markdown
+    from explorer.resources import SOURCE_ROOT
+
+    # In a child process: the app's window context (GLX) cannot be made current in a process that
+    # already made an EGL context current (Xlib then exits the whole process on BadAccess).
+    done = subprocess.run([sys.executable, "-c", APP_CHILD.format(frames=APP_FRAMES)], cwd=SOURCE_ROOT,
+                          capture_output=True, text=True, timeout=1200)
+    if done.returncode != 0:
+        raise RuntimeError((done.stderr.strip().splitlines() or ["no output"])[-1])
+    return app_markdown(json.loads(done.stdout)["rows"])
+
+
+APP_CHILD = ("import json, contextlib, io, sys\n"
+             "from explorer.cli.bench import run_app_bench\n"
+             "with contextlib.redirect_stdout(io.StringIO()):\n"
+             "    rows = run_app_bench(as_json=True, size=512, frames={frames})\n"
+             "print(json.dumps({{'rows': rows}}))\n")
 
 
 def _accuracy() -> str:
