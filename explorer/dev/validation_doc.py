@@ -248,7 +248,7 @@ def build_document(sections: Sequence[Section], only: Sequence[str] | None = Non
     parts = [INTRO, ""]
     for section in sections:
         if only is None or section.name in only:
-            if progress is not None:
+            if progress is not None and not section.by_hand:
                 progress(f"validation_doc: measuring {section.name} ({section.command})")
             try:
                 parts.append(render_section(section, section.measure(), when, machine))
