@@ -69,6 +69,15 @@ def parse_markdown_table(text: str) -> list[list[str]]:
     return table
 
 
+#: Table 1's column order (the paper's methods, then ours): a method not listed goes last.
+METHOD_ORDER = ("basic", "subdivided", "improved", "tabulated")
+
+
+def _dE_max(value: float) -> str:
+    # One decimal as in the paper's tables, two below 1 where one would print a converged method as 0.0.
+    return f"{value:.1f}" if value >= 1 else f"{value:.2f}"
+
+
 def _method_label(name: str, s) -> str:
     return name if s is None else f"{name} s = {s}"
 
@@ -85,6 +94,7 @@ def bench_markdown(document: dict) -> str:
         key = (r["method"], r["s"])
         if key not in methods and r["method"] not in ("reference", "schlick"):
             methods.append(key)
+    methods.sort(key=lambda key: METHOD_ORDER.index(key[0]) if key[0] in METHOD_ORDER else len(METHOD_ORDER))
     by = {(r["Lambda"], r["method"], r["s"]): r for r in rows}
 
     def reference(Lambda):
@@ -108,7 +118,7 @@ def bench_markdown(document: dict) -> str:
            "the reference's time and each method's speed-up over it.", "", markdown_table(header, speed), ""]
     accuracy = []
     for L in lambdas:
-        accuracy.append([f"{L} nm"] + [f"{by[(L, m, s)]['dE_median']:.2f} / {by[(L, m, s)]['dE_max']:.1f}"
+        accuracy.append([f"{L} nm"] + [f"{by[(L, m, s)]['dE_median']:.2f} / {_dE_max(by[(L, m, s)]['dE_max'])}"
                                        if (L, m, s) in by and by[(L, m, s)]["dE_median"] is not None else ""
                                        for m, s in [("reference", None), *methods]])
     out += ["Median / max ΔE2000 against the converged spectral reference over θ ∈ [0°, 89.5°] "
