@@ -195,3 +195,10 @@ def test_validation_doc_is_atomic_when_interrupted(tmp_path, no_gl, monkeypatch)
     assert out.read_text(encoding="utf-8") == "old\n" and list(tmp_path.iterdir()) == [out]
     bad = tmp_path / "validation.txt"
     assert validation_doc.main(["--out", str(bad)], sections=_stub_sections([])) == 1 and not bad.exists()
+
+
+@pytest.mark.parametrize("args", [("bench", "--markdown", "--json"), ("bench", "--app", "--markdown"),
+                                  ("bench", "--tables", "--markdown")])
+def test_bench_markdown_rejects_what_it_cannot_format(args):
+    done = run_cli(*args)
+    assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1 and "--markdown" in done.stderr

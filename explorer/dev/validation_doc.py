@@ -28,6 +28,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from explorer import resources
 from explorer.errors import OutputError
 from explorer.files import write_text_atomic
 
@@ -268,9 +269,10 @@ def main(argv: Sequence[str] | None = None, sections: Sequence[Section] = SECTIO
     parser = argparse.ArgumentParser(prog="python -m explorer.dev.validation_doc", description=__doc__.split("\n\n")[0])
     parser.add_argument("--only", action="append", choices=[s.name for s in sections], metavar="NAME",
                         help="measure only this table (repeatable): " + ", ".join(s.name for s in sections))
-    parser.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"the file to write (default {DEFAULT_OUT})")
+    parser.add_argument("--out", type=Path, help=f"the file to write (default: the checkout's {DEFAULT_OUT})")
     arguments = parser.parse_args(argv)
-    out: Path = arguments.out
+    resources.require_checkout("python -m explorer.dev.validation_doc")
+    out: Path = arguments.out or resources.CHECKOUT_ROOT / DEFAULT_OUT
     try:
         previous = out.read_text(encoding="utf-8") if out.is_file() else ""
         failures: list[str] = []
