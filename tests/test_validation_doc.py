@@ -202,3 +202,14 @@ def test_validation_doc_is_atomic_when_interrupted(tmp_path, no_gl, monkeypatch)
 def test_bench_markdown_rejects_what_it_cannot_format(args):
     done = run_cli(*args)
     assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1 and "--markdown" in done.stderr
+
+
+def test_the_committed_validation_md_has_every_section_and_well_formed_tables():
+    from explorer.resources import SOURCE_ROOT
+
+    text = (SOURCE_ROOT / validation_doc.DEFAULT_OUT).read_text(encoding="utf-8")
+    assert list(validation_doc.existing_sections(text)) == list(validation_doc.NAMES)
+    for section in validation_doc.SECTIONS:
+        body = validation_doc.existing_sections(text)[section.name]
+        tables = tables_in(body)  # every table well formed
+        assert section.by_hand or (f"Regenerate: `{section.command}`" in body and tables)
