@@ -89,7 +89,7 @@ def table_rebuild_ms(mirror: bragg.BraggMirror, repeats: int = 5) -> float:
     return float(np.median(times) * 1e3)
 
 
-def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
+def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3, markdown: bool = False) -> dict:
     """Measure and print Table 1 (see the module docstring). Returns the JSON document."""
     from explorer.gpu import Renderer
 
@@ -134,6 +134,10 @@ def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
     }
     if as_json:
         print(json.dumps(document, indent=2))
+    elif markdown:
+        from explorer.cli.markdown_tables import bench_markdown
+
+        print(bench_markdown(document))
     else:
         print(format_table(rows, device, size, table_ms))
     return document
@@ -239,12 +243,17 @@ def plot_accuracy(rows: list[dict], path: Path) -> None:
         plt.close(figure)
 
 
-def run_accuracy(as_json: bool = False, plot: Path | None = None) -> list[dict]:
+def run_accuracy(as_json: bool = False, plot: Path | None = None, markdown: bool = False) -> list[dict]:
     rows = figure4_accuracy()
     if plot is not None:
         plot_accuracy(rows, plot)
         _progress(f"accuracy: wrote {plot}")
-    print(json.dumps({"rows": rows}, indent=2) if as_json else format_accuracy(rows))
+    if markdown:
+        from explorer.cli.markdown_tables import accuracy_markdown
+
+        print(accuracy_markdown(rows, FIGURE4_LAMBDAS, FIGURE4_DELTAS))
+    else:
+        print(json.dumps({"rows": rows}, indent=2) if as_json else format_accuracy(rows))
     return rows
 
 
@@ -303,7 +312,7 @@ def thin_film_accuracy(values: dict) -> dict[str, tuple[float, float]]:
     return result
 
 
-def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3) -> dict:
+def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3, markdown: bool = False) -> dict:
     """
     ``bragg-explorer bench --thin-film``: ΔE2000 of every method on the Figure 7 film and on every
     thin-film preset; the frame time of every method of ``thin_film.brd`` (Figure 7 film) on a lit
@@ -344,6 +353,11 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
     document = {"device": device, "size": size, "repeats": repeats, "view": "lit",
                 "theta_degrees": [float(THETA_DEGREES[0]), float(THETA_DEGREES[-1]), len(THETA_DEGREES)],
                 "accuracy": accuracy, "timing": timing}
+    if markdown and not as_json:
+        from explorer.cli.markdown_tables import thin_film_markdown
+
+        print(thin_film_markdown(document))
+        return document
     print(json.dumps(document, indent=2) if as_json else format_thin_film(document))
     return document
 
@@ -415,7 +429,7 @@ def slice_accuracy(alpha: float, size: int = 64) -> dict:
     return row
 
 
-def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64) -> dict:
+def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64, markdown: bool = False) -> dict:
     """
     ``bragg-explorer bench --layers``: the host tables' build times (F_alpha for a new alpha, one layer's
     tables for Figure 7's A, B, A'; interleaved repeats, medians; :func:`explorer.physics.layered.measure_timings`)
@@ -436,6 +450,11 @@ def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64) ->
                   "luminance_threshold": SLICE_LUMINANCE_THRESHOLD, "rows": accuracy},
         "stack": stack_study(repeats=max(repeats // 2, 1)),
     }
+    if markdown and not as_json:
+        from explorer.cli.markdown_tables import layers_markdown
+
+        print(layers_markdown(document))
+        return document
     print(json.dumps(document, indent=2) if as_json else format_layers(document))
     return document
 

@@ -420,8 +420,9 @@ def presets(material, as_json):
 @click.option("--scaling", "scaling", is_flag=True,
               help="Instead: table cost against N and table size, frame time against sphere size (with --plot PNG).")
 @click.option("--plot", type=click.Path(dir_okay=False, writable=True), default=None, help="With --scaling: write the plot here.")
+@click.option("--markdown", is_flag=True, help="Print Table 1, --thin-film or --layers as Markdown tables (docs/validation.md).")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot, markdown):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -429,6 +430,8 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if markdown and (as_json or app or position_free or design_count is not None or tables or scaling):
+        raise click.UsageError("--markdown goes with Table 1, --thin-film or --layers, without --json")
     if position_free:
         from explorer.cli.bench import run_position_free_bench
 
@@ -459,12 +462,12 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
         if thin_film:
             raise click.UsageError("--layers and --thin-film are exclusive")
         source = click.get_current_context().get_parameter_source("repeats")
-        run_layers_bench(as_json=as_json, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
+        run_layers_bench(as_json=as_json, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5, markdown=markdown)
         return
     if thin_film:
-        run_thin_film_bench(as_json=as_json, size=size, repeats=repeats)
+        run_thin_film_bench(as_json=as_json, size=size, repeats=repeats, markdown=markdown)
         return
-    run_bench(as_json=as_json, size=size, repeats=repeats)
+    run_bench(as_json=as_json, size=size, repeats=repeats, markdown=markdown)
 
 
 @cli.command()
@@ -473,15 +476,17 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
 @click.option("--strips", type=click.Path(dir_okay=False), help="Also write Figure 4's colour strips (GPU) to a PNG.")
 @click.option("--presets", "presets_", is_flag=True,
               help="Instead: median and max ΔE2000 per shipped Bragg preset (mirrors, layers, stacks' layers) and method.")
-@click.option("--markdown", is_flag=True, help="With --presets: print the table as Markdown (docs/accuracy.md).")
+@click.option("--markdown", is_flag=True, help="Print the tables as Markdown (the Figure 4 grid, or with --presets docs/accuracy.md's).")
 @_errors
 def accuracy(as_json, plot, strips, presets_, markdown):
     """ΔE2000 of the approximations on the grid of Figure 4 (s = 2..8, both variants and numberings).
 
     With --presets: on every shipped preset's Bragg mirror, per method, over the gradient's angles.
     """
-    if presets_ or markdown:
-        if plot or strips or (markdown and as_json):
+    if markdown and as_json:
+        raise click.UsageError("--markdown and --json are exclusive")
+    if presets_:
+        if plot or strips:
             raise click.UsageError("--presets takes --json or --markdown, not --plot or --strips")
         from explorer.cli.accuracy import run_preset_accuracy
 
@@ -495,7 +500,7 @@ def accuracy(as_json, plot, strips, presets_, markdown):
             check_file(path, suffixes)  # before the seconds of work
     if strips:
         figure4_strips(Path(strips))
-    run_accuracy(as_json=as_json, plot=Path(plot) if plot else None)
+    run_accuracy(as_json=as_json, plot=Path(plot) if plot else None, markdown=markdown)
 
 
 @cli.command("default", hidden=True)
