@@ -42,6 +42,8 @@ from explorer.resources import material_path
 BSDF_NAMES = ("bragg_mirror", "bragg_layer", "bragg_stack", "thin_film", "layered_lobes")
 #: The rough ones (Mitsuba's chi2 test runs on these).
 ROUGH_BSDFS = ("bragg_layer", "bragg_stack", "thin_film", "layered_lobes")
+#: The plugins' ``method`` where the scene sets none (see ExplorerBSDF.__init__).
+DEFAULT_METHOD = 3
 #: Samples per numpy call in spectral Eq. 34 (bounds the (samples, 471) temporaries).
 CHUNK = 1 << 14
 
@@ -247,7 +249,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
         for w in colorimetry.WAVELENGTHS:
             d = mi.cie_d65(mi.ScalarFloat(w)) if not jit else mi.cie_d65(mi.Float(w))
             values.append(float(np.asarray(d).ravel()[0]))
-        return np.asarray(values) * mi.MI_CIE_D65_NORMALIZATION
+        return np.asarray(values)  # mi.cie_d65 is normalised already (the d65 texture's values)
 
     def d65_weight(wavelengths: np.ndarray) -> np.ndarray:
         """1 / Mitsuba's normalised D65 at ``wavelengths``: its white emitters then light as illuminant E."""
@@ -265,6 +267,10 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
                 value = _float_property(props, p.name, p.default)
                 if value is not None:
                     overrides[p.name] = bool(value) if p.type == "bool" else value
+            if "method" not in overrides and "method" in self.values_declared():
+                # RGB renders default to the converged table (Bragg) or Eq. 10's m_max = 3 (thin film): the
+                # explorer's colours at a table lookup per sample, not a 471-wavelength sum.
+                overrides["method"] = DEFAULT_METHOD
             self.values = self.material.resolve(overrides)
             self.illuminant = props.get("illuminant", "d65") if props.has_property("illuminant") else "d65"
             if self.illuminant not in ("d65", "e"):
@@ -276,6 +282,9 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
                 flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             self.m_components = [flags]
             self.m_flags = flags
+
+        def values_declared(self):
+            return {p.name for p in self.material.parameters}
 
         def _rebuild(self):
             self.model = model_for(self.material, self.material.physical_values(self.values))
@@ -336,11 +345,10 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            v = vec_to_numpy(si.wi)
-            n = v.shape[0]
-            u1 = np.broadcast_to(to_numpy(sample1), (n,))
+            v, u1 = vec_to_numpy(si.wi), to_numpy(sample1)
             u2 = np.stack(np.broadcast_arrays(to_numpy(sample2.x), to_numpy(sample2.y)), axis=-1)
-            u2 = np.broadcast_to(u2, (n, 2))
+            n = max(v.shape[0], u1.shape[0], u2.shape[0])
+            v, u1, u2 = np.broadcast_to(v, (n, 3)), np.broadcast_to(u1, (n,)), np.broadcast_to(u2, (n, 2))
             bs = mi.BSDFSample3f()
             bs.eta = 1.0
             bs.sampled_component = 0

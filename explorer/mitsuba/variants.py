@@ -31,7 +31,7 @@ PROBE_TIMEOUT_S = 180
 _PROBE = r"""
 import mitsuba as mi
 mi.set_variant("llvm_ad_rgb")
-scene = mi.load_dict({"type": "scene", "s": {"type": "sphere"}, "e": {"type": "constant"},
+scene = mi.load_dict({"type": "scene", "integrator": {"type": "path"}, "s": {"type": "sphere"}, "e": {"type": "constant"},
     "sensor": {"type": "orthographic", "film": {"type": "hdrfilm", "width": 4, "height": 4},
                "sampler": {"type": "independent", "sample_count": 2}}})
 image = mi.render(scene)
