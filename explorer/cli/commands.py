@@ -92,13 +92,17 @@ def parse_exposure(text: str | None, out: Path) -> float:
 
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
-    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64,
+    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
     :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
     """
+    if view == "env" and engine == "mitsuba":
+        from explorer.cli.export import render_env_with_mitsuba
+
+        return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
         return _render_env(material, values, width, height, engine, environment, spp)
     if view == "textured":
@@ -240,7 +244,8 @@ def _errors(function):
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
-@click.option("--engine", type=click.Choice(["gl", "numpy"]), default="gl", show_default=True, help="The GPU shader, or its numpy twin.")
+@click.option("--engine", type=click.Choice(["gl", "numpy", "mitsuba"]), default="gl", show_default=True,
+              help="The GPU shader, its numpy twin, or (env view) Mitsuba 3 with the explorer's BSDF plugins.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
@@ -250,9 +255,10 @@ def _errors(function):
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view: Monte Carlo samples per pixel (default 64).")
+@click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp):
+           prefilter, env_file, spp, variant):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -299,7 +305,12 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
     elif env_file is not None or spp is not None:
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
-    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
+    if engine == "mitsuba" or variant is not None:
+        from explorer.cli.export import check_mitsuba_render
+
+        check_mitsuba_render(view, engine, variant)
+    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
+                            variant=variant)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
@@ -424,9 +435,11 @@ def default_job():
 
 
 from explorer.cli.inverse import figure_command, inverse_command  # noqa: E402  (the layered lobes' commands)
+from explorer.cli.export import export_command  # noqa: E402  (materials out: Mitsuba, BRDF Explorer, tables)
 
 cli.add_command(inverse_command)
 cli.add_command(figure_command)
+cli.add_command(export_command)
 
 
 def main(argv: list[str] | None = None) -> None:

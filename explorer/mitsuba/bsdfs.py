@@ -122,6 +122,17 @@ def spectral_mirror(model, cos_theta: np.ndarray, wavelengths: np.ndarray) -> np
     return bragg.bragg_reflectance(np.clip(cos_theta, microfacet.COS_THETA_MIN, 1.0)[:, None], wavelengths, model.mirror)
 
 
+#: Nodes in cos(theta) of the thin film's reference colours in the RGB variants (linear interpolation).
+REFERENCE_NODES = 1024
+
+
+def reference_table(model) -> np.ndarray:
+    """The reference method's RGB over ``cos theta = k / (size - 1)``: Bragg's converged table, or the film's sum."""
+    if isinstance(getattr(model, "mirror", None), bragg.BraggMirror):
+        return bragg.tabulated_rgb_table(model.mirror)
+    return model.reflectance(np.linspace(0.0, 1.0, REFERENCE_NODES))
+
+
 # --------------------------------------------------------------------------------------------------
 # Sampling lobes per material: GGX roughnesses, their weights and a cosine lobe's (the env view's hooks)
 
@@ -184,7 +195,7 @@ def mixture_sample(alphas, weights, cosine_weight, v: np.ndarray, u_lobe: np.nda
 
 
 def _float_property(props, name: str, default):
-    if not props.has_property(name):
+    if name not in props:
         return None
     value = props[name]
     try:
@@ -272,7 +283,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
                 # explorer's colours at a table lookup per sample, not a 471-wavelength sum.
                 overrides["method"] = DEFAULT_METHOD
             self.values = self.material.resolve(overrides)
-            self.illuminant = props.get("illuminant", "d65") if props.has_property("illuminant") else "d65"
+            self.illuminant = props["illuminant"] if "illuminant" in props else "d65"
             if self.illuminant not in ("d65", "e"):
                 raise ValueError(f"{self.material_name}: illuminant must be 'd65' or 'e', got {self.illuminant!r}")
             self._rebuild()
@@ -288,21 +299,37 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
 
         def _rebuild(self):
             self.model = model_for(self.material, self.material.physical_values(self.values))
+            if not spectral and round_integer(self.values.get("method", -1)) == 0:
+                # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
+                # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
+                self.model.reflectance = functools.partial(bragg.tabulated_rgb, reference_table(self.model))
 
         # -- parameters
         def traverse(self, callback):
+            # Dr.Jit holders (mi.traverse assigns into them): Color3f for colours, Color1f for the rest
+            # (bools as 0 / 1, ints as floats, as BRDF Explorer's files have them).
+            self._holders = {}
             for p in self.material.parameters:
                 value = self.values[p.name]
-                if p.type == "color":
-                    value = mi.ScalarColor3f(*value)
-                elif p.type == "bool":
-                    value = bool(value)
-                else:
-                    value = float(value)
-                callback.put(p.name, value, mi.ParamFlags.NonDifferentiable)
+                holder = mi.Color3f(*(float(c) for c in value)) if p.type == "color" else mi.Color1f(float(value))
+                self._holders[p.name] = holder
+                callback.put(p.name, holder, mi.ParamFlags.NonDifferentiable)
 
         def parameters_changed(self, keys=None):
-            # mi.traverse writes plain Python values back through `put`: re-read and rebuild the model.
+            # Read the holders back (one value each), check them against the .brd ranges, rebuild the model.
+            overrides = {}
+            for p in self.material.parameters:
+                holder = self._holders.get(p.name) if hasattr(self, "_holders") else None
+                if holder is None:
+                    continue
+                flat = np.asarray(holder, dtype=np.float64).ravel()
+                if p.type == "color":
+                    overrides[p.name] = tuple(float(c) for c in flat[:3])
+                elif p.type == "bool":
+                    overrides[p.name] = bool(flat[0] != 0.0)
+                else:
+                    overrides[p.name] = float(flat[0])
+            self.values = self.material.resolve(overrides)
             self._rebuild()
 
         def to_string(self):
