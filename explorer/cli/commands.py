@@ -377,8 +377,11 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--mitsuba", "mitsuba", is_flag=True,
+              help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
+@click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app):
+def bench(as_json, size, repeats, thin_film, layers, app, mitsuba, spp):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -386,6 +389,13 @@ def bench(as_json, size, repeats, thin_film, layers, app):
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
+    if mitsuba:
+        from explorer.mitsuba.bench import run_mitsuba_bench
+
+        source = click.get_current_context().get_parameter_source("size")
+        run_mitsuba_bench(as_json=as_json, size=size if source == click.core.ParameterSource.COMMANDLINE else 64, spp=spp,
+                          echo=click.echo)
+        return
     if app:
         from explorer.cli.bench import run_app_bench
 
