@@ -12,7 +12,7 @@ import click
 from explorer.materials.brd import MaterialError
 
 PROG = "bragg-explorer"
-TARGETS = ("mitsuba", "table", "materialx")  # a self-contained BRDF Explorer .brdf: not yet (docs/export.md)
+TARGETS = ("mitsuba", "brdf", "table", "materialx")
 
 
 def _warn(message: str) -> None:
@@ -59,8 +59,8 @@ def _values(loaded, preset, params_file, assignments):
 @click.command("export")
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--to", "target", type=click.Choice(TARGETS), required=True,
-              help="mitsuba: a scene directory; table: an EXR of reflectance(cos theta[, roughness]); "
-                   "materialx: a .mtlx (thin_film).")
+              help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
@@ -86,7 +86,12 @@ def export_command(material, target, preset, params_file, assignments, env_file,
             return
         if env_file is not None or mesh is not None:
             raise click.BadParameter("--env and --mesh are for --to mitsuba", param_hint="--to")
-        if target == "table":
+        if target == "brdf":
+            from explorer.materials.export_brdf import export_brdf
+
+            path = export_brdf(loaded, values, Path(out))
+            click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
+        elif target == "table":
             from explorer.materials.export_table import export_table
 
             path, shape = export_table(loaded, values, Path(out))
