@@ -99,7 +99,7 @@ def _table(name: str, data: np.ndarray) -> str:
     return f"""{_vec3_array(f"{name}_texels", flat)}
 vec4 {name}_fetch(int i, int j) {{ return vec4({name}_texels[clamp(j, 0, {height - 1}) * {width} + clamp(i, 0, {width - 1})], 1.0); }}
 vec4 {name}_linear(float u) {{
-    float x = u * {float(width)} - 0.5;
+    float x = clamp(u * {float(width)} - 0.5, -1.0, {float(width)});  // as CLAMP_TO_EDGE, before int() can overflow
     float i = floor(x);
     return mix({name}_fetch(int(i), 0), {name}_fetch(int(i) + 1, 0), x - i);
 }}"""
@@ -203,8 +203,18 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
         raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(EXPORTABLE)})")
     ints = [p.name for p in material.parameters if p.type == "int"]
     shader = round_int_parameters(material.shader, ints)
-    flat = flatten(shader, str(material.path))
+    defined = {}
     tables = material_tables(material, values)
+    if material.model == "thin_film":
+        # The film's export is specialised to its method: the 4096 x 2 sensitivity_fourier table, inlined,
+        # takes Mesa's compiler many minutes, so only methods 1-3 (which read it) carry it.
+        from explorer.materials.brd import round_integer
+
+        method = round_integer(values["method"])
+        defined["SPECIALISED_method"] = str(method)
+        if method not in (1, 2, 3):
+            tables.pop("sensitivity_fourier")
+    flat = flatten(shader, str(material.path), defined)
     flat = _forward_declare(inline_tables(flat, tables), list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):
