@@ -70,36 +70,45 @@ def _values(loaded, preset, params_file, assignments):
 @click.argument("out", type=click.Path())
 def export_command(material, target, preset, params_file, assignments, env_file, mesh, spp, out):
     """Write MATERIAL (a file or a built-in's name) for use elsewhere, to OUT (a directory for --to mitsuba)."""
-    from explorer.cli.commands import _errors, _load
+    from explorer.errors import LocatedError
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+    from explorer.views.images import OutputError
 
-    @_errors
-    def run():
-        loaded = _load(material)
-        values = _values(loaded, preset, params_file, assignments)
-        if target == "mitsuba":
-            from explorer.mitsuba.export import export_scene
-            from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+    try:
+        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load_material(material_path(material)))
+    except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
+        click.echo(f"{PROG}: error: {error}", err=True)
+        raise SystemExit(1) from None
 
-            environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
-            path = export_scene(loaded, values, out, environment, mesh, spp)
-            click.echo(f"wrote {path} (load it with explorer.mitsuba.load_file)")
-            return
-        if env_file is not None or mesh is not None:
-            raise click.BadParameter("--env and --mesh are for --to mitsuba", param_hint="--to")
-        if target == "brdf":
-            from explorer.materials.export_brdf import export_brdf
 
-            path = export_brdf(loaded, values, Path(out))
-            click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
-        elif target == "table":
-            from explorer.materials.export_table import export_table
+def _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded):
+    """The export itself (bad input raises LocatedError / OutputError / click.BadParameter)."""
+    for warning in loaded.warnings:
+        _warn(warning)
+    values = _values(loaded, preset, params_file, assignments)
+    if target == "mitsuba":
+        from explorer.mitsuba.export import export_scene
+        from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
 
-            path, shape = export_table(loaded, values, Path(out))
-            click.echo(f"wrote {path} ({shape[1]}x{shape[0]} RGB, docs/export.md)")
-        else:
-            from explorer.materials.export_materialx import export_materialx
+        environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+        path = export_scene(loaded, values, out, environment, mesh, spp)
+        click.echo(f"wrote {path} (load it with explorer.mitsuba.load_file)")
+        return
+    if env_file is not None or mesh is not None:
+        raise click.BadParameter("--env and --mesh are for --to mitsuba", param_hint="--to")
+    if target == "brdf":
+        from explorer.materials.export_brdf import export_brdf
 
-            path = export_materialx(loaded, values, Path(out))
-            click.echo(f"wrote {path} (MaterialX standard_surface with thin_film_thickness and thin_film_IOR)")
+        path = export_brdf(loaded, values, Path(out))
+        click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
+    elif target == "table":
+        from explorer.materials.export_table import export_table
 
-    run()
+        path, shape = export_table(loaded, values, Path(out))
+        click.echo(f"wrote {path} ({shape[1]}x{shape[0]} RGB, docs/export.md)")
+    else:
+        from explorer.materials.export_materialx import export_materialx
+
+        path = export_materialx(loaded, values, Path(out))
+        click.echo(f"wrote {path} (MaterialX standard_surface with thin_film_thickness and thin_film_IOR)")

@@ -107,7 +107,7 @@ def render_env_mitsuba(material, values: Mapping[str, object], width: int, heigh
     The env view rendered by Mitsuba: ``(height, width, 3)`` float32 linear sRGB in the explorer's colour
     convention. ``variant`` defaults to ``llvm_ad_rgb`` (scalar where LLVM cannot run, with a ``note``).
     """
-    from explorer.mitsuba import register
+    from explorer.mitsuba.registry import register
     from explorer.mitsuba.variants import choose_variant
 
     variant = choose_variant(variant, note)
