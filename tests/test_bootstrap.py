@@ -29,6 +29,29 @@ def test_parse_mode_test_strips_keyword_and_adds_extras():
     assert bs.parse_mode(["test", "-q", "-k", "gl"]) == ("test", ["-q", "-k", "gl"], ("test",))
 
 
+def test_mitsuba_commands_bring_the_mitsuba_extra():
+    for argv in (["render", "m", "--engine", "mitsuba"], ["render", "--engine=mitsuba"],
+                 ["export", "thin_film", "--to", "mitsuba", "d"], ["bench", "--mitsuba"]):
+        assert bs.parse_mode(argv)[2] == ("mitsuba",), argv
+    for argv in (["render", "--engine", "gl"], ["export", "x", "--to", "brdf", "mitsuba"], ["mitsuba"]):
+        assert bs.parse_mode(argv)[2] == (), argv
+
+
+def test_llvm_is_optional_and_only_for_the_mitsuba_extras(monkeypatch, capsys):
+    assert bs.optional_packages_for(()) == ()
+    assert bs.optional_packages_for(("mitsuba",)) == bs.optional_packages_for(("test",)) == ("libllvm19",)
+    assert "libllvm19" in bs.PROBES
+    monkeypatch.setattr(bs.sys, "platform", "linux")
+    monkeypatch.setattr(bs, "missing_packages", lambda wanted: list(wanted))
+
+    def fail(packages, **kwargs):
+        raise bs.SetupError("[setup] error: no apt-get")
+    monkeypatch.setattr(bs, "install_system_packages", fail)
+    bs.ensure_optional_packages(("mitsuba",))  # a note, not an error
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "libllvm19" in err and "scalar" in err
+
+
 def test_final_command_for_tests_is_pytest_module():
     assert bs.final_command("test", "/r/.venv/bin/python", ["-q", "-x"]) == [
         "/r/.venv/bin/python", "-m", "pytest", "-q", "-x"]
@@ -336,6 +359,7 @@ def test_main_prints_one_line_and_fails_when_nothing_can_install(monkeypatch, ca
 def test_main_execs_venv_pytest_from_repo_root(monkeypatch, tmp_path):
     monkeypatch.delenv(bs.ENV_NO_SETUP, raising=False)
     monkeypatch.setattr(bs, "ensure_system_packages", lambda mode: None)
+    monkeypatch.setattr(bs, "ensure_optional_packages", lambda extras: None)
     monkeypatch.setattr(bs, "ensure_python_packages", lambda extras, inside: False)
     monkeypatch.setattr(bs, "in_venv", lambda venv_dir: False)
     monkeypatch.chdir(tmp_path)

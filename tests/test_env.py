@@ -602,6 +602,30 @@ def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
 
 
 @pytest.mark.gl
+@pytest.mark.parametrize("method", [1, 3])
+def test_smooth_mirror_is_a_dirac_in_the_env_view(gl_renderer, method):
+    """A smooth Bragg mirror under an environment shows R(V.N) Le(reflect(-V, N)) and nothing else, in GL and numpy."""
+    from explorer.materials.brd import load_material
+    from explorer.views.env import EnvironmentMap, env_integral_numpy
+    from explorer.materials.models import model_for
+
+    material = load_material(REPO_ROOT / "shaders" / "bragg_mirror.brd")
+    values = material.resolve({"method": method})
+    environment = EnvironmentMap.default()
+    render = ProgressiveEnvRender(gl_renderer, material, values, environment, 16, 16)
+    render.step(2)
+    image = render.image()
+    render.release()
+    model = model_for(material, values)
+    _, V, N, _, _, inside, _ = brdf_view_geometry("lit", 16, 16)
+    v, n = V[inside].astype(np.float64), N[inside].astype(np.float64)
+    expected = model.reflectance(np.sum(v * n, -1)) * environment.radiance(2.0 * np.sum(v * n, -1, keepdims=True) * n - v)
+    assert expected.max() > 0.05
+    np.testing.assert_allclose(image[inside], expected, rtol=3e-3, atol=2e-4)
+    np.testing.assert_allclose(env_integral_numpy(model, environment, 16, 16)[inside], expected, rtol=1e-6, atol=1e-7)
+
+
+@pytest.mark.gl
 @pytest.mark.parametrize("declaration", ["const float PI = 3.14159265358979323846;", "#define PI 3.14159265358979323846"])
 def test_brdf_explorer_pi_does_not_clash_with_the_library(gl_renderer, tmp_path, declaration):
     """BRDF Explorer files declare PI (a const or a macro) before the env view includes the GGX library."""

@@ -110,13 +110,17 @@ def parse_exposure(text: str | None, out: Path) -> float:
 
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
-    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64,
+    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
     :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
     """
+    if view == "env" and engine == "mitsuba":
+        from explorer.cli.export import render_env_with_mitsuba
+
+        return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
         return _render_env(material, values, width, height, engine, environment, spp)
     if view == "textured":
@@ -274,8 +278,8 @@ def _errors(function):
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
-@click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="gl", show_default=True,
-              help="The GPU shader, its numpy twin, or (bragg_stack, lit and slice) the position-free reference.")
+@click.option("--engine", type=click.Choice(["gl", "numpy", "position-free", "mitsuba"]), default="gl", show_default=True,
+              help="The GPU shader, its numpy twin, (bragg_stack, lit and slice) the position-free reference, or (env view) Mitsuba 3 with the explorer's BSDF plugins.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
@@ -285,9 +289,10 @@ def _errors(function):
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
+@click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp):
+           prefilter, env_file, spp, variant):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -334,12 +339,17 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
     elif env_file is not None or (spp is not None and engine != "position-free"):
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
+    if engine == "mitsuba" or variant is not None:
+        from explorer.cli.export import check_mitsuba_render
+
+        check_mitsuba_render(view, engine, variant)
     if engine == "position-free":
         from explorer.cli.albedo import render_position_free
 
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
-        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64)
+        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
+                                variant=variant)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
@@ -421,8 +431,11 @@ def presets(material, as_json):
               help="Instead: table cost against N and table size, frame time against sphere size (with --plot PNG).")
 @click.option("--plot", type=click.Path(dir_okay=False, writable=True), default=None, help="With --scaling: write the plot here.")
 @click.option("--markdown", is_flag=True, help="Print Table 1, --thin-film or --layers as Markdown tables (docs/validation.md).")
+@click.option("--mitsuba", "mitsuba", is_flag=True,
+              help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
+@click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot, markdown):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot, markdown, mitsuba, spp):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -430,7 +443,7 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
     """
     from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
 
-    if markdown and (as_json or app or position_free or design_count is not None or tables or scaling):
+    if markdown and (as_json or app or position_free or design_count is not None or tables or scaling or mitsuba):
         raise click.UsageError("--markdown goes with Table 1, --thin-film or --layers, without --json")
     if position_free:
         from explorer.cli.bench import run_position_free_bench
@@ -452,6 +465,13 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
 
         source = click.get_current_context().get_parameter_source("repeats")
         run_tables_bench(as_json=as_json, size=size, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
+        return
+    if mitsuba:
+        from explorer.mitsuba.bench import run_mitsuba_bench
+
+        source = click.get_current_context().get_parameter_source("size")
+        run_mitsuba_bench(as_json=as_json, size=size if source == click.core.ParameterSource.COMMANDLINE else 64, spp=spp,
+                          echo=click.echo)
         return
     if app:
         from explorer.cli.bench import run_app_bench
@@ -530,6 +550,10 @@ cli.add_command(albedo_command)
 from explorer.cli.design import design_command  # noqa: E402  (inverse design of mirrors and films)
 
 cli.add_command(design_command)
+
+from explorer.cli.export import export_command  # noqa: E402  (materials out: Mitsuba, BRDF Explorer, tables)
+
+cli.add_command(export_command)
 
 
 def main(argv: list[str] | None = None) -> None:

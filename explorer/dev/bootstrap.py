@@ -64,6 +64,12 @@ MODE_TEST = "test"
 # backend (glcontext) dlopens next to libEGL.so.1.
 EGL_PACKAGES = ("libegl1", "libgl1", "libegl-mesa0", "libgl1-mesa-dri")
 XVFB_PACKAGES = ("xvfb", "xauth")
+# The Mitsuba extra's LLVM variants need a system libLLVM >= 17 (Debian 12's default 15 aborts the first
+# render); drjit finds Debian's libllvm19 by itself. Optional: without it the scalar variants still run
+# (explorer.mitsuba.variants probes LLVM in a subprocess), so a failed install is a note, not an error.
+MITSUBA_PACKAGES = ("libllvm19",)
+#: The pip extras that bring Mitsuba (the test extra includes it: CI runs the Mitsuba tests).
+MITSUBA_EXTRAS = ("mitsuba", "test")
 
 RUN_CLI_SNIPPET = "from explorer.dev.bootstrap import run_cli; run_cli()"
 PIP_TAIL_LINES = 25
@@ -81,16 +87,32 @@ def log(message: str) -> None:
 # Command line
 
 
+def wants_mitsuba(argv: Sequence[str]) -> bool:
+    """Whether a CLI command line uses Mitsuba (``--engine mitsuba``, ``--to mitsuba``, ``bench --mitsuba``)."""
+    argv = list(argv)
+    for k, arg in enumerate(argv):
+        if arg in ("--engine=mitsuba", "--to=mitsuba", "--mitsuba"):
+            return True
+        if arg in ("--engine", "--to") and k + 1 < len(argv) and argv[k + 1] == "mitsuba":
+            return True
+    return False
+
+
 def parse_mode(argv: Sequence[str]) -> tuple[str, list[str], tuple[str, ...]]:
     """Return (mode, remaining args, pip extras) for ``python3 -m explorer`` argv."""
     argv = list(argv)
     if argv and argv[0] == MODE_TEST:
         return MODE_TEST, argv[1:], ("test",)
-    return MODE_RUN, argv, ()
+    return MODE_RUN, argv, ("mitsuba",) if wants_mitsuba(argv) else ()
 
 
 def system_packages_for(mode: str) -> tuple[str, ...]:
     return EGL_PACKAGES + (XVFB_PACKAGES if mode == MODE_TEST else ())
+
+
+def optional_packages_for(extras: Sequence[str]) -> tuple[str, ...]:
+    """System packages that only speed things up: libLLVM 19 for Mitsuba's LLVM variants."""
+    return MITSUBA_PACKAGES if any(e in MITSUBA_EXTRAS for e in extras) else ()
 
 
 def final_command(mode: str, python: str, args: Sequence[str]) -> list[str]:
@@ -234,6 +256,7 @@ PROBES: dict[str, Callable[[], bool]] = {
     "libgl1-mesa-dri": have_swrast_dri,
     "xvfb": lambda: have_program("Xvfb") and have_program("xvfb-run"),
     "xauth": lambda: have_program("xauth"),
+    "libllvm19": lambda: have_library("libLLVM.so.19.1") or have_library("libLLVM-19.so.1"),
 }
 
 
@@ -409,6 +432,19 @@ def ensure_system_packages(mode: str) -> None:
     install_system_packages(
         missing, what=f"{system_packages_label(missing)} ({' '.join(missing)})")
     log(f"system packages installed ({time.monotonic() - start:.0f} s)")
+
+
+def ensure_optional_packages(extras: Sequence[str]) -> None:
+    """Install :func:`optional_packages_for` ``extras``; where that fails, one note (scalar Mitsuba still runs)."""
+    if not sys.platform.startswith("linux"):
+        return
+    missing = missing_packages(optional_packages_for(extras))
+    if not missing:
+        return
+    try:
+        install_system_packages(missing, what=f"LLVM 19 for Mitsuba's fast variants ({' '.join(missing)})")
+    except SetupError:
+        log(f"note: {' '.join(missing)} not installed: Mitsuba falls back to its (slow) scalar variants")
 
 
 # --------------------------------------------------------------------------
@@ -635,6 +671,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         run_in_process(mode, args)
     try:
         ensure_system_packages(mode)
+        ensure_optional_packages(extras)
         inside = in_venv(VENV_DIR)
         installed = ensure_python_packages(extras, inside)
     except SetupError as exc:

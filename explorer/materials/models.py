@@ -69,6 +69,17 @@ class BraggMirrorModel:
         """The shader's ``BRDF``: the reflectance at the half-vector angle (unit vectors ``(..., 3)``)."""
         return self.reflectance(_cos_half_angle(L, V))
 
+    def mirror_reflection(self, V, N) -> np.ndarray:
+        """
+        The smooth mirror's Dirac under an environment: its reflectance at ``cos theta = V.N`` into
+        reflect(-V, N) (``(..., 3)``); the env view adds nothing else (:attr:`mirror_only`).
+        """
+        cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)
+        return self.reflectance(cos_theta)
+
+    #: The env view integrates no finite BRDF: a smooth mirror is a Dirac (``MIRROR_ONLY`` in the shader).
+    mirror_only = True
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
@@ -121,6 +132,9 @@ class BraggLayerModel(BraggMirrorModel):
     """
 
     name = "bragg_layer"
+    # A rough layer is no Dirac: the env view integrates its BRDF.
+    mirror_reflection = None
+    mirror_only = False
 
     def __init__(self, values: Mapping[str, object]):
         super().__init__(values)

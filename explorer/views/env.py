@@ -414,8 +414,9 @@ def env_integral_numpy(
     directions, solid_angle, radiance = environment.quadrature(s)
     weighted = radiance * solid_angle[:, None]
     values = np.zeros((rows.size, 3))
+    mirror_only = bool(getattr(model, "mirror_only", False))  # a smooth mirror: the Dirac below, nothing else
     for k, (r, c) in enumerate(zip(rows, columns)):
-        if inside[r, c]:
+        if inside[r, c] and not mirror_only:
             n = N[r, c].astype(np.float64)
             frame = [a[r, c].astype(np.float64) for a in (V, N, X, Y)]
             for start in range(0, directions.shape[0], QUADRATURE_BLOCK):

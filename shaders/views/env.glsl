@@ -21,7 +21,10 @@
 // A Dirac reflection (a smooth coating, Eq. 34's f_r,0) cannot be sampled by directions; a material declares it
 //   #define HAS_MIRROR_REFLECTION
 //   vec3 mirror_reflection(vec3 V, vec3 N);  // its weight into reflect(-V, N)
-// and every sample adds mirror_reflection(V, N) Le(reflect(-V, N)) exactly (no variance).
+// and every sample adds mirror_reflection(V, N) Le(reflect(-V, N)) exactly (no variance). A material that is
+// nothing but that Dirac (a smooth mirror) also declares
+//   #define MIRROR_ONLY
+// and its BRDF (what the slice view shows) is not sampled.
 //
 // Environment: equirectangular, linear RGB, texture row 0 (v = 0) at the zenith +y (the sphere's screen
 // up), v = theta / pi with theta the angle from +y; the centre column u = 0.5 faces away from the viewer
@@ -109,6 +112,9 @@ void main() {
         }
         float cos_light = dot(normal, light);
         vec3 value = vec3(0.0);
+#ifdef MIRROR_ONLY
+        cos_light = 0.0;
+#endif
         if (cos_light > 0.0) {
             float pdf = cosine_weight * cos_light * (1.0 / PI);
             for (int j = 0; j < 4; ++j) {

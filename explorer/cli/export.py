@@ -1,0 +1,114 @@
+"""
+``bragg-explorer export MATERIAL --to {mitsuba,brdf,table,materialx} OUT``: a material out of the explorer
+(docs/export.md, docs/mitsuba.md), and ``render --engine mitsuba``'s checks.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from explorer.materials.brd import MaterialError
+
+PROG = "bragg-explorer"
+TARGETS = ("mitsuba", "brdf", "table", "materialx")
+
+
+def _warn(message: str) -> None:
+    click.echo(f"{PROG}: warning: {message}", err=True)
+
+
+def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
+    """``--engine mitsuba`` renders the env view only; ``--variant`` belongs to it."""
+    if engine == "mitsuba" and view != "env":
+        raise click.BadParameter("--engine mitsuba renders the env view (--view env)", param_hint="--engine")
+    if variant is not None and engine != "mitsuba":
+        raise click.BadParameter("--variant is for --engine mitsuba", param_hint="--variant")
+
+
+def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
+    """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
+    from explorer.mitsuba import BSDF_NAMES
+    from explorer.mitsuba.scene import render_env_mitsuba
+
+    if material.model not in BSDF_NAMES:
+        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
+    return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=_warn)
+
+
+def _values(loaded, preset, params_file, assignments):
+    """--preset, then --params, then --set (the render command's order)."""
+    from explorer.materials.brd import parse_assignment
+
+    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    if params_file is not None:
+        from explorer.app.parameter_files import load_values
+
+        loaded_values = load_values(params_file, loaded)
+        for skipped in loaded_values.skipped:
+            _warn(f"{params_file}: skipped {skipped}")
+        overrides = {**loaded_values.values, **overrides}
+    if preset is not None:
+        from explorer.materials.presets import presets_for
+
+        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
+    return loaded.resolve(overrides)
+
+
+@click.command("export")
+@click.argument("material", type=click.Path(dir_okay=False))
+@click.option("--to", "target", type=click.Choice(TARGETS), required=True,
+              help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film).")
+@click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
+@click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
+@click.option("--env", "env_file", metavar="FILE", help="mitsuba: the environment (.hdr or .exr; default the env view's).")
+@click.option("--mesh", metavar="FILE", help="mitsuba: an .obj or .ply in place of the unit sphere.")
+@click.option("--spp", type=click.IntRange(min=1), default=256, show_default=True, help="mitsuba: samples per pixel.")
+@click.argument("out", type=click.Path())
+def export_command(material, target, preset, params_file, assignments, env_file, mesh, spp, out):
+    """Write MATERIAL (a file or a built-in's name) for use elsewhere, to OUT (a directory for --to mitsuba)."""
+    from explorer.errors import LocatedError
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+    from explorer.views.images import OutputError
+
+    try:
+        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load_material(material_path(material)))
+    except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
+        click.echo(f"{PROG}: error: {error}", err=True)
+        raise SystemExit(1) from None
+
+
+def _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded):
+    """The export itself (bad input raises LocatedError / OutputError / click.BadParameter)."""
+    for warning in loaded.warnings:
+        _warn(warning)
+    values = _values(loaded, preset, params_file, assignments)
+    if target == "mitsuba":
+        from explorer.mitsuba.export import export_scene
+        from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+
+        environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+        path = export_scene(loaded, values, out, environment, mesh, spp)
+        click.echo(f"wrote {path} (load it with explorer.mitsuba.load_file)")
+        return
+    if env_file is not None or mesh is not None:
+        raise click.BadParameter("--env and --mesh are for --to mitsuba", param_hint="--to")
+    if target == "brdf":
+        from explorer.materials.export_brdf import export_brdf
+
+        path = export_brdf(loaded, values, Path(out))
+        click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
+    elif target == "table":
+        from explorer.materials.export_table import export_table
+
+        path, shape = export_table(loaded, values, Path(out))
+        click.echo(f"wrote {path} ({shape[1]}x{shape[0]} RGB, docs/export.md)")
+    else:
+        from explorer.materials.export_materialx import export_materialx
+
+        path = export_materialx(loaded, values, Path(out))
+        click.echo(f"wrote {path} (MaterialX standard_surface with thin_film_thickness and thin_film_IOR)")

@@ -1,0 +1,97 @@
+"""
+``export MATERIAL --to table out.exr``: a homogeneous material baked into an RGB table any engine can sample.
+
+Layout (docs/export.md): a float32 RGB OpenEXR, linear sRGB in the explorer's colour convention.
+
+- Columns ``j = 0 .. W - 1``: ``cos theta = j / (W - 1)`` (the view's angle to the normal), W = :data:`COLUMNS`.
+- A material with no roughness parameter (``bragg_mirror``): one row, its reflectance ``R(cos theta)``.
+- A rough one (a parameter ``alpha`` or ``alpha_k``): rows ``i = 0 .. H - 1`` at roughness
+  ``alpha = i / (H - 1)`` (every ``alpha`` parameter set to it), H = :data:`ROWS`; each texel is the
+  directional albedo ``int f(l, v) cos theta_l d omega_l`` for ``v`` at that ``cos theta``: the split-sum
+  "environment BRDF" of real-time engines, in colour. Row 0 is the smooth limit ``R(cos theta)`` (the
+  material's ``reflectance``), where GGX with ``alpha -> 0`` is a Dirac.
+
+The albedo is a stratified estimate (:data:`STRATA`\\ ² samples per texel) of one-sample MIS over the GGX
+visible normals (Heitz 2018) and a cosine lobe, the estimator of the env view; unbiased for any material.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from explorer.errors import LocatedError
+from explorer.physics import microfacet
+
+COLUMNS = 64
+ROWS = 32
+STRATA = 24
+#: The cosine lobe's share of the samples (the base's diffuse light).
+COSINE_SHARE = 0.25
+
+
+class TableExportError(LocatedError):
+    """A table that cannot be made for this material (one line)."""
+
+
+def roughness_names(material) -> list[str]:
+    return [p.name for p in material.parameters if p.name == "alpha" or p.name.startswith("alpha_")]
+
+
+def _albedo(model, cos_v: np.ndarray, alpha: float) -> np.ndarray:
+    """Directional albedo (RGB) at each ``cos_v``, by a stratified MIS estimate."""
+    alpha_s = max(alpha, 1e-3)
+    k = np.arange(STRATA)
+    u1, u2 = np.meshgrid((k + 0.5) / STRATA, (k + 0.5) / STRATA)
+    u1, u2 = u1.ravel(), u2.ravel()
+    e = np.eye(3)
+    out = np.zeros((cos_v.size, 3))
+    for c, cos in enumerate(cos_v):
+        cos = min(max(cos, 1e-3), 1.0)
+        v = np.array([np.sqrt(1.0 - cos * cos), 0.0, cos])
+        vv = np.broadcast_to(v, (u1.size, 3))
+        m = microfacet.sample_ggx_visible_normal(vv, alpha_s, u1, u2)
+        l_ggx = 2.0 * np.sum(vv * m, axis=-1, keepdims=True) * m - vv
+        r, phi = np.sqrt(u1), 2.0 * np.pi * u2
+        l_cos = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - u1))], axis=-1)
+        total = np.zeros(3)
+        for l, share in ((l_ggx, 1.0 - COSINE_SHARE), (l_cos, COSINE_SHARE)):
+            pdf = (1.0 - COSINE_SHARE) * microfacet.ggx_reflection_pdf(l, vv, alpha_s) + COSINE_SHARE * np.maximum(l[:, 2], 0.0) / np.pi
+            ok = (l[:, 2] > 0.0) & (pdf > 0.0)
+            with np.errstate(all="ignore"):
+                f = model.brdf(l[ok], vv[ok], e[2], e[0], e[1])
+            f = np.where(np.isfinite(f), f, 0.0)
+            total += share * np.sum(f * (l[ok, 2] / pdf[ok])[:, None], axis=0) / u1.size
+        out[c] = total
+    return out
+
+
+def material_table(material, values) -> np.ndarray:
+    """The table (``(rows, COLUMNS, 3)`` float32) described in the module's docstring."""
+    from explorer.materials.models import model_for
+
+    names = roughness_names(material)
+    cos = np.linspace(0.0, 1.0, COLUMNS)
+    base = model_for(material, material.physical_values(values))
+    if base is None or not callable(getattr(base, "reflectance", None)):
+        raise TableExportError(material.path, None, "this material has no numpy twin to bake (no known '# model:' line)")
+    smooth = np.asarray(base.reflectance(cos), dtype=np.float64)
+    if not names:
+        return smooth[None].astype(np.float32)
+    rows = [smooth]
+    for alpha in np.linspace(0.0, 1.0, ROWS)[1:]:
+        model = model_for(material, material.physical_values({**values, **{n: float(alpha) for n in names}}))
+        rows.append(_albedo(model, cos, float(alpha)))
+    return np.asarray(rows, dtype=np.float32)
+
+
+def export_table(material, values, out: Path) -> tuple[Path, tuple[int, int]]:
+    """Write :func:`material_table` to ``out`` (``.exr``) atomically; returns the path and (rows, columns)."""
+    from explorer.views.images import write_image
+
+    if out.suffix.lower() != ".exr":
+        raise TableExportError(out, None, "the table is an OpenEXR file: name it .exr")
+    table = material_table(material, values)
+    write_image(table, out)
+    return out, table.shape[:2]

@@ -1,0 +1,121 @@
+"""
+The env view's scene in Mitsuba 3, and its colour convention.
+
+The scene is the GL env view's (``shaders/views/env.glsl``, :mod:`explorer.views.env`): the unit sphere at
+the origin seen by an orthographic camera along ``V = (0, 0, 1)`` whose film spans ``[-1, 1]^2``, screen up
+``+y``, under an equirectangular environment. Mitsuba's ``envmap`` reads ``u = atan2(x, -z) / 2 pi`` with
+texel ``k`` centred at ``u = k / W`` and ``v = k / (H - 1)`` (it appends a wrapped column); ours reads
+``u = 0.5 + atan2(x, -z) / 2 pi`` with centres at ``(k + 0.5) / W``. So the scene's bitmap is our
+environment resampled (bilinearly, as the GL view reads it) at Mitsuba's texel directions.
+
+Colour convention (docs/mitsuba.md): the explorer's, everywhere. A reflectance spectrum's colour is its
+XYZ under illuminant E, adapted to D65 by Bradford and scaled so that white is RGB (1, 1, 1)
+(:mod:`explorer.physics.colorimetry`).
+
+- RGB variants: the BSDF returns the explorer's RGB (its numpy twin), multiplied per channel by the
+  environment's RGB: the GL estimator's arithmetic.
+- Spectral variants: Mitsuba's RGB emitters are D65 spectra; the plugins, given ``illuminant="e"``,
+  divide by that D65, so the envmap's white lights the material as illuminant E. The film records XYZ
+  (``pixel_format="xyz"``) and :func:`xyz_to_explorer_rgb` takes it to linear sRGB with the explorer's
+  matrix.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Callable, Mapping
+
+import numpy as np
+
+from explorer.mitsuba.variants import is_spectral
+from explorer.physics import colorimetry
+from explorer.views.env import EnvironmentMap, uv_to_direction
+
+#: Mitsuba's environment bitmap: this many times our environment's texels per side (bilinear resampling
+#: onto shifted texel centres smooths a little; twice as many keeps that below the GL view's own noise).
+ENV_OVERSAMPLE = 2
+#: Path depth: one bounce off a convex sphere (its reflections never hit it again).
+MAX_DEPTH = 2
+
+
+def mitsuba_environment(environment: EnvironmentMap, oversample: int = ENV_OVERSAMPLE) -> np.ndarray:
+    """
+    Our environment resampled for Mitsuba's ``envmap`` (``(H', W', 3)`` float32): texel ``(j, k)`` holds our
+    bilinear radiance toward Mitsuba's direction of ``u = k / W'``, ``v = j / (H' - 1)``, that is our
+    ``u + 0.5``.
+    """
+    width, height = environment.width * oversample, environment.height * oversample
+    u_mitsuba = np.arange(width) / width
+    v = np.arange(height) / (height - 1)
+    d = uv_to_direction((u_mitsuba + 0.5)[None, :], v[:, None])  # our u = Mitsuba's u + 1/2
+    return environment.radiance(d).astype(np.float32)
+
+
+def bsdf_properties(material, values: Mapping[str, object], variant: str | None = None) -> dict:
+    """A material's values as plugin properties (``.brd`` names; colours as RGB triples)."""
+    import mitsuba as mi
+
+    props: dict = {"type": material.model}
+    for p in material.parameters:
+        value = values[p.name]
+        if p.type == "color":
+            props[p.name] = mi.ScalarColor3f(*(float(c) for c in value))
+        elif p.type == "bool":
+            props[p.name] = bool(value)
+        else:
+            props[p.name] = float(value)
+    if variant is not None and is_spectral(variant):
+        props["illuminant"] = "e"
+    return props
+
+
+def env_scene_dict(material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
+                   spp: int, variant: str, env_bitmap=None) -> dict:
+    """The env view's scene as a ``mi.load_dict`` dictionary (the variant must be set)."""
+    import mitsuba as mi
+
+    T = mi.ScalarTransform4f
+    bitmap = env_bitmap if env_bitmap is not None else mi.Bitmap(mitsuba_environment(environment))
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": MAX_DEPTH, "hide_emitters": True},
+        "sphere": {"type": "sphere", "bsdf": bsdf_properties(material, values, variant)},
+        "environment": {"type": "envmap", "bitmap": bitmap},
+        "sensor": {
+            "type": "orthographic",
+            # Mitsuba's look_at puts the film's +x at world +x here (its camera x axis is 'left').
+            "to_world": T().look_at(origin=[0.0, 0.0, 4.0], target=[0.0, 0.0, 0.0], up=[0.0, 1.0, 0.0]),
+            "film": {"type": "hdrfilm", "width": int(width), "height": int(height),
+                     "pixel_format": "xyz" if is_spectral(variant) else "rgb",
+                     "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": int(spp)},
+        },
+    }
+
+
+def xyz_to_explorer_rgb(xyz: np.ndarray) -> np.ndarray:
+    """Mitsuba's XYZ film (flat spectrum of 1 -> Y = 1, its CIE 1931 tables) to the explorer's linear sRGB."""
+    return colorimetry.xyz_to_rgb(xyz)
+
+
+def render_env_mitsuba(material, values: Mapping[str, object], width: int, height: int, spp: int = 64,
+                       environment: EnvironmentMap | None = None, variant: str | None = None,
+                       note: Callable[[str], None] | None = None, seed: int = 0) -> np.ndarray:
+    """
+    The env view rendered by Mitsuba: ``(height, width, 3)`` float32 linear sRGB in the explorer's colour
+    convention. ``variant`` defaults to ``llvm_ad_rgb`` (scalar where LLVM cannot run, with a ``note``).
+    """
+    from explorer.mitsuba.registry import register
+    from explorer.mitsuba.variants import choose_variant
+
+    variant = choose_variant(variant, note)
+    mi = register(variant)
+    mi.set_log_level(mi.LogLevel.Error)  # out-of-gamut (negative) RGB samples are expected, not warnings
+    environment = environment if environment is not None else EnvironmentMap.default()
+    scene = mi.load_dict(env_scene_dict(material, values, environment, width, height, spp, variant))
+    image = np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)[..., :3]
+    if is_spectral(variant):
+        image = xyz_to_explorer_rgb(image)
+    return image.astype(np.float32)
