@@ -219,8 +219,8 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):
         raise BrdfExportError(material.path, None, "a preprocessor line is left in the exported shader")
-    header = (f"analytic\n\n"
-              f"::begin parameters\n" + "\n".join(_parameter_lines(material, values)) + "\n::end parameters\n\n")
+    header = ("analytic\n\n"
+              "::begin parameters\n" + "\n".join(_parameter_lines(material, values)) + "\n::end parameters\n\n")
     return (header + "::begin shader\n"
             f"// {material.model} exported by bragg-explorer (export --to brdf): self-contained, no preprocessor;\n"
             "// the tables are baked for the exported values.\n"

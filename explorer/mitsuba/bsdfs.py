@@ -79,7 +79,6 @@ def spectral_brdf(name: str, model, i: np.ndarray, o: np.ndarray, wavelengths: n
     ``o`` (view), ``(n, 3)``, and wavelengths ``(n, W)``; ``rgb_upsample(rgb (n, 3), wavelengths)`` turns
     RGB albedos (and the RGB-only layered lobes) into spectra (Mitsuba's sRGB model).
     """
-    n = i.shape[0]
     above = (i[:, 2] > 0.0) & (o[:, 2] > 0.0)
     out = np.zeros(wavelengths.shape)
     if not above.any():

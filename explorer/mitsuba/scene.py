@@ -22,9 +22,6 @@ XYZ under illuminant E, adapted to D65 by Bradford and scaled so that white is R
 
 from __future__ import annotations
 
-import math
-import os
-from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
