@@ -85,7 +85,7 @@ def test_no_import_cycles():
 #: The packages from the bottom up: a package imports only packages of a lower rank (or its own).
 #: ``errors`` is the foundation, ``resources`` (paths) and ``files`` (atomic outputs) stand on it; the
 #: store ``tables`` knows no physics; ``views`` (what each pixel of a view shows, without GL) comes below
-#: ``gpu``, which draws the views; ``cli`` opens the ``app``; ``dev`` (the checkout's set-up and
+#: ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared with the GL views) above it; ``cli`` opens the ``app``; ``dev`` (the checkout's set-up and
 #: regeneration scripts, not in the wheel) and ``__main__`` stand outside.
 LAYERS = {
     "errors": 0,
@@ -95,9 +95,10 @@ LAYERS = {
     "materials": 4,
     "views": 5,
     "gpu": 6,
-    "app": 7,
-    "cli": 8,
-    "dev": 9, "__main__": 10,
+    "mitsuba": 7,
+    "app": 8,
+    "cli": 9,
+    "dev": 10, "__main__": 11,
 }
 
 

@@ -103,10 +103,15 @@ def _export(material, target, preset, params_file, assignments, env_file, mesh, 
         path = export_brdf(loaded, values, Path(out))
         click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
     elif target == "table":
-        from explorer.materials.export_table import export_table
+        from explorer.materials.export_table import TableExportError, material_table
+        from explorer.views.images import write_image
 
-        path, shape = export_table(loaded, values, Path(out))
-        click.echo(f"wrote {path} ({shape[1]}x{shape[0]} RGB, docs/export.md)")
+        path = Path(out)
+        if path.suffix.lower() != ".exr":
+            raise TableExportError(path, None, "the table is an OpenEXR file: name it .exr")
+        table = material_table(loaded, values)
+        write_image(table, path)  # atomically
+        click.echo(f"wrote {path} ({table.shape[1]}x{table.shape[0]} RGB, docs/export.md)")
     else:
         from explorer.materials.export_materialx import export_materialx
 

@@ -59,7 +59,15 @@ def flatten(text: str, name: str, defined: dict[str, str] | None = None, seen: s
         include = _INCLUDE.match(line)
         if include:
             if active:
-                path = (SHADER_DIR / include.group(1)).resolve()
+                from explorer.materials.shader_constants import GENERATED
+
+                target = include.group(1)
+                if target in GENERATED:  # the shared constants, written from the physics (no file)
+                    if target not in seen:
+                        seen.add(target)
+                        out.append(GENERATED[target]().rstrip("\n"))
+                    continue
+                path = (SHADER_DIR / target).resolve()
                 if path not in seen:
                     seen.add(path)
                     out.append(flatten(path.read_text(encoding="utf-8"), str(path), defined, seen))
@@ -212,9 +220,15 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
 
         method = round_integer(values["method"])
         defined["SPECIALISED_method"] = str(method)
-        if method not in (1, 2, 3):
+        from explorer.materials.thinfilm_model import TABULATED_FOURIER
+
+        if method not in TABULATED_FOURIER:
             tables.pop("sensitivity_fourier")
-    flat = flatten(shader, str(material.path), defined)
+    # The methods' names, which the host #defines in every program: constants here (no preprocessor).
+    from explorer.materials.methods import glsl_defines
+
+    names = "".join(f"const int {name} = {value};\n" for name, value in glsl_defines().items())
+    flat = flatten(names + shader, str(material.path), defined)
     flat = _forward_declare(inline_tables(flat, tables), list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):

@@ -17,7 +17,6 @@ visible normals (Heitz 2018) and a cosine lobe, the estimator of the env view; u
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
@@ -84,14 +83,3 @@ def material_table(material, values) -> np.ndarray:
         model = model_for(material, material.physical_values({**values, **{n: float(alpha) for n in names}}))
         rows.append(_albedo(model, cos, float(alpha)))
     return np.asarray(rows, dtype=np.float32)
-
-
-def export_table(material, values, out: Path) -> tuple[Path, tuple[int, int]]:
-    """Write :func:`material_table` to ``out`` (``.exr``) atomically; returns the path and (rows, columns)."""
-    from explorer.views.images import write_image
-
-    if out.suffix.lower() != ".exr":
-        raise TableExportError(out, None, "the table is an OpenEXR file: name it .exr")
-    table = material_table(material, values)
-    write_image(table, out)
-    return out, table.shape[:2]

@@ -15,6 +15,7 @@ import json
 import time
 import warnings
 
+from explorer.materials.methods import BraggMethod
 import numpy as np
 
 from explorer.mitsuba.bsdfs import BSDF_NAMES
@@ -51,7 +52,7 @@ def run_mitsuba_bench(as_json: bool = False, size: int = 64, spp: int = 64, vari
     warmed = set()
     for name in materials or BSDF_NAMES:
         material = load_material(material_path(name))
-        values = material.resolve({"method": 3} if name.startswith("bragg_mirror") or name == "bragg_layer" else {})
+        values = material.resolve({"method": int(BraggMethod.TABULATED)} if name.startswith("bragg_mirror") or name == "bragg_layer" else {})
         start = time.perf_counter()
         gl = render_env(material, values, size, size, spp=spp, renderer=renderer)
         rows.append({"material": name, "engine": "gl", "seconds": time.perf_counter() - start, "delta_e_vs_gl": 0.0})

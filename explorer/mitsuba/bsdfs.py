@@ -33,6 +33,7 @@ import functools
 
 import numpy as np
 
+from explorer.materials.methods import BraggMethod
 from explorer.materials.brd import load_material, round_integer
 from explorer.materials.models import model_for
 from explorer.physics import bragg, colorimetry, layered, microfacet, thinfilm
@@ -298,7 +299,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
 
         def _rebuild(self):
             self.model = model_for(self.material, self.material.physical_values(self.values))
-            if not spectral and round_integer(self.values.get("method", -1)) == 0:
+            if not spectral and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
                 # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
                 # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
                 self.model.reflectance = functools.partial(bragg.tabulated_rgb, reference_table(self.model))
