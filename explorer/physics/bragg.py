@@ -349,6 +349,19 @@ def _spectrum_function(cos_theta, mirror: BraggMirror, float64: bool):
     :func:`reflectance_spectra` at the angles ``cos_theta[rows]`` (rows may repeat; ``wavelengths`` 1D,
     shared, or 2D, one set per row), with the angles' geometry computed once.
     """
+    return _row_spectrum_function(
+        cos_theta, mirror,
+        lambda omega, geometries, rows: _reflectance_real(omega, geometries, rows, float64),
+        reflectance_polarised,
+    )
+
+
+def _row_spectrum_function(cos_theta, mirror: BraggMirror, real_path, complex_path):
+    """
+    The row-blocked ``spectrum(wavelengths, rows)`` shared by the reference and the windowed table: the
+    angles' geometry once, rows with real angles through ``real_path(omega, geometries, rows)``, the others
+    (a host, evanescent layers) through ``complex_path(omega, geometry)`` averaged over the polarisations.
+    """
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
     first = geometries[0]
@@ -368,9 +381,9 @@ def _spectrum_function(cos_theta, mirror: BraggMirror, float64: bool):
                 at = slice(start, start + block) if mask.all() else where[start : start + block]
                 om = omega[at] if per_row else omega
                 if fast_path:
-                    out[at] = _reflectance_real(om, geometries, rows[at], float64)
+                    out[at] = real_path(om, geometries, rows[at])
                 else:
-                    out[at] = sum(reflectance_polarised(om, _take(g, rows[at])) for g in geometries) / len(geometries)
+                    out[at] = sum(complex_path(om, _take(g, rows[at])) for g in geometries) / len(geometries)
         return out
 
     return spectrum
@@ -1200,30 +1213,11 @@ def windowed_spectrum_function(
     ``Rbar + W (R - Rbar)`` (the section's comment above) at the angles ``cos_theta[rows]``, as
     :func:`explorer.physics._spectrum_function` gives ``R``.
     """
-    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
-    geometries = tuple(cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
-    first = geometries[0]
-    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1
-
-    def spectrum(wavelengths, rows):
-        omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
-        rows = np.asarray(rows)
-        per_row = omega.ndim == 2
-        out = np.empty((rows.size, omega.shape[-1]))
-        is_real = real[rows]
-        block = max(1, ROW_BLOCK * 471 // max(omega.shape[-1], 1))
-        for mask, fast_path in ((is_real, True), (~is_real, False)):
-            where = np.arange(rows.size) if mask.all() else np.flatnonzero(mask)
-            for start in range(0, where.size, block):
-                at = slice(start, start + block) if mask.all() else where[start : start + block]
-                om = omega[at] if per_row else omega
-                if fast_path:
-                    out[at] = _windowed_real(om, geometries, rows[at], float64)
-                else:
-                    out[at] = sum(_windowed_complex(om, _take(g, rows[at])) for g in geometries) / len(geometries)
-        return out
-
-    return spectrum
+    return _row_spectrum_function(
+        cos_theta, mirror,
+        lambda omega, geometries, rows: _windowed_real(omega, geometries, rows, float64),
+        _windowed_complex,
+    )
 
 
 def windowed_converged_spectra(
