@@ -13,32 +13,13 @@ import time
 import click
 import numpy as np
 
-PROG = "bragg-explorer"
+from explorer.cli.materials import PROG, load, resolve_values  # noqa: F401  (PROG: the messages)
 DEFAULT_THETA = "0,15,30,45,60,75,85"
 #: Paths per angle (albedo) of the position-free engine by default.
 DEFAULT_SAMPLES = 20000
 #: The position-free render's views and its default paths per pixel.
 POSITION_FREE_VIEWS = ("lit", "slice")
 DEFAULT_SPP = 64
-
-
-def resolve_values(loaded, preset: str | None, params_file: str | None, assignments) -> dict:
-    """The material's values: its defaults, under ``--preset``, under ``--params``, under ``--set`` (as ``render``)."""
-    from explorer.materials.brd import parse_assignment
-
-    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
-    if params_file is not None:
-        from explorer.app.parameter_files import load_values
-
-        loaded_values = load_values(params_file, loaded)
-        for skipped in loaded_values.skipped:
-            click.echo(f"{PROG}: warning: {params_file}: skipped {skipped}", err=True)
-        overrides = {**loaded_values.values, **overrides}
-    if preset is not None:
-        from explorer.materials.presets import presets_for
-
-        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
-    return loaded.resolve(overrides)
 
 
 def parse_theta(text: str) -> np.ndarray:
@@ -65,17 +46,6 @@ def progress_printer(label: str, unit: str):
             click.echo(f"{PROG}: {label}: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
 
     return progress
-
-
-def _load(path):
-    """A material file, or a built-in material by name, its warnings on stderr (as ``render`` loads it)."""
-    from explorer.materials.brd import load_material
-    from explorer.resources import material_path
-
-    material = load_material(material_path(path))
-    for warning in material.warnings:
-        click.echo(f"{PROG}: warning: {warning}", err=True)
-    return material
 
 
 def _twin(loaded, values):
@@ -121,7 +91,7 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
             raise click.BadParameter("paths per angle are for --engine position-free", param_hint="--samples")
         if samples is not None and samples < 1:
             raise click.BadParameter(f"{samples} is not a positive number of paths", param_hint="--samples")
-        loaded = _load(material)
+        loaded = load(material)
         values = resolve_values(loaded, preset, params_file, assignments)
         stderr = None
         if engine == "gl":

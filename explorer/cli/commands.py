@@ -17,12 +17,13 @@ from pathlib import Path
 import click
 import numpy as np
 
-from explorer.materials.brd import Material, MaterialError, load_material, parse_assignment, round_integer
+from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
-from explorer.resources import DEFAULT_MATERIAL, display_path, material_path
+from explorer.resources import DEFAULT_MATERIAL, display_path
 
-PROG = "bragg-explorer"
+from explorer.cli.materials import PROG, resolve_values
+from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
 MAX_SIZE = 1 << 16
 
@@ -44,14 +45,6 @@ def _terminate(signum, _frame) -> None:
 def _fail(message: str) -> None:
     click.echo(f"{PROG}: error: {message}", err=True)
     sys.exit(1)
-
-
-def _load(path: str | Path) -> Material:
-    """A material file, or a built-in material by name (:func:`explorer.resources.material_path`)."""
-    material = load_material(material_path(path))
-    for warning in material.warnings:
-        click.echo(f"{PROG}: warning: {warning}", err=True)
-    return material
 
 
 def parse_size(text: str | None, view: str) -> tuple[int, int]:
@@ -309,19 +302,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     exposure_factor = parse_exposure(exposure, Path(out))
     light_angles = parse_light(light, view)
     loaded = _load(material)
-    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
-    if params_file is not None:
-        from explorer.app.parameter_files import load_values
-
-        loaded_values = load_values(params_file, loaded)
-        for skipped in loaded_values.skipped:
-            click.echo(f"{PROG}: warning: {params_file}: skipped {skipped}", err=True)
-        overrides = {**loaded_values.values, **overrides}
-    if preset is not None:
-        from explorer.materials.presets import presets_for
-
-        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
-    values = loaded.resolve(overrides)
+    values = resolve_values(loaded, preset, params_file, assignments)
     width, height = parse_size(size, view)
     thickness = None
     if view == "textured":

@@ -11,12 +11,8 @@ import click
 
 from explorer.materials.brd import MaterialError
 
-PROG = "bragg-explorer"
+from explorer.cli.materials import PROG, load, resolve_values, warn  # noqa: F401
 TARGETS = ("mitsuba", "brdf", "table", "materialx")
-
-
-def _warn(message: str) -> None:
-    click.echo(f"{PROG}: warning: {message}", err=True)
 
 
 def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
@@ -34,26 +30,7 @@ def render_env_with_mitsuba(material, values, width, height, environment, spp, v
 
     if material.model not in BSDF_NAMES:
         raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
-    return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=_warn)
-
-
-def _values(loaded, preset, params_file, assignments):
-    """--preset, then --params, then --set (the render command's order)."""
-    from explorer.materials.brd import parse_assignment
-
-    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
-    if params_file is not None:
-        from explorer.app.parameter_files import load_values
-
-        loaded_values = load_values(params_file, loaded)
-        for skipped in loaded_values.skipped:
-            _warn(f"{params_file}: skipped {skipped}")
-        overrides = {**loaded_values.values, **overrides}
-    if preset is not None:
-        from explorer.materials.presets import presets_for
-
-        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
-    return loaded.resolve(overrides)
+    return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
 @click.command("export")
@@ -71,12 +48,10 @@ def _values(loaded, preset, params_file, assignments):
 def export_command(material, target, preset, params_file, assignments, env_file, mesh, spp, out):
     """Write MATERIAL (a file or a built-in's name) for use elsewhere, to OUT (a directory for --to mitsuba)."""
     from explorer.errors import LocatedError
-    from explorer.materials.brd import load_material
-    from explorer.resources import material_path
     from explorer.views.images import OutputError
 
     try:
-        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load_material(material_path(material)))
+        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load(material))
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
@@ -85,8 +60,8 @@ def export_command(material, target, preset, params_file, assignments, env_file,
 def _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded):
     """The export itself (bad input raises LocatedError / OutputError / click.BadParameter)."""
     for warning in loaded.warnings:
-        _warn(warning)
-    values = _values(loaded, preset, params_file, assignments)
+        warn(warning)
+    values = resolve_values(loaded, preset, params_file, assignments)
     if target == "mitsuba":
         from explorer.mitsuba.export import export_scene
         from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap

@@ -23,14 +23,13 @@ Disney BRDF Explorer, src/shaderTemplates (the template interface); Fourneau et 
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from pathlib import Path
 from typing import Mapping
 
 import numpy as np
 
+from explorer.files import write_text_atomic
 from explorer.errors import LocatedError
 from explorer.resources import SHADER_DIR
 
@@ -246,14 +245,5 @@ def export_brdf(material, values: Mapping[str, object], out: Path) -> Path:
     if out.suffix.lower() != ".brdf":
         raise BrdfExportError(out, None, "a BRDF Explorer file: name it .brdf")
     text = brdf_text(material, values)
-    directory = out.parent if str(out.parent) else Path(".")
-    if not directory.is_dir():
-        raise BrdfExportError(out, None, "its directory does not exist")
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".brdf", dir=directory)
-    except OSError as error:
-        raise BrdfExportError(out, None, f"cannot write ({error.strerror})") from None
-    with os.fdopen(handle, "w", encoding="utf-8") as stream:
-        stream.write(text)
-    os.replace(temporary, out)
+    write_text_atomic(out, text)  # explorer.files: a temporary file renamed; OutputError (one line) otherwise
     return out

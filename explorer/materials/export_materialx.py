@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.files import write_text_atomic
 from explorer.errors import LocatedError
 
 
@@ -79,8 +80,6 @@ def validate_document(text: str, origin: str = "<mtlx>") -> None:
 
 def export_materialx(material, values, out: Path) -> Path:
     """Write the document to ``out`` atomically, validated first when the ``materialx`` package is present."""
-    import os
-    import tempfile
 
     if out.suffix.lower() != ".mtlx":
         raise MaterialXExportError(out, None, "a MaterialX document: name it .mtlx")
@@ -89,16 +88,7 @@ def export_materialx(material, values, out: Path) -> Path:
         validate_document(text, str(out))
     except ImportError:
         pass  # the materialx package is optional (the test extra has it)
-    directory = out.parent if str(out.parent) else Path(".")
-    if not directory.is_dir():
-        raise MaterialXExportError(out, None, "its directory does not exist")
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".mtlx", dir=directory)
-    except OSError as error:
-        raise MaterialXExportError(out, None, f"cannot write ({error.strerror})") from None
-    with os.fdopen(handle, "w", encoding="utf-8") as stream:
-        stream.write(text)
-    os.replace(temporary, out)
+    write_text_atomic(out, text)  # explorer.files: a temporary file renamed; OutputError (one line) otherwise
     return out
 
 
