@@ -28,16 +28,14 @@ def _member(cls, value: int, label: str, options: dict):
 
 
 class _Method(enum.IntEnum):
-    """A method: its integer value, a label, and what it needs."""
+    """A method: its integer value, a label, and what it needs (members are ``(value, label, options)``)."""
+
+    def __new__(cls, value, label, options):  # the subclasses' members, through Enum's __new_member__
+        return _member(cls, value, label, options)
 
     @classmethod
     def glsl_prefix(cls) -> str:
         raise NotImplementedError
-
-    @classmethod
-    def choices(cls) -> dict[int, str]:
-        """``{number: "number label"}``, as the app's combo and ``info`` show them."""
-        return {int(m): f"{int(m)} {m.label}" for m in cls}
 
 
 class BraggMethod(_Method):
@@ -48,9 +46,6 @@ class BraggMethod(_Method):
     SUBDIVIDED = (2, "subdivided", dict(source="Fourneau et al. 2024, Section 3.2 (quality s)"))
     TABULATED = (3, "tabulated", dict(table=True, approximate=False, source="ours: the converged spectral colour over cos theta"))
     IMPROVED = (4, "improved", dict(source="ours: fringe-averaged, graded boxes"))
-
-    def __new__(cls, value, label, options):
-        return _member(cls, value, label, options)
 
     @classmethod
     def glsl_prefix(cls) -> str:
@@ -66,9 +61,6 @@ class ThinFilmMethod(_Method):
     FOURIER_3 = (3, "Fourier m=3", dict(source="Belcour & Barla 2017, Eq. 10, m = 3, with its remainder"))
     GAUSSIAN = (4, "Gaussian fits", dict(source="Belcour & Barla 2017, Eq. 10, m = 3, Gaussian XYZ fits"))
     NAIVE = (5, "naive RGB", dict(source="Belcour & Barla 2017, Section 4 (one wavelength per channel)"))
-
-    def __new__(cls, value, label, options):
-        return _member(cls, value, label, options)
 
     @classmethod
     def glsl_prefix(cls) -> str:
