@@ -1,0 +1,46 @@
+"""
+How every command takes a material and its values: ``MATERIAL`` (a file or a built-in's name), then its
+defaults under ``--preset``, under ``--params``, under ``--set``. One place for ``render``, ``albedo``,
+``export`` and the others, imported by each command module (none imports :mod:`explorer.cli.commands`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from explorer.materials.brd import Material, load_material, parse_assignment
+from explorer.resources import material_path
+
+PROG = "bragg-explorer"
+
+
+def warn(message: str) -> None:
+    """A one-line warning on stderr."""
+    click.echo(f"{PROG}: warning: {message}", err=True)
+
+
+def load(path: str | Path) -> Material:
+    """A material file, or a built-in material by name (:func:`explorer.resources.material_path`), its warnings on stderr."""
+    material = load_material(material_path(path))
+    for warning in material.warnings:
+        warn(warning)
+    return material
+
+
+def resolve_values(loaded: Material, preset: str | None, params_file: str | None, assignments) -> dict:
+    """The material's values: its defaults, under ``--preset``, under ``--params``, under ``--set``."""
+    overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
+    if params_file is not None:
+        from explorer.app.parameter_files import load_values
+
+        loaded_values = load_values(params_file, loaded)
+        for skipped in loaded_values.skipped:
+            warn(f"{params_file}: skipped {skipped}")
+        overrides = {**loaded_values.values, **overrides}
+    if preset is not None:
+        from explorer.materials.presets import presets_for
+
+        overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
+    return loaded.resolve(overrides)
