@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from explorer.dev.validation_studies import BRUTE_FORCE_STEP, brute_force_rgb, relative_error
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.materials.models import model_for
 from explorer.views.geometry import view_cos_theta
@@ -25,33 +26,12 @@ TABLE_RTOL = 2e-3
 GL_RTOL = 2e-3
 #: The host's real float32 path against the complex float64 one, per channel.
 FAST_PATH_ATOL = 2e-5
-#: The brute-force integral's step (nm).
-BRUTE_FORCE_STEP = 0.005
 #: A handful of angles, grazing ones included (the resonances are narrowest there, s polarised).
 ANGLES_DEGREES = np.array([0.0, 45.0, 70.0, 80.0, 88.0])
 
 FIGURE4 = [(Lambda, delta) for Lambda in (244.0, 500.0, 988.0) for delta in (0.25, 0.5, 0.75)]
 #: Mirrors under a host nh != n1 (Appendix D): water-like layers in air, and a denser host (TIR).
 HOST_MIRRORS = [dict(n1=1.33, n2=1.8, Lambda=300.0, delta=0.5, nh=1.0), dict(n1=1.0, n2=1.5, Lambda=500.0, delta=0.5, nh=1.4)]
-
-
-def brute_force_rgb(cos_theta, mirror, step=BRUTE_FORCE_STEP):
-    """The colour integral at a fixed fine step: trapezoids of R_lambda times the linearly interpolated CMFs."""
-    cmf = colorimetry.colour_matching_functions()
-    nodes = np.arange(colorimetry.WAVELENGTH_MIN - 1, colorimetry.WAVELENGTH_MAX + 2, dtype=np.float64)
-    padded = np.vstack([np.zeros(3), cmf, np.zeros(3)])
-    wavelengths = np.linspace(nodes[0], nodes[-1], int(round((nodes[-1] - nodes[0]) / step)) + 1)
-    xyz = np.zeros((cos_theta.size, 3))
-    for chunk in np.array_split(np.arange(wavelengths.size), 8):
-        lam = wavelengths[chunk[0] : chunk[-1] + 2]  # chunks overlap by one sample
-        R = bragg.bragg_reflectance(cos_theta[:, None], lam, mirror)
-        weights = np.stack([np.interp(lam, nodes, padded[:, c]) for c in range(3)], axis=-1)
-        xyz += np.trapezoid(R[:, :, None] * weights[None], lam, axis=1)
-    return colorimetry.xyz_to_rgb(xyz)
-
-
-def relative_error(rgb, reference):
-    return np.abs(rgb - reference).max(axis=-1) / np.abs(reference).max(axis=-1)
 
 
 def test_hat_average_keeps_the_1nm_sum_and_white():

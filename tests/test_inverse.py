@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error, run_cli
+from explorer.dev.validation_studies import INVERSE_CASES, brightest_channel_below
 from explorer.physics import inverse, lobes, lobes_fgd
 from explorer.physics.inverse import InverseError, Lobe
 
@@ -23,31 +24,7 @@ ROUND_TRIP_TOLERANCE = 1e-3
 #: measured up to 1.2e-3 on the cases below.
 OTHER_CHANNEL_VARIANCE = 5e-3
 
-CASES = {
-    "fig5a_dielectric": [Lobe(0.04, 0.0)],
-    "rough_dielectric": [Lobe(0.2, 0.02)],
-    "fig14a_conductor": [Lobe([0.9, 0.7, 0.5], 0.03, base="conductor")],
-    "fig14a_coated_conductor": [Lobe(0.04, 0.0), Lobe([0.9, 0.7, 0.5], 0.03, base="conductor")],
-    "fig10a_two_layer_smooth": [Lobe(0.15, 0.0, layers=2)],
-    "fig10c_two_layer_rough": [Lobe(0.15, 0.02, layers=2)],
-    "fig14b_two_layer_coloured": [Lobe([0.1, 0.2, 0.1], 0.03, layers=2)],
-    "fig14b_coated": [Lobe(0.04, 0.0), Lobe([0.1, 0.2, 0.1], 0.03, layers=2)],
-    "fig15b_two_layer_coloured": [Lobe([0.09, 0.09, 0.15], 0.0, layers=2)],
-    "fig16_two_layer_conductor": [Lobe(0.45, 0.03, layers=2, base="conductor")],
-    "fig19b_haze": [Lobe(0.1, 0.0), Lobe([0.35, 0.25, 0.3], 0.04, base="conductor")],
-    "fig20_haze_colour": [Lobe([0.09, 0.14, 0.09], 0.005, layers=2), Lobe(0.09, 0.1)],
-    "three_lobes": [Lobe(0.05, 0.0), Lobe(0.06, 0.03), Lobe(0.08, 0.1)],
-}
-
-
-def brightest_channel_below(stack, lobe_list, k):
-    """The channel that set lobe k's roughness: the largest R' under the layers above (Eq. 18)."""
-    above = sum(lobe.layers for lobe in lobe_list[:k])
-    if above == 0:
-        return int(np.argmax(lobe_list[k].energy))
-    statistics = lobes.stack_statistics(stack, above)
-    R_prime = 1.0 / (statistics.T_0n * statistics.T_n0 / lobe_list[k].energy + statistics.R_n0)
-    return int(np.argmax(R_prime))
+CASES = INVERSE_CASES
 
 
 @pytest.mark.parametrize("case", list(CASES))

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import tmm
 
 from conftest import REPO_ROOT
-from explorer.physics import lobes, microfacet
+from explorer.dev.validation_studies import FURNACE_STACKS, GL_STACKS, brute_force_fgd, hemisphere
+from explorer.dev.validation_studies import tmm_incoherent_reflectance as tmm_reflectance
+from explorer.physics import lobes
 from explorer.materials.brd import load_material
 from explorer.views.env import EnvironmentMap, env_integral_numpy
 from explorer.gpu.env import ProgressiveEnvRender
@@ -30,19 +31,6 @@ TMM_TOLERANCE = 1e-3
 FGD_TOLERANCE = 5e-3
 #: White furnace: the albedo may not exceed 1 by more than the quadrature's error.
 FURNACE_SLACK = 2e-3
-
-
-def tmm_reflectance(etas, taus, theta, base_kappa=0.0, wavelength=500.0):
-    """Unpolarised incoherent reflectance of media ``etas`` (optical depths ``taus`` between them) by tmm."""
-    k = 1e-5  # a weakly absorbing layer of thickness d has tau = 4 pi k d / lambda; k too small to change Fresnel
-    ns, ds = [etas[0]], [np.inf]
-    for eta, tau in zip(etas[1:-1], taus):
-        ns.append(eta + 1j * k)
-        ds.append(tau * wavelength / (4 * np.pi * k))
-    ns.append(etas[-1] + 1j * base_kappa)
-    ds.append(np.inf)
-    coherency = ["i"] * len(ns)
-    return np.mean([tmm.inc_tmm(p, ns, ds, coherency, theta, wavelength)["R"] for p in "sp"])
 
 
 THETAS = np.radians(np.linspace(0.0, 89.0, 46))
@@ -71,19 +59,6 @@ def test_smooth_coated_conductor_equals_incoherent_tmm():
         reference = np.array([tmm_reflectance([1.0, 1.5, eta[ch]], [tau[ch]], t, kappa[ch]) for t in THETAS])
         error = np.abs(ours[:, ch] - reference).max()
         assert error <= TMM_TOLERANCE, f"channel {ch}: max |lobes - inc_tmm| = {error:.2e}"
-
-
-def brute_force_fgd(cos_theta, alpha, eta, kappa=0.0, count=400):
-    """int f_r cos theta_o d omega_o of the GGX BRDF with Fresnel F_{s,p}(i.h), on a (theta_o, phi_o) grid."""
-    theta = (np.arange(count) + 0.5) / count * np.pi / 2
-    phi = (np.arange(2 * count) + 0.5) / (2 * count) * 2 * np.pi
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    o = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
-    i = np.array([np.sqrt(1 - cos_theta**2), 0.0, cos_theta])
-    lobe, cos_d, above = microfacet.microfacet_lobe(i, o, np.array([0.0, 0.0, 1.0]), alpha)
-    F = lobes.fresnel_sp(cos_d, eta, kappa)
-    d_omega = np.sin(t) * (np.pi / 2 / count) * (2 * np.pi / (2 * count))
-    return (F * (lobe * o[..., 2] * d_omega)).sum(axis=(-1, -2))
 
 
 @pytest.mark.parametrize("cos_theta, alpha, eta", [
@@ -126,25 +101,11 @@ def test_two_interfaces_follow_eq5_at_normal_incidence():
     np.testing.assert_allclose(variances[0], f(alpha_1), rtol=1e-12)
 
 
-def hemisphere(count=96):
-    theta = (np.arange(count) + 0.5) / count * np.pi / 2
-    phi = (np.arange(2 * count) + 0.5) / (2 * count) * 2 * np.pi
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    o = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
-    d_omega = (np.sin(t) * (np.pi / 2 / count) * (np.pi / count)).ravel()
-    return o, d_omega
-
-
-@pytest.mark.parametrize("overrides", [
-    {"layers": 3, "eta_1": 1.5, "eta_2": 4.0, "eta_3": 1.0, "alpha_1": 0.3, "alpha_2": 0.6, "alpha_3": 0.9},
-    {"layers": 2, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 0.4, "alpha_2": 0.8},
-    {"layers": 2, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 1.0, "alpha_2": 1.0},
-    {"layers": 1, "conductor": 1, "eta_base": "0.05", "kappa_base": "6", "alpha_1": 0.2},  # the brightest: 0.89
-])
+@pytest.mark.parametrize("overrides", FURNACE_STACKS)  # the brightest, a bare conductor at alpha = 0.2: 0.89
 def test_white_furnace_at_most_one(overrides):
     material = load_material(MATERIAL)
     model = model_for(material, material.resolve(overrides))
-    o, d_omega = hemisphere()
+    o, d_omega = hemisphere(96)
     for cos_theta in (1.0, 0.7, 0.3, 0.05):
         L = np.array([np.sqrt(1 - cos_theta**2), 0.0, cos_theta])
         albedo = (model.brdf(L, o, np.array([0.0, 0.0, 1.0]), None, None) * (o[:, 2] * d_omega)[:, None]).sum(axis=0)
@@ -177,11 +138,7 @@ def test_bad_stack_is_one_line():
 # --------------------------------------------------------------------------------------------------
 # GL against numpy
 
-CASES = {
-    "two_dielectric": {},
-    "coated_conductor": {"conductor": 1, "tau_1": "0.2,0.5,1.0", "alpha_1": 0.02, "alpha_2": 0.25},
-    "three_tir": {"layers": 3, "eta_1": 2.5, "eta_2": 1.0, "eta_3": 1.5, "tau_2": "0.3,0.1,0", "alpha_3": 0.6, "tir": 1},
-}
+CASES = GL_STACKS
 
 
 @pytest.fixture(scope="module")

@@ -4,8 +4,9 @@ of ``docs/validation.md`` in-process and write the file atomically, so that its 
 
 Each table is a :class:`Section` of :data:`SECTIONS` (one registry; ``--only`` and the file's order derive
 from it): a heading, the command that regenerates the table, the date and machine (GL renderer, CPU count),
-the short fixed prose that explains it, and the Markdown the command prints (``--markdown``,
-:mod:`explorer.cli.markdown_tables`). Slow measurements run reduced (a smaller sphere, fewer repeats), and
+the short fixed prose that explains it, and the Markdown the command prints (``bench``/``accuracy
+--markdown`` through :mod:`explorer.cli.markdown_tables`, or :mod:`explorer.dev.validation_studies` for the
+measurements no user command makes: under a host, exactness, the layered lobes). Slow measurements run reduced (a smaller sphere, fewer repeats), and
 the reduction is written beside the table. With ``--only``, the other sections keep their text from the
 existing file.
 
@@ -55,11 +56,6 @@ class Section:
     after: str = ""
     #: How this run differs from ``command``'s defaults (a smaller sphere, fewer repeats), or "".
     reduction: str = ""
-
-    @property
-    def by_hand(self) -> bool:
-        """No command writes this table yet: its text is copied from :data:`BY_HAND_FILE`."""
-        return not self.command
 
 
 def _quiet(function, *args, **kwargs):
@@ -119,16 +115,13 @@ def _layers() -> str:
     return layers_markdown(_quiet(run_layers_bench, as_json=True, repeats=LAYERS_REPEATS))
 
 
-#: Tables no command writes yet, verbatim from the hand-written file (one marker per section).
-BY_HAND_FILE = Path(__file__).with_name("validation_by_hand.md")
-BY_HAND_DATE = "2026-11-25"
+def _study(name: str) -> Callable[[], str]:
+    """A table of :mod:`explorer.dev.validation_studies` (the measurements no user command makes)."""
+    def measure() -> str:
+        from explorer.dev.validation_studies import STUDIES
 
-
-def _by_hand(name: str) -> Callable[[], str]:
-    def text() -> str:
-        sections = existing_sections(BY_HAND_FILE.read_text(encoding="utf-8"))
-        return sections[name].split("\n", 1)[1]  # without its marker line
-    return text
+        return STUDIES[name](lambda message: print(message, file=sys.stderr, flush=True))
+    return measure
 
 
 #: Reductions of the slow measurements (the commands' defaults: 60 frames, a 512² sphere, 5 layer repeats).
@@ -158,7 +151,14 @@ SECTIONS: tuple[Section, ...] = (
               "(the reading consistent with the paper's Table 1), **absolute** from mode 0.",
         after="The goal is a median ΔE2000 ≤ 2 at s = 3: compare the paper's variant with the improved one (method 4, "
               "same box budget, sub-boxes by share of CMF mass)."),
-    Section("host", "Accuracy under a host medium (Appendix D)", "", _by_hand("host")),
+    Section(
+        "host", "Accuracy under a host medium (Appendix D)", "python3 -m explorer.dev.validation_studies host", _study("host"),
+        prose="Under a host nh ≠ n1 (Appendix D) the host interface reflects coherently with the mirror. The improved "
+              "method weights each box with the fringes' average of Appendix D's |r_hN|² itself: with x = cot(N K Λ), "
+              "r_hN = (P + Q x) / (S + T x) is a Möbius map of x, and x sweeps the real line with a Cauchy density over "
+              "a fringe, so the average is a closed form by residues (`bragg.fringe_average_under_host`). Applying the "
+              "host interface incoherently to the no-host average instead misses a slow modulation of R of up to ~0.07 "
+              "(water-like layers in air)."),
     Section(
         "bench", "Speed of the Bragg mirror's methods (Table 1)", "python3 -m explorer bench --markdown", _bench,
         prose="Time per frame of a sphere (bounded by `glFinish`), Λ ∈ {244, 500, 988} nm (n1 = 1, n2 = 1.5, δ = 0.5, "
@@ -168,7 +168,26 @@ SECTIONS: tuple[Section, ...] = (
               "texture fetch per pixel, close to a plain Schlick-Fresnel shader. Without a GPU (llvmpipe) the "
               "reference's loop dominates, so the speed-ups exceed the paper's.",
         reduction=f"a {BENCH_SIZE}² sphere (the command's default: 512²)"),
-    Section("exactness", "Exactness of the Bragg mirror and its converged reference", "", _by_hand("exactness")),
+    Section(
+        "exactness", "Exactness of the Bragg mirror and its converged reference",
+        "python3 -m explorer.dev.validation_studies exactness", _study("exactness"),
+        prose="*The converged reference.* Beside band edges, Yeh's reflectance has transmission resonances narrower "
+              "than a nanometre (narrower as N grows, ∝ 1/N³ for the first ones), which the paper's 1-nm samples hit or "
+              "miss. `bragg.reference_rgb` (numpy, no step) integrates R_λ against the CMFs interpolated linearly between "
+              "their 1-nm nodes: that equals the 1-nm sum with each sample R(λ_i) replaced by R's average over the hat "
+              "function of node i, so white and the XYZ → RGB matrix stay those of the 1-nm sum. The averages are refined "
+              "per 1-nm cell (`colorimetry.converged_spectra`): trapezoid sums every 1/K nm, Richardson-extrapolated "
+              "between successive K (Simpson's rule), K doubling until one comparison changes the cell's share of the "
+              "colour by less than 2e-4 of the row's brightest channel divided among the 472 cells; only the cells beside "
+              "band edges and under narrow resonances refine further (to 1/1024 nm). Thin films "
+              "(`thinfilm.reference_rgb`) and the layer tables of `bragg_stack.brd` (Eq. 28) use the same hat averages.",
+        after="*The table* (method 3) refines where the second differences of its 256 entries say that linear "
+              "interpolation may miss by more than 5e-4, up to 4081 entries (the colour turns fastest near Brewster's "
+              "angle, where the p band gap closes). *GL, method 0*: `wavelength_step = 1` is the paper's sum; at 1/32 nm "
+              "the shader equals the converged numpy reference to 2e-3 of the brightest channel, and every GL image equals "
+              "its numpy twin to 2e-3 per linear channel (tests/test_converged.py, the twins' tests). In float32, a mirror "
+              "with N = 1000 and total internal reflection in layer 2 differs from float64 by up to ~3.5e-3 in isolated "
+              "columns, and so does θ = 89.75°, beyond the 89.5° in scope."),
     Section(
         "thin-film", "Thin films (Belcour & Barla 2017)", "python3 -m explorer bench --thin-film --markdown", _thin_film,
         prose="ΔE2000 of the thin-film methods of `thin_film.brd` on Figure 7's film and every thin-film preset, and "
@@ -186,7 +205,18 @@ SECTIONS: tuple[Section, ...] = (
         after="With ρd = 0 every method shares the lobe D G1 G1 / (4 cos θi cos θo) and differs only in R_rgb(θd). "
               "Tables under Appendix D's host take the complex float64 path of Yeh's reflectance, hence their cost.",
         reduction=f"{LAYERS_REPEATS} repeats (the command's default: 5)"),
-    Section("lobes", "Layered lobes (Bati et al. 2021)", "", _by_hand("lobes")),
+    Section(
+        "lobes", "Layered lobes (Bati et al. 2021)", "python3 -m explorer.dev.validation_studies lobes", _study("lobes"),
+        prose="The checks of `tests/test_lobes.py` and `tests/test_inverse.py`, measured on more cases than the tests "
+              "hold (their bounds in brackets).",
+        after="Known limits: Eq. 3 takes R_k and σ_k at the light's angle, so the BRDF is reciprocal only for pairs of "
+              "equal polar angle (tested there). Near the critical angle of an interface seen from its denser side "
+              "(η < 1) with α < 0.1, the 33-node FGD table misses TIR's sharp rise (hence η > 1 above). Rough conductors "
+              "use E(θ, α) F(c̄_d) instead of Belcour's 4D table; Belcour's TIR term is not used (Bati et al. find it "
+              "negligible at normal incidence); instead `tir` (off by default, `inverse --tir`) lets light going up a "
+              "rough interface see the FGD of its own side. Coloured 2-layer lobes reach the requested variance on one "
+              "channel only (Sec. 5.2.3). The white furnace stays below 1 because Eq. 3's GGX lobes lose their "
+              "shadowing once more after FGD."),
 )
 
 NAMES = tuple(section.name for section in SECTIONS)
@@ -214,13 +244,8 @@ def _marker(name: str) -> str:
 
 def render_section(section: Section, table: str, when: str, machine: str) -> str:
     """One section's Markdown: heading, command, date and machine, reduction, prose, table, closing prose."""
-    if section.by_hand:
-        lines = [_marker(section.name), f"## {section.title}", "",
-                 f"No command writes these values yet: measured by hand ({BY_HAND_DATE} or before; "
-                 f"`{BY_HAND_FILE.name}` holds them).", ""]
-    else:
-        lines = [_marker(section.name), f"## {section.title}", "", f"Regenerate: `{section.command}`  ",
-                 f"Measured {when} on {machine}" + (f"; reduced: {section.reduction}." if section.reduction else "."), ""]
+    lines = [_marker(section.name), f"## {section.title}", "", f"Regenerate: `{section.command}`  ",
+             f"Measured {when} on {machine}" + (f"; reduced: {section.reduction}." if section.reduction else "."), ""]
     if section.prose:
         lines += [section.prose, ""]
     lines += [table.rstrip(), ""]
@@ -249,7 +274,7 @@ def build_document(sections: Sequence[Section], only: Sequence[str] | None = Non
     parts = [INTRO, ""]
     for section in sections:
         if only is None or section.name in only:
-            if progress is not None and not section.by_hand:
+            if progress is not None:
                 progress(f"validation_doc: measuring {section.name} ({section.command})")
             try:
                 parts.append(render_section(section, section.measure(), when, machine))
