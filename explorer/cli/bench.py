@@ -191,28 +191,6 @@ def figure4_accuracy(s_values=range(2, 9)) -> list[dict]:
     return rows
 
 
-def format_accuracy(rows: list[dict]) -> str:
-    """Markdown tables: median / max ΔE2000 per mirror, basic and s = 2..8, and the 1-nm sum's own error."""
-    out = []
-    one_nm = {(r["Lambda"], r["delta"]): r for r in rows if r["variant"] == "1-nm sum"}
-    for variant, numbering in (("paper", "relative"), ("paper", "absolute"), ("improved", "relative")):
-        subset = [r for r in rows if r["variant"] == variant and (r["mode_numbering"] == numbering or r["s"] == 0)]
-        s_values = sorted({r["s"] for r in subset if r["s"] > 0})
-        how = "sub-boxes by share of CMF mass" if variant == "improved" else f"mode numbering **{numbering}**"
-        out.append(f"**{variant}** variant, {how} — median / max ΔE2000 over θ ∈ [0°, 89.5°] against the converged reference\n")
-        out.append("| Λ (nm) | δ | basic | " + " | ".join(f"s = {s}" for s in s_values) + " | 1-nm sum |")
-        out.append("|---|---|---|" + "---|" * (len(s_values) + 1))
-        for Lambda in FIGURE4_LAMBDAS:
-            for delta in FIGURE4_DELTAS:
-                cell = {r["s"]: r for r in subset if r["Lambda"] == int(Lambda) and r["delta"] == delta}
-                values = [f"{cell[s]['dE_median']:.2f} / {cell[s]['dE_max']:.1f}" for s in [0, *s_values]]
-                own = one_nm.get((int(Lambda), delta))
-                values.append(f"{own['dE_median']:.2f} / {own['dE_max']:.2f}" if own else "")
-                out.append(f"| {Lambda:g} | {delta:g} | " + " | ".join(values) + " |")
-        out.append("")
-    return "\n".join(out)
-
-
 def plot_accuracy(rows: list[dict], path: Path) -> None:
     """Median ΔE2000 against s per mirror, paper vs improved (a PNG through matplotlib)."""
     import matplotlib
@@ -244,16 +222,17 @@ def plot_accuracy(rows: list[dict], path: Path) -> None:
 
 
 def run_accuracy(as_json: bool = False, plot: Path | None = None, markdown: bool = False) -> list[dict]:
+    """``accuracy``: the Figure 4 grid as JSON, or as the Markdown tables of :func:`accuracy_markdown` (with or without ``markdown``)."""
     rows = figure4_accuracy()
     if plot is not None:
         plot_accuracy(rows, plot)
         _progress(f"accuracy: wrote {plot}")
-    if markdown:
+    if as_json:
+        print(json.dumps({"rows": rows}, indent=2))
+    else:  # the text output is the Markdown tables (--markdown says so explicitly)
         from explorer.cli.markdown_tables import accuracy_markdown
 
         print(accuracy_markdown(rows, FIGURE4_LAMBDAS, FIGURE4_DELTAS))
-    else:
-        print(json.dumps({"rows": rows}, indent=2) if as_json else format_accuracy(rows))
     return rows
 
 
