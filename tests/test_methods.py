@@ -15,6 +15,8 @@ from explorer.materials.methods import BraggMethod, ThinFilmMethod, glsl_defines
 #: A method compared with, or set to, a literal number (in Python; the shaders' ``m`` too).
 LITERAL = re.compile(r"""(\bmethod\b["']?\]?\s*(==|!=|<=|>=|<|>|=|:)\s*\(?\s*\d)|(method\s+(not\s+)?in\s+\(\d)""")
 SHADER_LITERAL = re.compile(r"\bm\s*(==|!=|<=|>=|<|>)\s*\d")
+#: Methods listed as literal numbers (``for m in (1, 2, 3, 4) if m != model.method``).
+NUMBERS_LITERAL = re.compile(r"\b(m|method)\s+in\s+\((\d+,\s*)+\d+\)")
 
 
 def test_no_method_number_outside_its_declaration():
@@ -27,13 +29,16 @@ def test_no_method_number_outside_its_declaration():
             code = line.split("#")[0] if path.suffix == ".py" else line.split("//")[0]
             if path.suffix == ".brd" and line.startswith("#"):
                 continue
-            if LITERAL.search(code) or (path.suffix == ".brd" and SHADER_LITERAL.search(code)):
+            if (LITERAL.search(code) or (path.suffix == ".brd" and SHADER_LITERAL.search(code))
+                    or ("method" in code and NUMBERS_LITERAL.search(code))):  # not the quality s in (2, 3, 4, 5)
                 found.append(f"{path.relative_to(REPO_ROOT)}:{number}: {line.strip()}")
     assert not found, "method numbers spelled outside explorer/materials/methods.py:\n" + "\n".join(found)
 
 
 def test_the_check_sees_a_literal():
     assert LITERAL.search("if self.method == 3:") and LITERAL.search('values = {"method": 0}')
+    assert NUMBERS_LITERAL.search("others = tuple(m for m in (1, 2, 3, 4) if m != model.method)")
+    assert not NUMBERS_LITERAL.search('[{"method": int(B.SUBDIVIDED), "s": s} for s in (2, 3, 4, 5)]')
     assert SHADER_LITERAL.search("if (m == 4) return x;") and not SHADER_LITERAL.search("if (m == BRAGG_IMPROVED)")
 
 

@@ -152,6 +152,6 @@ def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | No
     options = dict(s=model.s, wavelength_step=model.wavelength_step)
     accuracies = mirror_accuracy(model.mirror, (model.method,), **options)
     if not accuracies[model.method].accurate:  # only then are the others needed (render's note, the app's hint)
-        others = tuple(m for m in (1, 2, 3, 4) if m != model.method)
+        others = tuple(int(m) for m in BraggMethod if m is not BraggMethod.REFERENCE and m != model.method)
         accuracies.update(mirror_accuracy(model.mirror, others, **options))
     return AccuracyBadge(model.method, accuracies)
