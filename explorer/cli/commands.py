@@ -20,6 +20,7 @@ import numpy as np
 from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
+from explorer.views.geometry import VIEWS
 from explorer.resources import DEFAULT_MATERIAL, display_path
 
 from explorer.cli.materials import PROG, resolve_values
@@ -267,7 +268,7 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured", "env"]), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(VIEWS), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")

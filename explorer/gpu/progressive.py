@@ -106,15 +106,12 @@ class ProgressiveView:
 
     def _allocate(self, size: tuple[int, int]) -> None:
         if self.full is not None:
-            self._release(self.full)
+            self.renderer.resources.release(self.full)
         self.size = size
         self.full = self._framebuffer(size)
 
     def _framebuffer(self, size):
         return self.renderer.resources.framebuffer(*size, origin="view size")
-
-    def _release(self, framebuffer) -> None:
-        self.renderer.resources.release(framebuffer)
 
     # -- drawing -----------------------------------------------------------------------------------
 
@@ -165,7 +162,7 @@ class ProgressiveView:
                     return spent
                 if preview != self.preview_size:
                     if self.preview is not None:
-                        self._release(self.preview)
+                        self.renderer.resources.release(self.preview)
                     self.preview = self._framebuffer(preview)
                     import moderngl
 
@@ -200,5 +197,5 @@ class ProgressiveView:
     def release(self) -> None:
         for framebuffer in (self.full, self.preview):
             if framebuffer is not None:
-                self._release(framebuffer)
+                self.renderer.resources.release(framebuffer)
         self.full = self.preview = None

@@ -253,9 +253,6 @@ class Renderer:
         """
         return self.resources.framebuffer(width, height, count, texture=texture)
 
-    def _release(self, framebuffer) -> None:
-        self.resources.release(framebuffer)
-
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
         *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
@@ -276,7 +273,7 @@ class Renderer:
             self.draw(program, framebuffer, **bindings, finish=False)
             data = framebuffer.read(components=4, dtype="f4")
         finally:
-            self._release(framebuffer)
+            self.resources.release(framebuffer)
         image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
         return np.ascontiguousarray(image)
 
@@ -293,4 +290,4 @@ class Renderer:
         try:
             return self.draw(program, framebuffer, **bindings)
         finally:
-            self._release(framebuffer)
+            self.resources.release(framebuffer)
