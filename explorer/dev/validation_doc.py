@@ -158,7 +158,8 @@ SECTIONS: tuple[Section, ...] = (
               "r_hN = (P + Q x) / (S + T x) is a Möbius map of x, and x sweeps the real line with a Cauchy density over "
               "a fringe, so the average is a closed form by residues (`bragg.fringe_average_under_host`). Applying the "
               "host interface incoherently to the no-host average instead misses a slow modulation of R of up to ~0.07 "
-              "(water-like layers in air)."),
+              "(water-like layers in air). Columns: the basic method, the subdivided method in the paper's variant and in "
+              "ours (improved, method 4), and the paper's 1-nm sum."),
     Section(
         "bench", "Speed of the Bragg mirror's methods (Table 1)", "python3 -m explorer bench --markdown", _bench,
         prose="Time per frame of a sphere (bounded by `glFinish`), Λ ∈ {244, 500, 988} nm (n1 = 1, n2 = 1.5, δ = 0.5, "
@@ -208,7 +209,7 @@ SECTIONS: tuple[Section, ...] = (
     Section(
         "lobes", "Layered lobes (Bati et al. 2021)", "python3 -m explorer.dev.validation_studies lobes", _study("lobes"),
         prose="The checks of `tests/test_lobes.py` and `tests/test_inverse.py`, measured on more cases than the tests "
-              "hold (their bounds in brackets).",
+              "hold (a result's \"bound\" is its test's tolerance).",
         after="Known limits: Eq. 3 takes R_k and σ_k at the light's angle, so the BRDF is reciprocal only for pairs of "
               "equal polar angle (tested there). Near the critical angle of an interface seen from its denser side "
               "(η < 1) with α < 0.1, the 33-node FGD table misses TIR's sharp rise (hence η > 1 above). Rough conductors "
