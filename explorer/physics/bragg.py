@@ -1374,10 +1374,8 @@ def _cmf_nodes() -> tuple[np.ndarray, np.ndarray]:
 def _cmf_linear(wavelength: np.ndarray) -> np.ndarray:
     """The CMFs interpolated linearly between their 1-nm nodes (zero outside 359-831 nm), ``(n, 3)``."""
     c, _ = _cmf_nodes()
-    x = np.clip(wavelength - colorimetry.HAT_LOW, 0.0, c.shape[0] - 1.0)
-    i = np.minimum(x.astype(np.int64), c.shape[0] - 2)
-    f = (x - i)[:, None]
-    return c[i] * (1.0 - f) + c[i + 1] * f
+    nodes = colorimetry.HAT_LOW + np.arange(c.shape[0], dtype=np.float64)
+    return np.stack([np.interp(wavelength, nodes, c[:, channel], left=0.0, right=0.0) for channel in range(3)], axis=-1)
 
 
 def _cmf_integral_to(wavelength: np.ndarray) -> np.ndarray:
@@ -1611,11 +1609,14 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         sub, sub_lo, sub_width = _panels(np.arange(piece.size), chi_lo, chi_hi, split)
         x, w = _gauss_legendre(n * scale)
         chi = sub_lo[:, None] + sub_width[:, None] * x
-        kk = k[sub][:, None]
-        cos_chi, sin_chi = np.cos(chi), np.sin(chi)
-        psi = np.arctan2(sin_chi, kk * cos_chi)  # arctan(tan(chi) / k) in [0, pi / 2]
+        if kind == 3:
+            kk = k[sub][:, None]
+            cos_chi, sin_chi = np.cos(chi), np.sin(chi)
+            psi = np.arctan2(sin_chi, kk * cos_chi)  # arctan(tan(chi) / k) in [0, pi / 2]
+            jacobian = np.abs(t_span[sub][:, None]) * (2.0 / np.pi) * kk / (kk * kk * cos_chi * cos_chi + sin_chi * sin_chi)
+        else:  # k = 1: psi = chi
+            psi, jacobian = chi, np.abs(t_span[sub][:, None]) * (2.0 / np.pi)
         nodes_t.append((t_a[sub][:, None] + t_span[sub][:, None] * (2.0 / np.pi) * psi).ravel())
-        jacobian = np.abs(t_span[sub][:, None]) * (2.0 / np.pi) * kk / (kk * kk * cos_chi * cos_chi + sin_chi * sin_chi)
         nodes_w.append((sub_width[:, None] * w * jacobian).ravel())
         nodes_piece.append(np.repeat(piece[sub], x.size))
         nodes_kind.append(np.full(chi.size, kind, dtype=np.int8))
@@ -1626,8 +1627,9 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
     weight = np.concatenate(nodes_w) * np.abs(2.0 * span[node_piece] * t) * wavelength / omega
     node_line = piece_line[node_piece]
     value = _line_reflectance(lines, omega, node_line, np.concatenate(nodes_kind))
-    contribution = (value * weight)[:, None] * _cmf_linear(wavelength)
-    xyz = np.stack([np.bincount(node_line, contribution[:, c], minlength=n_lines) for c in range(3)], axis=-1)
+    contribution = value * weight
+    cmf = _cmf_linear(wavelength)
+    xyz = np.stack([np.bincount(node_line, contribution * cmf[:, c], minlength=n_lines) for c in range(3)], axis=-1)
     # Gaps beyond their exact part reflect 1: the CMFs' integral in closed form.
     ones = cut < 1.0
     if ones.any():
