@@ -90,7 +90,8 @@ def test_cost_is_bounded_in_N(monkeypatch):
     samples = {}
     for N in (20, 100, 300, 1000, 3000):
         count = 0
-        bragg._converged_rgb(cos_theta, bragg.BraggMirror(N=N))
+        # The windowed rule itself (the table takes band pieces from bragg.PIECES_MIN_N: tests/test_fast_tables.py).
+        bragg.windowed_converged_spectra(cos_theta, bragg.BraggMirror(N=N), substeps_max=bragg.TABLE_MAX_SUBSTEPS)
         samples[N] = count
     assert max(samples.values()) <= 4.0 * samples[20], samples
     assert samples[3000] < samples[1000] < samples[300], samples

@@ -980,11 +980,22 @@ TABLE_MAX_SUBSTEPS = 1024
 
 def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
     """
-    The converged reference's colours (:func:`reference_rgb`) from the fringe average plus the fringes
-    near band edges (:func:`windowed_converged_spectra`), at a cost that does not grow with ``N``.
+    The converged reference's colours (:func:`reference_rgb`) at a cost that does not grow with ``N``: by Gauss
+    quadrature over band pieces (:func:`band_pieces_rgb`) from :data:`PIECES_MIN_N` cells where every wave
+    propagates and ``nh == n1``; elsewhere from the fringe average plus the fringes near band edges
+    (:func:`windowed_converged_spectra`), which costs less there (docs/performance.md).
     """
-    spectra, _ = windowed_converged_spectra(cos_theta, mirror, substeps_max=TABLE_MAX_SUBSTEPS)
-    return colorimetry.spectrum_to_rgb(spectra)
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    first = cell_geometry(cos_theta, mirror, "s")
+    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1 & (mirror.N >= PIECES_MIN_N)
+    rgb = np.empty((cos_theta.size, 3))
+    if real.any():
+        rgb[real] = band_pieces_rgb(cos_theta[real], mirror)
+    if not real.all():
+        # A host nh != n1, or evanescent layers: the windowed rule (complex arithmetic).
+        spectra, _ = windowed_converged_spectra(cos_theta[~real], mirror, substeps_max=TABLE_MAX_SUBSTEPS)
+        rgb[~real] = colorimetry.spectrum_to_rgb(spectra)
+    return rgb
 
 
 def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
@@ -997,6 +1008,32 @@ def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
     estimate = np.maximum(second[:-1], second[1:]) / 8.0
     brightest = np.maximum(np.abs(table[:-1]).max(axis=-1), np.abs(table[1:]).max(axis=-1))
     return estimate / np.maximum(brightest, colorimetry.CONVERGENCE_FLOOR)
+
+
+#: A midpoint is taken from the cubic through its four neighbouring entries where that cubic's error,
+#: estimated from fourth differences, is below this fraction of the brightest channel.
+TABLE_CUBIC_TOLERANCE = 5e-5
+
+
+def _cubic_midpoints(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Per interval of a uniform table: the midpoint of the cubic through the entries ``i - 1 .. i + 2``,
+    ``(-f[i-1] + 9 f[i] + 9 f[i+1] - f[i+2]) / 16``, and whether its error ``3/128 h^4 |f^(4)|`` (from the
+    larger of the two fourth differences around the interval, doubled) is below :data:`TABLE_CUBIC_TOLERANCE`
+    of the brightest channel (at least 0.05). The first two and last two intervals are never trusted.
+    """
+    n = table.shape[0]
+    cubic = np.zeros((n - 1, 3))
+    trusted = np.zeros(n - 1, dtype=bool)
+    if n < 6:
+        return cubic, trusted
+    cubic[1:-1] = (-table[:-3] + 9.0 * table[1:-2] + 9.0 * table[2:-1] - table[3:]) / 16.0
+    fourth = np.abs(table[:-4] - 4.0 * table[1:-3] + 6.0 * table[2:-2] - 4.0 * table[3:-1] + table[4:]).max(axis=-1)
+    # Interval i (entries i, i + 1) sees the fourth differences centred on entries i and i + 1.
+    estimate = 2.0 * (3.0 / 128.0) * np.maximum(fourth[:-1], fourth[1:])
+    brightest = np.maximum(np.abs(table[2:-3]).max(axis=-1), np.abs(table[3:-2]).max(axis=-1))
+    trusted[2:-2] = estimate <= TABLE_CUBIC_TOLERANCE * np.maximum(brightest, colorimetry.CONVERGENCE_FLOOR)
+    return cubic, trusted
 
 
 @functools.lru_cache(maxsize=32)
@@ -1023,7 +1060,12 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
         midpoints = 0.5 * (cos_theta[:-1] + cos_theta[1:])
         values = 0.5 * (table[:-1] + table[1:])
         if refine.any():
-            values[refine] = _converged_rgb(midpoints[refine], mirror)
+            # Midpoints the cubic through four neighbours already gives to TABLE_CUBIC_TOLERANCE are not computed.
+            cubic, trusted = _cubic_midpoints(table)
+            values[refine & trusted] = cubic[refine & trusted]
+            computed = refine & ~trusted
+            if computed.any():
+                values[computed] = _converged_rgb(midpoints[computed], mirror)
         finer = np.empty((2 * table.shape[0] - 1, 3))
         finer[0::2], finer[1::2] = table, values
         table = finer
@@ -1259,3 +1301,417 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     spectra, _ = windowed_converged_spectra(cos_theta, mirror, **kwargs)
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
+
+
+# --------------------------------------------------------------------------------------------------
+# The converged colour by Gauss quadrature over band pieces (ours)
+#
+# The integral of Yeh's R against the CMFs interpolated linearly (what the converged reference computes,
+# :func:`explorer.physics.colorimetry.converged_spectra`), with a few hundred reflectances per angle
+# whatever N. With x = omega n_+ and Delta = p1 - p2, Eq. 8 is a trigonometric polynomial,
+#
+#     cos K Lambda = a(omega) = (1/2 + Omega/4) cos(omega n_+) + (1/2 - Omega/4) cos(omega Delta),
+#
+# whose gaps hold the modes omega_m = m pi / n_+ (Eq. 13) and whose Airy points (a = 0) lie between
+# them (Appendix A). Each interval [omega_m, omega_{m+1}] is cut at its band edges e+_m, e-_{m+1}
+# (|a| = 1) and its Airy point into four pieces, each anchored at its band edge with the map
+# omega = e + S t^2 (t in [0, 1]): Yeh's R is analytic in omega, the fringe average's square root
+# 1 - a^2 ~ (omega - e) becomes linear in t, and fringes near the edge (u = K Lambda ~ t) are evenly
+# spaced in t. On each piece:
+#
+# - a pass band's first BAND_EDGE_FRINGES fringes from its edge (u < M pi / N): Yeh's exact R. The cut lies
+#   on a transmission dip (sin N u = 0), where the fringes' integration-by-parts boundary terms vanish (see
+#   the windowed section above). Panels end at every half fringe (u = h pi / 2N, found by Newton's method);
+#   around each dip 1 - R = 1 / (1 + F sin^2 N u), F = |C|^2 / sin^2 u, is integrated on nodes squeezed by
+#   psi = arctan(tan(chi) / k), k = sqrt(1 + F), under which (1 - R) d psi = d chi / k: a dip of any
+#   sharpness (F ~ (N |C|)^2 near edges) costs FRINGE_NODES nodes a side;
+# - the rest of the pass band: the fringe average Rbar (its harmonics integrate to O((N u')^-2)),
+#   smooth in t, on panels graded geometrically from the cut. Where fringes are wider than FRINGE_MEAN_NM
+#   anywhere in a piece, or N < PIECES_EXACT_N, Yeh's R throughout instead;
+# - a gap: Yeh's R while N Im[K] Lambda < GAP_DECAY (its deficit 1 - R decays like exp(-2 N Im[K] Lambda)),
+#   then R = 1, integrated against the CMFs in closed form.
+#
+# Every panel is also cut to at most PANEL_NM nm for the CMFs. The pieces tile the visible range exactly
+# (tests/test_fast_tables.py). References: Section 3.1 (Eqs. 2, 8-10), Appendix A; Yeh (1988), Chapter 6.
+
+#: Fringes from a band edge integrated exactly (Yeh's R); beyond them, the fringe average.
+BAND_EDGE_FRINGES = 4
+#: Gauss-Legendre nodes per panel (one panel per fringe near band edges).
+GAUSS_NODES = 8
+#: Nodes per fringe near band edges (clustered at the fringe's ends, where its transmission dip is).
+FRINGE_NODES = 6
+#: A pass piece whose fringes are wider than this (nm) at its Airy point is Yeh's R throughout.
+FRINGE_MEAN_NM = 1.0
+#: Dips with k = sqrt(1 + F) above this are integrated as 1 - (1 - R), the dip on squeezed nodes.
+DIP_SHARP = 2.0
+#: Panels of a gap's exact part.
+GAP_PANELS = 4
+#: Widest panel in wavelength (nm), for the CMFs' own structure.
+PANEL_NM = 16.0
+#: N Im[K] Lambda beyond which a gap reflects 1 (to exp(-2 GAP_DECAY)).
+GAP_DECAY = 12.0
+#: Newton steps (bisection-safeguarded) for the Airy points, band edges and the cuts.
+ROOT_STEPS = 12
+#: Fringe boundaries: u on this many points of t per piece for first guesses, then Newton steps.
+ROOT_GRID = 17
+ROOT_POLISH = 5
+
+
+@functools.lru_cache(maxsize=None)
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+@functools.lru_cache(maxsize=None)
+def _cmf_nodes() -> tuple[np.ndarray, np.ndarray]:
+    """The CMFs at the 473 nodes 359..831 nm (zero at both ends) and their exact cumulative integral there."""
+    c = np.vstack([np.zeros(3), colorimetry.colour_matching_functions(), np.zeros(3)])
+    cumulative = np.vstack([np.zeros(3), np.cumsum(0.5 * (c[:-1] + c[1:]), axis=0)])
+    return c, cumulative
+
+
+def _cmf_linear(wavelength: np.ndarray) -> np.ndarray:
+    """The CMFs interpolated linearly between their 1-nm nodes (zero outside 359-831 nm), ``(n, 3)``."""
+    c, _ = _cmf_nodes()
+    nodes = colorimetry.HAT_LOW + np.arange(c.shape[0], dtype=np.float64)
+    return np.stack([np.interp(wavelength, nodes, c[:, channel], left=0.0, right=0.0) for channel in range(3)], axis=-1)
+
+
+def _cmf_integral_to(wavelength: np.ndarray) -> np.ndarray:
+    """``int_359^lambda`` of :func:`_cmf_linear` in closed form (piecewise quadratic), ``(n, 3)``."""
+    c, cumulative = _cmf_nodes()
+    x = np.clip(wavelength - colorimetry.HAT_LOW, 0.0, c.shape[0] - 1.0)
+    i = np.minimum(x.astype(np.int64), c.shape[0] - 2)
+    f = (x - i)[:, None]
+    return cumulative[i] + c[i] * f + (c[i + 1] - c[i]) * (0.5 * f * f)
+
+
+@dataclass
+class _Lines:
+    """Per (angle, polarisation) line: Eq. 8's trigonometric form and Eq. 10's slab terms (real angles)."""
+
+    n_plus: np.ndarray
+    delta_p: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+    p2: np.ndarray
+    r12_2: np.ndarray
+    N: int
+
+    def a(self, omega, line):
+        """``cos K Lambda`` (Eq. 8) and its derivative in omega."""
+        x, y = omega * self.n_plus[line], omega * self.delta_p[line]
+        alpha, beta = self.alpha[line], self.beta[line]
+        return (alpha * np.cos(x) + beta * np.cos(y),
+                -(alpha * self.n_plus[line] * np.sin(x) + beta * self.delta_p[line] * np.sin(y)))
+
+
+def _safeguarded_newton(g, lo, hi, guess, positive_at_lo, steps=ROOT_STEPS):
+    """The root of ``g`` (returning value and slope) in ``[lo, hi]``, where it changes sign once."""
+    x = np.clip(guess, np.minimum(lo, hi), np.maximum(lo, hi))
+    for _ in range(steps):
+        value, slope = g(x)
+        same = (value >= 0.0) == positive_at_lo
+        lo, hi = np.where(same, x, lo), np.where(same, hi, x)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = x - value / slope
+        # A converged x sits on its bracket's end: its Newton step (x itself) is kept, not bisected away.
+        inside = np.isfinite(step) & ((step - lo) * (step - hi) <= 0.0)
+        x = np.where(inside, step, 0.5 * (lo + hi))
+    return x
+
+
+def _panels(piece, lo, hi, count):
+    """``count`` equal panels of ``[lo, hi]`` per entry (flattened): their piece, lower end and width."""
+    count = np.asarray(count, dtype=np.int64)
+    panel_piece = np.repeat(piece, count)
+    j = np.arange(panel_piece.size) - np.repeat(np.cumsum(count) - count, count)
+    width = np.repeat((hi - lo) / np.maximum(count, 1), count)
+    return panel_piece, np.repeat(lo, count) + j * width, width
+
+
+def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.ndarray:
+    """XYZ (the CMFs' integral of R) of every line, ``(n_lines, 3)``; ``scale`` multiplies every node count."""
+    N = lines.N
+    n_lines = lines.n_plus.size
+    omega_lo, omega_hi = 2.0 * np.pi / colorimetry.HAT_HIGH, 2.0 * np.pi / colorimetry.HAT_LOW
+    m_first = np.floor(omega_lo * lines.n_plus / np.pi)
+    m_last = np.floor(omega_hi * lines.n_plus / np.pi)
+    count = int((m_last - m_first).max()) + 1
+    line, k = np.divmod(np.arange(n_lines * count), count)
+    m = m_first[line] + k
+    valid = m <= m_last[line]
+    line, m = line[valid], m[valid]
+    n_plus = lines.n_plus[line]
+    omega_m, omega_next = m * np.pi / n_plus, (m + 1.0) * np.pi / n_plus
+    sign_m = np.where(m % 2 == 0, 1.0, -1.0)  # the sign of a at omega_m (Appendix A)
+
+    def shifted_a(sign, shift):
+        def g(w):
+            value, slope = lines.a(w, line)
+            return sign * value - shift, sign * slope
+        return g
+
+    airy = _safeguarded_newton(shifted_a(sign_m, 0.0), omega_m, omega_next, 0.5 * (omega_m + omega_next), True)
+    edge_up = _safeguarded_newton(shifted_a(sign_m, 1.0), omega_m, airy, 0.5 * (omega_m + airy), True)
+    edge_up = np.where(m == 0, 0.0, edge_up)
+    edge_down = _safeguarded_newton(shifted_a(-sign_m, 1.0), airy, omega_next, 0.5 * (airy + omega_next), False)
+    # Four pieces per interval, each anchored at a band edge e with omega = e + S t^2: two halves of the pass band
+    # (towards the Airy point), two halves of gaps (towards the modes).
+    anchor = np.concatenate([edge_up, edge_down, edge_up, edge_down])
+    span = np.concatenate([airy - edge_up, airy - edge_down, omega_m - edge_up, omega_next - edge_down])
+    piece_line = np.tile(line, 4)
+    is_gap = np.repeat([False, False, True, True], line.size)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q_lo, q_hi = (omega_lo - anchor) / span, (omega_hi - anchor) / span
+    t0 = np.sqrt(np.clip(np.nan_to_num(np.minimum(q_lo, q_hi), nan=1.0), 0.0, 1.0))
+    t1 = np.sqrt(np.clip(np.nan_to_num(np.maximum(q_lo, q_hi), nan=0.0), 0.0, 1.0))
+    keep = t1 > t0
+    anchor, span, piece_line, is_gap, t0, t1 = (v[keep] for v in (anchor, span, piece_line, is_gap, t0, t1))
+
+    def omega_at(t, pieces):
+        return anchor[pieces] + span[pieces] * t * t
+
+    def a_at_t(t, pieces):
+        value, slope = lines.a(omega_at(t, pieces), piece_line[pieces])
+        return value, slope * 2.0 * span[pieces] * t
+
+    def nm_between(t_a, t_b, pieces):
+        return np.abs(2.0 * np.pi / omega_at(t_a, pieces) - 2.0 * np.pi / omega_at(t_b, pieces))
+
+    # u (or Im[K] Lambda in a gap) ~ sqrt(2 |a'(e)| |S|) t near the edge: the roots' first guesses.
+    _, slope_e = lines.a(anchor, piece_line)
+    u_slope = np.sqrt(np.maximum(2.0 * np.abs(slope_e * span), 1e-300))
+    # Panels: (piece, t_a, t_span, k, kind): t = t_a + t_span (2 / pi) arctan(tan(chi) / k), chi in [0, pi / 2].
+    panels = []
+
+    def add(piece, t_a, t_span, k, kind, nodes):
+        chi_hi = np.full(piece.size, 0.5 * np.pi)
+        panels.append((piece, t_a, t_span, k, kind, nodes, chi_hi))
+
+    band = np.flatnonzero(~is_gap)
+    # Each pass piece is exact up to u_cut: M fringes from its edge, or the whole piece where fringes
+    # (lambda^2 / (2 N du/domega) wide) are wider than FRINGE_MEAN_NM at its Airy point or at either end of its
+    # visible part, as the fringe average's far harmonics then do not cancel against the CMFs.
+    def fringe_nm_at(t):
+        value, slope = lines.a(omega_at(t, band), piece_line[band])
+        du_domega = np.abs(slope) / np.maximum(np.sqrt(np.maximum(1.0 - value * value, 0.0)), 1e-300)
+        lam = 2.0 * np.pi / omega_at(t, band)
+        return lam * lam / (2.0 * N * np.maximum(du_domega, 1e-300))
+
+    fringe_nm = np.maximum(np.maximum(fringe_nm_at(t0[band]), fringe_nm_at(t1[band])), fringe_nm_at(np.ones(band.size)))
+    whole = exact_everywhere | (fringe_nm > FRINGE_MEAN_NM) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
+    u_cut = np.where(whole, 0.5 * np.pi, BAND_EDGE_FRINGES * np.pi / N)
+    def fringe_panels(band, u_cut):
+        """The exact part of the pass pieces ``band`` (up to ``u_cut``), as panels; returns the cut in t."""
+        # Fringe boundaries: u = h pi / (2 N), h = 1..H (clamped to each piece's cut); the transmission dips at even h.
+        H = int(np.ceil(2.0 * u_cut.max() * N / np.pi - 1e-9))
+        halves = np.arange(1, H + 1)
+        targets = np.minimum(halves[None, :] * 0.5 * np.pi / N, u_cut[:, None])  # (band, H)
+        bp = np.repeat(band, H)
+        target = targets.ravel()
+
+        def g(t):
+            value, slope = a_at_t(t, bp)
+            u = np.arccos(np.clip(np.abs(value), 0.0, 1.0))
+            return u - target, -np.sign(value) * slope / np.maximum(np.sin(u), 1e-300)
+
+        # First guesses: u on a grid of t per piece, inverted linearly; then Newton within the grid's bracket.
+        grid = np.linspace(0.0, 1.0, ROOT_GRID)
+        u_grid = np.arccos(np.clip(np.abs(a_at_t(np.tile(grid, band.size), np.repeat(band, ROOT_GRID))[0]), 0.0, 1.0))
+        u_grid = np.maximum.accumulate(u_grid.reshape(band.size, ROOT_GRID), axis=1)
+        j = np.clip((u_grid[:, :, None] < targets[:, None, :]).sum(axis=1), 1, ROOT_GRID - 1)  # (band, H)
+        u_a = np.take_along_axis(u_grid, j - 1, axis=1)
+        u_b = np.take_along_axis(u_grid, j, axis=1)
+        f = np.clip((targets - u_a) / np.maximum(u_b - u_a, 1e-300), 0.0, 1.0)
+        guess = (grid[j - 1] + f * (grid[1] - grid[0])).ravel()
+        bounds = _safeguarded_newton(g, grid[j - 1].ravel(), grid[j].ravel(), guess, False, steps=ROOT_POLISH)
+        bounds = np.where(target >= 0.5 * np.pi - 1e-12, 1.0, bounds).reshape(band.size, H)
+        cut_t = bounds[:, -1]
+        bounds = np.concatenate([np.zeros((band.size, 1)), bounds], axis=1)  # columns: h = 0..H
+        # From the edge to the first half fringe: no dip (R -> kappa^2 / (1 + kappa^2) at the edge), Yeh's R.
+        add(band, bounds[:, 0], bounds[:, 1] - bounds[:, 0], np.ones(band.size), 0, GAUSS_NODES)
+        # Beyond it, two half panels around each dip u = j pi / N. Sharp dips (k = sqrt(1 + F) > DIP_SHARP): R = 1 - (1 - R),
+        # the 1 on plain nodes, the dip 1 - R = 1 / (1 + F sin^2 N u) on nodes squeezed by psi = arctan(tan(chi) / k),
+        # under which (1 - R) d psi = d chi / k for a fixed F: the dip, however narrow, is spread over the panel.
+        dips = np.arange(2, H + 1, 2)
+        if dips.size:
+            t_dip = bounds[:, dips]
+            dip_piece = np.repeat(band, dips.size)
+            omega_dip = omega_at(t_dip.ravel(), dip_piece)
+            line_dip = piece_line[dip_piece]
+            sin_phi = np.sin(omega_dip * lines.p2[line_dip])
+            r12_2 = lines.r12_2[line_dip]
+            C2 = 4.0 * r12_2 * sin_phi * sin_phi / (1.0 - r12_2) ** 2  # |C|^2 (Eq. 2) = |r1|^2 / |t1|^2
+            F = C2 / np.maximum(np.sin(np.tile(dips * 0.5 * np.pi / N, band.size)) ** 2, 1e-300)
+            k = np.sqrt(1.0 + F)
+            left = bounds[:, dips - 1].ravel() - t_dip.ravel()
+            right = bounds[:, np.minimum(dips + 1, H)].ravel() - t_dip.ravel()
+            sharp = k > DIP_SHARP
+            # The map takes psi linear in t over the half panel; the dip's width in t is set by dpsi/dt at the dip.
+            value, slope = a_at_t(t_dip.ravel(), dip_piece)
+            dpsi_dt = N * np.abs(slope) / np.maximum(np.sqrt(np.maximum(1.0 - value * value, 0.0)), 1e-300)
+            for side in (left, right):
+                k = np.sqrt(1.0 + F) * np.clip(dpsi_dt * np.abs(side) / (0.5 * np.pi), 0.25, 4.0)
+                # Soft dips: Yeh's R on plain nodes (1 and R - 1 would cancel to R's small values).
+                add(dip_piece[~sharp], t_dip.ravel()[~sharp], side[~sharp], np.ones(int((~sharp).sum())), 0, FRINGE_NODES)
+                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], np.ones(int(sharp.sum())), 2, FRINGE_NODES)
+                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], k[sharp], 3, FRINGE_NODES)
+        return cut_t
+
+    cut_band = np.ones(band.size)
+    for group in (whole, ~whole):
+        if group.any():
+            cut_band[group] = fringe_panels(band[group], u_cut[group])
+    # The rest of the pass band: the fringe average, panels graded geometrically from the cut.
+    s0 = cut_band
+    rest = s0 < 1.0
+    smooth, s0 = band[rest], s0[rest]
+    doublings = np.ceil(np.log2(1.0 / np.maximum(s0, 1e-12))).clip(1, 40).astype(np.int64)
+    geo_piece = np.repeat(smooth, doublings)
+    jj = np.arange(geo_piece.size) - np.repeat(np.cumsum(doublings) - doublings, doublings)
+    ratio = (1.0 / np.repeat(np.maximum(s0, 1e-12), doublings)) ** (1.0 / np.repeat(doublings, doublings))
+    geo_lo = np.where(jj == 0, np.repeat(s0, doublings), np.repeat(np.maximum(s0, 1e-12), doublings) * ratio**jj)
+    geo_hi = np.minimum(np.repeat(np.maximum(s0, 1e-12), doublings) * ratio ** (jj + 1), 1.0)
+    add(geo_piece, geo_lo, geo_hi - geo_lo, np.ones(geo_piece.size), 1, GAUSS_NODES)
+    # Gaps: Yeh's R up to N Im[K] Lambda = GAP_DECAY, then 1.
+    gap = np.flatnonzero(is_gap)
+    cut = np.ones(gap.size)
+    if not exact_everywhere:
+        x_cut = GAP_DECAY / N
+
+        def h(t):
+            value, slope = a_at_t(t, gap)
+            abs_a = np.maximum(np.abs(value), 1.0)
+            return np.arccosh(abs_a) - x_cut, np.sign(value) * slope / np.maximum(np.sqrt(abs_a * abs_a - 1.0), 1e-300)
+
+        end_value, _ = a_at_t(np.ones(gap.size), gap)
+        deep = np.arccosh(np.maximum(np.abs(end_value), 1.0)) > x_cut
+        solved = _safeguarded_newton(h, np.zeros(gap.size), np.ones(gap.size), np.clip(x_cut / u_slope[gap], 0.0, 1.0), False)
+        cut = np.where(deep, solved, 1.0)
+    gap_piece, gap_lo, gap_width = _panels(gap, np.zeros(gap.size), cut, np.full(gap.size, GAP_PANELS))
+    add(gap_piece, gap_lo, gap_width, np.ones(gap_piece.size), 0, GAUSS_NODES)
+    # Nodes: each panel clipped to its piece's visible part (in chi), split for the CMFs (PANEL_NM), Gauss-Legendre.
+    nodes_t, nodes_w, nodes_piece, nodes_kind = [], [], [], []
+    for piece, t_a, t_span, k, kind, n, _ in panels:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel_lo = np.clip((t0[piece] - t_a) / t_span, 0.0, 1.0)
+            rel_hi = np.clip((t1[piece] - t_a) / t_span, 0.0, 1.0)
+        rel_lo, rel_hi = np.nan_to_num(np.minimum(rel_lo, rel_hi)), np.nan_to_num(np.maximum(rel_lo, rel_hi))
+        chi_lo, chi_hi = np.arctan(k * np.tan(0.5 * np.pi * rel_lo)), np.arctan(k * np.tan(0.5 * np.pi * np.minimum(rel_hi, 1.0 - 1e-16)))
+        chi_hi = np.where(rel_hi >= 1.0, 0.5 * np.pi, chi_hi)
+        inside = (chi_hi > chi_lo) & (t_span != 0.0)
+        piece, t_a, t_span, k, chi_lo, chi_hi = (v[inside] for v in (piece, t_a, t_span, k, chi_lo, chi_hi))
+        split = np.ceil(nm_between(t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(chi_lo) / k),
+                                   t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(np.minimum(chi_hi, 0.5 * np.pi - 1e-16)) / k), piece)
+                        / PANEL_NM).clip(1, None)
+        sub, sub_lo, sub_width = _panels(np.arange(piece.size), chi_lo, chi_hi, split)
+        x, w = _gauss_legendre(n * scale)
+        chi = sub_lo[:, None] + sub_width[:, None] * x
+        if kind == 3:
+            kk = k[sub][:, None]
+            cos_chi, sin_chi = np.cos(chi), np.sin(chi)
+            psi = np.arctan2(sin_chi, kk * cos_chi)  # arctan(tan(chi) / k) in [0, pi / 2]
+            jacobian = np.abs(t_span[sub][:, None]) * (2.0 / np.pi) * kk / (kk * kk * cos_chi * cos_chi + sin_chi * sin_chi)
+        else:  # k = 1: psi = chi
+            psi, jacobian = chi, np.abs(t_span[sub][:, None]) * (2.0 / np.pi)
+        nodes_t.append((t_a[sub][:, None] + t_span[sub][:, None] * (2.0 / np.pi) * psi).ravel())
+        nodes_w.append((sub_width[:, None] * w * jacobian).ravel())
+        nodes_piece.append(np.repeat(piece[sub], x.size))
+        nodes_kind.append(np.full(chi.size, kind, dtype=np.int8))
+    t = np.concatenate(nodes_t)
+    node_piece = np.concatenate(nodes_piece)
+    omega = omega_at(t, node_piece)
+    wavelength = 2.0 * np.pi / omega
+    weight = np.concatenate(nodes_w) * np.abs(2.0 * span[node_piece] * t) * wavelength / omega
+    node_line = piece_line[node_piece]
+    value = _line_reflectance(lines, omega, node_line, np.concatenate(nodes_kind))
+    contribution = value * weight
+    cmf = _cmf_linear(wavelength)
+    xyz = np.stack([np.bincount(node_line, contribution * cmf[:, c], minlength=n_lines) for c in range(3)], axis=-1)
+    # Gaps beyond their exact part reflect 1: the CMFs' integral in closed form.
+    ones = cut < 1.0
+    if ones.any():
+        pieces = gap[ones]
+        t_a, t_b = np.clip(cut[ones], t0[pieces], t1[pieces]), t1[pieces]
+        total = np.abs(_cmf_integral_to(2.0 * np.pi / omega_at(t_a, pieces)) - _cmf_integral_to(2.0 * np.pi / omega_at(t_b, pieces)))
+        xyz += np.stack([np.bincount(piece_line[pieces], total[:, c], minlength=n_lines) for c in range(3)], axis=-1)
+    return xyz
+
+
+def _line_reflectance(lines: _Lines, omega, line, kind) -> np.ndarray:
+    """
+    At each node by ``kind``: 0, Yeh's R; 1, its fringe average; 2, 1; 3, R - 1. Real arithmetic (Eqs. 2, 8-10;
+    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2``, as :func:`_reflectance_real`).
+    """
+    out = np.ones(omega.shape)
+    rows = np.flatnonzero(kind != 2)
+    omega, line, kind = omega[rows], line[rows], kind[rows]
+    a, _ = lines.a(omega, line)
+    r12_2 = lines.r12_2[line]
+    sin_phi = np.sin(omega * lines.p2[line])
+    r1_2 = 4.0 * r12_2 * sin_phi * sin_phi
+    t1_2 = (1.0 - r12_2) ** 2
+    exact, mean = np.flatnonzero(kind != 1), np.flatnonzero(kind == 1)
+    N = float(lines.N)
+    value = np.empty(omega.shape)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        ae, r1e, t1e = a[exact], r1_2[exact], t1_2[exact]
+        a_band = np.clip(ae, -1.0, 1.0)
+        Q_band = (1.0 - a_band * a_band) / np.sin(N * np.arccos(a_band)) ** 2
+        abs_a = np.maximum(np.abs(ae), 1.0)
+        xg = np.maximum(np.arccosh(abs_a), 1e-12)
+        Q_gap = (np.exp(-(N - 1.0) * xg) * _one_minus_exp_minus_2x(xg) / _one_minus_exp_minus_2x(N * xg)) ** 2
+        Q = np.where(np.abs(ae) < 1.0, Q_band, Q_gap)
+        # R - 1 = -t1^2 Q / (r1^2 + t1^2 Q) without cancellation; R = 1 + that.
+        deficit = t1e * Q / (r1e + t1e * Q)
+        value[exact] = np.where(kind[exact] == 3, -deficit, 1.0 - deficit)
+        am, r1m, t1m = a[mean], r1_2[mean], t1_2[mean]
+        t_sin = t1m * np.maximum(1.0 - am * am, 0.0)
+        denominator = r1m + t_sin
+        value[mean] = 1.0 - np.sqrt(np.where(denominator > 0.0, t_sin / denominator, 1.0))
+    out[rows] = value
+    return out
+
+
+#: Below this many cells the pieces integrate Yeh's R throughout (the fringe average's far harmonics still count).
+PIECES_EXACT_N = 64
+#: From this many cells the table's colours come from the band pieces (measured faster than the windowed rule).
+PIECES_MIN_N = 600
+
+
+def band_pieces_rgb(cos_theta: ArrayLike, mirror: BraggMirror, scale: int = 1) -> np.ndarray:
+    """
+    Linear sRGB of the converged spectral reference (:func:`reference_rgb` without a step) by Gauss quadrature
+    over band pieces (the section's comment), for angles where every wave propagates and ``nh == n1``.
+
+    Parameters
+    ----------
+    cos_theta : array_like
+    mirror : BraggMirror
+    scale : int
+        Multiplies every panel's node count (convergence studies).
+
+    Returns
+    -------
+    ndarray, shape ``(cos_theta.size, 3)``
+
+    References
+    ----------
+    Fourneau et al. (2024), Section 3.1 (Eqs. 2, 8-10), Appendix A; Yeh (1988), Chapter 6.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    geometries = [cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS]
+    first = geometries[0]
+    if not (first.host_is_n1 and (first.cos_theta_1.imag == 0).all() and (first.cos_theta_2.imag == 0).all()):
+        raise ValueError("band_pieces_rgb: real angles only (nh == n1, no evanescent layer)")
+    p1 = np.concatenate([g.p1.real for g in geometries])
+    p2 = np.concatenate([g.p2.real for g in geometries])
+    Omega_ = np.concatenate([g.Omega.real for g in geometries])
+    lines = _Lines(p1 + p2, p1 - p2, 0.5 + 0.25 * Omega_, 0.5 - 0.25 * Omega_, p2,
+                   np.concatenate([g.r12.real ** 2 for g in geometries]), int(mirror.N))
+    exact_everywhere = mirror.N < PIECES_EXACT_N or BAND_EDGE_FRINGES * np.pi / mirror.N >= 0.5 * np.pi
+    xyz = _pieces_xyz(lines, exact_everywhere, scale)
+    xyz = 0.5 * (xyz[: cos_theta.size] + xyz[cos_theta.size :])
+    return colorimetry.xyz_to_rgb(xyz)

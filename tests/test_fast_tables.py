@@ -1,0 +1,103 @@
+"""
+Issue 22: the converged table built from fewer computed colours (explorer/physics/bragg.py): midpoints from
+a cubic where its error estimate allows (``_cubic_midpoints``), against independent values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from explorer.physics import bragg, colorimetry
+
+
+def test_cubic_midpoints_are_trusted_only_where_accurate():
+    x = np.linspace(0.0, 1.0, 65)
+    midpoints = 0.5 * (x[:-1] + x[1:])
+    smooth = np.stack([0.5 + 0.4 * np.sin(3.0 * x), 0.5 + 0.3 * np.cos(2.0 * x), np.full_like(x, 0.5)], axis=-1)
+    cubic, trusted = bragg._cubic_midpoints(smooth)
+    exact = np.stack([0.5 + 0.4 * np.sin(3.0 * midpoints), 0.5 + 0.3 * np.cos(2.0 * midpoints), np.full_like(midpoints, 0.5)], axis=-1)
+    assert trusted.sum() == x.size - 5  # all but the two intervals at each end
+    assert np.abs(cubic[trusted] - exact[trusted]).max() <= bragg.TABLE_CUBIC_TOLERANCE * 0.9
+    # A kink (as at a critical angle): the intervals around it are computed, not interpolated.
+    kinked = np.repeat(np.abs(x - 0.5)[:, None], 3, axis=-1) + 0.2
+    _, trusted = bragg._cubic_midpoints(kinked)
+    assert not trusted[30:34].any() and trusted[10:20].all()
+
+
+# --------------------------------------------------------------------------------------------------
+# Gauss quadrature over band pieces (bragg.band_pieces_rgb)
+
+#: Of the brightest linear RGB channel (at least colorimetry.CONVERGENCE_FLOOR), as tests/test_fringes.py.
+NODE_RTOL = 4e-4
+
+
+def relative_error(rgb, reference):
+    return np.abs(rgb - reference).max(axis=-1) / np.maximum(np.abs(reference).max(axis=-1), colorimetry.CONVERGENCE_FLOOR)
+
+
+def random_real_mirrors(seed: int, count: int, N_choices):
+    """Mirrors over bragg_mirror.brd's box (nh = n1) and angles where every wave propagates."""
+    rng = np.random.default_rng(seed)
+    found = []
+    while len(found) < count:
+        mirror = bragg.BraggMirror(
+            float(rng.uniform(1.0, 2.5)), float(rng.uniform(1.0, 2.5)), float(rng.uniform(50.0, 1500.0)),
+            float(rng.uniform(0.0, 1.0)), int(rng.choice(N_choices)),
+        )
+        cos_theta = rng.uniform(0.0, 1.0, 3)
+        first = bragg.cell_geometry(cos_theta, mirror, "s")
+        real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0)
+        if real.any():
+            found.append((mirror, cos_theta[real]))
+    return found
+
+
+def test_band_pieces_tile_the_visible_range(monkeypatch):
+    """With R = 1 and flat CMFs the pieces' nodes integrate to the visible range's width: band edges, Airy
+    points, fringe boundaries and the gaps' closed form neither overlap nor leave holes."""
+    low, high = colorimetry.HAT_LOW, colorimetry.HAT_HIGH
+    monkeypatch.setattr(bragg, "_line_reflectance", lambda lines, omega, line, kind: np.where(kind == 3, 0.0, 1.0))
+    monkeypatch.setattr(bragg, "_cmf_linear", lambda lam: np.repeat(((lam >= low) & (lam <= high))[:, None], 3, axis=1).astype(float))
+    monkeypatch.setattr(bragg, "_cmf_integral_to", lambda lam: np.repeat((np.clip(lam, low, high) - low)[:, None], 3, axis=1))
+    monkeypatch.setattr(colorimetry, "xyz_to_rgb", lambda xyz: xyz)
+    for mirror, cos_theta in random_real_mirrors(5, 12, [1, 3, 20, 64, 100, 300, 1000]):
+        width = bragg.band_pieces_rgb(cos_theta, mirror)
+        np.testing.assert_allclose(width, high - low, rtol=1e-9, err_msg=str(mirror))
+
+
+def test_band_pieces_equal_converged_reference_on_random_mirrors():
+    """Random mirrors over the box, every N regime: Yeh's R throughout (N < 64), edges plus the fringe average."""
+    failures = []
+    for mirror, cos_theta in random_real_mirrors(22, 16, [1, 7, 20, 64, 150, 300, 1000]):
+        error = relative_error(bragg.band_pieces_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror))
+        if error.max() > NODE_RTOL:
+            failures.append(f"{mirror} at cos {cos_theta[error.argmax()]:.4f}: {error.max():.2e}")
+    assert not failures, "\n".join(failures)
+
+
+def test_band_pieces_cost_is_bounded_in_N(monkeypatch):
+    """Reflectances evaluated per angle, counted: bounded from N = 1000 to N = 10000 (no fringe floor)."""
+    count = 0
+    original = bragg._line_reflectance
+
+    def counting(lines, omega, line, kind):
+        nonlocal count
+        count += int(np.sum(kind != 2))
+        return original(lines, omega, line, kind)
+
+    monkeypatch.setattr(bragg, "_line_reflectance", counting)
+    cos_theta = np.linspace(0.0, 1.0, 17)
+    samples = {}
+    for N in (1000, 3000, 10000):
+        count = 0
+        bragg.band_pieces_rgb(cos_theta, bragg.BraggMirror(N=N))
+        samples[N] = count / cos_theta.size
+    assert max(samples.values()) <= 1.5 * min(samples.values()) and max(samples.values()) < 2000, samples
+
+
+def test_band_pieces_refuse_complex_angles():
+    with pytest.raises(ValueError, match="real angles only"):
+        bragg.band_pieces_rgb([0.5], bragg.BraggMirror(n1=1.5, n2=1.0, N=20))  # beyond the critical angle
+    with pytest.raises(ValueError, match="real angles only"):
+        bragg.band_pieces_rgb([0.5], bragg.BraggMirror(N=20, nh=1.4))
