@@ -110,6 +110,12 @@ def render_material(
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
     :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
     """
+    if material.measured is not None:
+        from explorer.views.geometry import VIEW_REGISTRY
+
+        if VIEW_REGISTRY[view].evaluates not in ("brdf", "environment"):
+            shown = ", ".join(name for name, v in VIEW_REGISTRY.items() if v.evaluates in ("brdf", "environment"))
+            raise MaterialError(material.path, None, f"a measured BRDF (MERL) has no reflectance(cos_theta) for the {view} view; its views: {shown}")
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
 
