@@ -104,11 +104,13 @@ def parse_exposure(text: str | None, out: Path) -> float:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
+    mesh=None,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
-    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
+    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view; ``mesh``
+    (an :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -121,7 +123,7 @@ def render_material(
 
         return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp)
+        return _render_env(material, values, width, height, engine, environment, spp, mesh)
     if view == "textured":
         from explorer.views.thickness import ThicknessTexture, check_prefilter
 
@@ -140,7 +142,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
@@ -151,6 +153,10 @@ def render_material(
             material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
             uniforms={"prefilter": thickness.prefilter},
         )
+    if mesh is not None:
+        from explorer.gpu.mesh import render_mesh
+
+        return render_mesh(renderer, material, values, view, mesh, width, height, light=light)
     return renderer.render(material, values, view, width, height, light=light)
 
 
@@ -164,7 +170,7 @@ def check_numpy_size(width: int, height: int) -> None:
                                            f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
 
 
-def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
+def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
@@ -191,7 +197,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         click.echo(f"{PROG}: warning: {message}", err=True)
 
     return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn)
+                      progress=progress, warn=warn, mesh=mesh)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -289,9 +295,10 @@ def _errors(function):
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
+@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant):
+           prefilter, env_file, spp, variant, mesh):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -326,6 +333,14 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
     elif env_file is not None or (spp is not None and engine != "position-free"):
         raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
+    mesh_shape = None
+    if mesh is not None:
+        from explorer.views.mesh import mesh_named
+
+        if view not in ("lit", "env") or engine not in ("gl", "numpy"):
+            raise click.BadParameter(f"a mesh is drawn in the lit and env views by the gl and numpy engines, not {view} ({engine})",
+                                     param_hint="--mesh")
+        mesh_shape = mesh_named(mesh)
     if engine == "mitsuba" or variant is not None:
         from explorer.cli.export import check_mitsuba_render
 
@@ -336,7 +351,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant)
+                                variant=variant, mesh=mesh_shape)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())

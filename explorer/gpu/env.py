@@ -72,7 +72,7 @@ class ProgressiveEnvRender:
 
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
-        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -92,6 +92,12 @@ class ProgressiveEnvRender:
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(renderer.resources, environment)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
+        #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals, read by views/mesh/env.glsl.
+        self._surface = None
+        if mesh is not None:
+            from explorer.gpu.mesh import mesh_normals
+
+            self._surface = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
         self.reset()
@@ -100,7 +106,7 @@ class ProgressiveEnvRender:
         """Drop every sample; with ``values``, render the material with those parameters from now on."""
         if values is not None:
             self.values = dict(values)
-        self.program = self.renderer.program(self.material, "env", self.values)
+        self.program = self.renderer.program(self.material, "env" if self._surface is None else "mesh/env", self.values)
         self._framebuffer.use()
         self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
         #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
@@ -113,6 +119,8 @@ class ProgressiveEnvRender:
         uniforms, textures = self.renderer.bindings(self.program, self.material, self.values)
         uniforms["seed"] = self.seed
         textures["environment"] = self._texture
+        if self._surface is not None:
+            textures["mesh_normals"] = self._surface
         return {"uniforms": uniforms, "textures": textures}
 
     def _pass(self, bindings: dict, count: int, rows: tuple[int, int] | None = None) -> float:
@@ -214,19 +222,20 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture)
+        self.renderer.resources.release(self._framebuffer, self._texture, self._surface)
 
 
 def render_env(
     material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
     environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
-    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None, mesh=None,
 ) -> np.ndarray:
     """
     The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
     (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
-    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
+    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite. ``mesh`` (an
+    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere.
     """
     if not 1 <= spp <= MAX_SPP:
         raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
@@ -235,9 +244,9 @@ def render_env(
         from explorer.materials.models import model_for
 
         model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress)
+        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh)
     renderer = Renderer() if renderer is None else renderer
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh)
     try:
         while render.samples < spp:
             render.step(min(spp - render.samples, max(1, render.samples_per_pass)))

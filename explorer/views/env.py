@@ -371,7 +371,7 @@ def quadrature_subdivisions(model, environment: EnvironmentMap) -> int:
 
 def env_integral_numpy(
     model, environment: EnvironmentMap, width: int, height: int, pixels=None, subdivisions: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, mesh=None,
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
@@ -394,6 +394,8 @@ def env_integral_numpy(
         Cells per texel side (default :func:`quadrature_subdivisions`).
     progress : callable, optional
         ``progress(done, total)`` after each pixel.
+    mesh : explorer.views.mesh.Mesh, optional
+        Drawn instead of the sphere (its normals by :func:`explorer.views.mesh.rasterise`).
 
     Returns
     -------
@@ -402,7 +404,13 @@ def env_integral_numpy(
     """
     from explorer.views.geometry import brdf_view_geometry, view_brdf
 
-    _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
+    if mesh is not None:
+        from explorer.views.mesh import mesh_view_geometry, rasterise
+
+        surface = rasterise(mesh, width, height)
+        _, V, N, X, Y, inside, _ = mesh_view_geometry(surface.normals, surface.covered)
+    else:
+        _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:
         rows, columns = np.nonzero(inside)
     else:

@@ -53,15 +53,12 @@ vec3 environment_radiance(vec3 d) {
 float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }
 
 void main() {
-    vec2 p;
-    float r2;
-    if (!disc_point(resolution, p, r2)) {
+    vec3 normal, tangent, bitangent;
+    if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh (views/mesh/env.glsl)
         sum_out = vec4(0.0, 0.0, 0.0, float(samples_per_pass));
         square_out = vec4(0.0);
         return;
     }
-    vec3 normal, tangent, bitangent;
-    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     vec3 t, b;
     sampling_basis(normal, t, b);
