@@ -104,7 +104,7 @@ def parse_exposure(text: str | None, out: Path) -> float:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
-    mesh=None,
+    mesh=None, background: bool = False,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
@@ -123,7 +123,7 @@ def render_material(
 
         return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp, mesh)
+        return _render_env(material, values, width, height, engine, environment, spp, mesh, background)
     if view == "textured":
         from explorer.views.thickness import ThicknessTexture, check_prefilter
 
@@ -170,7 +170,8 @@ def check_numpy_size(width: int, height: int) -> None:
                                            f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
 
 
-def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None) -> np.ndarray:
+def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None,
+                background: bool = False) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
@@ -197,7 +198,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         click.echo(f"{PROG}: warning: {message}", err=True)
 
     return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn, mesh=mesh)
+                      progress=progress, warn=warn, mesh=mesh, background=background)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -296,9 +297,11 @@ def _errors(function):
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
 @click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
+@click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env view: the environment turned about the vertical.")
+@click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant, mesh):
+           prefilter, env_file, spp, variant, mesh, env_rotation, background):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -331,8 +334,12 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
 
         environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
-    elif env_file is not None or (spp is not None and engine != "position-free"):
-        raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
+        if (env_rotation is not None or background) and engine == "mitsuba":
+            raise click.BadParameter("--env-rotation and --background are for the gl and numpy engines", param_hint="--engine")
+        if env_rotation is not None:
+            environment = environment.rotated(env_rotation)
+    elif env_file is not None or (spp is not None and engine != "position-free") or env_rotation is not None or background:
+        raise click.BadParameter("--env, --spp, --env-rotation and --background are for the env view", param_hint="--view")
     mesh_shape = None
     if mesh is not None:
         from explorer.views.mesh import mesh_named
@@ -351,7 +358,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant, mesh=mesh_shape)
+                                variant=variant, mesh=mesh_shape, background=background)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())

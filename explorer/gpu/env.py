@@ -72,7 +72,7 @@ class ProgressiveEnvRender:
 
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
-        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None, background: bool = False,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -100,6 +100,8 @@ class ProgressiveEnvRender:
             self._surface = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
+        #: Off the object, the environment behind it (exact, no samples needed), else black.
+        self.background = bool(background)
         self.reset()
 
     def reset(self, values: Mapping[str, object] | None = None) -> None:
@@ -118,6 +120,8 @@ class ProgressiveEnvRender:
         """The program's uniforms and textures for :meth:`_pass` (the material's, the environment, the seed)."""
         uniforms, textures = self.renderer.bindings(self.program, self.material, self.values)
         uniforms["seed"] = self.seed
+        uniforms["environment_turn"] = self.environment.turn
+        uniforms["show_background"] = self.background
         textures["environment"] = self._texture
         if self._surface is not None:
             textures["mesh_normals"] = self._surface
@@ -229,13 +233,14 @@ def render_env(
     material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
     environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
     progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None, mesh=None,
+    background: bool = False,
 ) -> np.ndarray:
     """
     The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
     (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
     pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite. ``mesh`` (an
-    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere.
+    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere; ``background``: the environment behind it.
     """
     if not 1 <= spp <= MAX_SPP:
         raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
@@ -244,9 +249,10 @@ def render_env(
         from explorer.materials.models import model_for
 
         model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh)
+        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh, background=background)
     renderer = Renderer() if renderer is None else renderer
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh)
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh,
+                                  background=background)
     try:
         while render.samples < spp:
             render.step(min(spp - render.samples, max(1, render.samples_per_pass)))

@@ -154,9 +154,13 @@ class EnvironmentMap:
         Finite radiance values.
     name : str
         Where it comes from (a path), for messages.
+    rotation : float
+        The probe's turn about the vertical ``+y`` in degrees: the radiance toward ``d`` is the texel at
+        ``u(d) - rotation / 360`` (the shader's ``environment_turn``; GL's ``REPEAT`` in ``u`` makes any
+        turn exact under the bilinear lookup).
     """
 
-    def __init__(self, pixels, name: str = "<array>"):
+    def __init__(self, pixels, name: str = "<array>", rotation: float = 0.0):
         data = np.ascontiguousarray(pixels, dtype=np.float32)
         if data.ndim != 3 or data.shape[2] != 3 or data.shape[0] < 1 or data.shape[1] < 1:
             raise EnvironmentFileError(name, None, f"environment must be an RGB image (height, width, 3), got shape {data.shape}")
@@ -165,6 +169,18 @@ class EnvironmentMap:
         data.setflags(write=False)
         self.pixels = data
         self.name = name
+        if not math.isfinite(float(rotation)):
+            raise EnvironmentFileError(name, None, f"environment rotation {rotation!r} is not a finite angle")
+        self.rotation = float(rotation)
+
+    @property
+    def turn(self) -> float:
+        """:attr:`rotation` as a fraction of a turn in [0, 1) (the shader's ``environment_turn``)."""
+        return (self.rotation / 360.0) % 1.0
+
+    def rotated(self, degrees: float) -> "EnvironmentMap":
+        """The same texels, the probe turned by ``degrees`` about ``+y``."""
+        return EnvironmentMap(self.pixels, self.name, degrees)
 
     @property
     def width(self) -> int:
@@ -227,7 +243,7 @@ class EnvironmentMap:
     def radiance(self, d) -> np.ndarray:
         """Bilinear radiance ``(..., 3)`` (float64) toward unit directions ``d``: the shader's lookup."""
         u, v = direction_to_uv(d)
-        return self.radiance_uv(u, v)
+        return self.radiance_uv(u - self.turn, v)
 
     def radiance_uv(self, u, v) -> np.ndarray:
         """Bilinear radiance at texture coordinates (GL's ``LINEAR``, ``REPEAT`` in u, ``CLAMP_TO_EDGE`` in v)."""
@@ -259,7 +275,7 @@ class EnvironmentMap:
         v = 0.5 * (v_edges[1:] + v_edges[:-1])
         u = (np.arange(columns) + 0.5) / columns
         band = (np.cos(np.pi * v_edges[:-1]) - np.cos(np.pi * v_edges[1:])) * (2.0 * np.pi / columns)
-        directions = uv_to_direction(u[None, :], v[:, None]).reshape(-1, 3)
+        directions = uv_to_direction(u[None, :] + self.turn, v[:, None]).reshape(-1, 3)  # texel (u, v) under the turn
         solid_angle = np.broadcast_to(band[:, None], (rows, columns)).reshape(-1)
         radiance = self.radiance_uv(u[None, :], v[:, None]).reshape(-1, 3)
         return directions, solid_angle, radiance
@@ -369,9 +385,27 @@ def quadrature_subdivisions(model, environment: EnvironmentMap) -> int:
     return int(min(s, MAX_SUBDIVISIONS))
 
 
+#: The backdrop's pinhole: the tangent of its half field of view (60 degrees across the shorter side).
+BACKDROP_TAN = math.tan(math.radians(30.0))
+
+
+def backdrop(environment: EnvironmentMap, width: int, height: int) -> np.ndarray:
+    """
+    The environment behind the object (the env view's ``show_background``): at pixel ``p`` (``2 (i + 1/2) - W``
+    over the shorter side, rows from the top), the radiance toward ``normalize(p BACKDROP_TAN, -1)``, a
+    pinhole looking along ``-z``; ``(height, width, 3)`` float64.
+    """
+    side = min(width, height)
+    x = (2.0 * (np.arange(width) + 0.5) - width) / side
+    y = (height - 2.0 * (np.arange(height) + 0.5)) / side
+    X, Y = np.meshgrid(x * BACKDROP_TAN, y * BACKDROP_TAN)
+    d = np.stack([X, Y, -np.ones_like(X)], axis=-1)
+    return environment.radiance(d / np.linalg.norm(d, axis=-1, keepdims=True))
+
+
 def env_integral_numpy(
     model, environment: EnvironmentMap, width: int, height: int, pixels=None, subdivisions: int | None = None,
-    progress: Callable[[int, int], None] | None = None, mesh=None,
+    progress: Callable[[int, int], None] | None = None, mesh=None, background: bool = False,
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
@@ -396,6 +430,8 @@ def env_integral_numpy(
         ``progress(done, total)`` after each pixel.
     mesh : explorer.views.mesh.Mesh, optional
         Drawn instead of the sphere (its normals by :func:`explorer.views.mesh.rasterise`).
+    background : bool
+        Off the object, the environment behind it (:func:`backdrop`) instead of 0.
 
     Returns
     -------
@@ -444,9 +480,14 @@ def env_integral_numpy(
         v, n = V[rows, columns][hit].astype(np.float64), N[rows, columns][hit].astype(np.float64)
         reflected = 2.0 * np.sum(v * n, axis=-1, keepdims=True) * n - v
         values[hit] += mirror(v, n) * environment.radiance(reflected)
+    if background:
+        off = ~inside[rows, columns]
+        values[off] = backdrop(environment, width, height)[rows[off], columns[off]]
     if pixels is not None:
         return values
     image = np.zeros((height, width, 3), dtype=np.float32)
+    if background:
+        image[:] = backdrop(environment, width, height)
     image[rows, columns] = values
     return image
 

@@ -37,6 +37,12 @@
 
 uniform vec2 resolution;
 uniform sampler2D environment;
+// The probe's turn about the vertical +y (a fraction of a turn: u shifts by it; explorer.views.env.EnvironmentMap.rotation).
+uniform float environment_turn;
+// Off the object: the environment behind it (a pinhole's view along -z, BACKDROP_TAN the tangent of its
+// half field; twin: explorer.views.env.backdrop), else black.
+uniform bool show_background;
+#define BACKDROP_TAN 0.57735026918962576
 uniform uint first_sample;
 uniform int samples_per_pass;
 uniform uint seed;
@@ -44,7 +50,7 @@ layout(location = 0) out vec4 sum_out;
 layout(location = 1) out vec4 square_out;
 
 vec3 environment_radiance(vec3 d) {
-    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI);
+    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI) - environment_turn;
     float v = atan(length(d.xz), d.y) * (1.0 / PI);
     return textureLod(environment, vec2(u, v), 0.0).rgb;
 }
@@ -55,8 +61,14 @@ float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }
 void main() {
     vec3 normal, tangent, bitangent;
     if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh (views/mesh/env.glsl)
-        sum_out = vec4(0.0, 0.0, 0.0, float(samples_per_pass));
-        square_out = vec4(0.0);
+        vec3 behind = vec3(0.0);
+        if (show_background) {
+            vec2 p = (2.0 * gl_FragCoord.xy - resolution) / min(resolution.x, resolution.y);
+            behind = environment_radiance(normalize(vec3(p * BACKDROP_TAN, -1.0)));
+        }
+        float n = float(samples_per_pass);
+        sum_out = vec4(behind * n, n);  // exact: no variance
+        square_out = vec4(behind * behind * n, 0.0);
         return;
     }
     vec3 view = vec3(0.0, 0.0, 1.0);
