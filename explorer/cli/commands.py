@@ -293,7 +293,7 @@ def _errors(function):
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
-@click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
+@click.option("--env", "env_file", metavar="FILE|NAME", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
 @click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
@@ -331,9 +331,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
     environment = None
     if view == "env":
-        from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+        from explorer.views.env import DEFAULT_ENVIRONMENT, environment_named
 
-        environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+        environment = environment_named(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
         if (env_rotation is not None or background) and engine == "mitsuba":
             raise click.BadParameter("--env-rotation and --background are for the gl and numpy engines", param_hint="--engine")
         if env_rotation is not None:

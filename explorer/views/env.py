@@ -311,6 +311,43 @@ def generate_default_environment(width: int = DEFAULT_SIZE[0], height: int = DEF
     return image.astype(np.float32)
 
 
+def studio_environment(width: int = 128, height: int = 64) -> EnvironmentMap:
+    """
+    A studio: a dim grey surround (0.05) and two soft rectangular lights, a warm key (radiance 6 x (1, 0.85,
+    0.7)) up and to the viewer's right and a cool fill (1.5 x (0.6, 0.75, 1)) to the left, each 40 x 25
+    degrees; generated, deterministic.
+    """
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    azimuth, elevation = np.meshgrid(360.0 * (u - 0.5), 90.0 - 180.0 * v)  # azimuth 0 looks away from the viewer
+    image = np.full((height, width, 3), 0.05)
+    for centre, colour in (((140.0, 35.0), (6.0, 5.1, 4.2)), ((-120.0, 15.0), (0.9, 1.125, 1.5))):
+        inside = (np.abs((azimuth - centre[0] + 180.0) % 360.0 - 180.0) < 20.0) & (np.abs(elevation - centre[1]) < 12.5)
+        image[inside] = colour
+    return EnvironmentMap(image.astype(np.float32), "studio")
+
+
+def white_furnace(width: int = 16, height: int = 8) -> EnvironmentMap:
+    """Radiance 1 everywhere: the env view then shows each pixel's directional albedo (an energy check)."""
+    return EnvironmentMap(np.ones((height, width, 3), np.float32), "white furnace")
+
+
+#: The environments by name (``render --env NAME``, the app's choice): the shipped sky and two generated ones.
+ENVIRONMENTS: dict[str, Callable[[], EnvironmentMap]] = {
+    "sky": lambda: EnvironmentMap.default(),
+    "studio": studio_environment,
+    "white furnace": white_furnace,
+}
+
+
+def environment_named(text: str | os.PathLike[str]) -> EnvironmentMap:
+    """``--env``: one of :data:`ENVIRONMENTS` by name (where no such file exists), else a ``.hdr`` or ``.exr`` file."""
+    text = os.fspath(text)
+    if text in ENVIRONMENTS and not Path(text).exists():
+        return ENVIRONMENTS[text]()
+    return EnvironmentMap.load(text)
+
+
 def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
     """Write :func:`generate_default_environment` as Radiance RGBE (``python -m explorer.views.env``)."""
     cv2 = _cv2()

@@ -24,7 +24,8 @@ void lit_sphere_frame(vec2 p, float r2, out vec3 normal, out vec3 tangent, out v
 #ifdef MESH_NORMALS
 uniform sampler2D mesh_normals;
 bool view_surface(vec2 resolution, out vec3 normal, out vec3 tangent, out vec3 bitangent) {
-    vec4 surface = texelFetch(mesh_normals, ivec2(gl_FragCoord.xy), 0);
+    // The texel under the pixel: the same size (a headless render), or the app's preview at a smaller one.
+    vec4 surface = texelFetch(mesh_normals, ivec2(gl_FragCoord.xy * vec2(textureSize(mesh_normals, 0)) / resolution), 0);
     if (surface.w <= 0.0) return false;
     normal = normalize(surface.xyz);
     vec3 across = cross(vec3(0.0, 1.0, 0.0), normal);
