@@ -11,9 +11,12 @@ from typing import Callable, Mapping
 import numpy as np
 
 from explorer.errors import LocatedError
-from explorer.views.env import EnvironmentMap, env_integral_numpy
+from explorer.views.env import EnvironmentMap, env_integral_numpy, environment_sampling_tables
 from explorer.gpu.renderer import Renderer
 
+#: The share of samples drawn from the environment (one-sample MIS with the material's own sampling, the
+#: balance heuristic: shaders/views/env.glsl); 0 turns environment sampling off.
+ENVIRONMENT_SAMPLING_WEIGHT = 0.5
 #: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
 PASS_BUDGET_MS = 50.0
 #: Samples per pixel in one pass at most (the shader's loop).
@@ -73,6 +76,7 @@ class ProgressiveEnvRender:
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
         *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None, background: bool = False,
+        environment_sampling: float = ENVIRONMENT_SAMPLING_WEIGHT,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -91,6 +95,13 @@ class ProgressiveEnvRender:
         self.sample_ms: float | None = None
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(renderer.resources, environment)
+        if not 0.0 <= float(environment_sampling) < 1.0:
+            raise ValueError(f"environment_sampling must be in [0, 1), got {environment_sampling}")
+        #: The share of samples drawn from the environment's luminance (explorer.views.env.environment_sampling_tables).
+        self.environment_sampling = float(environment_sampling)
+        marginal, conditional = environment_sampling_tables(environment)
+        self._marginal = renderer.resources.texture(marginal, origin=environment.name)
+        self._conditional = renderer.resources.texture(conditional, origin=environment.name)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
         #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals, read by views/mesh/env.glsl.
         self._surface = None
@@ -122,6 +133,9 @@ class ProgressiveEnvRender:
         uniforms["seed"] = self.seed
         uniforms["environment_turn"] = self.environment.turn
         uniforms["show_background"] = self.background
+        uniforms["environment_sampling_weight"] = self.environment_sampling
+        textures["environment_marginal"] = self._marginal
+        textures["environment_conditional"] = self._conditional
         textures["environment"] = self._texture
         if self._surface is not None:
             textures["mesh_normals"] = self._surface
@@ -226,7 +240,7 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture, self._surface)
+        self.renderer.resources.release(self._framebuffer, self._texture, self._surface, self._marginal, self._conditional)
 
 
 def render_env(

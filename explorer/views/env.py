@@ -396,6 +396,67 @@ def sample_cosine_hemisphere(u1, u2) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------------
+# Twins of the environment's importance sampling (shaders/lib/sampling.glsl)
+
+#: Luminance of linear sRGB (Rec. 709 Y): what the environment's texels are sampled in proportion to.
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+
+def environment_sampling_tables(environment: EnvironmentMap) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The two CDFs of the environment's sampling (Pharr et al., PBRT 3, Sec. 14.2.4), float32 as the shader's
+    textures: ``marginal`` ``(1, H + 1)`` over rows and ``conditional`` ``(H, W + 1)`` over each row's texels,
+    of ``max(luminance, 0) sin(theta)`` per texel (``theta`` at the row's centre); a black environment (or
+    row) is sampled uniformly in ``(u, v)`` times ``sin(theta)``.
+    """
+    height, width = environment.height, environment.width
+    sin_theta = np.sin(np.pi * (np.arange(height) + 0.5) / height)
+    weight = np.maximum(environment.pixels.astype(np.float64) @ LUMINANCE, 0.0) * sin_theta[:, None]
+    if weight.sum() <= 0.0:
+        weight = np.broadcast_to(sin_theta[:, None], (height, width)).copy()
+    rows = weight.sum(axis=1)
+    blank = rows <= 0.0
+    weight[blank] = 1.0  # a black row is never chosen (its marginal mass is 0): any conditional will do
+    conditional = np.concatenate([np.zeros((height, 1)), np.cumsum(weight, axis=1)], axis=1)
+    conditional /= conditional[:, -1:]
+    marginal = np.concatenate([[0.0], np.cumsum(rows)]) / rows.sum()
+    conditional[:, -1] = 1.0
+    marginal[-1] = 1.0
+    return marginal[None, :].astype(np.float32), conditional.astype(np.float32)
+
+
+def sample_environment(tables, turn: float, u1, u2) -> np.ndarray:
+    """Directions ``(..., 3)`` for uniform ``u1``, ``u2`` (the shader's ``sample_environment``, in float64 on the float32 CDFs)."""
+    marginal, conditional = (np.asarray(t, np.float64) for t in tables)
+    marginal = marginal[0]
+    rows, columns = conditional.shape[0], conditional.shape[1] - 1
+    u1, u2 = np.asarray(u1, np.float64), np.asarray(u2, np.float64)
+    i = np.clip(np.searchsorted(marginal, u1, side="right") - 1, 0, rows - 1)
+    fv = np.clip((u1 - marginal[i]) / np.maximum(marginal[i + 1] - marginal[i], 1e-30), 0.0, 1.0)
+    cdf = conditional[i]
+    j = np.clip(np.sum(cdf <= u2[..., None], axis=-1) - 1, 0, columns - 1)
+    c0, c1 = np.take_along_axis(cdf, j[..., None], -1)[..., 0], np.take_along_axis(cdf, j[..., None] + 1, -1)[..., 0]
+    fu = np.clip((u2 - c0) / np.maximum(c1 - c0, 1e-30), 0.0, 1.0)
+    return uv_to_direction((j + fu) / columns + turn, (i + fv) / rows)
+
+
+def environment_pdf(tables, turn: float, d) -> np.ndarray:
+    """The density in solid angle of :func:`sample_environment` toward unit ``d`` (the shader's ``environment_pdf``)."""
+    marginal, conditional = (np.asarray(t, np.float64) for t in tables)
+    marginal = marginal[0]
+    rows, columns = conditional.shape[0], conditional.shape[1] - 1
+    d = np.asarray(d, np.float64)
+    u, v = direction_to_uv(d)
+    u = np.mod(u - turn, 1.0)
+    i = np.clip((v * rows).astype(np.int64), 0, rows - 1)
+    j = np.clip((u * columns).astype(np.int64), 0, columns - 1)
+    mass = (marginal[i + 1] - marginal[i]) * (conditional[i, j + 1] - conditional[i, j])
+    sin_theta = np.hypot(d[..., 0], d[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(sin_theta > 1e-7, mass * rows * columns / (2.0 * np.pi ** 2 * sin_theta), 0.0)
+
+
+# --------------------------------------------------------------------------------------------------
 # The numpy twin: the exact integral by quadrature
 
 
