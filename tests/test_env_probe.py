@@ -83,3 +83,20 @@ def test_gl_rotation_and_background_equal_numpy(gl_renderer):
     np.testing.assert_allclose(mean[outside], backdrop(environment, size, size)[outside], rtol=BACKDROP_RTOL)
     np.testing.assert_allclose(exact[outside], backdrop(environment, size, size)[outside], rtol=1e-6)
     assert not np.allclose(backdrop(environment, size, size), backdrop(smooth_environment(), size, size), rtol=1e-2)
+
+
+def test_named_environments(tmp_path):
+    from explorer.views.env import ENVIRONMENTS, EnvironmentFileError, environment_named
+
+    assert set(ENVIRONMENTS) == {"sky", "studio", "white furnace"}
+    furnace = environment_named("white furnace")
+    np.testing.assert_array_equal(furnace.radiance(np.array([[0.0, 1.0, 0.0], [0.6, 0.0, -0.8]])), 1.0)
+    studio = environment_named("studio")
+    assert studio.pixels.max() == pytest.approx(6.0) and studio.pixels.min() == pytest.approx(0.05)
+    with pytest.raises(EnvironmentFileError):
+        environment_named("no such environment")
+    out = tmp_path / "furnace.npy"
+    run = run_cli("render", GGX, "--view", "env", "--env", "white furnace", "--engine", "numpy", "--size", "4", "--out", out)
+    assert run.returncode == 0, run.stderr
+    image = np.load(out)
+    assert 0.0 < image.max() <= 1.0  # a passive material's directional albedo under radiance 1

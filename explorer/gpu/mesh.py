@@ -44,7 +44,9 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
     ctx = renderer.ctx
     renderer.limits.check_target(width, height)
     positions, normals = view_space(mesh)
-    program = ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
+    program = getattr(renderer, "_mesh_normals_program", None)
+    if program is None:  # compiled once per renderer (its context)
+        program = renderer._mesh_normals_program = ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
     vertices = ctx.buffer(np.ascontiguousarray(np.concatenate([positions, normals], axis=1), dtype="f4").tobytes())
     indices = ctx.buffer(np.ascontiguousarray(mesh.triangles, dtype="i4").tobytes())
     array = ctx.vertex_array(program, [(vertices, "3f 3f", "position", "normal")], index_buffer=indices, index_element_size=4)
@@ -63,7 +65,7 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
         data = np.frombuffer(colour.read(), dtype=np.float32).reshape(height, width, 4)
         return data.copy()
     finally:
-        for obj in (framebuffer, depth, colour, array, indices, vertices, program):
+        for obj in (framebuffer, depth, colour, array, indices, vertices):
             obj.release()
 
 
