@@ -154,6 +154,7 @@ def _render_jobs(installed: Installed) -> dict[str, list[str]]:
     jobs["preset"] = ["render", "bragg_stack.brd", "--view", "lit", "--preset", "figure1_stacked_pair", "--size", "16",
                       "--out", "preset.npy"]
     jobs["env"] = ["render", "ggx_schlick", "--view", "env", "--spp", "4", "--size", "16", "--out", "env.npy"]
+    jobs["mesh"] = ["render", "ggx_schlick", "--view", "lit", "--mesh", "teapot", "--size", "16", "--out", "mesh.npy"]  # shaders/meshes, views/mesh
     jobs["textured"] = ["render", "thin_film", "--view", "textured", "--set", "method=3", "--size", "16",
                         "--out", "textured.npy"]
     jobs["png"] = ["render", "bragg_mirror", "--view", "gradient", "--exposure", "2", "--size", "32", "--out", "strip.png"]

@@ -81,31 +81,60 @@ class TablePrefetcher:
             self._executor.shutdown(wait=True)
 
 
+def model_mesh(name: str, cache: dict):
+    """The mesh of a Sphere window model (None for the sphere), generated once per session."""
+    if name == "sphere":
+        return None
+    if name not in cache:
+        from explorer.views.mesh import SHAPES
+
+        cache[name] = SHAPES[name]()
+    return cache[name]
+
+
 class EnvSphere:
-    """The env mode: progressive Monte Carlo under the default sky (:mod:`explorer.gpu.env`), restarted on change."""
+    """
+    The env mode: progressive Monte Carlo (:mod:`explorer.gpu.env`) under the chosen environment, turned,
+    with or without the environment behind the sphere or mesh; restarted on change, and converged (no more
+    samples drawn) once it holds ``state.env_target_spp`` samples per pixel.
+    """
 
     def __init__(self, renderer):
         self.renderer = renderer
-        self.environment: EnvironmentMap | None = None
+        self.environments: dict[str, EnvironmentMap] = {}
+        self.meshes: dict = {}
         self.render: ProgressiveEnvRender | None = None
         self.source: AccumulatedImage | None = None
         self._key = None
-        self._size = None
+        self._structure = None
         self.pending = False  # requested this frame: advanced by the scheduler
+
+    def environment(self, name: str) -> EnvironmentMap:
+        """An environment of :data:`explorer.views.env.ENVIRONMENTS` by name, loaded once."""
+        from explorer.views.env import ENVIRONMENTS
+
+        if name not in self.environments:
+            self.environments[name] = ENVIRONMENTS[name]()
+        return self.environments[name]
 
     def request(self, state: AppState, size) -> AccumulatedImage:
         """The render of ``state``'s material and values at ``size``, as a display source."""
-        key = (id(state.material), tuple(sorted(state.values.items())), size, tuple(state.camera), tuple(state.light))
+        key = (id(state.material), tuple(sorted(state.values.items())), size, tuple(state.camera), tuple(state.light),
+               state.environment, state.env_rotation, state.env_background, state.model)
         if self._key != key or self.render is None:
+            environment = self.environment(state.environment).rotated(state.env_rotation)
             # Another material (Files > Open, Reload) needs a render of its own: resetting the old one with
-            # the new values would bind them to the old material's uniforms.
-            if self.render is None or self._size != size or self.render.material is not state.material:
+            # the new values would bind them to the old material's uniforms. So do another environment,
+            # model or size (their textures); a turn of the probe only restarts the samples.
+            structure = (size, state.environment, state.env_background, state.model)
+            if self.render is None or self._structure != structure or self.render.material is not state.material:
                 if self.render is not None:
                     self.render.release()
-                self.environment = self.environment or EnvironmentMap.default()
-                self.render = ProgressiveEnvRender(self.renderer, state.material, state.values, self.environment, *size)
-                self._size = size
+                self.render = ProgressiveEnvRender(self.renderer, state.material, state.values, environment, *size,
+                                                   mesh=model_mesh(state.model, self.meshes), background=state.env_background)
+                self._structure = structure
             else:
+                self.render.environment = environment
                 self.render.reset(values=state.values)
             self._key = key
         self.pending = True
@@ -113,7 +142,14 @@ class EnvSphere:
             self.source = AccumulatedImage(self.render)
         return self.source
 
-    def work(self, budget_ms: float) -> None:
+    def progress(self, target: int) -> dict:
+        """``{"samples", "target", "converged"}``: whole samples per pixel so far, and whether they reach ``target``."""
+        samples = 0 if self.render is None else self.render.samples
+        return {"samples": samples, "target": int(target), "converged": samples >= target}
+
+    def work(self, budget_ms: float, target: int | None = None) -> None:
+        if target is not None and self.render.samples >= target:
+            return  # converged: the image stays, nothing more is drawn
         # Bands of rows when one sample costs more than the budget; the display pass divides by the counts.
         self.render.advance(max(0.5 * budget_ms, 5.0))
 
@@ -158,7 +194,8 @@ class Scheduler:
                 break
             job.work(remaining)
         if self.env.pending and state.mode == "env":
-            self.env.work(budget - (time.perf_counter() - start) * 1e3)
+            self.env.work(budget - (time.perf_counter() - start) * 1e3, state.env_target_spp)
+            state.env_progress = self.env.progress(state.env_target_spp)
         self.env.pending = False
         for panel in panels:
             panel.after_gl()

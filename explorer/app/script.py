@@ -32,7 +32,8 @@ class ScriptRobot:
 
     Actions (dicts): ``{"wait": N}`` frames; ``{"wait_complete": true}`` until the active view is fully
     refined; ``{"wait_for": NAME}`` until a panel's report ``state.NAME`` is a dict not ``running`` (the
-    Design window's worker); ``{"wait_accuracy": true}`` until the accuracy badge shows the current values;
+    Design window's worker); ``{"wait_accuracy": true}`` until the accuracy badge shows the current values; ``{"wait_converged": true}``
+    until the env mode holds its target samples per pixel;
     ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
@@ -190,6 +191,13 @@ def _wait_accuracy(robot, app, io, action, step):  # the Parameters window's bad
     return done or _timed_out(robot, action, step, "wait_accuracy", 2000)
 
 
+def _wait_converged(robot, app, io, action, step):  # the env mode holds its target samples per pixel
+    done = step > 1 and bool(app.state.env_progress.get("converged"))
+    if done:
+        robot.script.log.append(f"converged at {app.state.env_progress.get('samples')} samples per pixel")
+    return done or _timed_out(robot, action, step, "wait_converged", 3000)
+
+
 def _mark(robot, app, io, action, step):
     robot.script.mark = action["mark"]
     return True
@@ -255,6 +263,7 @@ ACTIONS = {
     "wait_for": _wait_for,
     "wait_complete": _wait_complete,
     "wait_accuracy": _wait_accuracy,
+    "wait_converged": _wait_converged,
     "mark": _mark,
     "set": _set,
     "drag": lambda robot, app, io, action, step: robot._drag(app.state, io, action, step),

@@ -16,6 +16,10 @@ from explorer.materials.methods import BraggMethod
 from explorer.materials.brd import Material
 
 VIEW_SIZES = (128, 256, 512, 1024)
+#: The env mode's "converged" sample counts (samples per pixel), its default the second.
+ENV_TARGETS = (64, 256, 1024, 4096)
+#: The Sphere window's models: the sphere, or a generated mesh (explorer.views.mesh.SHAPES) in the lit and env modes.
+SPHERE_MODELS = ("sphere", "teapot", "cube", "torus")
 DEFAULT_VIEW_SIZE = 512
 MODES = ("lit", "sphere", "env")
 
@@ -64,6 +68,16 @@ class AppState:
     camera: list = field(default_factory=lambda: [0.0, 0.0])  # yaw, pitch: turns the light relative to the view
     zoom: float = 1.0
     exposure: float = 1.0
+    # The env mode (explorer.app.scheduler.EnvSphere): its environment (a name of explorer.views.env.ENVIRONMENTS),
+    # the probe's turn (degrees), the environment behind the object, the samples per pixel that make it
+    # converged (no more are drawn), and its progress (samples, target, converged) for the status and report.
+    environment: str = "sky"
+    env_rotation: float = 0.0
+    env_background: bool = False
+    env_target_spp: int = ENV_TARGETS[1]
+    env_progress: dict = field(default_factory=dict)
+    # "Switch model": the sphere or a mesh of SPHERE_MODELS (lit and env; the white-furnace sphere stays a sphere).
+    model: str = "sphere"
     gamut: bool = False
     mean_delta_e: float | None = None
     accuracy: str = ""  # the Parameters window's accuracy badge (a Bragg mirror's method vs the converged table)

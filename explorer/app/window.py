@@ -224,6 +224,8 @@ class App:
             "frames": s.frame_times, "screenshots": s.screenshots, "screenshot_info": s.screenshot_info,
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
+            "env": {"environment": s.environment, "rotation": s.env_rotation, "background": s.env_background,
+                    "model": s.model, **s.env_progress},
         }
         from explorer.files import write_text_atomic
 

@@ -548,20 +548,35 @@ def app_bench_script(frames: int = 60) -> list:
             {"drag": "param:Lambda", "from": 0.15, "to": 0.85, "frames": frames},
             {"mark": None}, {"wait": 3},
         ]
-    return script + [{"quit": True}]
+    return script + app_mesh_steps(frames) + [{"quit": True}]
+
+
+#: ``bench --app``'s mesh cases (issue 18): the Sphere window's teapot, lit and under the environment (tabulated method).
+APP_MESH_CASES = (("teapot lit", "mode:lit"), ("teapot env", "mode:env"))
+
+
+def app_mesh_steps(frames: int) -> list:
+    """Drag Lambda with the teapot shown (Switch model), lit and in the env mode (its progressive first passes)."""
+    steps: list = [{"set": {"method": int(BraggMethod.TABULATED)}}, {"click": "model_combo"}, {"click": "model:teapot"}]
+    for mark, mode in APP_MESH_CASES:
+        steps += [{"click": mode}, {"wait": 8}, {"mark": mark},
+                  {"drag": "param:Lambda", "from": 0.15, "to": 0.85, "frames": frames}, {"mark": None}, {"wait": 3}]
+    return steps
 
 
 def summarise_app_frames(frames: list[dict]) -> list[dict]:
     """Per method: frame times (ms) of the frames spent dragging, and the resolution shown meanwhile."""
     rows = []
-    for method, name in APP_METHODS:
+    cases = [(method, name, f"method {method}") for method, name in APP_METHODS]
+    cases += [(int(BraggMethod.TABULATED), mark, mark) for mark, _ in APP_MESH_CASES]
+    for method, name, mark in cases:
         # Only frames where the parameter changed: a frame that redraws nothing new is not a drag frame.
-        chosen = [f for f in frames if f.get("mark") == f"method {method}" and f.get("dragging") and f.get("changed")]
+        chosen = [f for f in frames if f.get("mark") == mark and f.get("dragging") and f.get("changed")]
         if not chosen:
             continue
         ms = np.array([f["ms"] for f in chosen[2:] or chosen])
         # How often the sphere shows new values: its tables may be one frame late (built on a worker thread).
-        drag = [f for f in frames if f.get("mark") == f"method {method}" and f.get("dragging")]
+        drag = [f for f in frames if f.get("mark") == mark and f.get("dragging")]
         generations = [f["main"].get("generation", 0) for f in drag]
         updates = sum(1 for a, b in zip(generations, generations[1:]) if b != a)
         seconds = 1e-3 * sum(f["ms"] for f in drag[1:])

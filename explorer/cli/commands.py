@@ -105,18 +105,26 @@ def parse_exposure(text: str | None, out: Path) -> float:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
+    mesh=None, background: bool = False,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
-    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
+    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view; ``mesh``
+    (an :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views.
     """
+    if material.measured is not None:
+        from explorer.views.geometry import VIEW_REGISTRY
+
+        if VIEW_REGISTRY[view].evaluates not in ("brdf", "environment"):
+            shown = ", ".join(name for name, v in VIEW_REGISTRY.items() if v.evaluates in ("brdf", "environment"))
+            raise MaterialError(material.path, None, f"a measured BRDF (MERL) has no reflectance(cos_theta) for the {view} view; its views: {shown}")
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
 
         return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp)
+        return _render_env(material, values, width, height, engine, environment, spp, mesh, background)
     if view == "textured":
         from explorer.views.thickness import ThicknessTexture, check_prefilter
 
@@ -135,7 +143,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
@@ -146,6 +154,10 @@ def render_material(
             material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
             uniforms={"prefilter": thickness.prefilter},
         )
+    if mesh is not None:
+        from explorer.gpu.mesh import render_mesh
+
+        return render_mesh(renderer, material, values, view, mesh, width, height, light=light)
     return renderer.render(material, values, view, width, height, light=light)
 
 
@@ -159,7 +171,8 @@ def check_numpy_size(width: int, height: int) -> None:
                                            f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
 
 
-def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
+def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None,
+                background: bool = False) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
@@ -186,7 +199,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         click.echo(f"{PROG}: warning: {message}", err=True)
 
     return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn)
+                      progress=progress, warn=warn, mesh=mesh, background=background)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -281,12 +294,15 @@ def _errors(function):
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
-@click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
+@click.option("--env", "env_file", metavar="FILE|NAME", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
+@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
+@click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env view: the environment turned about the vertical.")
+@click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant):
+           prefilter, env_file, spp, variant, mesh, env_rotation, background):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -316,11 +332,23 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
     environment = None
     if view == "env":
-        from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+        from explorer.views.env import DEFAULT_ENVIRONMENT, environment_named
 
-        environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
-    elif env_file is not None or (spp is not None and engine != "position-free"):
-        raise click.BadParameter("--env and --spp are for the env view", param_hint="--view")
+        environment = environment_named(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+        if (env_rotation is not None or background) and engine == "mitsuba":
+            raise click.BadParameter("--env-rotation and --background are for the gl and numpy engines", param_hint="--engine")
+        if env_rotation is not None:
+            environment = environment.rotated(env_rotation)
+    elif env_file is not None or (spp is not None and engine != "position-free") or env_rotation is not None or background:
+        raise click.BadParameter("--env, --spp, --env-rotation and --background are for the env view", param_hint="--view")
+    mesh_shape = None
+    if mesh is not None:
+        from explorer.views.mesh import mesh_named
+
+        if view not in ("lit", "env") or engine not in ("gl", "numpy"):
+            raise click.BadParameter(f"a mesh is drawn in the lit and env views by the gl and numpy engines, not {view} ({engine})",
+                                     param_hint="--mesh")
+        mesh_shape = mesh_named(mesh)
     if engine == "mitsuba" or variant is not None:
         from explorer.cli.export import check_mitsuba_render
 
@@ -331,7 +359,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant)
+                                variant=variant, mesh=mesh_shape, background=background)
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())

@@ -11,9 +11,12 @@ from typing import Callable, Mapping
 import numpy as np
 
 from explorer.errors import LocatedError
-from explorer.views.env import EnvironmentMap, env_integral_numpy
+from explorer.views.env import EnvironmentMap, env_integral_numpy, environment_sampling_tables
 from explorer.gpu.renderer import Renderer
 
+#: The share of samples drawn from the environment (one-sample MIS with the material's own sampling, the
+#: balance heuristic: shaders/views/env.glsl); 0 turns environment sampling off.
+ENVIRONMENT_SAMPLING_WEIGHT = 0.5
 #: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
 PASS_BUDGET_MS = 50.0
 #: Samples per pixel in one pass at most (the shader's loop).
@@ -72,7 +75,8 @@ class ProgressiveEnvRender:
 
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
-        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None, background: bool = False,
+        environment_sampling: float = ENVIRONMENT_SAMPLING_WEIGHT,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -91,16 +95,31 @@ class ProgressiveEnvRender:
         self.sample_ms: float | None = None
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(renderer.resources, environment)
+        if not 0.0 <= float(environment_sampling) < 1.0:
+            raise ValueError(f"environment_sampling must be in [0, 1), got {environment_sampling}")
+        #: The share of samples drawn from the environment's luminance (explorer.views.env.environment_sampling_tables).
+        self.environment_sampling = float(environment_sampling)
+        marginal, conditional = environment_sampling_tables(environment)
+        self._marginal = renderer.resources.texture(marginal, origin=environment.name)
+        self._conditional = renderer.resources.texture(conditional, origin=environment.name)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
+        #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals, read by views/mesh/env.glsl.
+        self._surface = None
+        if mesh is not None:
+            from explorer.gpu.mesh import mesh_normals
+
+            self._surface = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
+        #: Off the object, the environment behind it (exact, no samples needed), else black.
+        self.background = bool(background)
         self.reset()
 
     def reset(self, values: Mapping[str, object] | None = None) -> None:
         """Drop every sample; with ``values``, render the material with those parameters from now on."""
         if values is not None:
             self.values = dict(values)
-        self.program = self.renderer.program(self.material, "env", self.values)
+        self.program = self.renderer.program(self.material, "env" if self._surface is None else "mesh/env", self.values)
         self._framebuffer.use()
         self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
         #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
@@ -112,7 +131,14 @@ class ProgressiveEnvRender:
         """The program's uniforms and textures for :meth:`_pass` (the material's, the environment, the seed)."""
         uniforms, textures = self.renderer.bindings(self.program, self.material, self.values)
         uniforms["seed"] = self.seed
+        uniforms["environment_turn"] = self.environment.turn
+        uniforms["show_background"] = self.background
+        uniforms["environment_sampling_weight"] = self.environment_sampling
+        textures["environment_marginal"] = self._marginal
+        textures["environment_conditional"] = self._conditional
         textures["environment"] = self._texture
+        if self._surface is not None:
+            textures["mesh_normals"] = self._surface
         return {"uniforms": uniforms, "textures": textures}
 
     def _pass(self, bindings: dict, count: int, rows: tuple[int, int] | None = None) -> float:
@@ -214,19 +240,21 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture)
+        self.renderer.resources.release(self._framebuffer, self._texture, self._surface, self._marginal, self._conditional)
 
 
 def render_env(
     material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
     environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
-    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None, mesh=None,
+    background: bool = False,
 ) -> np.ndarray:
     """
     The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
     (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
-    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
+    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite. ``mesh`` (an
+    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere; ``background``: the environment behind it.
     """
     if not 1 <= spp <= MAX_SPP:
         raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
@@ -235,9 +263,10 @@ def render_env(
         from explorer.materials.models import model_for
 
         model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress)
+        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh, background=background)
     renderer = Renderer() if renderer is None else renderer
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh,
+                                  background=background)
     try:
         while render.samples < spp:
             render.step(min(spp - render.samples, max(1, render.samples_per_pass)))

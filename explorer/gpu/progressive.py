@@ -85,11 +85,16 @@ class ProgressiveView:
     def request(
         self, material: Material, values: Mapping[str, object], view: str, size: tuple[int, int], *,
         light: tuple[float, float, float] | None = None, uniforms: Mapping[str, object] | None = None,
-        dragging: bool = False,
+        dragging: bool = False, inputs: Mapping[str, np.ndarray] | None = None, inputs_key=None,
     ) -> None:
-        """What to show; a change restarts the image (``dragging``: stay on the preview)."""
+        """
+        What to show; a change restarts the image (``dragging``: stay on the preview). ``inputs``: the view's
+        textures (a mesh's normals, :mod:`explorer.gpu.mesh`), which ``inputs_key`` names (arrays are not compared).
+        """
         self.dragging = dragging
-        key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}))
+        self.inputs = dict(inputs) if inputs else None
+        key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}),
+               inputs_key if inputs else None)
         if key == self._key:
             return
         self._key = key
@@ -121,7 +126,7 @@ class ProgressiveView:
     def _draw(self, framebuffer, size, rows: tuple[int, int] | None = None) -> float:
         """Draw into ``framebuffer`` (rows ``[top, bottom)`` from the top only); returns ms (glFinish-bounded)."""
         program = self._program()
-        uniforms, textures = self.renderer.bindings(program, self.material, self.values, None, self.uniforms)
+        uniforms, textures = self.renderer.bindings(program, self.material, self.values, getattr(self, "inputs", None), self.uniforms)
         if self.light is not None:
             uniforms["light_direction"] = self.light
         elapsed = self.renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures, rows=rows)

@@ -374,6 +374,9 @@ class Material:
     model: str | None = None
     specialised: tuple[str, ...] = ()
     warnings: list[str] = field(default_factory=list)
+    #: A measured material's data (a MERL table, :class:`explorer.materials.merl.MerlTable`), which makes
+    #: its numpy twin (``measured.twin(values)``); None for an analytic file.
+    measured: Any = field(default=None, compare=False, repr=False)
 
     def parameter(self, name: str) -> Parameter:
         """Return the parameter called `name`.
@@ -744,7 +747,7 @@ def parse_material(text: str, path: str | os.PathLike[str] = "<string>") -> Mate
 
 
 def load_material(path: str | os.PathLike[str]) -> Material:
-    """Read and parse a material file (``.brd`` or BRDF Explorer's ``.brdf``).
+    """Read and parse a material file (``.brd`` or BRDF Explorer's ``.brdf``), or a MERL ``.binary`` table.
 
     Parameters
     ----------
@@ -758,6 +761,13 @@ def load_material(path: str | os.PathLike[str]) -> Material:
     ------
     MaterialError
         When the file cannot be read, or does not parse (see `parse_material`).
+        Also for a ``.binary`` file that is not a MERL isotropic table, and other binary data (one line
+        each: what the file is, what is supported).
+
+    Notes
+    -----
+    A MERL ``.binary`` table (by suffix, or by its header and size) loads as a measured material without
+    parameters (:mod:`explorer.materials.merl`).
     """
     name = os.fspath(path)
     try:
@@ -765,6 +775,16 @@ def load_material(path: str | os.PathLike[str]) -> Material:
             data = f.read()
     except OSError as exc:
         raise MaterialError(name, None, f"cannot read material file: {exc.strerror or exc}") from None
+    from explorer.materials import merl
+
+    try:
+        if name.lower().endswith(merl.SUFFIX) or merl.is_merl(data):
+            table = merl.MerlTable.from_bytes(data, name)
+            return Material(path=name, parameters=[], shader=merl.SHADER, shader_line=1, model=merl.MODEL, measured=table)
+        if merl.looks_binary(data):  # no text: say what it is and what is supported, not its garbled first line
+            raise merl.not_a_material(name, data)
+    except merl.MerlFileError as error:  # a MaterialError for every caller of the loader
+        raise MaterialError(error.path, error.line, error.message) from None
     try:
         return parse_material(data.decode("utf-8-sig"), name)
     except UnicodeDecodeError:

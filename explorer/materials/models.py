@@ -331,6 +331,9 @@ def model_for(material, values: Mapping[str, object], normalised: bool = False):
     ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.materials.brd.Material.physical_values`;
     ``normalised``: they already are, once per bind).
     """
+    measured = getattr(material, "measured", None)
+    if measured is not None:  # a measured material's data makes its twin (explorer.materials.merl)
+        return measured.twin(values)
     factory = MODELS.get(material.model or "")
     if factory is None:
         return None

@@ -154,9 +154,13 @@ class EnvironmentMap:
         Finite radiance values.
     name : str
         Where it comes from (a path), for messages.
+    rotation : float
+        The probe's turn about the vertical ``+y`` in degrees: the radiance toward ``d`` is the texel at
+        ``u(d) - rotation / 360`` (the shader's ``environment_turn``; GL's ``REPEAT`` in ``u`` makes any
+        turn exact under the bilinear lookup).
     """
 
-    def __init__(self, pixels, name: str = "<array>"):
+    def __init__(self, pixels, name: str = "<array>", rotation: float = 0.0):
         data = np.ascontiguousarray(pixels, dtype=np.float32)
         if data.ndim != 3 or data.shape[2] != 3 or data.shape[0] < 1 or data.shape[1] < 1:
             raise EnvironmentFileError(name, None, f"environment must be an RGB image (height, width, 3), got shape {data.shape}")
@@ -165,6 +169,18 @@ class EnvironmentMap:
         data.setflags(write=False)
         self.pixels = data
         self.name = name
+        if not math.isfinite(float(rotation)):
+            raise EnvironmentFileError(name, None, f"environment rotation {rotation!r} is not a finite angle")
+        self.rotation = float(rotation)
+
+    @property
+    def turn(self) -> float:
+        """:attr:`rotation` as a fraction of a turn in [0, 1) (the shader's ``environment_turn``)."""
+        return (self.rotation / 360.0) % 1.0
+
+    def rotated(self, degrees: float) -> "EnvironmentMap":
+        """The same texels, the probe turned by ``degrees`` about ``+y``."""
+        return EnvironmentMap(self.pixels, self.name, degrees)
 
     @property
     def width(self) -> int:
@@ -227,7 +243,7 @@ class EnvironmentMap:
     def radiance(self, d) -> np.ndarray:
         """Bilinear radiance ``(..., 3)`` (float64) toward unit directions ``d``: the shader's lookup."""
         u, v = direction_to_uv(d)
-        return self.radiance_uv(u, v)
+        return self.radiance_uv(u - self.turn, v)
 
     def radiance_uv(self, u, v) -> np.ndarray:
         """Bilinear radiance at texture coordinates (GL's ``LINEAR``, ``REPEAT`` in u, ``CLAMP_TO_EDGE`` in v)."""
@@ -259,7 +275,7 @@ class EnvironmentMap:
         v = 0.5 * (v_edges[1:] + v_edges[:-1])
         u = (np.arange(columns) + 0.5) / columns
         band = (np.cos(np.pi * v_edges[:-1]) - np.cos(np.pi * v_edges[1:])) * (2.0 * np.pi / columns)
-        directions = uv_to_direction(u[None, :], v[:, None]).reshape(-1, 3)
+        directions = uv_to_direction(u[None, :] + self.turn, v[:, None]).reshape(-1, 3)  # texel (u, v) under the turn
         solid_angle = np.broadcast_to(band[:, None], (rows, columns)).reshape(-1)
         radiance = self.radiance_uv(u[None, :], v[:, None]).reshape(-1, 3)
         return directions, solid_angle, radiance
@@ -293,6 +309,43 @@ def generate_default_environment(width: int = DEFAULT_SIZE[0], height: int = DEF
     angle = np.arccos(np.clip(d @ sun, -1.0, 1.0))
     image += SUN_PEAK * np.array([1.0, 0.92, 0.8]) * np.exp(-0.5 * (angle / np.radians(SUN_SIGMA)) ** 2)[..., None]
     return image.astype(np.float32)
+
+
+def studio_environment(width: int = 128, height: int = 64) -> EnvironmentMap:
+    """
+    A studio: a dim grey surround (0.05) and two soft rectangular lights, a warm key (radiance 6 x (1, 0.85,
+    0.7)) up and to the viewer's right and a cool fill (1.5 x (0.6, 0.75, 1)) to the left, each 40 x 25
+    degrees; generated, deterministic.
+    """
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    azimuth, elevation = np.meshgrid(360.0 * (u - 0.5), 90.0 - 180.0 * v)  # azimuth 0 looks away from the viewer
+    image = np.full((height, width, 3), 0.05)
+    for centre, colour in (((140.0, 35.0), (6.0, 5.1, 4.2)), ((-120.0, 15.0), (0.9, 1.125, 1.5))):
+        inside = (np.abs((azimuth - centre[0] + 180.0) % 360.0 - 180.0) < 20.0) & (np.abs(elevation - centre[1]) < 12.5)
+        image[inside] = colour
+    return EnvironmentMap(image.astype(np.float32), "studio")
+
+
+def white_furnace(width: int = 16, height: int = 8) -> EnvironmentMap:
+    """Radiance 1 everywhere: the env view then shows each pixel's directional albedo (an energy check)."""
+    return EnvironmentMap(np.ones((height, width, 3), np.float32), "white furnace")
+
+
+#: The environments by name (``render --env NAME``, the app's choice): the shipped sky and two generated ones.
+ENVIRONMENTS: dict[str, Callable[[], EnvironmentMap]] = {
+    "sky": lambda: EnvironmentMap.default(),
+    "studio": studio_environment,
+    "white furnace": white_furnace,
+}
+
+
+def environment_named(text: str | os.PathLike[str]) -> EnvironmentMap:
+    """``--env``: one of :data:`ENVIRONMENTS` by name (where no such file exists), else a ``.hdr`` or ``.exr`` file."""
+    text = os.fspath(text)
+    if text in ENVIRONMENTS and not Path(text).exists():
+        return ENVIRONMENTS[text]()
+    return EnvironmentMap.load(text)
 
 
 def write_default_environment(path: Path = DEFAULT_ENVIRONMENT) -> Path:
@@ -343,6 +396,67 @@ def sample_cosine_hemisphere(u1, u2) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------------
+# Twins of the environment's importance sampling (shaders/lib/sampling.glsl)
+
+#: Luminance of linear sRGB (Rec. 709 Y): what the environment's texels are sampled in proportion to.
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+
+def environment_sampling_tables(environment: EnvironmentMap) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The two CDFs of the environment's sampling (Pharr et al., PBRT 3, Sec. 14.2.4), float32 as the shader's
+    textures: ``marginal`` ``(1, H + 1)`` over rows and ``conditional`` ``(H, W + 1)`` over each row's texels,
+    of ``max(luminance, 0) sin(theta)`` per texel (``theta`` at the row's centre); a black environment (or
+    row) is sampled uniformly in ``(u, v)`` times ``sin(theta)``.
+    """
+    height, width = environment.height, environment.width
+    sin_theta = np.sin(np.pi * (np.arange(height) + 0.5) / height)
+    weight = np.maximum(environment.pixels.astype(np.float64) @ LUMINANCE, 0.0) * sin_theta[:, None]
+    if weight.sum() <= 0.0:
+        weight = np.broadcast_to(sin_theta[:, None], (height, width)).copy()
+    rows = weight.sum(axis=1)
+    blank = rows <= 0.0
+    weight[blank] = 1.0  # a black row is never chosen (its marginal mass is 0): any conditional will do
+    conditional = np.concatenate([np.zeros((height, 1)), np.cumsum(weight, axis=1)], axis=1)
+    conditional /= conditional[:, -1:]
+    marginal = np.concatenate([[0.0], np.cumsum(rows)]) / rows.sum()
+    conditional[:, -1] = 1.0
+    marginal[-1] = 1.0
+    return marginal[None, :].astype(np.float32), conditional.astype(np.float32)
+
+
+def sample_environment(tables, turn: float, u1, u2) -> np.ndarray:
+    """Directions ``(..., 3)`` for uniform ``u1``, ``u2`` (the shader's ``sample_environment``, in float64 on the float32 CDFs)."""
+    marginal, conditional = (np.asarray(t, np.float64) for t in tables)
+    marginal = marginal[0]
+    rows, columns = conditional.shape[0], conditional.shape[1] - 1
+    u1, u2 = np.asarray(u1, np.float64), np.asarray(u2, np.float64)
+    i = np.clip(np.searchsorted(marginal, u1, side="right") - 1, 0, rows - 1)
+    fv = np.clip((u1 - marginal[i]) / np.maximum(marginal[i + 1] - marginal[i], 1e-30), 0.0, 1.0)
+    cdf = conditional[i]
+    j = np.clip(np.sum(cdf <= u2[..., None], axis=-1) - 1, 0, columns - 1)
+    c0, c1 = np.take_along_axis(cdf, j[..., None], -1)[..., 0], np.take_along_axis(cdf, j[..., None] + 1, -1)[..., 0]
+    fu = np.clip((u2 - c0) / np.maximum(c1 - c0, 1e-30), 0.0, 1.0)
+    return uv_to_direction((j + fu) / columns + turn, (i + fv) / rows)
+
+
+def environment_pdf(tables, turn: float, d) -> np.ndarray:
+    """The density in solid angle of :func:`sample_environment` toward unit ``d`` (the shader's ``environment_pdf``)."""
+    marginal, conditional = (np.asarray(t, np.float64) for t in tables)
+    marginal = marginal[0]
+    rows, columns = conditional.shape[0], conditional.shape[1] - 1
+    d = np.asarray(d, np.float64)
+    u, v = direction_to_uv(d)
+    u = np.mod(u - turn, 1.0)
+    i = np.clip((v * rows).astype(np.int64), 0, rows - 1)
+    j = np.clip((u * columns).astype(np.int64), 0, columns - 1)
+    mass = (marginal[i + 1] - marginal[i]) * (conditional[i, j + 1] - conditional[i, j])
+    sin_theta = np.hypot(d[..., 0], d[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(sin_theta > 1e-7, mass * rows * columns / (2.0 * np.pi ** 2 * sin_theta), 0.0)
+
+
+# --------------------------------------------------------------------------------------------------
 # The numpy twin: the exact integral by quadrature
 
 
@@ -369,9 +483,27 @@ def quadrature_subdivisions(model, environment: EnvironmentMap) -> int:
     return int(min(s, MAX_SUBDIVISIONS))
 
 
+#: The backdrop's pinhole: the tangent of its half field of view (60 degrees across the shorter side).
+BACKDROP_TAN = math.tan(math.radians(30.0))
+
+
+def backdrop(environment: EnvironmentMap, width: int, height: int) -> np.ndarray:
+    """
+    The environment behind the object (the env view's ``show_background``): at pixel ``p`` (``2 (i + 1/2) - W``
+    over the shorter side, rows from the top), the radiance toward ``normalize(p BACKDROP_TAN, -1)``, a
+    pinhole looking along ``-z``; ``(height, width, 3)`` float64.
+    """
+    side = min(width, height)
+    x = (2.0 * (np.arange(width) + 0.5) - width) / side
+    y = (height - 2.0 * (np.arange(height) + 0.5)) / side
+    X, Y = np.meshgrid(x * BACKDROP_TAN, y * BACKDROP_TAN)
+    d = np.stack([X, Y, -np.ones_like(X)], axis=-1)
+    return environment.radiance(d / np.linalg.norm(d, axis=-1, keepdims=True))
+
+
 def env_integral_numpy(
     model, environment: EnvironmentMap, width: int, height: int, pixels=None, subdivisions: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, mesh=None, background: bool = False,
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
@@ -394,6 +526,10 @@ def env_integral_numpy(
         Cells per texel side (default :func:`quadrature_subdivisions`).
     progress : callable, optional
         ``progress(done, total)`` after each pixel.
+    mesh : explorer.views.mesh.Mesh, optional
+        Drawn instead of the sphere (its normals by :func:`explorer.views.mesh.rasterise`).
+    background : bool
+        Off the object, the environment behind it (:func:`backdrop`) instead of 0.
 
     Returns
     -------
@@ -402,7 +538,13 @@ def env_integral_numpy(
     """
     from explorer.views.geometry import brdf_view_geometry, view_brdf
 
-    _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
+    if mesh is not None:
+        from explorer.views.mesh import mesh_view_geometry, rasterise
+
+        surface = rasterise(mesh, width, height)
+        _, V, N, X, Y, inside, _ = mesh_view_geometry(surface.normals, surface.covered)
+    else:
+        _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     if pixels is None:
         rows, columns = np.nonzero(inside)
     else:
@@ -436,9 +578,14 @@ def env_integral_numpy(
         v, n = V[rows, columns][hit].astype(np.float64), N[rows, columns][hit].astype(np.float64)
         reflected = 2.0 * np.sum(v * n, axis=-1, keepdims=True) * n - v
         values[hit] += mirror(v, n) * environment.radiance(reflected)
+    if background:
+        off = ~inside[rows, columns]
+        values[off] = backdrop(environment, width, height)[rows[off], columns[off]]
     if pixels is not None:
         return values
     image = np.zeros((height, width, 3), dtype=np.float32)
+    if background:
+        image[:] = backdrop(environment, width, height)
     image[rows, columns] = values
     return image
 

@@ -29,7 +29,7 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None,
+    environment=None, mesh=None,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -39,14 +39,18 @@ def render_numpy(
     texture over the default D_inc range, without prefiltering).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
+    ``mesh`` (``lit``, ``env``): an :class:`explorer.views.mesh.Mesh` drawn instead of the sphere, its normals
+    by :func:`explorer.views.mesh.rasterise`.
     """
     evaluates = view_named(view).evaluates
+    if mesh is not None and view not in ("lit", "env"):
+        raise ValueError(f"a mesh is drawn in the lit and env views, not {view}")
     if evaluates == "environment":
         from explorer.views.env import EnvironmentMap, env_integral_numpy
 
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the env view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
-        return env_integral_numpy(model, EnvironmentMap.default() if environment is None else environment, width, height)
+        return env_integral_numpy(model, EnvironmentMap.default() if environment is None else environment, width, height, mesh=mesh)
     if evaluates == "textured_brdf":
         from explorer.views.thickness import ThicknessTexture
 
@@ -68,7 +72,13 @@ def render_numpy(
     if evaluates == "brdf":
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the {view} view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
-        L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
+        if mesh is not None:
+            from explorer.views.mesh import mesh_view_geometry, rasterise
+
+            surface = rasterise(mesh, width, height)
+            L, V, N, X, Y, inside, factor = mesh_view_geometry(surface.normals, surface.covered, light)
+        else:
+            L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
         image = np.zeros((height, width, 3), dtype=np.float32)
         vectors = [a[inside] for a in (L, V, N, X, Y)]
         image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]

@@ -66,3 +66,49 @@ float ggx_reflection_pdf(vec3 l, vec3 v, vec3 N, float alpha) {
     vec3 h = s / norm;
     return 0.25 * smith_G1_over_cos(dot(v, N), alpha) * ggx_D(dot(h, N), alpha);
 }
+
+// Environment importance sampling (Pharr, Jakob & Humphreys, PBRT 3rd ed., Sec. 14.2.4): a texel of an
+// equirectangular environment chosen in proportion to its luminance times sin(theta) by two float32 CDFs,
+// the rows' marginal (1 x (H + 1) texels) and each row's conditional (H x (W + 1)), then a uniform point
+// inside it in (u, v), turned by `turn` (the env view's environment_turn). Its density in solid angle is
+// p_texel W H / (2 pi^2 sin theta), p_texel read back from the same CDFs (their differences), so that the
+// density the estimator divides by is the one the float32 CDFs sample. Twins: explorer/views/env.py
+// (environment_sampling_tables, sample_environment, environment_pdf).
+
+// The last index k in [0, count - 1) with cdf(k) <= x, by bisection (cdf(0) = 0, cdf(count - 1) = 1).
+int cdf_search(sampler2D cdf, int row, int count, float x) {
+    int lo = 0, hi = count - 1;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (texelFetch(cdf, ivec2(mid, row), 0).r <= x) lo = mid; else hi = mid;
+    }
+    return lo;
+}
+
+vec3 environment_direction(float u, float v) {  // the inverse of the env view's (u, v) of a direction
+    float phi = 2.0 * PI * (u - 0.5), theta = PI * v;
+    return vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+}
+
+vec3 sample_environment(sampler2D marginal, sampler2D conditional, float turn, vec2 u) {
+    int rows = textureSize(conditional, 0).y, columns = textureSize(conditional, 0).x - 1;
+    int i = cdf_search(marginal, 0, rows + 1, u.x);
+    float r0 = texelFetch(marginal, ivec2(i, 0), 0).r, r1 = texelFetch(marginal, ivec2(i + 1, 0), 0).r;
+    float fv = clamp((u.x - r0) / max(r1 - r0, 1e-30), 0.0, 1.0);
+    int j = cdf_search(conditional, i, columns + 1, u.y);
+    float c0 = texelFetch(conditional, ivec2(j, i), 0).r, c1 = texelFetch(conditional, ivec2(j + 1, i), 0).r;
+    float fu = clamp((u.y - c0) / max(c1 - c0, 1e-30), 0.0, 1.0);
+    return environment_direction((float(j) + fu) / float(columns) + turn, (float(i) + fv) / float(rows));
+}
+
+float environment_pdf(sampler2D marginal, sampler2D conditional, float turn, vec3 d) {
+    int rows = textureSize(conditional, 0).y, columns = textureSize(conditional, 0).x - 1;
+    float sin_theta = length(d.xz);
+    if (sin_theta <= 1e-7) return 0.0;
+    float u = fract(0.5 + atan(d.x, -d.z) * (0.5 / PI) - turn);
+    float v = atan(sin_theta, d.y) * (1.0 / PI);
+    int i = clamp(int(v * float(rows)), 0, rows - 1), j = clamp(int(u * float(columns)), 0, columns - 1);
+    float row_mass = texelFetch(marginal, ivec2(i + 1, 0), 0).r - texelFetch(marginal, ivec2(i, 0), 0).r;
+    float column_mass = texelFetch(conditional, ivec2(j + 1, i), 0).r - texelFetch(conditional, ivec2(j, i), 0).r;
+    return row_mass * column_mass * float(rows * columns) / (2.0 * PI * PI * sin_theta);
+}

@@ -17,6 +17,32 @@ void lit_sphere_frame(vec2 p, float r2, out vec3 normal, out vec3 tangent, out v
     bitangent = normalize(cross(normal, tangent));
 }
 
+// The surface a pixel of the lit and env views shows, and its frame: the sphere's (above), or with
+// MESH_NORMALS a mesh's interpolated normal from a rasterising pass (explorer/gpu/mesh.py; w = 1 where the
+// mesh covers the pixel) in the same frame, X = (1, 0, 0) where cross((0, 1, 0), N) vanishes. False off
+// the surface. Twins: explorer/views/geometry.py (brdf_view_geometry), explorer/views/mesh.py (surface_frame).
+#ifdef MESH_NORMALS
+uniform sampler2D mesh_normals;
+bool view_surface(vec2 resolution, out vec3 normal, out vec3 tangent, out vec3 bitangent) {
+    // The texel under the pixel: the same size (a headless render), or the app's preview at a smaller one.
+    vec4 surface = texelFetch(mesh_normals, ivec2(gl_FragCoord.xy * vec2(textureSize(mesh_normals, 0)) / resolution), 0);
+    if (surface.w <= 0.0) return false;
+    normal = normalize(surface.xyz);
+    vec3 across = cross(vec3(0.0, 1.0, 0.0), normal);
+    tangent = length(across) > 1e-6 ? normalize(across) : vec3(1.0, 0.0, 0.0);
+    bitangent = normalize(cross(normal, tangent));
+    return true;
+}
+#else
+bool view_surface(vec2 resolution, out vec3 normal, out vec3 tangent, out vec3 bitangent) {
+    vec2 p;
+    float r2;
+    if (!disc_point(resolution, p, r2)) return false;
+    lit_sphere_frame(p, r2, normal, tangent, bitangent);
+    return true;
+}
+#endif
+
 // The rule of every view that evaluates a material's BRDF (lit, slice, scatter, textured, env; the numpy
 // twins in explorer/views/geometry.py have the same names): the BRDF is evaluated only where the light and the
 // view are both strictly above the surface, N.L > 0 and N.V > 0, and is 0 elsewhere (BRDF Explorer's lit

@@ -26,6 +26,11 @@
 //   #define MIRROR_ONLY
 // and its BRDF (what the slice view shows) is not sampled.
 //
+// Environment sampling (lib/sampling.glsl's sample_environment): with probability environment_sampling_weight a
+// sample is drawn from the environment's luminance (its CDFs environment_marginal, environment_conditional),
+// else from the material's mixture above; the density divided by is the whole mixture's,
+// (1 - w) (sum_k w_k pdf_k + w_c cos / pi) + w pdf_env (one-sample MIS, balance heuristic; Veach 1997, 9.2).
+//
 // Environment: equirectangular, linear RGB, texture row 0 (v = 0) at the zenith +y (the sphere's screen
 // up), v = theta / pi with theta the angle from +y; the centre column u = 0.5 faces away from the viewer
 // (-z) and u = 0.75 is +x: u = 0.5 + atan(x, -z) / 2 pi. Both angles come from atan, not acos: Mesa's
@@ -37,6 +42,15 @@
 
 uniform vec2 resolution;
 uniform sampler2D environment;
+// The probe's turn about the vertical +y (a fraction of a turn: u shifts by it; explorer.views.env.EnvironmentMap.rotation).
+uniform float environment_turn;
+// Off the object: the environment behind it (a pinhole's view along -z, BACKDROP_TAN the tangent of its
+// half field; twin: explorer.views.env.backdrop), else black.
+uniform bool show_background;
+uniform float environment_sampling_weight;  // 0: the material's sampling only
+uniform sampler2D environment_marginal;
+uniform sampler2D environment_conditional;
+#define BACKDROP_TAN 0.57735026918962576
 uniform uint first_sample;
 uniform int samples_per_pass;
 uniform uint seed;
@@ -44,7 +58,7 @@ layout(location = 0) out vec4 sum_out;
 layout(location = 1) out vec4 square_out;
 
 vec3 environment_radiance(vec3 d) {
-    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI);
+    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI) - environment_turn;
     float v = atan(length(d.xz), d.y) * (1.0 / PI);
     return textureLod(environment, vec2(u, v), 0.0).rgb;
 }
@@ -53,15 +67,18 @@ vec3 environment_radiance(vec3 d) {
 float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }
 
 void main() {
-    vec2 p;
-    float r2;
-    if (!disc_point(resolution, p, r2)) {
-        sum_out = vec4(0.0, 0.0, 0.0, float(samples_per_pass));
-        square_out = vec4(0.0);
+    vec3 normal, tangent, bitangent;
+    if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh (views/mesh/env.glsl)
+        vec3 behind = vec3(0.0);
+        if (show_background) {
+            vec2 p = (2.0 * gl_FragCoord.xy - resolution) / min(resolution.x, resolution.y);
+            behind = environment_radiance(normalize(vec3(p * BACKDROP_TAN, -1.0)));
+        }
+        float n = float(samples_per_pass);
+        sum_out = vec4(behind * n, n);  // exact: no variance
+        square_out = vec4(behind * behind * n, 0.0);
         return;
     }
-    vec3 normal, tangent, bitangent;
-    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     vec3 t, b;
     sampling_basis(normal, t, b);
@@ -93,8 +110,11 @@ void main() {
     for (int s = 0; s < samples_per_pass; ++s) {
         vec4 u = uniform_floats(pcg4d(uvec4(pixel, first_sample + uint(s), seed)));
         vec3 light;
-        float choice = u.x - cosine_weight;
-        if (choice < 0.0) {
+        float env_weight = environment_sampling_weight;
+        float choice = (u.x - env_weight) / (1.0 - env_weight) - cosine_weight;  // u.x past the environment's share
+        if (u.x < env_weight) {
+            light = sample_environment(environment_marginal, environment_conditional, environment_turn, u.yz);
+        } else if (choice < 0.0) {
             vec3 l = sample_cosine_hemisphere(u.yz);
             light = l.x * t + l.y * b + l.z * normal;
         } else {
@@ -119,6 +139,10 @@ void main() {
             float pdf = cosine_weight * cos_light * (1.0 / PI);
             for (int j = 0; j < 4; ++j) {
                 if (weights[j] > 0.0) pdf += weights[j] * ggx_reflection_pdf(light, view, normal, alphas[j]);
+            }
+            if (env_weight > 0.0) {
+                pdf = (1.0 - env_weight) * pdf
+                    + env_weight * environment_pdf(environment_marginal, environment_conditional, environment_turn, light);
             }
             if (pdf > 0.0 && above_surface(light, view, normal)) {
                 // lib/views.glsl's rule (view_brdf), the non-finite channels counted so the host can report them.

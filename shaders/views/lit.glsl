@@ -12,14 +12,11 @@ uniform vec3 light_direction;
 out vec4 frag_colour;
 
 void main() {
-    vec2 p;
-    float r2;
-    if (!disc_point(resolution, p, r2)) {
+    vec3 normal, tangent, bitangent;
+    if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh (views/mesh/lit.glsl)
         frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    vec3 normal, tangent, bitangent;
-    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     vec3 radiance = view_brdf(light_direction, view, normal, tangent, bitangent) * max(0.0, dot(normal, light_direction));
     frag_colour = vec4(radiance, 1.0);

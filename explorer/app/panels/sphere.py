@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from explorer.app.camera import light_vector
-from explorer.app.state import MODES, has_reflectance
+from explorer.app.scheduler import model_mesh
+from explorer.app.state import ENV_TARGETS, MODES, SPHERE_MODELS, has_reflectance
 from explorer.app.panels.base import Panel, record, show_image
 
 
@@ -22,6 +23,7 @@ class SpherePanel(Panel):
         imgui.new_line()
         if state.mode == "sphere" and not has_reflectance(state.material):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
+        self._model_and_environment(imgui)
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
         if state.mode == "env":
@@ -29,18 +31,80 @@ class SpherePanel(Panel):
         else:
             dragging = self.app.dragging
             values = scheduler.prefetcher.values(state.material, state.values, dragging)
-            job.request(state.material, values, state.main_view(), size, light=light_vector(state.light, state.camera), dragging=dragging)
+            view, inputs = state.main_view(), None
+            mesh = model_mesh(state.model, scheduler.env.meshes) if view == "lit" else None
+            if mesh is not None:  # the mesh's rasterised normals (explorer.gpu.mesh), once per model and size
+                from explorer.gpu.mesh import MESH_TEMPLATES, mesh_normals
+
+                if self._normals_key != (state.model, size):
+                    self._normals = mesh_normals(scheduler.renderer, mesh, *size)
+                    self._normals_key = (state.model, size)
+                view, inputs = MESH_TEMPLATES["lit"], {"mesh_normals": self._normals}
+            job.request(state.material, values, view, size, light=light_vector(state.light, state.camera), dragging=dragging,
+                        inputs=inputs, inputs_key=state.model)
             texture = scheduler.show("main", size, job)
         show_image(state, texture, size, "sphere_image", interactive=True)
-        if job.complete:
+        if state.mode == "env":  # the env mode's own progress: samples per pixel, converged at the target
+            env = state.env_progress or scheduler.env.progress(state.env_target_spp)
+            progress = (f"converged, {env['samples']} samples per pixel" if env["converged"]
+                        else f"converging, {env['samples']}/{env['target']} samples per pixel")
+        elif job.complete:
             progress = "done"
         elif job.has_preview and job.refined_rows == 0:
             progress = "preview %dx%d" % job.preview_size
         else:
             progress = f"refining {100 * job.progress:.0f}%"
-        imgui.text(f"{state.main_view()} {size[0]}x{size[1]}: {progress}; {state.frame_label()}")
+        shown = "env" if state.mode == "env" else state.main_view()
+        imgui.text(f"{shown} {size[0]}x{size[1]}: {progress}; {state.frame_label()}")
         if job.error:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), job.error)
+
+    _normals_key = None
+    _normals = None
+
+    def _model_and_environment(self, imgui) -> None:
+        """Switch model (the sphere or a mesh), and in the env mode the environment, its turn, backdrop and target."""
+        from explorer.views.env import ENVIRONMENTS
+
+        state = self.state
+        imgui.set_next_item_width(120)
+        if imgui.begin_combo("model", state.model):
+            for name in SPHERE_MODELS:
+                clicked, _ = imgui.selectable(name, state.model == name)
+                record(state, f"model:{name}")
+                if clicked:
+                    state.model = name
+            imgui.end_combo()
+        record(state, "model_combo")
+        if state.mode == "sphere" and state.model != "sphere":
+            imgui.same_line()
+            imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "(the white furnace shows the sphere)")
+        if state.mode != "env":
+            return
+        imgui.set_next_item_width(140)
+        if imgui.begin_combo("environment", state.environment):
+            for name in ENVIRONMENTS:
+                clicked, _ = imgui.selectable(name, state.environment == name)
+                record(state, f"environment:{name}")
+                if clicked:
+                    state.environment = name
+            imgui.end_combo()
+        record(state, "environment_combo")
+        imgui.same_line()
+        _, state.env_background = imgui.checkbox("background", state.env_background)
+        record(state, "env_background")
+        imgui.set_next_item_width(200)
+        changed, turn = imgui.slider_float("probe rotation", state.env_rotation, -180.0, 180.0, "%.0f deg")
+        record(state, "env_rotation")
+        if changed:
+            state.env_rotation = float(turn)
+        imgui.same_line()
+        imgui.set_next_item_width(90)
+        targets = [str(t) for t in ENV_TARGETS]
+        current = ENV_TARGETS.index(state.env_target_spp) if state.env_target_spp in ENV_TARGETS else 1
+        changed, index = imgui.combo("converged at (spp)", current, targets)
+        if changed:
+            state.env_target_spp = ENV_TARGETS[index]
 
     def gl_jobs(self) -> list:
         return [self.scheduler.job("main")] if self.state.mode != "env" else []
