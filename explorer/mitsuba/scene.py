@@ -35,6 +35,10 @@ from explorer.views.env import EnvironmentMap, uv_to_direction
 ENV_OVERSAMPLE = 2
 #: Path depth: one bounce off a convex sphere (its reflections never hit it again).
 MAX_DEPTH = 2
+#: Paths per render pass (width x height x spp): more samples per pixel are rendered in passes of
+#: different seeds and averaged (the same estimator), so that a wavefront's memory (Dr.Jit's and the
+#: plugins' numpy temporaries) stays bounded at any spp.
+PATHS_PER_PASS = 1 << 20
 
 
 def mitsuba_environment(environment: EnvironmentMap, oversample: int = ENV_OVERSAMPLE) -> np.ndarray:
@@ -112,7 +116,10 @@ def render_env_mitsuba(material, values: Mapping[str, object], width: int, heigh
     mi.set_log_level(mi.LogLevel.Error)  # out-of-gamut (negative) RGB samples are expected, not warnings
     environment = environment if environment is not None else EnvironmentMap.default()
     scene = mi.load_dict(env_scene_dict(material, values, environment, width, height, spp, variant))
-    image = np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)[..., :3]
+    passes = -(-int(spp) * width * height // PATHS_PER_PASS)  # ceil
+    counts = [int(spp) // passes + (k < int(spp) % passes) for k in range(passes)]
+    image = sum(count * np.asarray(mi.render(scene, spp=count, seed=int(seed) * passes + k), dtype=np.float64)[..., :3]
+                for k, count in enumerate(counts)) / int(spp)
     if is_spectral(variant):
         image = xyz_to_explorer_rgb(image)
     return image.astype(np.float32)
