@@ -319,3 +319,15 @@ def test_spectral_env_view_is_the_product_of_spectra(mi_llvm):
     np.testing.assert_allclose(ratio, 1.0, atol=0.01)
     to_product, to_gl = median_delta_e(rendered, expected["spectral"]), median_delta_e(rendered, expected["gl"])
     assert to_product < to_gl - 0.3, (to_product, to_gl)
+
+
+def test_bench_rows_and_verdicts(mi_llvm):
+    """bench --mitsuba: a GL row and one per variant, each timed, its ΔE against GL judged against 1."""
+    from explorer.mitsuba.bench import ACCEPTED_DELTA_E, run_mitsuba_bench
+
+    lines = []
+    rows = run_mitsuba_bench(size=8, spp=2, variants=("llvm_ad_rgb",), materials=["bragg_mirror"], echo=lines.append)
+    assert [r["engine"] for r in rows] == ["gl", "mitsuba llvm_ad_rgb"]
+    assert all(r["seconds"] > 0 for r in rows) and np.isfinite(rows[1]["delta_e_vs_gl"])
+    verdict = "ok" if rows[1]["delta_e_vs_gl"] <= ACCEPTED_DELTA_E else "above"
+    assert lines[-1].rstrip().endswith(verdict) and "ΔE" in lines[-1]
