@@ -79,20 +79,13 @@ def save_json(path: os.PathLike[str] | str, material: Material, values: Mapping[
 
 
 def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
-    """Write BRDF Explorer's ``.bparam`` (``%f`` numbers, floats then bools then colours, as it does)."""
-    lines = [f"bparam {Path(material.path).resolve()}", "", "::begin parameters"]
-    for p in material.parameters:
-        if p.type in ("float", "int"):  # BRDF Explorer's files know no int: an int is saved as a float
-            lines.append(f"float {p.name} {p.min:f} {p.max:f} {float(values[p.name]):f}")
-    for p in material.parameters:
-        if p.type == "bool":
-            lines.append(f"bool {p.name} {1 if values[p.name] else 0}")
-    for p in material.parameters:
-        if p.type == "color":
-            r, g, b = values[p.name]
-            lines.append(f"color {p.name} {r:f} {g:f} {b:f}")
-    lines.append("::end parameters")
-    _write_text(path, "\n".join(lines) + "\n")
+    """
+    Write BRDF Explorer's ``.bparam`` (``%f`` numbers, floats then bools then colours, as it does), naming
+    the material's file: for a material opened from an exported ``.brdf``, that ``.brdf``.
+    """
+    from explorer.materials.export_brdf import bparam_text
+
+    _write_text(path, bparam_text(str(Path(material.path).resolve()), material.parameters, values))
 
 
 def _write_text(path: os.PathLike[str] | str, text: str) -> None:

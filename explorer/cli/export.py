@@ -75,8 +75,8 @@ def _export(material, target, preset, params_file, assignments, env_file, mesh, 
     if target == "brdf":
         from explorer.materials.export_brdf import export_brdf
 
-        path = export_brdf(loaded, values, Path(out))
-        click.echo(f"wrote {path} (Disney BRDF Explorer: File > Open BRDF)")
+        path, bparam = export_brdf(loaded, values, Path(out))
+        click.echo(f"wrote {path} and {bparam} (Disney BRDF Explorer: File > Open BRDF, either file)")
     elif target == "table":
         from explorer.materials.export_table import TableExportError, material_table
         from explorer.views.images import write_image

@@ -144,6 +144,86 @@ def inline_tables(flat: str, tables: Mapping[str, np.ndarray]) -> str:
     return flat
 
 
+#: The thin film's ``sensitivity_fourier`` envelope in the export: every ENVELOPE_STRIDE-th node of the
+#: 4096-node table (70 nm apart: 586 nodes, 4095 = 7 x 585, so the last node is kept), read by Catmull-Rom
+#: cubic interpolation. It departs from the GL view's linear reading of all nodes by at most 1.0e-4 of the
+#: envelope's peak (``python -m explorer.materials.export_brdf``); the full table, 8192 ``vec3`` inlined,
+#: took Mesa's compiler more than 15 minutes, this one seconds.
+ENVELOPE_STRIDE = 7
+
+
+def envelope_nodes(stride: int = ENVELOPE_STRIDE) -> np.ndarray:
+    """The coarse envelope's nodes: ``(2, count, 3)``, rows real and imaginary parts, ``mu = 10 stride k`` nm."""
+    from explorer.physics import thinfilm
+    from explorer.tables import luts
+
+    table = luts.load("sensitivity_fourier").reshape(2, thinfilm.SENSITIVITY_FOURIER_COUNT, 3)
+    last = thinfilm.SENSITIVITY_FOURIER_COUNT - 1
+    if last % stride:
+        raise ValueError(f"the stride {stride} must divide {last} (the last node is kept)")
+    return table[:, ::stride]
+
+
+def catmull_rom(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``nodes`` (``(count, ...)``) at fractional indices ``x``, Catmull-Rom, the end nodes repeated (the GLSL's)."""
+    last = nodes.shape[0] - 1
+    i = np.clip(np.floor(x).astype(np.int64), 0, last - 1)
+    f = (x - i).reshape(-1, *([1] * (nodes.ndim - 1)))
+    p0, p1, p2, p3 = (nodes[np.clip(i + k, 0, last)] for k in (-1, 0, 1, 2))
+    return p1 + 0.5 * f * (p2 - p0 + f * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + f * (3.0 * (p1 - p2) + p3 - p0)))
+
+
+def envelope_error(stride: int = ENVELOPE_STRIDE, samples: int = 200_001) -> float:
+    """Largest ``|coarse cubic - fine linear|`` of the envelope over its range, over the envelope's peak."""
+    from explorer.physics import thinfilm  # noqa: F401 (declares the table)
+    from explorer.tables import luts
+
+    fine = luts.load("sensitivity_fourier").reshape(2, -1, 3)
+    x = np.linspace(0.0, fine.shape[1] - 1.0, samples)
+    i = np.minimum(np.floor(x).astype(np.int64), fine.shape[1] - 2)
+    f = (x - i)[:, None]
+    linear = fine[:, i] * (1.0 - f) + fine[:, i + 1] * f
+    coarse = envelope_nodes(stride)
+    cubic = np.stack([catmull_rom(coarse[r], x / stride) for r in range(2)])
+    peak = np.abs(fine[0] + 1j * fine[1]).max()
+    return float(np.abs((cubic[0] - linear[0]) + 1j * (cubic[1] - linear[1])).max() / peak)
+
+
+def _envelope_glsl(stride: int = ENVELOPE_STRIDE) -> str:
+    """GLSL ``sensitivity_fourier_envelope`` reading :func:`envelope_nodes` (same contract as lib/thinfilm.glsl's)."""
+    nodes = envelope_nodes(stride)
+    last = nodes.shape[1] - 1
+    return f"""{_vec3_array("sensitivity_fourier_envelope_re", nodes[0])}
+{_vec3_array("sensitivity_fourier_envelope_im", nodes[1])}
+// The demodulated envelope E_j(mu) (lib/thinfilm.glsl), from every {stride}th node of the table by
+// Catmull-Rom (the export's stand-in for the 4096-node table: explorer/materials/export_brdf.py).
+bool sensitivity_fourier_envelope(float mu, out vec3 re, out vec3 im) {{
+    float x = mu / SENSITIVITY_FOURIER_STEP;
+    re = vec3(0.0);
+    im = vec3(0.0);
+    if (!(x >= 0.0 && x <= {float(last * stride)})) return false;
+    float y = x / {float(stride)};
+    int i = min(int(floor(y)), {last - 1});
+    float f = y - float(i);
+    int i0 = max(i - 1, 0), i3 = min(i + 2, {last});
+    vec4 w = vec4(f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f),
+                  f * (0.5 + f * (2.0 - 1.5 * f)), f * f * (-0.5 + 0.5 * f));
+    re = w.x * sensitivity_fourier_envelope_re[i0] + w.y * sensitivity_fourier_envelope_re[i]
+       + w.z * sensitivity_fourier_envelope_re[i + 1] + w.w * sensitivity_fourier_envelope_re[i3];
+    im = w.x * sensitivity_fourier_envelope_im[i0] + w.y * sensitivity_fourier_envelope_im[i]
+       + w.z * sensitivity_fourier_envelope_im[i + 1] + w.w * sensitivity_fourier_envelope_im[i3];
+    return true;
+}}"""
+
+
+def _coarse_envelope(flat: str) -> str:
+    """Replace the film's table-reading ``sensitivity_fourier_envelope`` by :func:`_envelope_glsl`."""
+    pattern = r"bool sensitivity_fourier_envelope\(float mu, out vec3 re, out vec3 im\) \{.*?\n\}"
+    if not re.search(pattern, flat, flags=re.S):
+        raise BrdfExportError("<export>", None, "lib/thinfilm.glsl's sensitivity_fourier_envelope was not found")
+    return re.sub(pattern, lambda _m: _envelope_glsl(), flat, count=1, flags=re.S)
+
+
 def _forward_declare(flat: str, names: list[str]) -> str:
     """Prototypes of the functions appended after their callers (tabulated_rgb_NAME)."""
     protos = "".join(f"vec3 tabulated_rgb_{n}(float cos_theta);\n" for n in names if f"vec3 tabulated_rgb_{n}(float cos_theta) {{" in flat)
@@ -219,15 +299,20 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
 
         method = round_integer(values["method"])
         defined["SPECIALISED_method"] = str(method)
-        from explorer.materials.thinfilm_model import TABULATED_FOURIER
-
-        if method not in TABULATED_FOURIER:
-            tables.pop("sensitivity_fourier")
-    # The methods' names, which the host #defines in every program: constants here (no preprocessor).
+        # Methods 1-3 read the envelope through _coarse_envelope (below), not the inlined table.
+        tables.pop("sensitivity_fourier")
+    # The methods' names, which the host #defines in every program: substituted by their values, as PI is
+    # (a `const int BRAGG_REFERENCE` would break the explorer's own loading of the file, whose host
+    # #defines the same names).
     from explorer.materials.methods import glsl_defines
 
-    names = "".join(f"const int {name} = {value};\n" for name, value in glsl_defines().items())
-    flat = flatten(names + shader, str(material.path), defined)
+    defined.update({name: str(value) for name, value in glsl_defines().items()})
+    flat = flatten(shader, str(material.path), defined)
+    if material.model == "thin_film":
+        from explorer.materials.thinfilm_model import TABULATED_FOURIER
+
+        if method in TABULATED_FOURIER:
+            flat = _coarse_envelope(flat)
     flat = _forward_declare(inline_tables(flat, tables), list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):
@@ -240,10 +325,35 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
             f"{flat}\n::end shader\n")
 
 
-def export_brdf(material, values: Mapping[str, object], out: Path) -> Path:
-    """Write :func:`brdf_text` to ``out`` (``.brdf``) atomically."""
+def bparam_text(brdf_file: str, parameters, values: Mapping[str, object]) -> str:
+    """
+    A ``.bparam`` naming ``brdf_file``, as BRDF Explorer's "Save Params" writes it
+    (``BRDFBase::saveParamsFile``): ``bparam FILE``, then ``%f`` floats (``name min max value``; our ``int``
+    parameters too, which its files do not know), bools, colours. Opening it, BRDF Explorer loads
+    ``FILE`` (relative to its working directory unless absolute) and sets these values.
+    """
+    lines = [f"bparam {brdf_file}", "", "::begin parameters"]
+    lines += [f"float {p.name} {p.min:f} {p.max:f} {float(values[p.name]):f}" for p in parameters if p.type in ("float", "int")]
+    lines += [f"bool {p.name} {1 if values[p.name] else 0}" for p in parameters if p.type == "bool"]
+    lines += [f"color {p.name} {' '.join(f'{float(c):f}' for c in values[p.name])}" for p in parameters if p.type == "color"]
+    return "\n".join(lines + ["::end parameters"]) + "\n"
+
+
+def export_brdf(material, values: Mapping[str, object], out: Path) -> tuple[Path, Path]:
+    """
+    Write :func:`brdf_text` to ``out`` (``.brdf``) and, beside it, ``out`` with ``.bparam`` holding the
+    exported values and naming the ``.brdf`` by its absolute path (the pair opens in BRDF Explorer from any
+    working directory); both atomically. Returns ``(brdf, bparam)``.
+    """
     if out.suffix.lower() != ".brdf":
         raise BrdfExportError(out, None, "a BRDF Explorer file: name it .brdf")
     text = brdf_text(material, values)
+    bparam = out.with_suffix(".bparam")
     write_text_atomic(out, text)  # explorer.files: a temporary file renamed; OutputError (one line) otherwise
-    return out
+    write_text_atomic(bparam, bparam_text(str(out.resolve()), material.parameters, values))
+    return out, bparam
+
+
+if __name__ == "__main__":  # the coarse envelope's error (docs/export.md)
+    print(f"sensitivity_fourier envelope, every {ENVELOPE_STRIDE}th node, Catmull-Rom: "
+          f"max |cubic - linear| = {envelope_error():.2e} of the peak")

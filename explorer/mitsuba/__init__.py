@@ -38,14 +38,14 @@ def render_file(path, variant: str | None = None, spp: int | None = None, seed: 
     """Render an exported scene: ``(H, W, 3)`` float32 linear sRGB in the explorer's colour convention."""
     import numpy as np
 
-    from explorer.mitsuba.scene import xyz_to_explorer_rgb
+    from explorer.mitsuba.scene import render_in_passes, xyz_to_explorer_rgb
     from explorer.mitsuba.variants import is_spectral
 
     scene = load_file(path, variant)
     import mitsuba as mi
 
     mi.set_log_level(mi.LogLevel.Error)
-    image = np.asarray(mi.render(scene, spp=spp or 0, seed=seed), dtype=np.float64)[..., :3]
+    image = render_in_passes(mi, scene, spp, seed)
     if is_spectral(mi.variant()):
         image = xyz_to_explorer_rgb(image)
     return image.astype(np.float32)

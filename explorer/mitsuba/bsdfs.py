@@ -346,8 +346,14 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
                 if self.illuminant == "e":
                     f = f * d65_weight(wl)
             else:
+                # In CHUNK rows: a wavefront holds millions of samples, and bragg_stack's twin makes
+                # (samples, 471) spectra (64x64 at 1024 spp unchunked: 22 GB, killed).
+                f = np.empty((l.shape[0], 3))
+                frame = (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
                 with np.errstate(all="ignore"):
-                    f = self.model.brdf(l, v, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+                    for start in range(0, l.shape[0], CHUNK):
+                        part = slice(start, start + CHUNK)
+                        f[part] = self.model.brdf(l[part], v[part], *frame)
                 above = (l[:, 2] > 0.0) & (v[:, 2] > 0.0)
                 f = np.where(above[:, None] & np.isfinite(f), f, 0.0)
             return f * cos_l[:, None]

@@ -35,6 +35,10 @@ from explorer.views.env import EnvironmentMap, uv_to_direction
 ENV_OVERSAMPLE = 2
 #: Path depth: one bounce off a convex sphere (its reflections never hit it again).
 MAX_DEPTH = 2
+#: Paths per render pass (width x height x spp): more samples per pixel are rendered in passes of
+#: different seeds and averaged (the same estimator), so that a wavefront's memory (Dr.Jit's and the
+#: plugins' numpy temporaries) stays bounded at any spp.
+PATHS_PER_PASS = 1 << 20
 
 
 def mitsuba_environment(environment: EnvironmentMap, oversample: int = ENV_OVERSAMPLE) -> np.ndarray:
@@ -92,6 +96,21 @@ def env_scene_dict(material, values: Mapping[str, object], environment: Environm
     }
 
 
+def render_in_passes(mi, scene, spp: int | None = None, seed: int = 0) -> np.ndarray:
+    """
+    ``mi.render(scene, spp)``'s first three channels (float64), rendered in passes of at most
+    :data:`PATHS_PER_PASS` paths with seeds of their own and averaged, weighted by their spp (the same
+    estimator, bounded memory). ``spp`` None or 0: the scene's sampler's count.
+    """
+    sensor = scene.sensors()[0]
+    spp = int(spp or sensor.sampler().sample_count())
+    width, height = (int(c) for c in sensor.film().crop_size())
+    passes = max(1, -(-spp * width * height // PATHS_PER_PASS))  # ceil
+    counts = [spp // passes + (k < spp % passes) for k in range(passes)]
+    return sum(count * np.asarray(mi.render(scene, spp=count, seed=int(seed) * passes + k), dtype=np.float64)[..., :3]
+               for k, count in enumerate(counts) if count) / spp
+
+
 def xyz_to_explorer_rgb(xyz: np.ndarray) -> np.ndarray:
     """Mitsuba's XYZ film (flat spectrum of 1 -> Y = 1, its CIE 1931 tables) to the explorer's linear sRGB."""
     return colorimetry.xyz_to_rgb(xyz)
@@ -112,7 +131,7 @@ def render_env_mitsuba(material, values: Mapping[str, object], width: int, heigh
     mi.set_log_level(mi.LogLevel.Error)  # out-of-gamut (negative) RGB samples are expected, not warnings
     environment = environment if environment is not None else EnvironmentMap.default()
     scene = mi.load_dict(env_scene_dict(material, values, environment, width, height, spp, variant))
-    image = np.asarray(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)[..., :3]
+    image = render_in_passes(mi, scene, int(spp), seed)
     if is_spectral(variant):
         image = xyz_to_explorer_rgb(image)
     return image.astype(np.float32)

@@ -1,0 +1,123 @@
+"""
+Why the spectral variants differ from the GL env view: a noise-free decomposition on the smooth mirror.
+
+The GL env view (and the RGB variants) shade a pixel as ``RGB(R) * RGB(L)``, channel by channel: the
+material's colour times the environment's. A spectral renderer shades it as the colour of the product of
+spectra, ``RGB(R(lambda) L(lambda))``. For a smooth ``bragg_mirror`` both are exact per pixel (a Dirac:
+one reflected direction, no Monte Carlo), so their difference is computed here in numpy, pixel by pixel:
+
+- ``roundtrip``: the environment's RGB has no spectrum; Mitsuba's spectral ``envmap`` upsamples each texel
+  with its sRGB model (Jakob & Hanika 2019, fitted on the colour divided by twice its maximum, under D65)
+  and our plugins divide its D65 out (illuminant E, docs/mitsuba.md). The colour of that spectrum in the
+  explorer's convention is not exactly the texel's RGB (illuminant E + Bradford vs D65 unadapted);
+- ``product``: the median ΔE2000 of ``RGB(R L_up)`` against ``RGB(R) * RGB(L)``, Mitsuba's upsampling;
+- ``product_consistent``: the same with each texel's spectrum pre-corrected so that its explorer colour is
+  exactly its RGB (a fixed point on the model's input), isolating the product's own difference;
+- ``white``: the same under a white environment (flat spectrum): zero, the product is then exact.
+
+``python -m explorer.mitsuba.spectral_gap`` prints them (docs/mitsuba.md).
+
+References
+----------
+Jakob, Hanika (2019). A Low-Dimensional Function Space for Efficient Spectral Upsampling.
+Fourneau, Pacanowski, Barla (2024), Eqs. 2, 9, 10 (the mirror's R_lambda).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.materials.methods import BraggMethod
+from explorer.physics import bragg, colorimetry
+
+
+def _srgb_model_spectra(rgb: np.ndarray) -> np.ndarray:
+    """Mitsuba's spectral ``envmap`` upsampling of RGB radiances ``(n, 3)`` on the 1-nm grid, D65 divided out."""
+    import mitsuba as mi
+
+    if not mi.variant():
+        mi.set_variant("scalar_spectral")
+    scale = np.maximum(rgb.max(axis=-1), 1e-8) * 2.0  # envmap.cpp: the colour at half its maximum
+    unit = rgb / scale[:, None]
+    coeff = np.array([np.asarray(mi.srgb_model_fetch(mi.ScalarColor3f(*(float(c) for c in row)))).ravel()[:3] for row in unit])
+    w = colorimetry.WAVELENGTHS
+    x = (coeff[:, :1] * w + coeff[:, 1:2]) * w + coeff[:, 2:3]
+    return (0.5 + x / (2.0 * np.sqrt(1.0 + x * x))) * scale[:, None]
+
+
+def _consistent_spectra(rgb: np.ndarray, iterations: int = 6) -> np.ndarray:
+    """Spectra of the sRGB model whose explorer colour is ``rgb``: its input corrected by a fixed point."""
+    target = np.asarray(rgb, dtype=np.float64)
+    given = target.copy()
+    for _ in range(iterations):
+        given = given + (target - colorimetry.spectrum_to_rgb(_srgb_model_spectra(np.maximum(given, 1e-9))))
+    return _srgb_model_spectra(np.maximum(given, 1e-9))
+
+
+def mirror_pixels(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The env view's pixels on its unit sphere (orthographic, V = +z, rows from the top): the mask of the
+    pixel centres inside the disc, their normals and reflected directions ``(n, 3)``."""
+    c = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    x, y = np.meshgrid(c, -c)
+    inside = x * x + y * y < 1.0
+    n = np.stack([x[inside], y[inside], np.sqrt(1.0 - x[inside] ** 2 - y[inside] ** 2)], axis=-1)
+    return inside, n, 2.0 * n[:, 2:3] * n - np.array([0.0, 0.0, 1.0])
+
+
+def mirror_images(model, environment, size: int = 64, consistent: bool = False) -> dict[str, np.ndarray]:
+    """
+    Per pixel inside the disc (``mask``), for a smooth mirror ``model`` (its numpy twin): ``gl``, the GL env
+    view's ``RGB(R) * RGB(L)``; ``spectral``, ``RGB(R(lambda) L_up(lambda))`` with the sky upsampled as
+    Mitsuba does (``consistent``: corrected to its exact RGB); ``sky``, its RGB, and ``sky_upsampled``,
+    the explorer colour of its upsampled spectrum.
+    """
+    inside, normals, reflected = mirror_pixels(size)
+    cos_theta = normals[:, 2]
+    radiance = environment.radiance(reflected).astype(np.float64)
+    R = bragg.bragg_reflectance(cos_theta[:, None], colorimetry.WAVELENGTHS[None, :], model.mirror)
+    sky = _consistent_spectra(radiance) if consistent else _srgb_model_spectra(radiance)
+    return {"mask": inside, "gl": model.reflectance(cos_theta) * radiance, "reflectance": model.reflectance(cos_theta),
+            "reflectance_spectral": colorimetry.spectrum_to_rgb(R), "spectral": colorimetry.spectrum_to_rgb(R * sky),
+            "sky": radiance, "sky_upsampled": colorimetry.spectrum_to_rgb(sky)}
+
+
+def spectral_gap(model, environment, size: int = 64) -> dict[str, float]:
+    """The decomposition of the module docstring for a smooth mirror ``model`` (its numpy twin)."""
+    from explorer.mitsuba.bench import median_delta_e
+
+    mitsuba_sky = mirror_images(model, environment, size)
+    corrected = mirror_images(model, environment, size, consistent=True)
+    return {
+        "roundtrip": median_delta_e(mitsuba_sky["sky_upsampled"], mitsuba_sky["sky"]),
+        "roundtrip_max": float(np.max(colorimetry.delta_E_2000(np.clip(mitsuba_sky["sky_upsampled"], 0, None), mitsuba_sky["sky"]))),
+        "product": median_delta_e(mitsuba_sky["spectral"], mitsuba_sky["gl"]),
+        "product_consistent": median_delta_e(corrected["spectral"], corrected["gl"]),
+        "white": median_delta_e(mitsuba_sky["reflectance_spectral"], mitsuba_sky["reflectance"]),
+    }
+
+
+#: The mirrors of the printed table: the defaults (Lambda = 500 nm) and two other periods.
+MIRRORS = ({}, {"Lambda": 400.0}, {"Lambda": 600.0})
+
+
+def main() -> None:
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import model_for
+    from explorer.resources import material_path
+    from explorer.views.env import EnvironmentMap
+
+    material = load_material(material_path("bragg_mirror"))
+    print("bragg_mirror (method 3), default sky, 64x64 pixel centres: median ΔE2000 of")
+    print("  roundtrip: the sky's RGB upsampled as Mitsuba does, read in the explorer's convention, vs its RGB")
+    print("  product: spectral RGB(R L) vs GL's RGB(R) RGB(L); consistent: the sky's spectra corrected to its RGB")
+    print("  white: the same under a white sky")
+    for overrides in MIRRORS:
+        values = material.resolve({"method": int(BraggMethod.TABULATED), **overrides})
+        gap = spectral_gap(model_for(material, material.physical_values(values)), EnvironmentMap.default())
+        label = ", ".join(f"{k} = {v:g}" for k, v in overrides.items()) or "defaults"
+        print(f"  {label:<14} roundtrip {gap['roundtrip']:.2f} (max {gap['roundtrip_max']:.2f})  product {gap['product']:.2f}"
+              f"  consistent {gap['product_consistent']:.2f}  white {gap['white']:.2f}")
+
+
+if __name__ == "__main__":
+    main()
