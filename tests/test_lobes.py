@@ -212,3 +212,102 @@ def test_cli_negative_optical_depth_is_one_line(tmp_path):
                   "--out", tmp_path / "unused.png")
     assert not (tmp_path / "unused.png").exists()
     assert "parameter 'tau_1': component -1 is outside its range [0, 100]" in one_line_error(run)  # the declared range
+
+
+# --------------------------------------------------------------------------------------------------
+# The smooth limit: exact Fresnel at every angle (numpy and GL), and the albedo over the declared box
+
+#: A smooth interface (alpha = 0) against exact Fresnel (tmm), theta in [0, 89.9] degrees: the FGD tables'
+#: alpha = 0 rows are the closed-form smooth limit (explorer.physics.lobes_fgd.smooth_lobe_moments), so
+#: only rounding remains in numpy (before, 8e-3 at 89.9 degrees for eta = 4, kappa = 1e-4); float32 in GL.
+SMOOTH_TOLERANCE = 1e-6
+SMOOTH_GL_TOLERANCE = 1e-3
+SMOOTH_THETAS = np.radians(np.linspace(0.0, 89.9, 400))
+#: Bare smooth interfaces: (eta_0, eta_1, kappa_1) per RGB channel; eta_0 > eta_1 is seen from the denser
+#: side (eta < 1: total internal reflection beyond the critical angle).
+SMOOTH_INTERFACES = {
+    "gold-like conductor": (1.0, [0.2, 0.4, 1.1], [3.5, 2.5, 2.0]),
+    "near-dielectric conductor": (1.0, [4.0, 1.5, 0.05], [1e-4, 0.5, 6.0]),
+    "dielectric eta 1.5": (1.0, 1.5, None),
+    "dielectric eta 4": (1.0, 4.0, None),
+    "dielectric eta 1 / 1.5": (1.5, 1.0, None),
+    "dielectric eta 1.2 / 1.33": (1.33, 1.2, None),
+    "dielectric eta 1 / 4": (4.0, 1.0, None),
+}
+
+
+def smooth_interface(name: str) -> lobes.Stack:
+    eta_0, eta_1, kappa = SMOOTH_INTERFACES[name]
+    return lobes.make_stack([eta_1], [0.0], base_kappa=kappa, eta_0=eta_0)
+
+
+def exact_fresnel(name: str, thetas: np.ndarray) -> np.ndarray:
+    """``(len(thetas), 3)``: tmm's unpolarised reflectance of the bare interface, channel by channel."""
+    eta_0, eta_1, kappa = SMOOTH_INTERFACES[name]
+    eta_1, kappa = np.broadcast_to(eta_1, 3), np.broadcast_to(0.0 if kappa is None else kappa, 3)
+    return np.array([[tmm_reflectance([eta_0, eta_1[ch]], [], t, kappa[ch]) for ch in range(3)] for t in thetas])
+
+
+@pytest.mark.parametrize("name", list(SMOOTH_INTERFACES))
+def test_smooth_interface_is_exact_fresnel(name):
+    """The alpha -> 0 limit of layered_lobes is Fresnel's at every angle, grazing and TIR included."""
+    ours = lobes.reflectance(smooth_interface(name), np.cos(SMOOTH_THETAS))
+    error = np.abs(ours - exact_fresnel(name, SMOOTH_THETAS))
+    worst = np.unravel_index(error.argmax(), error.shape)
+    assert error.max() <= SMOOTH_TOLERANCE, f"{name}: {error.max():.2e} at {np.degrees(SMOOTH_THETAS[worst[0]]):.2f} deg"
+
+
+GL_PROBE = """#include "lib/lobes.glsl"
+uniform sampler2D lobes_fgd;
+uniform sampler2D lobes_ggx_moments;
+uniform float eta_0, eta_1;
+uniform bool conductor;
+uniform vec3 eta_base, kappa_base;
+out vec4 result;
+void main() {
+    LobeStack s;
+    s.count = 1;
+    for (int i = 0; i <= LOBES_MAX; ++i) { s.eta[i] = 1.0; s.alpha[i] = 0.0; s.tau[i] = vec3(0.0); }
+    s.eta[0] = eta_0;
+    s.eta[1] = eta_1;
+    s.conductor = conductor;
+    s.tir = false;
+    s.eta_base = eta_base;
+    s.kappa_base = kappa_base;
+    result = vec4(lobes_reflectance(s, lobes_fgd, lobes_ggx_moments, texelFetch(cos_thetas, ivec2(gl_FragCoord.xy), 0).r), 1.0);
+}
+"""
+
+
+@pytest.mark.gl
+def test_smooth_interface_is_exact_fresnel_in_gl(gl_renderer):
+    """The GLSL twin (lib/lobes.glsl's lobes_reflectance on a one-interface LobeStack, the shader's tables) at
+    the same float32 cosines, eta < 1 included (the material's ambient is air: a probe sets eta_0)."""
+    from explorer.gpu.context import VERTEX_SHADER
+    from explorer.materials.glsl import ShaderBuilder
+    from explorer.materials.lobes_model import fgd_texture, moments_texture
+    from explorer.resources import SHADER_DIR
+
+    ctx, resources = gl_renderer.ctx, gl_renderer.resources
+    builder = ShaderBuilder(include_dirs=[SHADER_DIR])
+    builder.add_source("uniform sampler2D cos_thetas;\n" + GL_PROBE, "probe")
+    program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=builder.build().code)
+    cos_theta = np.cos(SMOOTH_THETAS).astype(np.float32)
+    textures = {"lobes_fgd": resources.texture(fgd_texture()), "lobes_ggx_moments": resources.texture(moments_texture()),
+                "cos_thetas": resources.texture(cos_theta.reshape(1, -1, 1), components=1)}
+    framebuffer = ctx.framebuffer(color_attachments=[ctx.renderbuffer((cos_theta.size, 1), 4, dtype="f4")])
+    try:
+        for name, (eta_0, eta_1, kappa) in SMOOTH_INTERFACES.items():
+            uniforms = {"eta_0": eta_0, "eta_1": float(np.mean(eta_1)), "conductor": kappa is not None,
+                        "eta_base": tuple(np.broadcast_to(eta_1, 3).tolist()),
+                        "kappa_base": tuple(np.broadcast_to(0.0 if kappa is None else kappa, 3).tolist())}
+            gl_renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures)
+            gl = np.frombuffer(framebuffer.read(components=4, dtype="f4"), dtype=np.float32).reshape(-1, 4)[:, :3]
+            error = np.abs(gl - exact_fresnel(name, np.arccos(cos_theta.astype(np.float64))))
+            worst = np.unravel_index(error.argmax(), error.shape)
+            assert error.max() <= SMOOTH_GL_TOLERANCE, f"{name}: {error.max():.2e} at cos theta {cos_theta[worst[0]]}"
+    finally:
+        framebuffer.color_attachments[0].release()
+        framebuffer.release()
+        resources.release(*textures.values())
+        program.release()

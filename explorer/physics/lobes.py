@@ -20,7 +20,10 @@ What is ours, where the papers leave a choice:
   smooth interfaces whatever the interpolation. A rough conductor's is ``E(theta, alpha) F(cbar_d)``,
   the GGX lobe's albedo times the Fresnel term at its mean half-angle cosine
   (``luts/lobes_ggx_moments.npy``), which Bati et al. (Sec. 5.1.2) observe is nearly Fresnel's at
-  normal incidence: a 3D table instead of Belcour's 4D one.
+  normal incidence: a 3D table instead of Belcour's 4D one. Both tables' ``alpha = 0`` rows are the
+  closed-form smooth limit (``E = 1``, ``cbar_d = cos theta``, correction 0:
+  :func:`explorer.physics.lobes_fgd.smooth_lobe_moments`), so a smooth interface is exact Fresnel at
+  every angle, grazing and total internal reflection included.
 - Variances are per RGB channel (Bati et al., footnote 1) and each is expressed in the medium where it
   is observed: the Jacobian ``j = eta_{i+1} cos theta_{i+1} / (eta_i cos theta_i)`` of Belcour's
   implementation maps medium ``i + 1`` to medium ``i``; at normal incidence ``j_{0n} = eta_n / eta_0`` as
@@ -107,7 +110,11 @@ def fgd_dielectric(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike) -> np
 
 
 def fgd_conductor(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike, kappa: ArrayLike) -> np.ndarray:
-    """``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices)."""
+    """
+    ``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices),
+    bilinear in (cos theta, alpha); exactly ``F_{s,p}(cos theta)`` at ``alpha = 0`` (the table's smooth row,
+    linear in cos theta, is reproduced by the interpolation).
+    """
     from explorer.tables import luts
 
     table = luts.load("lobes_ggx_moments")
