@@ -108,11 +108,13 @@ vec2 fgd_dielectric(sampler2D table, float cos_theta, float alpha, float eta) {
             correction += w * ((1.0 - fc) * texelFetch(table, ivec2(ic, row), 0).r + fc * texelFetch(table, ivec2(ic + 1, row), 0).r);
         }
     }
-    // Shared by s and p in proportion to their Fresnel terms (explorer.physics.lobes.fgd_dielectric).
+    // Shared by s and p in proportion to their reflectances where FGD < F, to their transmittances where
+    // FGD > F: both stay in [0, 1] (explorer.physics.lobes.fgd_dielectric).
     vec2 F = fresnel_sp(cos_theta, eta);
     float mean = 0.5 * (F.x + F.y);
     float target = clamp(mean + correction, 0.0, 1.0);
-    return clamp(mean > 1e-9 ? F * (target / max(mean, 1e-9)) : vec2(target), 0.0, 1.0);
+    vec2 R = target <= mean ? F * (mean > 0.0 ? target / mean : 1.0) : 1.0 - (1.0 - F) * (mean < 1.0 ? (1.0 - target) / (1.0 - mean) : 1.0);
+    return clamp(R, 0.0, 1.0);  // rounding only
 }
 
 // FGD of a rough conductor: the lobe's albedo E times Fresnel at its mean half-angle cosine.
