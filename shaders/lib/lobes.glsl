@@ -86,11 +86,12 @@ void lobes_axis(float value, int count, float lo, float hi, out int i, out float
     f = x - float(i);
 }
 
-// The table's warped cosine (explorer.physics.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2.
+// The table's warped cosine (explorer.physics.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2,
+// sqrt(cos theta - cos theta_c) above it (where Fresnel is smooth).
 float fgd_cos_coordinate(float cos_theta, float eta) {
     float c = clamp(cos_theta, 0.0, 1.0), c_c = sqrt(max(1.0 - eta * eta, 0.0));
     if (c_c <= 0.0) return c;
-    return c <= c_c ? 0.5 * c / max(c_c, 1e-12) : 0.5 + 0.5 * (c - c_c) / max(1.0 - c_c, 1e-12);
+    return c <= c_c ? 0.5 * c / max(c_c, 1e-12) : 0.5 + 0.5 * sqrt(max(c - c_c, 0.0) / max(1.0 - c_c, 1e-12));
 }
 
 // FGD of a rough dielectric interface: exact Fresnel per polarisation plus the tabulated (unpolarised) correction.
