@@ -20,7 +20,10 @@ What is ours, where the papers leave a choice:
   smooth interfaces whatever the interpolation. A rough conductor's is ``E(theta, alpha) F(cbar_d)``,
   the GGX lobe's albedo times the Fresnel term at its mean half-angle cosine
   (``luts/lobes_ggx_moments.npy``), which Bati et al. (Sec. 5.1.2) observe is nearly Fresnel's at
-  normal incidence: a 3D table instead of Belcour's 4D one.
+  normal incidence: a 3D table instead of Belcour's 4D one. Both tables' ``alpha = 0`` rows are the
+  closed-form smooth limit (``E = 1``, ``cbar_d = cos theta``, correction 0:
+  :func:`explorer.physics.lobes_fgd.smooth_lobe_moments`), so a smooth interface is exact Fresnel at
+  every angle, grazing and total internal reflection included.
 - Variances are per RGB channel (Bati et al., footnote 1) and each is expressed in the medium where it
   is observed: the Jacobian ``j = eta_{i+1} cos theta_{i+1} / (eta_i cos theta_i)`` of Belcour's
   implementation maps medium ``i + 1`` to medium ``i``; at normal incidence ``j_{0n} = eta_n / eta_0`` as
@@ -82,7 +85,8 @@ def fgd_dielectric(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike) -> np
     ``FGD_{s,p}`` of a rough dielectric interface of relative index ``eta`` (achromatic or per channel):
     the exact Fresnel term plus the (unpolarised) tabulated correction, interpolated trilinearly in
     (:func:`fgd_cos_coordinate`, alpha, log eta), split
-    between s and p in proportion to their Fresnel terms. Leading axis 2.
+    between s and p in proportion to their Fresnel reflectances where it lowers FGD below F, to their
+    transmittances where it raises it (both stay in [0, 1], their mean is the unpolarised FGD). Leading axis 2.
     """
     from explorer.tables import luts
 
@@ -97,17 +101,26 @@ def fgd_dielectric(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike) -> np
         for da, wa in ((0, 1.0 - fa), (1, fa)):
             for dc, wc in ((0, 1.0 - fc), (1, fc)):
                 correction = correction + (we * wa * wc) * table[ie + de, ia + da, ic + dc]
-    # The unpolarised FGD = F + correction, shared by s and p in proportion to their Fresnel terms (both
-    # stay >= 0 where one alone would go negative, near Brewster's angle).
+    # The unpolarised FGD = F + correction, shared by s and p: where the rough interface reflects less than
+    # the smooth one, in proportion to their reflectances F_{s,p} (both stay >= 0 where one alone would go
+    # negative, near Brewster's angle); where it reflects more, in proportion to their transmittances
+    # 1 - F_{s,p} (both stay <= 1: scaling F_s up overshot 1 just past a critical angle, where F_s ~ 1 and
+    # F_p ~ 0, and two such interfaces facing each other made the adding equations' 1 - R R' vanish).
     F = fresnel_sp(cos_theta, eta)
     mean = F.mean(axis=0)
-    target = np.clip(mean + correction, 0.0, 1.0)
-    scale = np.where(mean > 1e-9, target / np.maximum(mean, 1e-9), 1.0)
-    return np.clip(np.where(mean > 1e-9, F * scale, target), 0.0, 1.0)
+    target = np.clip(mean + correction, 0.0, 1.0)  # the table's interpolation, kept an albedo
+    less = target <= mean
+    reflected = F * np.where(less & (mean > 0.0), target / np.where(mean > 0.0, mean, 1.0), 1.0)
+    transmitted = (1.0 - F) * np.where(~less, (1.0 - target) / np.where(mean < 1.0, 1.0 - mean, 1.0), 1.0)
+    return np.clip(np.where(less, reflected, 1.0 - transmitted), 0.0, 1.0)  # rounding only: |r|^2 = 1 + 4e-16 under TIR
 
 
 def fgd_conductor(cos_theta: ArrayLike, alpha: ArrayLike, eta: ArrayLike, kappa: ArrayLike) -> np.ndarray:
-    """``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices)."""
+    """
+    ``FGD_{s,p} ~ E(theta, alpha) F_{s,p}(cbar_d)`` of a rough conductor ``eta + i kappa`` (relative indices),
+    bilinear in (cos theta, alpha); exactly ``F_{s,p}(cos theta)`` at ``alpha = 0`` (the table's smooth row,
+    linear in cos theta, is reproduced by the interpolation).
+    """
     from explorer.tables import luts
 
     table = luts.load("lobes_ggx_moments")

@@ -86,11 +86,12 @@ void lobes_axis(float value, int count, float lo, float hi, out int i, out float
     f = x - float(i);
 }
 
-// The table's warped cosine (explorer.physics.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2.
+// The table's warped cosine (explorer.physics.lobes.fgd_cos_coordinate): the critical angle of eta < 1 at t = 1/2,
+// sqrt(cos theta - cos theta_c) above it (where Fresnel is smooth).
 float fgd_cos_coordinate(float cos_theta, float eta) {
     float c = clamp(cos_theta, 0.0, 1.0), c_c = sqrt(max(1.0 - eta * eta, 0.0));
     if (c_c <= 0.0) return c;
-    return c <= c_c ? 0.5 * c / max(c_c, 1e-12) : 0.5 + 0.5 * (c - c_c) / max(1.0 - c_c, 1e-12);
+    return c <= c_c ? 0.5 * c / max(c_c, 1e-12) : 0.5 + 0.5 * sqrt(max(c - c_c, 0.0) / max(1.0 - c_c, 1e-12));
 }
 
 // FGD of a rough dielectric interface: exact Fresnel per polarisation plus the tabulated (unpolarised) correction.
@@ -108,11 +109,13 @@ vec2 fgd_dielectric(sampler2D table, float cos_theta, float alpha, float eta) {
             correction += w * ((1.0 - fc) * texelFetch(table, ivec2(ic, row), 0).r + fc * texelFetch(table, ivec2(ic + 1, row), 0).r);
         }
     }
-    // Shared by s and p in proportion to their Fresnel terms (explorer.physics.lobes.fgd_dielectric).
+    // Shared by s and p in proportion to their reflectances where FGD < F, to their transmittances where
+    // FGD > F: both stay in [0, 1] (explorer.physics.lobes.fgd_dielectric).
     vec2 F = fresnel_sp(cos_theta, eta);
     float mean = 0.5 * (F.x + F.y);
     float target = clamp(mean + correction, 0.0, 1.0);
-    return clamp(mean > 1e-9 ? F * (target / max(mean, 1e-9)) : vec2(target), 0.0, 1.0);
+    vec2 R = target <= mean ? F * (mean > 0.0 ? target / mean : 1.0) : 1.0 - (1.0 - F) * (mean < 1.0 ? (1.0 - target) / (1.0 - mean) : 1.0);
+    return clamp(R, 0.0, 1.0);  // rounding only
 }
 
 // FGD of a rough conductor: the lobe's albedo E times Fresnel at its mean half-angle cosine.
