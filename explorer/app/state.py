@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.materials.methods import BraggMethod
+from explorer.materials.methods import opening_values
 from explorer.materials.brd import Material
 
 VIEW_SIZES = (128, 256, 512, 1024)
@@ -27,9 +27,7 @@ def has_reflectance(material: Material) -> bool:
 
 def initial_values(material: Material, preset: str | None, is_default: bool) -> dict:
     """The values the app starts with: defaults, the default material's tabulated method, a preset."""
-    overrides: dict = {}
-    if is_default and any(p.name == "method" for p in material.parameters):
-        overrides["method"] = int(BraggMethod.TABULATED)  # the default material opens on its fastest exact method
+    overrides: dict = dict(opening_values(material)) if is_default else {}  # as render opens it
     if preset is not None:
         from explorer.materials.presets import presets_for
 

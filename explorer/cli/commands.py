@@ -85,16 +85,23 @@ def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     return theta, phi
 
 
-def parse_exposure(text: str | None, out: Path) -> float:
-    """``--exposure``: a positive multiplier of the linear values before the PNG's sRGB encode."""
+def parse_exposure(text: str | None, out: Path) -> float | None:
+    """
+    ``--exposure``: a positive multiplier of the linear values before the PNG's sRGB encode, or ``auto``
+    (None: :func:`explorer.views.exposure.auto_exposure` of the image).
+    """
     if text is None:
         return 1.0
-    try:
-        exposure = float(text)
-    except ValueError:
-        exposure = float("nan")
-    if not (np.isfinite(exposure) and exposure > 0.0):
-        raise click.BadParameter(f"{text!r} is not a positive multiplier (e.g. 2 for one stop brighter)", param_hint="--exposure")
+    if text.strip().lower() == "auto":
+        exposure = None
+    else:
+        try:
+            exposure = float(text)
+        except ValueError:
+            exposure = float("nan")
+        if not (np.isfinite(exposure) and exposure > 0.0):
+            raise click.BadParameter(f"{text!r} is not a positive multiplier (e.g. 2 for one stop brighter) or auto",
+                                     param_hint="--exposure")
     if out.suffix.lower() != ".png":
         raise click.BadParameter(f"scales the 8-bit .png encode; {out.suffix or 'this output'} keeps the linear values",
                                  param_hint="--exposure")
@@ -188,14 +195,58 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
                       progress=progress, warn=warn)
 
 
-@click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
+def summary(command: click.Command) -> str:
+    """A command's line in ``--help``: its ``short_help``, or its docstring's whole first paragraph."""
+    if command.short_help:
+        return command.short_help
+    paragraph = (command.help or "").strip().split("\n\n")[0]
+    return " ".join(paragraph.split())
+
+
+class FullSummaryGroup(click.Group):
+    """
+    A group whose command list shows each command's whole summary (:func:`summary`), wrapped: click's
+    own cuts it at about 45 characters or at the first full stop ("Bati et al., Figs.").
+    """
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, summary(command)) for name in self.list_commands(ctx)
+                if (command := self.get_command(ctx, name)) is not None and not command.hidden]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+def package_version() -> str:
+    """The installed distribution's version, or a source checkout's ``pyproject.toml`` version."""
+    from importlib import metadata
+
+    from explorer.resources import APP_NAME, CHECKOUT_ROOT
+
+    if CHECKOUT_ROOT is not None:  # a checkout run through PYTHONPATH may have no (or another) installed copy
+        import re
+
+        match = re.search(r'^version\s*=\s*"([^"]+)"', (CHECKOUT_ROOT / "pyproject.toml").read_text(encoding="utf-8"), re.M)
+        if match:
+            return match.group(1)
+    try:
+        return metadata.version(APP_NAME)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+@click.group(cls=FullSummaryGroup, invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help=f"Print the traceback of an unexpected error (a bug); also {DEBUG_ENV}=1.")
+@click.version_option(package_version(), "--version", prog_name=PROG, message="%(prog)s %(version)s")
 @click.pass_context
 def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() before click parses
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
     Without a command: open the explorer on the default Bragg mirror when a display exists; without
     one, say so and render it (sphere and angular gradient) to out/.
+
+    From a source checkout, python3 -m explorer test [PYTEST ARGS] runs the test suite (pytest, with
+    Xvfb for the app's scripted sessions).
     """
     if ctx.invoked_subcommand is None:
         from explorer.app import display_available
@@ -276,7 +327,7 @@ def _errors(function):
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
-@click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter).")
+@click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter), or auto: the bright end of the object to white.")
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
@@ -302,7 +353,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     exposure_factor = parse_exposure(exposure, Path(out))
     light_angles = parse_light(light, view)
     loaded = _load(material)
-    values = resolve_values(loaded, preset, params_file, assignments)
+    from explorer.materials.methods import method_labels, opening_values
+
+    values = resolve_values(loaded, preset, params_file, assignments, opening=opening_values(loaded))  # as the app opens it
     width, height = parse_size(size, view)
     thickness = None
     if view == "textured":
@@ -332,9 +385,16 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
                                 variant=variant)
     circles = scatter_circles(width, height) if view_named(view).circles else None
+    if exposure_factor is None:  # --exposure auto
+        from explorer.views.exposure import auto_exposure
+
+        exposure_factor = auto_exposure(image)
+        click.echo(f"{PROG}: exposure auto: {exposure_factor:.3g}", err=True)
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
-    click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
+    method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
+    what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
+    click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 
     note = accuracy_note(loaded, values)  # the chosen Bragg method off by more than ΔE2000 2 here: which one is not
@@ -348,14 +408,29 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 @_errors
 def info(material, as_json):
     """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film)."""
+    from explorer.materials.methods import method_labels, opening_values
+
     loaded = _load(material)
+    labels = method_labels(loaded)
+    opening = opening_values(loaded).get("method")
     if as_json:
-        click.echo(json.dumps(loaded.info(), indent=2))
+        document = loaded.info()
+        if labels:
+            document["methods"] = {str(value): label.partition(" ")[2] for value, label in labels.items()}
+        click.echo(json.dumps(document, indent=2))
         return
     click.echo(f"{display_path(loaded.path)}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
+    width = max((len(p.name) for p in loaded.parameters), default=0)
     for p in loaded.parameters:
-        bounds = "" if p.min is None else f" in [{p.min:g}, {p.max:g}]"
-        click.echo(f"  {p.type:5} {p.name:12} default {p.default}{bounds}")
+        shown = p.info()
+        if p.type == "int":  # a count or a switch: 20, not 20.0
+            shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
+        default = labels.get(shown["default"], shown["default"]) if p.name == "method" else shown["default"]
+        bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
+        opens = f" (the app and render open it on {labels.get(opening, opening)})" if p.name == "method" and opening is not None else ""
+        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
+        if p.name == "method" and labels:
+            click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
 
 
 @cli.command()
