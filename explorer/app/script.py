@@ -43,7 +43,8 @@ class ScriptRobot:
     sphere's resolution (the combo's values); ``{"key": "F12"}`` presses and releases a key (ImGui's
     name), then waits for a screenshot it asked for; ``{"focus": TITLE}`` brings a docked window to the
     front; ``{"write": PATH, "text": TEXT}`` writes a file (a user's editor between two reloads);
-    ``{"quit": true}``.
+    ``{"dialog": [PATH, ...]}`` answers the next File > Open... (:mod:`explorer.app.dialogs`);
+    ``{"save_slice": PATH}`` saves the Slice window's linear image once complete; ``{"quit": true}``.
     """
 
     def __init__(self, actions: list):
@@ -235,7 +236,25 @@ def _assign(name: str, convert):
     return handler
 
 
-ACTION_OF_FIELD = {"file_path": "file_path", "view_size": "view_size", "focus_request": "focus"}
+ACTION_OF_FIELD = {"file_path": "file_path", "focus_request": "focus"}
+
+
+def _view_size(robot, app, io, action, step):  # a fixed resolution (the combo's values), no longer fitting the window
+    app.state.view_size, app.state.view_size_auto = int(action["view_size"]), False
+    return True
+
+
+def _dialog(robot, app, io, action, step):  # the answer the next File > Open... gets, instead of a person's
+    app.state.dialog_answers.append([str(path) for path in action["dialog"]])
+    robot.script.log.append(f"queued dialog answer ({len(action['dialog'])} paths)")
+    return True
+
+
+def _save_slice(robot, app, io, action, step):  # the Slice window's linear image (.npy), once it is complete
+    state = app.state
+    if step == 0:
+        state.pending_slice_save = str(action["save_slice"])
+    return state.pending_slice_save is None or _timed_out(robot, action, step, "save_slice", 2000)
 
 
 def _write(robot, app, io, action, step):  # what a user's editor does to the material file between two reloads
@@ -264,7 +283,9 @@ ACTIONS = {
     "key": _key,
     "window_screenshot": _window_screenshot,
     "file_path": _assign("file_path", str),
-    "view_size": _assign("view_size", int),
+    "view_size": _view_size,
+    "dialog": _dialog,
+    "save_slice": _save_slice,
     "focus": _assign("focus_request", str),  # bring a docked window's tab to the front, as a click on it does
     "write": _write,
     "quit": _quit,

@@ -20,7 +20,7 @@ import numpy as np
 from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
-from explorer.resources import DEFAULT_MATERIAL, display_path
+from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
@@ -106,6 +106,36 @@ def parse_exposure(text: str | None, out: Path) -> float | None:
         raise click.BadParameter(f"scales the 8-bit .png encode; {out.suffix or 'this output'} keeps the linear values",
                                  param_hint="--exposure")
     return exposure
+
+
+def saved_view(params_file: str | None, ctx: click.Context) -> dict:
+    """
+    What ``--params FILE`` saved of the app's view (:func:`explorer.app.parameter_files.check_view`), as
+    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment`` and ``light``
+    (``(theta, phi)``: the app's light turned by its orbit camera into view space). Only for the options
+    the command line leaves unset; ``{}`` without a file or a saved view.
+    """
+    if params_file is None:
+        return {}
+    from explorer.app.parameter_files import load_view
+
+    view = load_view(params_file) or {}
+    given = {name for name in ("view", "light", "exposure", "env_file")
+             if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE}
+    result: dict = {}
+    if "view" in view and "view" not in given:
+        result["view"] = view["view"]
+    if "exposure" in view and "exposure" not in given:
+        result["exposure"] = repr(view["exposure"])
+    if "environment" in view and "env_file" not in given and result.get("view") == "env":
+        result["environment"] = view["environment"]
+    if ("light" in view or "camera" in view) and "light" not in given:
+        from explorer.app.camera import light_vector
+        from explorer.views.geometry import DEFAULT_LIGHT
+
+        x, y, z = (float(c) for c in light_vector(view.get("light", DEFAULT_LIGHT), view.get("camera", (0.0, 0.0))))
+        result["light"] = (float(np.degrees(np.arccos(np.clip(z, -1.0, 1.0)))), float(np.degrees(np.arctan2(y, x))))
+    return result
 
 
 def render_material(
@@ -217,24 +247,6 @@ class FullSummaryGroup(click.Group):
                 formatter.write_dl(rows)
 
 
-def package_version() -> str:
-    """The installed distribution's version, or a source checkout's ``pyproject.toml`` version."""
-    from importlib import metadata
-
-    from explorer.resources import APP_NAME, CHECKOUT_ROOT
-
-    if CHECKOUT_ROOT is not None:  # a checkout run through PYTHONPATH may have no (or another) installed copy
-        import re
-
-        match = re.search(r'^version\s*=\s*"([^"]+)"', (CHECKOUT_ROOT / "pyproject.toml").read_text(encoding="utf-8"), re.M)
-        if match:
-            return match.group(1)
-    try:
-        return metadata.version(APP_NAME)
-    except metadata.PackageNotFoundError:
-        return "unknown"
-
-
 @click.group(cls=FullSummaryGroup, invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help=f"Print the traceback of an unexpected error (a bug); also {DEBUG_ENV}=1.")
 @click.version_option(package_version(), "--version", prog_name=PROG, message="%(prog)s %(version)s")
@@ -252,25 +264,30 @@ def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() befor
         from explorer.app import display_available
 
         if display_available():
-            ctx.invoke(open_material, material=str(DEFAULT_MATERIAL), preset=None, script=None, report=None, window_size=None)
+            ctx.invoke(open_material, materials=(str(DEFAULT_MATERIAL),), preset=None, script=None, report=None, window_size=None)
             return
         click.echo(f"{PROG}: no display (DISPLAY is not set or cannot be opened): writing the headless render of the default view to out/", err=True)
         ctx.invoke(default_job)
 
 
 @cli.command("open")
-@click.argument("material", type=click.Path(dir_okay=False))
+@click.argument("materials", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets).")
 @click.option("--script", type=click.Path(dir_okay=False), hidden=True, help="A scripted session (JSON list of actions; tests, bench --app).")
 @click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
 @click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
-def open_material(material, preset, script, report, window_size):
-    """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
+def open_material(materials, preset, script, report, window_size):
+    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names).
+
+    Several materials are listed in the Materials window, each with its colour; the plots overlay the
+    visible ones and the sphere shows the chosen one (the first; --preset applies to it).
+    """
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
     try:
-        loaded = _load(material)
+        loaded = _load(materials[0])
+        more = [_load(other).path for other in materials[1:]]
         if preset is not None:
             from explorer.materials.presets import presets_for
 
@@ -292,7 +309,7 @@ def open_material(material, preset, script, report, window_size):
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
                            "for images without a window use: bragg-explorer render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
-                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve())
+                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
     except ImportError as error:
         _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
     except (LocatedError, GLUnavailable, OutputError, AppError) as error:
@@ -350,8 +367,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     from explorer.views.geometry import scatter_circles, view_named
 
     check_output(Path(out))
-    exposure_factor = parse_exposure(exposure, Path(out))
-    light_angles = parse_light(light, view)
+    saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
+    view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
+    exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
+    light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
     from explorer.materials.methods import method_labels, opening_values
 

@@ -29,7 +29,7 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None,
+    environment=None, slice_phi_d: float = 90.0,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -39,6 +39,7 @@ def render_numpy(
     texture over the default D_inc range, without prefiltering).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
+    ``slice_phi_d`` (``slice``): phi_d in degrees (the app's Slice window; 90 as BRDF Explorer).
     """
     evaluates = view_named(view).evaluates
     if evaluates == "environment":
@@ -68,7 +69,7 @@ def render_numpy(
     if evaluates == "brdf":
         if not callable(getattr(model, "brdf", None)):
             raise ValueError(f"the {view} view needs the model's brdf(L, V, N, X, Y); {type(model).__name__} has none")
-        L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
+        L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light, slice_phi_d)
         image = np.zeros((height, width, 3), dtype=np.float32)
         vectors = [a[inside] for a in (L, V, N, X, Y)]
         image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from explorer.app.camera import light_vector
-from explorer.app.state import MODES, has_reflectance
+from explorer.app.state import MODES, auto_view_size, has_reflectance
 from explorer.app.panels.base import Panel, record, show_image
 
 
@@ -22,6 +22,9 @@ class SpherePanel(Panel):
         imgui.new_line()
         if state.mode == "sphere" and not has_reflectance(state.material):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
+        if state.view_size_auto:  # the sphere fills the window, less its status line
+            avail = imgui.get_content_region_avail()
+            state.view_size = auto_view_size(avail.x, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
         if state.mode == "env":
