@@ -86,6 +86,7 @@ class OpenDialog:
         """The fallback: a window with a path field (``;`` between paths), Open and Cancel."""
         from explorer.app.panels.base import record
 
+        imgui.set_next_window_pos(imgui.get_main_viewport().get_center(), imgui.Cond_.appearing, imgui.ImVec2(0.5, 0.5))
         imgui.set_next_window_size(imgui.ImVec2(560, 0), imgui.Cond_.appearing)
         _, self._field_open = imgui.begin("Open materials", True)
         answer = None

@@ -35,13 +35,16 @@ def draw_help(imgui, state) -> None:
     """The Help menu's windows, while they are open."""
     from explorer.app.panels.base import record
 
+    centre = imgui.get_main_viewport().get_center()
     if state.show_about:
+        imgui.set_next_window_pos(centre, imgui.Cond_.appearing, imgui.ImVec2(0.5, 0.5))
         imgui.set_next_window_size(imgui.ImVec2(520, 0), imgui.Cond_.appearing)
         _, state.show_about = imgui.begin("About bragg-explorer", True)
         imgui.text_wrapped(about_text())
         record(state, "about_text")
         imgui.end()
     if state.show_controls:
+        imgui.set_next_window_pos(centre, imgui.Cond_.appearing, imgui.ImVec2(0.5, 0.5))
         imgui.set_next_window_size(imgui.ImVec2(560, 0), imgui.Cond_.appearing)
         _, state.show_controls = imgui.begin("Keyboard and mouse", True)
         if imgui.begin_table("controls", 2):

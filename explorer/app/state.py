@@ -102,6 +102,7 @@ class AppState:
     slice_report: dict | None = None  # what the Slice window shows (phi_d, gamma, chroma, its image's range)
     dialog_answers: list = field(default_factory=list)  # scripted answers to File > Open... (lists of paths)
     show_about: bool = False
+    first_screen: list = field(default_factory=list)  # the windows drawn on the first screen (reported)
     plotted: dict = field(default_factory=dict)  # plot window -> the materials it drew curves of (reported)
     show_controls: bool = False
     mode: str = "lit"  # one of MODES

@@ -22,6 +22,8 @@ from explorer.app.dialogs import OpenDialog
 from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, MaterialEntry, has_reflectance, initial_values
 
 DEFAULT_WINDOW = (1280, 800)
+#: The frame whose windows the report calls the first screen (the layout is done and focused by then).
+FIRST_SCREEN_FRAME = 3
 
 
 class AppError(Exception):
@@ -277,6 +279,8 @@ class App:
 
     def _record_frame(self, frame_s, work_s, gl_ms, ui_s, draw_s, swap_s) -> None:
         """One frame's times (ms) and what the sphere showed, for the report."""
+        if len(self.state.frame_times) == FIRST_SCREEN_FRAME:
+            self.state.first_screen = sorted(self.state.visible)
         values_key = tuple(sorted((k, str(v)) for k, v in self.state.values.items()))
         changed, self._last_values_key = values_key != self._last_values_key, values_key
         self.state.frame_times.append({
@@ -297,7 +301,8 @@ class App:
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
             "view_size_auto": s.view_size_auto, "materials": [entry.report() for entry in s.materials], "selected": s.selected,
-            "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted, "dialog": self.dialog.log,
+            "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted,
+            "first_screen": s.first_screen, "items": sorted(s.rects), "dialog": self.dialog.log,
         }
         from explorer.files import write_text_atomic
 

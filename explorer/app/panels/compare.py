@@ -51,6 +51,7 @@ class ComparePanel(Panel):
                     if clicked:
                         c.material_b = i
                 imgui.end_combo()
+            record(state, "compare_b")
             if not others:
                 imgui.text("(open a second material: File > Open...)")
         elif c.kind == "methods" and names:
