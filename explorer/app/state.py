@@ -103,6 +103,7 @@ class AppState:
     dialog_answers: list = field(default_factory=list)  # scripted answers to File > Open... (lists of paths)
     show_about: bool = False
     first_screen: list = field(default_factory=list)  # the windows drawn on the first screen (reported)
+    plotted_log: dict = field(default_factory=dict)  # script mark -> plotted, at its first frame (reported)
     plotted: dict = field(default_factory=dict)  # plot window -> the materials it drew curves of (reported)
     show_controls: bool = False
     mode: str = "lit"  # one of MODES

@@ -279,6 +279,9 @@ class App:
 
     def _record_frame(self, frame_s, work_s, gl_ms, ui_s, draw_s, swap_s) -> None:
         """One frame's times (ms) and what the sphere showed, for the report."""
+        mark = self.robot.mark if self.robot else None
+        if mark is not None and mark not in self.state.plotted_log:  # what the plots drew when a script marked
+            self.state.plotted_log[mark] = {k: list(v) for k, v in self.state.plotted.items()}
         if len(self.state.frame_times) == FIRST_SCREEN_FRAME:
             self.state.first_screen = sorted(self.state.visible)
         values_key = tuple(sorted((k, str(v)) for k, v in self.state.values.items()))
@@ -301,7 +304,7 @@ class App:
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
             "view_size_auto": s.view_size_auto, "materials": [entry.report() for entry in s.materials], "selected": s.selected,
-            "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted,
+            "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted, "plotted_log": s.plotted_log,
             "first_screen": s.first_screen, "items": sorted(s.rects), "dialog": self.dialog.log,
         }
         from explorer.files import write_text_atomic
@@ -318,8 +321,9 @@ class App:
         return bool(imgui.is_any_item_active() and imgui.is_mouse_down(0)) or self.state.orbit_drag
 
     def idle(self) -> bool:
-        """Nothing left to draw: the sphere, and the compare pair when it is on and shown."""
-        jobs = [self.scheduler.job("main")]
+        """Nothing left to draw: the sphere when shown, and the compare pair when it is on and shown (a hidden
+        tab's view is not drawn: another material chosen behind it waits until its tab is in front)."""
+        jobs = [self.scheduler.job("main")] if "Sphere" in self.state.visible or self.state.mode == "env" else []
         if self.state.compare.on and "Compare" in self.state.visible:
             jobs += [self.scheduler.job("compare_a"), self.scheduler.job("compare_b")]
         return all(job.complete or job.error is not None for job in jobs) and not self.dragging
