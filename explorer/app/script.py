@@ -35,7 +35,9 @@ class ScriptRobot:
     Design window's worker); ``{"wait_accuracy": true}`` until the accuracy badge shows the current values;
     ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
-    (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
+    (``preset_combo``, ``preset:NAME``, ``mode:lit``, ``param:method`` then ``method:N``, ``menu_file`` then
+    ``menu_open``, ``menu_help`` then ``menu_about``, the Materials list's ``material:I``,
+    ``material:I:visible``, ``material:I:solo``, ``material:I:close``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
     until complete; in ``env``, until a whole sample); ``{"window_screenshot": PATH}`` the whole window;
     ``{"type": LABEL, "text": TEXT}`` clicks a text field (one that selects all on focus), types TEXT and

@@ -51,7 +51,8 @@ class PolarPanel(Panel):
         if not curves:
             return
         if implot.begin_plot("polar", imgui.ImVec2(-1, -1), implot.Flags_.equal):
-            implot.setup_axes("", "")
+            fit = implot.AxisFlags_.auto_fit  # the axes follow the lobes: another material, another light
+            implot.setup_axes("", "", fit, fit)
             for entry, (theta, brdf) in curves:
                 radians = np.radians(theta)
                 if len(curves) == 1:
