@@ -59,6 +59,10 @@ def test_info_names_the_methods_and_prints_integers():
 
     document = json.loads(film.stdout)
     assert document["methods"] == {str(int(m)): m.label for m in ThinFilmMethod}
+    method = next(p for p in document["parameters"] if p["name"] == "method")
+    assert '"default": 0\n' in film.stdout and all(isinstance(method[k], int) for k in ("min", "max", "default"))
+    floats = [p for p in document["parameters"] if p["type"] == "float"]
+    assert floats and all(isinstance(p["default"], float) for p in floats)
 
 
 def test_render_opens_the_default_material_as_the_app_and_says_which_method(tmp_path):

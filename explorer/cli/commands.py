@@ -434,6 +434,9 @@ def info(material, as_json):
     opening = opening_values(loaded).get("method")
     if as_json:
         document = loaded.info()
+        for shown in document["parameters"]:
+            if shown["type"] == "int":  # a count or a switch: 20, not 20.0
+                shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
         if labels:
             document["methods"] = {str(value): label.partition(" ")[2] for value, label in labels.items()}
         click.echo(json.dumps(document, indent=2))
