@@ -83,7 +83,8 @@ def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_rend
 def test_open_dialog_field_slice_phi_d_and_disabled_layers(x_display, tmp_path):  # noqa: F811
     """
     Without a dialog program: File > Open... shows a path field (two paths typed); the Slice window of the
-    GGX at phi_d dragged from 90 deg is its numpy twin's; a stack's Lambda_3 slider (layers = 1) does not move.
+    GGX (chosen in the Sphere window's combo) at phi_d dragged from 90 deg is its numpy twin's; a stack's
+    Lambda_3 slider (layers = 1) does not move.
     """
     if native_dialog_available():
         pytest.skip("a native file dialog program is installed here: the field is for machines without one")
@@ -91,7 +92,7 @@ def test_open_dialog_field_slice_phi_d_and_disabled_layers(x_display, tmp_path):
     actions = [
         {"wait": 3}, {"view_size": VIEW}, {"click": "menu_file"}, {"wait": 1}, {"click": "menu_open"}, {"wait": 2},
         {"type": "open_dialog:paths", "text": f"{STACK}; {THIN_FILM}"}, {"wait": 3},
-        {"click": "material:0"}, {"wait": 1}, {"focus": "Slice"}, {"wait": 2},
+        {"click": "shown"}, {"wait": 1}, {"click": "shown:0"}, {"wait": 1}, {"focus": "Slice"}, {"wait": 2},  # the sphere's own choice
         {"drag": "slice_phi_d", "from": 0.5, "to": 0.3, "frames": 3}, {"click": "slice_chroma"}, {"wait": 2},
         {"save_slice": str(slice_npy)}, {"wait": 1},
         {"click": "material:1"}, {"wait": 2},

@@ -111,3 +111,14 @@ def test_exposure_auto_brings_a_dark_film_to_white(tmp_path):
     assert "--exposure" in line
     line = one_line_error(run_cli(*base, "--exposure", "bright", "--out", tmp_path / "x.png"))
     assert "or auto" in line
+
+
+def test_open_several_materials_names_the_one_that_fails(tmp_path):
+    """``open A B``: a missing or malformed second material is one line naming it, before any window."""
+    line = one_line_error(run_cli("open", "bragg_mirror", tmp_path / "missing.brd"))
+    assert "missing.brd" in line
+    broken = tmp_path / "broken.brdf"
+    broken.write_text("analytic\n::begin parameters\nfloat x 0 1\n::end parameters\n")
+    line = one_line_error(run_cli("open", "ggx_schlick", broken))
+    assert line.startswith(f"bragg-explorer: error: {broken}:3: "), line
+    assert "Missing argument" in one_line_error(run_cli("open"))

@@ -19,6 +19,16 @@ class SpherePanel(Panel):
                 state.mode = mode
             record(state, f"mode:{mode}")
             imgui.same_line()
+        if len(state.materials) > 1:  # which loaded material the sphere shows (as a click in the Materials list)
+            imgui.set_next_item_width(min(imgui.get_content_region_avail().x, 220.0))
+            if imgui.begin_combo("##shown", state.material_path.name):
+                for index, entry in enumerate(state.materials):
+                    clicked, _ = imgui.selectable(f"{entry.name}##{index}", index == state.selected)
+                    record(state, f"shown:{index}")
+                    if clicked:
+                        self.app.select(index)
+                imgui.end_combo()
+            record(state, "shown")
         imgui.new_line()
         if state.mode == "sphere" and not has_reflectance(state.material):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
