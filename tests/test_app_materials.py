@@ -136,3 +136,29 @@ def test_disney_brdf_matches_its_numpy_twin(gl_renderer, view):
             twins = render_both(gl_renderer, disney, disney.resolve(case), view, (48, 48))
             assert_twins_equal(twins, f"disney {view} {case}")
             assert np.abs(twins.reference).max() > 0.05
+
+
+def test_materials_list_logic_without_a_window(tmp_path):
+    """Open (one file failing), select (each keeps its values), Solo, Close (Compare's B follows its material)."""
+    from explorer.app import App
+
+    app = App(LAYER, more_paths=[GGX])
+    state = app.state
+    assert [e.name for e in state.materials] == ["bragg_layer.brd", "ggx_schlick.brd"] and state.view_size_auto
+    assert app.open_materials([DISNEY, tmp_path / "missing.brd"]) == 1
+    assert "missing.brd" in state.error and "1 failed" in state.status
+    assert state.selected == 2 and state.material_path == DISNEY and state.material is state.materials[2].material
+    state.values = state.material.resolve({**state.values, "roughness": 0.9})  # an edit of the shown material
+    app.select(0)
+    assert state.materials[2].values["roughness"] == 0.9 and state.material_path == LAYER
+    state.compare.material_b = 2
+    app.close(1)
+    assert [e.name for e in state.materials] == ["bragg_layer.brd", "disney.brdf"] and state.compare.material_b == 1
+    app.solo(1)
+    assert [e.visible for e in state.materials] == [False, True] and state.selected == 1
+    assert state.values["roughness"] == 0.9
+    assert len({e.colour for e in state.materials}) == 2
+    app.close(1)
+    assert [e.name for e in state.materials] == ["bragg_layer.brd"] and state.material_path == LAYER
+    app.close(0)  # the last one stays
+    assert len(state.materials) == 1

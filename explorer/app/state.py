@@ -146,6 +146,10 @@ class AppState:
     def select(self, index: int) -> None:
         """Show ``materials[index]`` in the sphere views and the Parameters window."""
         self.sync_selected()
+        self.show_entry(index)
+
+    def show_entry(self, index: int) -> None:
+        """Show ``materials[index]`` without saving the shown values first (the shown entry was closed)."""
         self.selected = index
         entry = self.materials[index]
         self.material, self.material_path, self.values = entry.material, entry.path, entry.values

@@ -191,13 +191,14 @@ class App:
             return
         state.sync_selected()
         closed = state.materials.pop(index)
-        if state.compare.material_b >= len(state.materials) or state.compare.material_b == index:
+        if state.compare.material_b > index:  # the same material stays B
+            state.compare.material_b -= 1
+        elif state.compare.material_b == index:
             state.compare.material_b = 0
-        if index < state.selected or state.selected >= len(state.materials):
-            state.selected = max(state.selected - 1, 0)
-            state.select(state.selected)
+        if index < state.selected:  # the shown material stays shown, one place up
+            state.selected -= 1
         elif index == state.selected:
-            state.select(min(index, len(state.materials) - 1))
+            state.show_entry(min(index, len(state.materials) - 1))
         if self.scheduler is not None:
             self.scheduler.prefetcher.forget()
         state.status = f"closed {closed.name}"
