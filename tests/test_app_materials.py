@@ -8,6 +8,8 @@ stack's disabled layer sliders.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -162,3 +164,18 @@ def test_materials_list_logic_without_a_window(tmp_path):
     assert [e.name for e in state.materials] == ["bragg_layer.brd"] and state.material_path == LAYER
     app.close(0)  # the last one stays
     assert len(state.materials) == 1
+
+
+def test_native_file_dialog_through_portable_file_dialogs(x_display, tmp_path, monkeypatch):  # noqa: F811
+    """File > Open... starts portable-file-dialogs' zenity (a stand-in here, on PATH) and opens what it answers."""
+    fake = tmp_path / "bin" / "zenity"
+    fake.parent.mkdir()
+    fake.write_text(f'#!/bin/sh\necho "$@" > {tmp_path / "args.txt"}\nprintf "%s\\n" "{THIN_FILM}" "{DISNEY}"\n')
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{fake.parent}:{os.environ['PATH']}")
+    actions = [{"wait": 3}, {"click": "menu_file"}, {"wait": 1}, {"click": "menu_open"}, {"wait": 30}, {"quit": True}]
+    _, report = run_session(x_display, GGX, actions, tmp_path)
+    assert report["dialog"] == ["native: 2 paths"], (report["dialog"], report["script_log"])
+    assert names(report) == ["ggx_schlick.brd", "thin_film.brd", "disney.brdf"] and report["selected"] == 2
+    arguments = (tmp_path / "args.txt").read_text()
+    assert "--multiple" in arguments and "*.brd *.brdf" in arguments
