@@ -83,17 +83,18 @@ class SlicePanel(BrdfViewPanel):
                 state.slice_report = {"phi_d": state.slice_phi_d, "gamma": state.slice_gamma, "chroma": state.slice_chroma,
                                       "exposure": state.exposure, "size": list(size), "raw_mean": raw.mean(axis=(0, 1)).tolist(),
                                       "shown_mean": rgba[..., :3].mean(axis=(0, 1)).tolist()}
-        if self._texture is None:
-            self.progress(imgui, job)
-            return
+        progressive = self.scheduler.show(self.view, size, job)  # the refining image (exposure, sRGB) until complete
+        current = job.complete and self._texture is not None and self._shown is not None and self._shown[0] == job.generation
+        # The processed picture holds rows from the top (theta_d = 0 first), the display pass's texture GL's rows
+        # from the bottom: each is mapped so that theta_d = 0 is at the bottom, as in BRDF Explorer.
+        texture, uv0, uv1 = (self._texture, (0, 1), (1, 0)) if current else (progressive, (0, 0), (1, 1))
         avail = imgui.get_content_region_avail()
         side = max(min(avail.x, avail.y - imgui.get_text_line_height_with_spacing()), 64)
         if implot.begin_plot("##slice", imgui.ImVec2(side, side), implot.Flags_.equal | implot.Flags_.no_legend):
             implot.setup_axes("theta_h (deg)", "theta_d (deg)", implot.AxisFlags_.lock, implot.AxisFlags_.lock)
             implot.setup_axes_limits(0, 90, 0, 90, imgui.Cond_.always)
-            # Rows from the top are theta_d from 0: upside down, so that theta_d = 0 is at the bottom (BRDF Explorer).
-            implot.plot_image("slice", imgui.ImTextureRef(self._texture.glo), implot.Point(0, 0), implot.Point(90, 90),
-                              imgui.ImVec2(0, 1), imgui.ImVec2(1, 0))
+            implot.plot_image("slice", imgui.ImTextureRef(texture.glo), implot.Point(0, 0), implot.Point(90, 90),
+                              imgui.ImVec2(*uv0), imgui.ImVec2(*uv1))
             implot.end_plot()
         record(state, "slice_plot")
         self.progress(imgui, job)
