@@ -70,6 +70,12 @@ def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_rend
     assert plotted["two"]["Polar"] == ["bragg_layer.brd", "ggx_schlick.brd"], plotted
     assert plotted["three visible"]["Polar"] == ["bragg_layer.brd", "disney.brdf", "thin_film.brd"], plotted
     assert plotted["two"]["Spectrum"] == ["bragg_layer.brd"]  # the GGX has no Bragg spectrum
+    from explorer.app.state import has_reflectance
+
+    strips = [p.name for p in (LAYER, DISNEY, THIN_FILM) if has_reflectance(load_material(p))]  # a gradient needs one
+    assert plotted["two"]["Strips"] == ["bragg_layer.brd", "ggx_schlick.brd"]
+    shown = plotted["three visible"]["Strips"]  # the shown material's methods first (the film, opened last), then the others
+    assert shown[0] == "thin_film.brd" and sorted(shown) == sorted(strips), shown
     # Side by side: the layer | the Disney BRDF, each its own material, lit; the mean ΔE is theirs.
     assert "compare_colour_bar" in report["items"]
     layer, disney = load_material(LAYER), load_material(DISNEY)
