@@ -131,7 +131,7 @@ def test_open_dialog_field_slice_phi_d_and_disabled_layers(x_display, tmp_path):
 
 @pytest.mark.parametrize("view", ["lit", "slice", "scatter"])
 def test_disney_brdf_matches_its_numpy_twin(gl_renderer, view):
-    """The principled BRDF the comparison uses is what Burley's equations give (tests/brdf_twins.DisneyTwin)."""
+    """The principled BRDF the comparison uses is what Burley's equations give (DisneyTwin in tests/brdf_twins.py)."""
     import brdf_twins
     from twins import render_both
 
