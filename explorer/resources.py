@@ -49,6 +49,21 @@ DEFAULT_TEXTURE = SHADER_DIR / "textures" / "thickness_noise.png"
 DEFAULT_ENVIRONMENT = SHADER_DIR / "environments" / "default.hdr"
 
 
+def package_version() -> str:
+    """A source checkout's ``pyproject.toml`` version, else the installed distribution's (``unknown`` without either)."""
+    import re
+    from importlib import metadata
+
+    if CHECKOUT_ROOT is not None:  # a checkout run through PYTHONPATH may have no (or another) installed copy
+        match = re.search(r'^version\s*=\s*"([^"]+)"', (CHECKOUT_ROOT / "pyproject.toml").read_text(encoding="utf-8"), re.M)
+        if match:
+            return match.group(1)
+    try:
+        return metadata.version(APP_NAME)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
 def require_checkout(command: str) -> None:
     """
     Exit with one line unless running from a source checkout: ``command`` rewrites shipped files, which in

@@ -206,9 +206,66 @@ class NonFiniteChannelsTwin(_Twin):
             return np.stack([np.sqrt(-k), np.exp(1000.0 * k), -0.25 * k], axis=-1)
 
 
+def _mix(a, b, t):
+    """GLSL's ``mix``: ``a (1 - t) + b t`` (so an infinite ``b`` with ``t = 0`` is NaN there too)."""
+    return a * (1.0 - t) + b * t
+
+
+class DisneyTwin(_Twin):
+    """tests/data/brdf_explorer/disney.brdf: Burley 2012's principled BRDF (diffuse, subsurface, sheen, GTR2, clearcoat)."""
+
+    name = "disney"
+
+    def brdf(self, L, V, N, X, Y) -> np.ndarray:
+        v = {k: (np.asarray(x, np.float64) if isinstance(x, tuple) else float(x)) for k, x in self.values.items()}
+        base, roughness = v["baseColor"], v["roughness"]
+        n_dot_l, n_dot_v = _dot(N, L)[..., None], _dot(N, V)[..., None]
+        H = _half_vector(L, V)
+        n_dot_h, l_dot_h = _dot(N, H)[..., None], _dot(L, H)[..., None]
+
+        def schlick(u):
+            m = np.clip(1.0 - u, 0.0, 1.0)
+            return m**5
+
+        luminance = 0.3 * base[0] + 0.6 * base[1] + 0.1 * base[2]
+        tint = base / luminance if luminance > 0.0 else np.ones(3)
+        specular0 = _mix(v["specular"] * 0.08 * _mix(np.ones(3), tint, v["specularTint"]), base, v["metallic"])
+        sheen_colour = _mix(np.ones(3), tint, v["sheenTint"])
+        fl, fv = schlick(n_dot_l), schlick(n_dot_v)
+        fd90 = 0.5 + 2.0 * l_dot_h**2 * roughness
+        fd = _mix(1.0, fd90, fl) * _mix(1.0, fd90, fv)
+        fss90 = l_dot_h**2 * roughness
+        fss = _mix(1.0, fss90, fl) * _mix(1.0, fss90, fv)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ss = 1.25 * (fss * (1.0 / (n_dot_l + n_dot_v) - 0.5) + 0.5)
+        aspect = np.sqrt(1.0 - v["anisotropic"] * 0.9)
+        ax, ay = max(0.001, roughness**2 / aspect), max(0.001, roughness**2 * aspect)
+        h_x, h_y = _dot(H, X)[..., None], _dot(H, Y)[..., None]
+        ds = 1.0 / (np.pi * ax * ay * ((h_x / ax) ** 2 + (h_y / ay) ** 2 + n_dot_h**2) ** 2)
+        fh = schlick(l_dot_h)
+        fs = _mix(specular0, 1.0, fh)
+
+        def smith_aniso(n_dot, w):
+            return 1.0 / (n_dot + np.sqrt((_dot(w, X)[..., None] * ax) ** 2 + (_dot(w, Y)[..., None] * ay) ** 2 + n_dot**2))
+
+        gs = smith_aniso(n_dot_l, L) * smith_aniso(n_dot_v, V)
+        a = _mix(0.1, 0.001, v["clearcoatGloss"])
+        dr = np.full_like(n_dot_h, 1.0 / np.pi) if a >= 1.0 else (a * a - 1.0) / (np.pi * np.log(a * a) * (1.0 + (a * a - 1.0) * n_dot_h**2))
+        fr = _mix(0.04, 1.0, fh)
+
+        def smith(n_dot, alpha):
+            return 1.0 / (n_dot + np.sqrt(alpha**2 + n_dot**2 - alpha**2 * n_dot**2))
+
+        gr = smith(n_dot_l, 0.25) * smith(n_dot_v, 0.25)
+        with np.errstate(invalid="ignore"):
+            diffuse = ((1.0 / np.pi) * _mix(fd, ss, v["subsurface"]) * base + fh * v["sheen"] * sheen_colour) * (1.0 - v["metallic"])
+            value = diffuse + gs * fs * ds + 0.25 * v["clearcoat"] * gr * fr * dr
+        return np.where((n_dot_l < 0.0) | (n_dot_v < 0.0), 0.0, value)
+
+
 TWINS = (
     LambertTwin, ColoredLambertTwin, BlinnPhongTwin, AshikhminShirleyTwin, AppAllKindsTwin, LimbDarkeningTwin,
-    AnisotropicWardTwin, CompactLobeTwin, AzimuthRatioTwin, LommelSeeligerTwin, NonFiniteChannelsTwin,
+    AnisotropicWardTwin, CompactLobeTwin, AzimuthRatioTwin, LommelSeeligerTwin, NonFiniteChannelsTwin, DisneyTwin,
 )
 
 

@@ -76,9 +76,11 @@ def test_scripted_session_slider_preset_screenshot(x_display, tmp_path, gl_rende
     assert values["N"] == 10 and values["delta"] == 0.5 and values["method"] == 3
     assert values["Lambda"] != 630 and 50 <= values["Lambda"] < 630
     assert any(f["dragging"] for f in report["frames"])
-    headless = gl_renderer.render(bragg_material, bragg_material.resolve(values), "sphere", 512, 512)
+    size = report["view_size"]  # the sphere fits its window (the resolution combo's default)
+    assert report["view_size_auto"] and 128 <= size <= 1024 and size % 32 == 0
+    headless = gl_renderer.render(bragg_material, bragg_material.resolve(values), "sphere", size, size)
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
-    assert png.shape == (512, 512, 3)
+    assert png.shape == (size, size, 3)
     assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
     linear = np.load(shot.with_suffix(".npy"))
     np.testing.assert_allclose(linear, headless, atol=2e-3)
@@ -124,7 +126,7 @@ def test_open_brdf_explorer_file(x_display, tmp_path, gl_renderer):
     values = report["values"]
     assert values["divide_by_NdotL"] is True and values["albedo"] == [0.82, 0.67, 0.16]
     material = load_material(material_path)
-    headless = gl_renderer.render(material, material.resolve(values), "lit", 512, 512)
+    headless = gl_renderer.render(material, material.resolve(values), "lit", report["view_size"], report["view_size"])
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
 
@@ -183,7 +185,7 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
     error = report["error"]
     assert re.match(rf"{re.escape(str(material_path))}:\d+: ", error) and len(error.splitlines()) == 1, error
     material = load_material(BRDF_DATA / "lambert.brdf")
-    headless = gl_renderer.render(material, material.resolve({}), "lit", 512, 512)
+    headless = gl_renderer.render(material, material.resolve({}), "lit", report["view_size"], report["view_size"])
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
 

@@ -199,7 +199,13 @@ def test_info_json_schema(cli_runs, name):
     run = cli_runs[1][name]
     assert run.returncode == 0 and run.stderr == "", run.stderr
     info = json.loads(run.stdout)
-    assert set(info) == {"parameters"}
+    assert set(info) <= {"parameters", "methods"}
+    if "methods" in info:  # the names of an int method parameter's values, from the enumeration
+        from explorer.materials.brd import load_material
+        from explorer.materials.methods import methods_for
+
+        enumeration = methods_for(load_material(INFO_FILES[name]).model)
+        assert info["methods"] == {str(int(m)): m.label for m in enumeration}
     rows = parameters_section(INFO_FILES[name])
     assert [p["name"] for p in info["parameters"]] == [row[1] for row in rows]
     for parameter, row in zip(info["parameters"], rows):

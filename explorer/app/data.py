@@ -146,9 +146,31 @@ def delta_e_map(a: np.ndarray, b: np.ndarray, mask: np.ndarray | None = None) ->
     return result, float(result[mask].mean()) if mask.any() else 0.0
 
 
-def heat_map_rgba(delta_e: np.ndarray, top: float = 10.0) -> np.ndarray:
+#: The ΔE2000 at the top of the heat-map's colour scale (and of its colour bar).
+HEAT_MAP_TOP = 10.0
+
+
+def heat_map_rgba(delta_e: np.ndarray, top: float = HEAT_MAP_TOP) -> np.ndarray:
     """An 8-bit RGBA image of ΔE2000 (matplotlib's viridis over [0, ``top``])."""
     from matplotlib import colormaps
 
     rgba = colormaps["viridis"](np.clip(delta_e / top, 0.0, 1.0))
+    return np.round(rgba * 255.0).astype(np.uint8)
+
+
+def slice_display(image: np.ndarray, exposure: float = 1.0, gamma: float = 2.2, chroma: bool = False) -> np.ndarray:
+    """
+    The Slice window's 8-bit RGBA picture of a linear BRDF slice, as BRDF Explorer's image slice shows it:
+    ``(exposure x)^(1/gamma)`` clamped to [0, 1]; with ``chroma`` each pixel divided by its largest channel
+    first (hue and saturation alone: where a lobe changes colour, not how bright it is). Rows as given.
+    """
+    rgb = np.nan_to_num(np.asarray(image, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    rgb = np.maximum(rgb, 0.0)  # out-of-gamut negatives: black, as the sRGB encode clamps them
+    if chroma:
+        peak = rgb.max(axis=-1, keepdims=True)
+        rgb = np.divide(rgb, peak, out=np.zeros_like(rgb), where=peak > 0.0)
+    else:
+        rgb = rgb * exposure
+    shown = np.clip(rgb, 0.0, 1.0) ** (1.0 / gamma)
+    rgba = np.concatenate([shown, np.ones(shown.shape[:-1] + (1,))], axis=-1)
     return np.round(rgba * 255.0).astype(np.uint8)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
@@ -42,6 +43,23 @@ def widget_kind(parameter: Parameter) -> str:
     return parameter.type
 
 
+#: A stack's layer parameters end with their layer's number (``Lambda_2``); the count parameter says how
+#: many layers the material draws (``bragg_stack.brd``, ``layered_lobes.brd``).
+LAYER_COUNT_PARAMETER = "layers"
+_LAYER_SUFFIX = re.compile(r"_(\d+)$")
+
+
+def inactive_parameters(material: Material, values: Mapping[str, object]) -> set[str]:
+    """
+    The parameters that change nothing with these values: those of a stack's layers beyond its
+    ``layers`` count (their sliders are disabled).
+    """
+    if not any(p.name == LAYER_COUNT_PARAMETER for p in material.parameters):
+        return set()
+    count = round(float(values[LAYER_COUNT_PARAMETER]))
+    return {p.name for p in material.parameters if (m := _LAYER_SUFFIX.search(p.name)) and int(m.group(1)) > count}
+
+
 def slider_format(parameter: Parameter) -> str:
     """A printf format showing enough digits for the parameter's range."""
     span = abs((parameter.max or 1.0) - (parameter.min or 0.0))
@@ -50,11 +68,67 @@ def slider_format(parameter: Parameter) -> str:
 
 @dataclass
 class LoadedValues:
-    """Values read from a file: those that apply to the material, and what was skipped (one line each)."""
+    """
+    Values read from a file: those that apply to the material, what was skipped (one line each), and the
+    view saved with them (:func:`check_view`), if any.
+    """
 
     values: dict[str, object]
     material: str | None = None
     skipped: list[str] = field(default_factory=list)
+    view: dict | None = None
+
+
+#: What a parameter set may save beside the values: the app's view, so that ``render --params`` shows it.
+VIEW_KEYS = ("view", "light", "camera", "exposure", "environment")
+
+
+def check_view(raw, where: str, line: int | None = None) -> dict:
+    """
+    A saved view, checked: ``view`` (a view's name), ``light`` ``[theta, phi]`` (degrees, theta in
+    [0, 180]), ``camera`` ``[yaw, pitch]`` (degrees, pitch in [-89, 89]), ``exposure`` (> 0),
+    ``environment`` (a file, or None). Missing keys are absent from the result; unknown ones are errors.
+    """
+    import math
+
+    from explorer.views.geometry import VIEWS as VIEW_NAMES
+
+    if not isinstance(raw, dict):
+        raise ParameterFileError(where, line, 'the view must be an object {"view": NAME, "light": [THETA, PHI], ...}')
+    unknown = sorted(set(raw) - set(VIEW_KEYS))
+    if unknown:
+        raise ParameterFileError(where, line, f"unknown view setting {unknown[0]!r} (known: {', '.join(VIEW_KEYS)})")
+
+    def pair(name, low, high):
+        value = raw[name]
+        try:
+            a, b = (float(v) for v in value)
+        except (TypeError, ValueError):
+            raise ParameterFileError(where, line, f"view {name!r}: expected two numbers in degrees") from None
+        if not (math.isfinite(a) and math.isfinite(b) and low[0] <= a <= low[1] and high[0] <= b <= high[1]):
+            raise ParameterFileError(where, line, f"view {name!r}: {a:g}, {b:g} out of [{low[0]:g}, {low[1]:g}] x [{high[0]:g}, {high[1]:g}]")
+        return [a, b]
+
+    view: dict = {}
+    if "view" in raw:
+        if raw["view"] not in VIEW_NAMES:
+            raise ParameterFileError(where, line, f"view {raw['view']!r} is not one of {', '.join(VIEW_NAMES)}")
+        view["view"] = raw["view"]
+    if "light" in raw:
+        view["light"] = pair("light", (0.0, 180.0), (-math.inf, math.inf))
+    if "camera" in raw:
+        view["camera"] = pair("camera", (-math.inf, math.inf), (-89.0, 89.0))
+    if "exposure" in raw:
+        try:
+            exposure = float(raw["exposure"])
+        except (TypeError, ValueError):
+            exposure = math.nan
+        if not (math.isfinite(exposure) and exposure > 0.0):
+            raise ParameterFileError(where, line, f"view 'exposure': {raw['exposure']!r} is not a positive number")
+        view["exposure"] = exposure
+    if raw.get("environment") is not None:
+        view["environment"] = str(raw["environment"])
+    return view
 
 
 def _display(path: os.PathLike[str] | str) -> str:
@@ -68,24 +142,35 @@ def _json_value(value):
     return list(value) if isinstance(value, tuple) else value
 
 
-def save_json(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
-    """Write ``{"material": path, "values": {...}}`` (colours as lists)."""
+def save_json(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object], view: Mapping | None = None) -> None:
+    """Write ``{"material": path, "values": {...}, "view": {...}}`` (colours as lists; the view when given)."""
     document = {
         "format": "bragg-explorer parameters",
         "material": str(Path(material.path).resolve()),
         "values": {p.name: _json_value(values[p.name]) for p in material.parameters},
     }
+    if view:
+        document["view"] = {k: v for k, v in view.items() if v is not None}
     _write_text(path, json.dumps(document, indent=2) + "\n")
 
 
-def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
+def save_bparam(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object], view: Mapping | None = None) -> None:
     """
     Write BRDF Explorer's ``.bparam`` (``%f`` numbers, floats then bools then colours, as it does), naming
-    the material's file: for a material opened from an exported ``.brdf``, that ``.brdf``.
+    the material's file (for a material opened from an exported ``.brdf``, that ``.brdf``), and the view in
+    a ``::begin view`` section of ``KEY VALUE...`` lines (BRDF Explorer skips sections it does not know).
     """
     from explorer.materials.export_brdf import bparam_text
 
-    _write_text(path, bparam_text(str(Path(material.path).resolve()), material.parameters, values))
+    lines = [bparam_text(str(Path(material.path).resolve()), material.parameters, values).rstrip("\n")]
+    if view:
+        lines += ["", "::begin view"]
+        for key in VIEW_KEYS:
+            value = view.get(key)
+            if value is not None:
+                lines.append(f"{key} {' '.join(repr(float(v)) for v in value) if isinstance(value, (list, tuple)) else value}")
+        lines.append("::end view")
+    _write_text(path, "\n".join(lines) + "\n")
 
 
 def _write_text(path: os.PathLike[str] | str, text: str) -> None:
@@ -136,6 +221,8 @@ def load_json(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
         raise ParameterFileError(where, None, 'expected an object with "values": {NAME: VALUE, ...}')
     result = _apply(material, raw, where, {})
     result.material = document.get("material") if isinstance(document.get("material"), str) else None
+    if "view" in document:
+        result.view = check_view(document["view"], where)
     return result
 
 
@@ -188,14 +275,57 @@ def load_bparam(path: os.PathLike[str] | str, material: Material) -> LoadedValue
     material_file, raw, lines = parse_bparam(text, where)
     result = _apply(material, raw, where, lines)
     result.material = material_file
+    result.view = parse_bparam_view(text, where)
     return result
 
 
-def save_values(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object]) -> None:
-    """Save as ``.bparam`` when the name ends so, as JSON otherwise."""
-    (save_bparam if str(path).lower().endswith(".bparam") else save_json)(path, material, values)
+def parse_bparam_view(text: str, where: str) -> dict | None:
+    """The ``::begin view`` section of a ``.bparam`` text (:func:`save_bparam`), checked; None without one."""
+    raw: dict = {}
+    section, first_line = None, None
+    for number, line in enumerate(text.splitlines(), start=1):
+        tokens = line.split()
+        if not tokens or tokens[0].startswith("#"):
+            continue
+        if tokens[0] in ("::begin", "::end"):
+            section = tokens[1] if tokens[0] == "::begin" and len(tokens) > 1 else None
+            first_line = first_line or (number if section == "view" else None)
+            continue
+        if section != "view":
+            continue
+        key, rest = tokens[0], tokens[1:]
+        if key in ("light", "camera"):
+            raw[key] = rest
+        elif key in ("view", "environment"):
+            raw[key] = line.strip()[len(key):].strip()
+        else:
+            raw[key] = rest[0] if len(rest) == 1 else rest
+    return check_view(raw, where, first_line) if first_line is not None else None
+
+
+def save_values(path: os.PathLike[str] | str, material: Material, values: Mapping[str, object], view: Mapping | None = None) -> None:
+    """Save as ``.bparam`` when the name ends so, as JSON otherwise; ``view``: the app's view beside the values."""
+    (save_bparam if str(path).lower().endswith(".bparam") else save_json)(path, material, values, view)
 
 
 def load_values(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
     """Load a ``.bparam`` or a JSON parameter set for ``material``."""
     return (load_bparam if str(path).lower().endswith(".bparam") else load_json)(path, material)
+
+
+def load_view(path: os.PathLike[str] | str) -> dict | None:
+    """The view saved in a parameter set (JSON ``"view"``, ``.bparam``'s ``::begin view``), checked; None without one."""
+    where = _display(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise ParameterFileError(where, None, f"cannot read ({error.strerror or error})") from None
+    except UnicodeDecodeError:
+        raise ParameterFileError(where, None, "not a text file") from None
+    if str(path).lower().endswith(".bparam"):
+        return parse_bparam_view(text, where)
+    try:
+        document = json.loads(text, parse_int=_json_int)
+    except (json.JSONDecodeError, RecursionError):
+        return None  # load_json reports what is wrong with the file
+    return check_view(document["view"], where) if isinstance(document, dict) and "view" in document else None

@@ -36,7 +36,9 @@ class ScriptRobot:
     until the env mode holds its target samples per pixel;
     ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
     width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
-    (``preset_combo``, ``preset:NAME``, ``mode:lit``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
+    (``preset_combo``, ``preset:NAME``, ``mode:lit``, ``param:method`` then ``method:N``, ``menu_file`` then
+    ``menu_open``, ``menu_help`` then ``menu_about``, the Materials list's ``material:I``,
+    ``material:I:visible``, ``material:I:solo``, ``material:I:close``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
     UI); ``{"mark": TEXT}`` tags the following frames; ``{"screenshot": PATH}`` the active view (waits
     until complete; in ``env``, until a whole sample); ``{"window_screenshot": PATH}`` the whole window;
     ``{"type": LABEL, "text": TEXT}`` clicks a text field (one that selects all on focus), types TEXT and
@@ -44,7 +46,8 @@ class ScriptRobot:
     sphere's resolution (the combo's values); ``{"key": "F12"}`` presses and releases a key (ImGui's
     name), then waits for a screenshot it asked for; ``{"focus": TITLE}`` brings a docked window to the
     front; ``{"write": PATH, "text": TEXT}`` writes a file (a user's editor between two reloads);
-    ``{"quit": true}``.
+    ``{"dialog": [PATH, ...]}`` answers the next File > Open... (:mod:`explorer.app.dialogs`);
+    ``{"save_slice": PATH}`` saves the Slice window's linear image once complete; ``{"quit": true}``.
     """
 
     def __init__(self, actions: list):
@@ -243,7 +246,25 @@ def _assign(name: str, convert):
     return handler
 
 
-ACTION_OF_FIELD = {"file_path": "file_path", "view_size": "view_size", "focus_request": "focus"}
+ACTION_OF_FIELD = {"file_path": "file_path", "focus_request": "focus"}
+
+
+def _view_size(robot, app, io, action, step):  # a fixed resolution (the combo's values), no longer fitting the window
+    app.state.view_size, app.state.view_size_auto = int(action["view_size"]), False
+    return True
+
+
+def _dialog(robot, app, io, action, step):  # the answer the next File > Open... gets, instead of a person's
+    app.state.dialog_answers.append([str(path) for path in action["dialog"]])
+    robot.script.log.append(f"queued dialog answer ({len(action['dialog'])} paths)")
+    return True
+
+
+def _save_slice(robot, app, io, action, step):  # the Slice window's linear image (.npy), once it is complete
+    state = app.state
+    if step == 0:
+        state.pending_slice_save = str(action["save_slice"])
+    return state.pending_slice_save is None or _timed_out(robot, action, step, "save_slice", 2000)
 
 
 def _write(robot, app, io, action, step):  # what a user's editor does to the material file between two reloads
@@ -273,7 +294,9 @@ ACTIONS = {
     "key": _key,
     "window_screenshot": _window_screenshot,
     "file_path": _assign("file_path", str),
-    "view_size": _assign("view_size", int),
+    "view_size": _view_size,
+    "dialog": _dialog,
+    "save_slice": _save_slice,
     "focus": _assign("focus_request", str),  # bring a docked window's tab to the front, as a click on it does
     "write": _write,
     "quit": _quit,

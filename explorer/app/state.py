@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.materials.methods import BraggMethod
+from explorer.materials.methods import opening_values
 from explorer.materials.brd import Material
 
 VIEW_SIZES = (128, 256, 512, 1024)
@@ -21,7 +21,20 @@ ENV_TARGETS = (64, 256, 1024, 4096)
 #: The Sphere window's models: the sphere, or a generated mesh (explorer.views.mesh.SHAPES) in the lit and env modes.
 SPHERE_MODELS = ("sphere", "teapot", "cube", "torus")
 DEFAULT_VIEW_SIZE = 512
+#: The sphere's side when it follows its window (``AppState.view_size_auto``): a multiple of this step
+#: (a dragged dock splitter re-renders it every step, not every pixel), within these bounds.
+AUTO_VIEW_STEP = 32
+AUTO_VIEW_BOUNDS = (128, 1024)
 MODES = ("lit", "sphere", "env")
+#: The loaded materials' colours in the plots (matplotlib's tab10, the first six), in loading order.
+MATERIAL_COLOURS = ((0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.84, 0.15, 0.16), (0.58, 0.4, 0.74),
+                    (0.55, 0.34, 0.29))
+
+
+def auto_view_size(width: float, height: float) -> int:
+    """The sphere's side for a window region of ``width`` x ``height`` pixels (see :data:`AUTO_VIEW_STEP`)."""
+    side = int(min(width, height)) // AUTO_VIEW_STEP * AUTO_VIEW_STEP
+    return min(max(side, AUTO_VIEW_BOUNDS[0]), AUTO_VIEW_BOUNDS[1])
 
 
 def has_reflectance(material: Material) -> bool:
@@ -31,9 +44,7 @@ def has_reflectance(material: Material) -> bool:
 
 def initial_values(material: Material, preset: str | None, is_default: bool) -> dict:
     """The values the app starts with: defaults, the default material's tabulated method, a preset."""
-    overrides: dict = {}
-    if is_default and any(p.name == "method" for p in material.parameters):
-        overrides["method"] = int(BraggMethod.TABULATED)  # the default material opens on its fastest exact method
+    overrides: dict = dict(opening_values(material)) if is_default else {}  # as render opens it
     if preset is not None:
         from explorer.materials.presets import presets_for
 
@@ -43,14 +54,37 @@ def initial_values(material: Material, preset: str | None, is_default: bool) -> 
 
 @dataclass
 class CompareState:
-    """The Compare window: two methods (``a``, ``b``) or two parameter sets (current | ``values_b``)."""
+    """
+    The Compare window: two methods (``a``, ``b``), two parameter sets (current | ``values_b``) or two
+    loaded materials (the selected one | the entry ``material_b``).
+    """
 
     values_b: dict
     on: bool = False
-    kind: str = "methods"  # or "sets"
+    kind: str = "methods"  # or "sets", "materials"
     a: int = 0
     b: int = 4
+    material_b: int = 0  # an index in AppState.materials
     heat: bool = False  # the ΔE2000 heat-map instead of the split sphere
+
+
+@dataclass
+class MaterialEntry:
+    """One loaded material: its file, values (the selected one's are ``AppState.values``), plot colour, visibility."""
+
+    path: Path
+    material: Material
+    values: dict
+    colour: tuple
+    visible: bool = True
+
+    @property
+    def name(self) -> str:
+        return self.path.name
+
+    def report(self) -> dict:
+        return {"path": str(self.path), "visible": self.visible, "colour": list(self.colour),
+                "values": {k: list(v) if isinstance(v, tuple) else v for k, v in self.values.items()}}
 
 
 @dataclass
@@ -63,6 +97,19 @@ class AppState:
     compare: CompareState
     preset: str | None = None
     view_size: int = DEFAULT_VIEW_SIZE
+    view_size_auto: bool = False  # the sphere's side follows its window (auto_view_size)
+    materials: list = field(default_factory=list)  # MaterialEntry, in loading order; materials[selected] is shown
+    selected: int = 0
+    slice_phi_d: float = 90.0  # the Slice window's phi_d (degrees)
+    slice_gamma: float = 2.2
+    slice_chroma: bool = False
+    slice_report: dict | None = None  # what the Slice window shows (phi_d, gamma, chroma, its image's range)
+    dialog_answers: list = field(default_factory=list)  # scripted answers to File > Open... (lists of paths)
+    show_about: bool = False
+    first_screen: list = field(default_factory=list)  # the windows drawn on the first screen (reported)
+    plotted_log: dict = field(default_factory=dict)  # script mark -> plotted, at its first frame (reported)
+    plotted: dict = field(default_factory=dict)  # plot window -> the materials it drew curves of (reported)
+    show_controls: bool = False
     mode: str = "lit"  # one of MODES
     light: list = field(default_factory=lambda: [45.0, 0.0])  # theta, phi (explorer.views.geometry.DEFAULT_LIGHT)
     camera: list = field(default_factory=lambda: [0.0, 0.0])  # yaw, pitch: turns the light relative to the view
@@ -92,6 +139,7 @@ class AppState:
     # Requests, served when the frame allows.
     pending_screenshot: str | None = None
     pending_window_shot: str | None = None
+    pending_slice_save: str | None = None
     focus_request: str | None = None
     quit: bool = False
     # This frame's UI.
@@ -102,6 +150,43 @@ class AppState:
     frame_times: list = field(default_factory=list)
     screenshots: list = field(default_factory=list)
     screenshot_info: dict = field(default_factory=dict)  # per screenshot: material, view, values, env samples
+
+    def sync_selected(self) -> None:
+        """The selected entry holds the values being edited (the plots of every visible entry read them there)."""
+        if self.materials:
+            entry = self.materials[self.selected]
+            entry.material, entry.path, entry.values = self.material, self.material_path, self.values
+
+    def select(self, index: int) -> None:
+        """Show ``materials[index]`` in the sphere views and the Parameters window."""
+        self.sync_selected()
+        self.show_entry(index)
+
+    def show_entry(self, index: int) -> None:
+        """Show ``materials[index]`` without saving the shown values first (the shown entry was closed)."""
+        self.selected = index
+        entry = self.materials[index]
+        self.material, self.material_path, self.values = entry.material, entry.path, entry.values
+        self.compare.values_b = dict(entry.values)
+        self.preset = None
+
+    def visible_entries(self) -> list:
+        """The materials the plots overlay (the selected one's values current)."""
+        self.sync_selected()
+        return [entry for entry in self.materials if entry.visible]
+
+    def next_colour(self) -> tuple:
+        used = {entry.colour for entry in self.materials}
+        free = [c for c in MATERIAL_COLOURS if c not in used]
+        return free[0] if free else MATERIAL_COLOURS[len(self.materials) % len(MATERIAL_COLOURS)]
+
+    def view_settings(self) -> dict:
+        """What a parameter set saves beside the values so that ``render --params`` shows this view."""
+        from explorer.resources import DEFAULT_ENVIRONMENT
+
+        return {"view": "env" if self.mode == "env" else self.main_view(), "light": list(self.light),
+                "camera": list(self.camera), "exposure": float(self.exposure),
+                "environment": str(DEFAULT_ENVIRONMENT) if self.mode == "env" else None}
 
     def main_view(self) -> str:
         """The sphere's view: ``sphere`` when chosen and the material has a reflectance, else ``lit``."""

@@ -18,9 +18,12 @@ from explorer.app.panels.base import record
 from explorer.app.scheduler import Scheduler
 from explorer.app.screenshots import screenshot_name, take_screenshot, window_shot
 from explorer.app.script import ScriptRobot
-from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, has_reflectance, initial_values
+from explorer.app.dialogs import OpenDialog
+from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, MaterialEntry, has_reflectance, initial_values
 
 DEFAULT_WINDOW = (1280, 800)
+#: The frame whose windows the report calls the first screen (the layout is done and focused by then).
+FIRST_SCREEN_FRAME = 3
 
 
 class AppError(Exception):
@@ -53,19 +56,26 @@ class App:
     script, report : a scripted session (a list of actions, see :class:`explorer.app.script.ScriptRobot`)
         and where to write its JSON report.
     window_size : the window's size in pixels.
-    view_size : the sphere's resolution.
+    view_size : the sphere's resolution; None: it follows the Sphere window's size.
     is_default : the default material (it opens on its tabulated method).
+    more_paths : further materials to load beside the first (``open A B ...``); the first is shown.
     """
 
     def __init__(self, material_path, preset: str | None = None, *, script: list | None = None,
-                 report: str | os.PathLike | None = None, window_size=DEFAULT_WINDOW, view_size: int = DEFAULT_VIEW_SIZE,
-                 is_default: bool = False):
+                 report: str | os.PathLike | None = None, window_size=DEFAULT_WINDOW, view_size: int | None = None,
+                 is_default: bool = False, more_paths=()):
         material = load_material(Path(material_path))
         values = initial_values(material, preset, is_default)
         self.state = AppState(
             material_path=Path(material_path), material=material, values=values, compare=CompareState(values_b=dict(values)),
-            preset=preset, view_size=int(view_size), mode="sphere" if has_reflectance(material) else "lit",
+            preset=preset, view_size=int(view_size or DEFAULT_VIEW_SIZE), view_size_auto=view_size is None,
+            mode="sphere" if has_reflectance(material) else "lit",
         )
+        self.state.materials.append(MaterialEntry(Path(material_path), material, values, self.state.next_colour()))
+        for path in more_paths:
+            self._add_material(Path(path), initial_values(load_material(Path(path)), None, False))
+        self.state.sync_selected()
+        self.dialog = OpenDialog()
         self.robot = ScriptRobot(script) if script is not None else None
         self.report_path = Path(report) if report else None
         self.window_size = tuple(window_size)
@@ -118,6 +128,7 @@ class App:
             state.error = str(error)
             return False
         state.material, state.material_path, state.values = material, path, values
+        state.sync_selected()
         # Nothing of the previous material's values may reach the new one's uniforms: the compare view's
         # set B (its ranges may differ: thin_film's method 5 is no mirror method) and the values shown
         # while a slider drags. The env render follows the material (EnvSphere.request). The mode stays
@@ -127,6 +138,70 @@ class App:
         state.error = ""
         state.status = f"loaded {path}"
         return True
+
+    def _add_material(self, path: Path, values: dict) -> MaterialEntry:
+        material = load_material(path)
+        entry = MaterialEntry(path, material, material.resolve(values), self.state.next_colour())
+        self.state.materials.append(entry)
+        return entry
+
+    def open_materials(self, paths) -> int:
+        """
+        Load ``paths`` beside the open materials (File > Open...) and show the last one loaded; a file that
+        fails is reported in the status line (its one-line error) and skipped. Returns how many loaded.
+        """
+        state, errors, loaded = self.state, [], 0
+        for path in paths:
+            try:
+                entry = self._add_material(Path(path), {})
+                if self.renderer is not None:  # compile now: a broken shader is reported here, not drawn
+                    self.renderer.program(entry.material, "lit", entry.values)
+            except LocatedError as error:
+                if state.materials and state.materials[-1].path == Path(path):
+                    state.materials.pop()
+                errors.append(str(error))
+                continue
+            loaded += 1
+        if loaded:
+            self.select(len(state.materials) - 1)
+        state.error = errors[0] if errors else state.error
+        state.status = f"opened {loaded} material{'s' * (loaded != 1)}" + (f"; {len(errors)} failed" if errors else "")
+        return loaded
+
+    def select(self, index: int) -> None:
+        """Show the loaded material ``index`` in the sphere views and the Parameters window."""
+        state = self.state
+        if index == state.selected:
+            return
+        state.select(index)
+        if self.scheduler is not None:
+            self.scheduler.prefetcher.forget()
+        state.status = f"showing {state.material_path.name}"
+
+    def solo(self, index: int) -> None:
+        """Only ``materials[index]`` visible in the plots (and shown)."""
+        for i, entry in enumerate(self.state.materials):
+            entry.visible = i == index
+        self.select(index)
+
+    def close(self, index: int) -> None:
+        """Unload ``materials[index]`` (the last one stays)."""
+        state = self.state
+        if len(state.materials) <= 1:
+            return
+        state.sync_selected()
+        closed = state.materials.pop(index)
+        if state.compare.material_b > index:  # the same material stays B
+            state.compare.material_b -= 1
+        elif state.compare.material_b == index:
+            state.compare.material_b = 0
+        if index < state.selected:  # the shown material stays shown, one place up
+            state.selected -= 1
+        elif index == state.selected:
+            state.show_entry(min(index, len(state.materials) - 1))
+        if self.scheduler is not None:
+            self.scheduler.prefetcher.forget()
+        state.status = f"closed {closed.name}"
 
     # -- window and loop ---------------------------------------------------------------------------
 
@@ -205,6 +280,11 @@ class App:
 
     def _record_frame(self, frame_s, work_s, gl_ms, ui_s, draw_s, swap_s) -> None:
         """One frame's times (ms) and what the sphere showed, for the report."""
+        mark = self.robot.mark if self.robot else None
+        if mark is not None and mark not in self.state.plotted_log:  # what the plots drew when a script marked
+            self.state.plotted_log[mark] = {k: list(v) for k, v in self.state.plotted.items()}
+        if len(self.state.frame_times) == FIRST_SCREEN_FRAME:
+            self.state.first_screen = sorted(self.state.visible)
         values_key = tuple(sorted((k, str(v)) for k, v in self.state.values.items()))
         changed, self._last_values_key = values_key != self._last_values_key, values_key
         self.state.frame_times.append({
@@ -226,6 +306,9 @@ class App:
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
             "env": {"environment": s.environment, "rotation": s.env_rotation, "background": s.env_background,
                     "model": s.model, **s.env_progress},
+            "view_size_auto": s.view_size_auto, "materials": [entry.report() for entry in s.materials], "selected": s.selected,
+            "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted, "plotted_log": s.plotted_log,
+            "first_screen": s.first_screen, "items": sorted(s.rects), "dialog": self.dialog.log,
         }
         from explorer.files import write_text_atomic
 
@@ -241,8 +324,9 @@ class App:
         return bool(imgui.is_any_item_active() and imgui.is_mouse_down(0)) or self.state.orbit_drag
 
     def idle(self) -> bool:
-        """Nothing left to draw: the sphere, and the compare pair when it is on and shown."""
-        jobs = [self.scheduler.job("main")]
+        """Nothing left to draw: the sphere when shown, and the compare pair when it is on and shown (a hidden
+        tab's view is not drawn: another material chosen behind it waits until its tab is in front)."""
+        jobs = [self.scheduler.job("main")] if "Sphere" in self.state.visible or self.state.mode == "env" else []
         if self.state.compare.on and "Compare" in self.state.visible:
             jobs += [self.scheduler.job("compare_a"), self.scheduler.job("compare_b")]
         return all(job.complete or job.error is not None for job in jobs) and not self.dragging
@@ -253,9 +337,16 @@ class App:
         if not self._layout_done:
             dock_layout(imgui, dockspace, self.panels)
             self._layout_done = True
+            # The first screen: the Spectrum window in front of its dock (Inverse and Design dock there too),
+            # the Polar one for a material without a Bragg mirror's spectrum.
+            from explorer.app.data import BRAGG_MODELS
+
+            state.focus_request = state.focus_request or ("Spectrum" if state.material.model in BRAGG_MODELS else "Polar")
+        state.sync_selected()
         state.visible = set()
         self._menu(imgui)
         self._keys(imgui)
+        self._dialogs(imgui)
         for panel in self.panels:
             expanded, _ = imgui.begin(panel.title)
             if expanded:
@@ -273,12 +364,28 @@ class App:
             self.reload()
         if imgui.is_key_pressed(imgui.Key.f12):
             self.state.pending_screenshot = screenshot_name(self.state)
+        if imgui.is_key_pressed(imgui.Key.f1):
+            self.state.show_controls = True
+        if imgui.get_io().key_ctrl and imgui.is_key_pressed(imgui.Key.o):
+            self.dialog.start(self.state)
+
+    def _dialogs(self, imgui) -> None:
+        """File > Open...'s answer when it comes, Help's windows."""
+        from explorer.app.help import draw_help
+
+        paths = self.dialog.poll(imgui, self.state)
+        if paths:
+            self.open_materials(paths)
+        draw_help(imgui, self.state)
 
     def _menu(self, imgui) -> None:
         state = self.state
         if not imgui.begin_main_menu_bar():
             return
         if imgui.begin_menu("File"):
+            if imgui.menu_item_simple("Open...", "Ctrl+O"):
+                self.dialog.start(state)
+            record(state, "menu_open")
             if imgui.menu_item_simple("Reload material", "F5"):
                 self.reload()
             if imgui.menu_item_simple("Screenshot of the active view", "F12"):
@@ -286,6 +393,7 @@ class App:
             if imgui.menu_item_simple("Quit"):
                 state.quit = True
             imgui.end_menu()
+        record(state, "menu_file")
         presets = self.presets()
         if imgui.begin_menu("Presets", bool(presets)):
             for name, preset in presets.items():
@@ -296,6 +404,15 @@ class App:
                     imgui.set_tooltip(f"{preset.figure}: {preset.description}")
             imgui.end_menu()
         record(state, "menu_presets")
+        if imgui.begin_menu("Help"):
+            if imgui.menu_item_simple("Keyboard and mouse", "F1"):
+                state.show_controls = True
+            record(state, "menu_controls")
+            if imgui.menu_item_simple("About"):
+                state.show_about = True
+            record(state, "menu_about")
+            imgui.end_menu()
+        record(state, "menu_help")
         imgui.text(f"   {state.frame_label()}")
         imgui.end_main_menu_bar()
 
@@ -318,7 +435,8 @@ def _style(imgui, implot) -> None:
 
 
 def run_app(material_path, preset: str | None = None, *, script=None, report=None, window_size=DEFAULT_WINDOW,
-            view_size: int = DEFAULT_VIEW_SIZE, is_default: bool = False) -> int:
-    """Open the explorer on ``material_path``; :class:`AppError` when no window can be opened."""
-    app = App(material_path, preset, script=script, report=report, window_size=window_size, view_size=view_size, is_default=is_default)
+            view_size: int | None = None, is_default: bool = False, more_paths=()) -> int:
+    """Open the explorer on ``material_path`` (and ``more_paths``); :class:`AppError` when no window can be opened."""
+    app = App(material_path, preset, script=script, report=report, window_size=window_size, view_size=view_size,
+              is_default=is_default, more_paths=more_paths)
     return app.run()

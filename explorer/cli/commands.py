@@ -21,7 +21,7 @@ from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
 from explorer.views.geometry import VIEWS
-from explorer.resources import DEFAULT_MATERIAL, display_path
+from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
@@ -86,20 +86,57 @@ def parse_light(text: str | None, view: str) -> tuple[float, float] | None:
     return theta, phi
 
 
-def parse_exposure(text: str | None, out: Path) -> float:
-    """``--exposure``: a positive multiplier of the linear values before the PNG's sRGB encode."""
+def parse_exposure(text: str | None, out: Path) -> float | None:
+    """
+    ``--exposure``: a positive multiplier of the linear values before the PNG's sRGB encode, or ``auto``
+    (None: :func:`explorer.views.exposure.auto_exposure` of the image).
+    """
     if text is None:
         return 1.0
-    try:
-        exposure = float(text)
-    except ValueError:
-        exposure = float("nan")
-    if not (np.isfinite(exposure) and exposure > 0.0):
-        raise click.BadParameter(f"{text!r} is not a positive multiplier (e.g. 2 for one stop brighter)", param_hint="--exposure")
+    if text.strip().lower() == "auto":
+        exposure = None
+    else:
+        try:
+            exposure = float(text)
+        except ValueError:
+            exposure = float("nan")
+        if not (np.isfinite(exposure) and exposure > 0.0):
+            raise click.BadParameter(f"{text!r} is not a positive multiplier (e.g. 2 for one stop brighter) or auto",
+                                     param_hint="--exposure")
     if out.suffix.lower() != ".png":
         raise click.BadParameter(f"scales the 8-bit .png encode; {out.suffix or 'this output'} keeps the linear values",
                                  param_hint="--exposure")
     return exposure
+
+
+def saved_view(params_file: str | None, ctx: click.Context) -> dict:
+    """
+    What ``--params FILE`` saved of the app's view (:func:`explorer.app.parameter_files.check_view`), as
+    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment`` and ``light``
+    (``(theta, phi)``: the app's light turned by its orbit camera into view space). Only for the options
+    the command line leaves unset; ``{}`` without a file or a saved view.
+    """
+    if params_file is None:
+        return {}
+    from explorer.app.parameter_files import load_view
+
+    view = load_view(params_file) or {}
+    given = {name for name in ("view", "light", "exposure", "env_file")
+             if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE}
+    result: dict = {}
+    if "view" in view and "view" not in given:
+        result["view"] = view["view"]
+    if "exposure" in view and "exposure" not in given:
+        result["exposure"] = repr(view["exposure"])
+    if "environment" in view and "env_file" not in given and result.get("view") == "env":
+        result["environment"] = view["environment"]
+    if ("light" in view or "camera" in view) and "light" not in given:
+        from explorer.app.camera import light_vector
+        from explorer.views.geometry import DEFAULT_LIGHT
+
+        x, y, z = (float(c) for c in light_vector(view.get("light", DEFAULT_LIGHT), view.get("camera", (0.0, 0.0))))
+        result["light"] = (float(np.degrees(np.arccos(np.clip(z, -1.0, 1.0)))), float(np.degrees(np.arctan2(y, x))))
+    return result
 
 
 def render_material(
@@ -202,38 +239,69 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
                       progress=progress, warn=warn, mesh=mesh, background=background)
 
 
-@click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
+def summary(command: click.Command) -> str:
+    """A command's line in ``--help``: its ``short_help``, or its docstring's whole first paragraph."""
+    if command.short_help:
+        return command.short_help
+    paragraph = (command.help or "").strip().split("\n\n")[0]
+    return " ".join(paragraph.split())
+
+
+class FullSummaryGroup(click.Group):
+    """
+    A group whose command list shows each command's whole summary (:func:`summary`), wrapped: click's
+    own cuts it at about 45 characters or at the first full stop ("Bati et al., Figs.").
+    """
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, summary(command)) for name in self.list_commands(ctx)
+                if (command := self.get_command(ctx, name)) is not None and not command.hidden]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+@click.group(cls=FullSummaryGroup, invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help=f"Print the traceback of an unexpected error (a bug); also {DEBUG_ENV}=1.")
+@click.version_option(package_version(), "--version", prog_name=PROG, message="%(prog)s %(version)s")
 @click.pass_context
 def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() before click parses
     """Real-time explorer of iridescent materials (Bragg mirrors, thin films).
 
     Without a command: open the explorer on the default Bragg mirror when a display exists; without
     one, say so and render it (sphere and angular gradient) to out/.
+
+    From a source checkout, python3 -m explorer test [PYTEST ARGS] runs the test suite (pytest, with
+    Xvfb for the app's scripted sessions).
     """
     if ctx.invoked_subcommand is None:
         from explorer.app import display_available
 
         if display_available():
-            ctx.invoke(open_material, material=str(DEFAULT_MATERIAL), preset=None, script=None, report=None, window_size=None)
+            ctx.invoke(open_material, materials=(str(DEFAULT_MATERIAL),), preset=None, script=None, report=None, window_size=None)
             return
         click.echo(f"{PROG}: no display (DISPLAY is not set or cannot be opened): writing the headless render of the default view to out/", err=True)
         ctx.invoke(default_job)
 
 
 @cli.command("open")
-@click.argument("material", type=click.Path(dir_okay=False))
+@click.argument("materials", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets).")
 @click.option("--script", type=click.Path(dir_okay=False), hidden=True, help="A scripted session (JSON list of actions; tests, bench --app).")
 @click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
 @click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
-def open_material(material, preset, script, report, window_size):
-    """Open the interactive explorer on MATERIAL (.brd, BRDF Explorer's .brdf, or a built-in's name)."""
+def open_material(materials, preset, script, report, window_size):
+    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names).
+
+    Several materials are listed in the Materials window, each with its colour; the plots overlay the
+    visible ones and the sphere shows the chosen one (the first; --preset applies to it).
+    """
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
     try:
-        loaded = _load(material)
+        loaded = _load(materials[0])
+        more = [_load(other).path for other in materials[1:]]
         if preset is not None:
             from explorer.materials.presets import presets_for
 
@@ -255,7 +323,7 @@ def open_material(material, preset, script, report, window_size):
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
                            "for images without a window use: bragg-explorer render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
-                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve())
+                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
     except ImportError as error:
         _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
     except (LocatedError, GLUnavailable, OutputError, AppError) as error:
@@ -290,7 +358,7 @@ def _errors(function):
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
-@click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter).")
+@click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter), or auto: the bright end of the object to white.")
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
@@ -316,10 +384,14 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     from explorer.views.geometry import scatter_circles, view_named
 
     check_output(Path(out))
-    exposure_factor = parse_exposure(exposure, Path(out))
-    light_angles = parse_light(light, view)
+    saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
+    view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
+    exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
+    light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
-    values = resolve_values(loaded, preset, params_file, assignments)
+    from explorer.materials.methods import method_labels, opening_values
+
+    values = resolve_values(loaded, preset, params_file, assignments, opening=opening_values(loaded))  # as the app opens it
     width, height = parse_size(size, view)
     thickness = None
     if view == "textured":
@@ -361,9 +433,16 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
                                 variant=variant, mesh=mesh_shape, background=background)
     circles = scatter_circles(width, height) if view_named(view).circles else None
+    if exposure_factor is None:  # --exposure auto
+        from explorer.views.exposure import auto_exposure
+
+        exposure_factor = auto_exposure(image)
+        click.echo(f"{PROG}: exposure auto: {exposure_factor:.3g}", err=True)
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())
-    click.echo(f"wrote {out} ({width}x{height}, {view}, {engine})" + (f"; {bad} non-finite values!" if bad else ""))
+    method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
+    what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
+    click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 
     note = accuracy_note(loaded, values)  # the chosen Bragg method off by more than ΔE2000 2 here: which one is not
@@ -377,14 +456,32 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 @_errors
 def info(material, as_json):
     """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film)."""
+    from explorer.materials.methods import method_labels, opening_values
+
     loaded = _load(material)
+    labels = method_labels(loaded)
+    opening = opening_values(loaded).get("method")
     if as_json:
-        click.echo(json.dumps(loaded.info(), indent=2))
+        document = loaded.info()
+        for shown in document["parameters"]:
+            if shown["type"] == "int":  # a count or a switch: 20, not 20.0
+                shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
+        if labels:
+            document["methods"] = {str(value): label.partition(" ")[2] for value, label in labels.items()}
+        click.echo(json.dumps(document, indent=2))
         return
     click.echo(f"{display_path(loaded.path)}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
+    width = max((len(p.name) for p in loaded.parameters), default=0)
     for p in loaded.parameters:
-        bounds = "" if p.min is None else f" in [{p.min:g}, {p.max:g}]"
-        click.echo(f"  {p.type:5} {p.name:12} default {p.default}{bounds}")
+        shown = p.info()
+        if p.type == "int":  # a count or a switch: 20, not 20.0
+            shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
+        default = labels.get(shown["default"], shown["default"]) if p.name == "method" else shown["default"]
+        bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
+        opens = f" (the app and render open it on {labels.get(opening, opening)})" if p.name == "method" and opening is not None else ""
+        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
+        if p.name == "method" and labels:
+            click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
 
 
 @cli.command()

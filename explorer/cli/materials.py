@@ -29,8 +29,12 @@ def load(path: str | Path) -> Material:
     return material
 
 
-def resolve_values(loaded: Material, preset: str | None, params_file: str | None, assignments) -> dict:
-    """The material's values: its defaults, under ``--preset``, under ``--params``, under ``--set``."""
+def resolve_values(loaded: Material, preset: str | None, params_file: str | None, assignments, opening: dict | None = None) -> dict:
+    """
+    The material's values: its defaults, under ``opening`` (the app's opening values,
+    :func:`explorer.materials.methods.opening_values`, for ``render``), under ``--preset``, under
+    ``--params``, under ``--set``.
+    """
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     if params_file is not None:
         from explorer.app.parameter_files import load_values
@@ -43,4 +47,4 @@ def resolve_values(loaded: Material, preset: str | None, params_file: str | None
         from explorer.materials.presets import presets_for
 
         overrides = {**presets_for(loaded.path).get(preset).values, **overrides}
-    return loaded.resolve(overrides)
+    return loaded.resolve({**(opening or {}), **overrides})

@@ -22,6 +22,10 @@ from explorer.gpu.tables import ModelCache
 from explorer.gpu.resources import GLResources
 
 
+#: The views' own uniforms at their headless values, bound to every draw that does not set them (a
+#: program is shared: the app's Slice window may have set another phi_d on it).
+VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2)}
+
 class Renderer:
     """Renders material views into float32 images; caches programs, library textures and model tables."""
 
@@ -144,6 +148,7 @@ class Renderer:
                 bound[parameter.name] = float(value)
         if "xyz_to_rgb_matrix" in program:
             bound["xyz_to_rgb_matrix"] = tuple(float(v) for v in colorimetry.xyz_to_rgb_matrix().T.ravel())  # column-major
+        bound.update({name: value for name, value in VIEW_UNIFORM_DEFAULTS.items() if name in program})
         bound.update(uniforms or {})
         textures = dict(self._library)
         if "sensitivity_fourier_prefiltered" in program:  # Section 5's table: built on first use

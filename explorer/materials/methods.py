@@ -89,3 +89,36 @@ def methods_for(model: str | None) -> type[_Method] | None:
 def glsl_defines() -> dict[str, int]:
     """``{"BRAGG_REFERENCE": 0, …}`` for every method: ``#define``d in every program at assembly."""
     return {f"{enumeration.glsl_prefix()}{m.name}": int(m) for enumeration in (BraggMethod, ThinFilmMethod) for m in enumeration}
+
+
+def method_labels(material) -> dict[int, str]:
+    """
+    ``{value: "value label"}`` of a material's ``method`` parameter over its declared range ({} without
+    one): what the app's combo and ``info`` show (a value the enumeration does not name is ``"value"``).
+    """
+    parameter = next((p for p in material.parameters if p.name == "method"), None)
+    if parameter is None or parameter.min is None:
+        return {}
+    methods = methods_for(material.model)
+    known = {int(m): m.label for m in methods} if methods else {}
+    return {m: f"{m} {known[m]}" if m in known else str(m) for m in range(int(parameter.min), int(parameter.max) + 1)}
+
+
+def opening_values(material) -> dict[str, int]:
+    """
+    The overrides a material opens with, in the app and in ``render`` alike: the default material
+    (``bragg_mirror.brd``) on its fastest exact method, the tabulated one (its file's default is the
+    reference, 1-nm sum); ``{}`` for every other material.
+    """
+    from pathlib import Path
+
+    from explorer.resources import DEFAULT_MATERIAL
+
+    path = getattr(material, "path", None)
+    if path is None or not any(p.name == "method" for p in material.parameters):
+        return {}
+    try:
+        same = Path(path).resolve() == DEFAULT_MATERIAL.resolve()
+    except OSError:
+        same = False
+    return {"method": int(BraggMethod.TABULATED)} if same else {}

@@ -139,14 +139,15 @@ def _rotate(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     return n + np.cos(angle)[..., None] * (v - n) + np.sin(angle)[..., None] * np.cross(axis, v)
 
 
-def brdf_view_geometry(view: str, width: int, height: int, light: tuple[float, float] | None = None):
+def brdf_view_geometry(view: str, width: int, height: int, light: tuple[float, float] | None = None, slice_phi_d: float = 90.0):
     """
     The arguments of ``BRDF(L, V, N, X, Y)`` at each pixel of a BRDF view, and its mask and factor.
 
     Returns ``(L, V, N, X, Y, inside, factor)``: five float32 ``(height, width, 3)`` arrays computed as
     the view's shader computes them (``shaders/views/{lit,slice,scatter}.glsl``), the bool mask of pixels
     that show the material (0 elsewhere), and the float64 factor the BRDF is multiplied by: max(0, N.L)
-    for ``lit``, 1 for ``slice``, cos(theta_o) for ``scatter``.
+    for ``lit``, 1 for ``slice``, cos(theta_o) for ``scatter``. ``slice_phi_d``: the slice's phi_d in
+    degrees (BRDF Explorer's default 90; the shader's ``slice_phi_d`` uniform).
     """
     f32 = np.float32
     shape = (height, width, 3)
@@ -176,7 +177,7 @@ def brdf_view_geometry(view: str, width: int, height: int, light: tuple[float, f
         N = np.array([0, 0, 1], f32)
         X = np.array([1, 0, 0], f32)
         Y = np.array([0, 1, 0], f32)
-        phi_h, phi_d = f32(0.0), f32(np.pi / 2)
+        phi_h, phi_d = f32(0.0), f32(np.radians(slice_phi_d)) if slice_phi_d != 90.0 else f32(np.pi / 2)
         fx = np.arange(width, dtype=f32) + f32(0.5)
         fy = f32(height) - (np.arange(height, dtype=f32) + f32(0.5))
         theta_h = np.broadcast_to(f32(np.pi / 2) * fx / f32(width), (height, width))

@@ -29,7 +29,7 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None, mesh=None,
+    environment=None, mesh=None, slice_phi_d: float = 90.0,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -41,6 +41,7 @@ def render_numpy(
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
     ``mesh`` (``lit``, ``env``): an :class:`explorer.views.mesh.Mesh` drawn instead of the sphere, its normals
     by :func:`explorer.views.mesh.rasterise`.
+    ``slice_phi_d`` (``slice``): phi_d in degrees (the app's Slice window; 90 as BRDF Explorer).
     """
     evaluates = view_named(view).evaluates
     if mesh is not None and view not in ("lit", "env"):
@@ -78,7 +79,7 @@ def render_numpy(
             surface = rasterise(mesh, width, height)
             L, V, N, X, Y, inside, factor = mesh_view_geometry(surface.normals, surface.covered, light)
         else:
-            L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
+            L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light, slice_phi_d)
         image = np.zeros((height, width, 3), dtype=np.float32)
         vectors = [a[inside] for a in (L, V, N, X, Y)]
         image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]

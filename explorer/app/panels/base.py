@@ -49,12 +49,15 @@ def record(state, label: str) -> None:
     state.rects[label] = (lo.x, lo.y, hi.x, hi.y)
 
 
-def show_image(state, texture, size, label: str, interactive: bool = False) -> None:
-    """An image fitted to the window, flipped to rows-from-the-top, zoomed about its centre when ``interactive``."""
+def show_image(state, texture, size, label: str, interactive: bool = False, side: float = 0.0) -> None:
+    """
+    An image fitted to the window (less ``side`` pixels on its right, for a colour bar), flipped to
+    rows-from-the-top, zoomed about its centre when ``interactive``.
+    """
     from imgui_bundle import imgui
 
     avail = imgui.get_content_region_avail()
-    scale = min(1.0, max(avail.x, 16) / size[0], max(avail.y - 24, 16) / size[1]) if size[0] > 0 else 1.0
+    scale = min(1.0, max(avail.x - side, 16) / size[0], max(avail.y - 24, 16) / size[1]) if size[0] > 0 else 1.0
     shown = imgui.ImVec2(size[0] * scale, size[1] * scale)
     half = 0.5 / (state.zoom if interactive else 1.0)
     imgui.image(imgui.ImTextureRef(texture.glo), shown, imgui.ImVec2(0.5 - half, 0.5 + half), imgui.ImVec2(0.5 + half, 0.5 - half))

@@ -1,4 +1,8 @@
-"""The Compare window: a split sphere of two methods or two parameter sets (A | B), or their ΔE2000 heat-map."""
+"""
+The Compare window: a split sphere of two methods, two parameter sets or two loaded materials (A | B: a
+Bragg layer beside BRDF Explorer's ``disney.brdf`` or ``ggx_schlick``), or their ΔE2000 heat-map with its
+colour bar.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +11,10 @@ import numpy as np
 from explorer.app import data
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, record, show_image
+from explorer.app.state import has_reflectance
+
+#: The heat-map's colour bar (pixels wide).
+COLOUR_BAR_WIDTH = 70
 
 
 class ComparePanel(Panel):
@@ -29,7 +37,24 @@ class ComparePanel(Panel):
         imgui.same_line()
         if imgui.radio_button("two parameter sets (A = current | B)", c.kind == "sets"):
             c.kind = "sets"
-        if c.kind == "methods" and names:
+        if imgui.radio_button("two materials (A = shown | B)", c.kind == "materials"):
+            c.kind = "materials"
+        record(state, "compare_materials")
+        if c.kind == "materials":
+            others = [i for i in range(len(state.materials)) if i != state.selected]
+            if c.material_b not in others:
+                c.material_b = others[0] if others else state.selected
+            if imgui.begin_combo("B (right)", state.materials[c.material_b].name):
+                for i in others:
+                    clicked, _ = imgui.selectable(f"{state.materials[i].name}##{i}", i == c.material_b)
+                    record(state, f"compare_b:{i}")
+                    if clicked:
+                        c.material_b = i
+                imgui.end_combo()
+            record(state, "compare_b")
+            if not others:
+                imgui.text("(open a second material: File > Open...)")
+        elif c.kind == "methods" and names:
             labels = [f"{m}: {n}" for m, n in names.items()]
             keys = list(names)
             _, ia = imgui.combo("A (left)", keys.index(c.a) if c.a in keys else 0, labels)
@@ -37,23 +62,40 @@ class ComparePanel(Panel):
             c.a, c.b = keys[ia], keys[ib]
         elif imgui.button("B := current parameters"):
             c.values_b = dict(state.values)
-        _, c.heat = imgui.checkbox("dE2000 heat-map (viridis, 0 to 10)", c.heat)
+        _, c.heat = imgui.checkbox(f"dE2000 heat-map (viridis, 0 to {data.HEAT_MAP_TOP:g})", c.heat)
+        record(state, "compare_heat")
         if not c.on:
             imgui.text("(off)")
             return
         size = (state.view_size // 2, state.view_size // 2) if state.view_size > 256 else (state.view_size, state.view_size)
-        if c.kind == "methods" and names:
+        if c.kind == "materials":
+            values_a, values_b = state.values, None  # B: the entry's own values, below
+        elif c.kind == "methods" and names:
             values_a = {**state.values, "method": float(c.a)}
             values_b = {**state.values, "method": float(c.b)}
         else:
             known = {p.name for p in state.material.parameters}
             values_a, values_b = state.values, state.material.resolve({k: v for k, v in c.values_b.items() if k in known})
         light, dragging, view = light_vector(state.light, state.camera), self.app.dragging, state.main_view()
+        material_b = state.material
+        if c.kind == "materials":
+            entry = state.materials[c.material_b]
+            material_b, values_b = entry.material, entry.values
+            # Two materials in one view: the sphere's when both have a reflectance, else both lit (every material has a BRDF).
+            if not (has_reflectance(state.material) and has_reflectance(material_b)):
+                view = "lit"
         a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
         a.request(state.material, values_a, view, size, light=light, dragging=dragging)
-        b.request(state.material, values_b, view, size, light=light, dragging=dragging)
+        b.request(material_b, values_b, view, size, light=light, dragging=dragging)
         if c.heat and self._heat_texture is not None:
-            show_image(state, self._heat_texture, size, "compare_image")
+            show_image(state, self._heat_texture, size, "compare_image", side=COLOUR_BAR_WIDTH + 8)
+            imgui.same_line()
+            from imgui_bundle import implot
+
+            shown = state.rects["compare_image"]
+            implot.colormap_scale("dE2000", 0.0, data.HEAT_MAP_TOP, imgui.ImVec2(COLOUR_BAR_WIDTH, shown[3] - shown[1]),
+                                  "%g", 0, implot.Colormap_.viridis)
+            record(state, "compare_colour_bar")
         else:
             show_image(state, self.scheduler.show("compare", size, a, b), size, "compare_image")
         if state.mean_delta_e is not None:
@@ -74,7 +116,7 @@ class ComparePanel(Panel):
             return
         mask = data.disc_mask(*a.size)
         delta_e, self.state.mean_delta_e = data.delta_e_map(a.read(), b.read(), mask)
-        rgba = data.heat_map_rgba(delta_e)
+        rgba = data.heat_map_rgba(delta_e, data.HEAT_MAP_TOP)
         rgba[~mask] = (0, 0, 0, 255)
         self._heat_texture = self.app.renderer.resources.replace(self._heat_texture, np.ascontiguousarray(rgba[::-1]),
                                                                  dtype="f1", linear=True, origin="ΔE map")

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from explorer.materials.brd import round_integer
-from explorer.app.parameter_files import slider_format, widget_kind
+from explorer.materials.methods import method_labels
+from explorer.app.parameter_files import inactive_parameters, slider_format, widget_kind
 from explorer.app.state import VIEW_SIZES
 from explorer.app.badge import BadgeWorker
 from explorer.app.panels.base import Panel, record
@@ -40,8 +41,11 @@ class ParametersPanel(Panel):
             record(state, "preset_combo")
         imgui.separator()
         io = imgui.get_io()
+        inactive = inactive_parameters(state.material, state.values)
         for parameter in state.material.parameters:
+            imgui.begin_disabled(parameter.name in inactive)  # a stack's layers beyond its `layers`
             self._parameter_widget(imgui, io, parameter)
+            imgui.end_disabled()
         self._accuracy_badge(imgui)
         imgui.separator()
         self._light_and_camera(imgui)
@@ -51,10 +55,13 @@ class ParametersPanel(Panel):
         if changed:
             state.exposure = exposure
         _, state.gamut = imgui.checkbox("gamut overlay (outside sRGB)", state.gamut)
-        sizes = [str(s) for s in VIEW_SIZES]
-        changed, index = imgui.combo("resolution", VIEW_SIZES.index(state.view_size) if state.view_size in VIEW_SIZES else 2, sizes)
+        sizes = ["fit the window"] + [str(s) for s in VIEW_SIZES]
+        current = 0 if state.view_size_auto else 1 + (VIEW_SIZES.index(state.view_size) if state.view_size in VIEW_SIZES else 2)
+        changed, index = imgui.combo("resolution", current, sizes)
         if changed:
-            state.view_size = VIEW_SIZES[index]
+            state.view_size_auto = index == 0
+            if index > 0:
+                state.view_size = VIEW_SIZES[index - 1]
         imgui.text(state.frame_label())
         if state.status:
             imgui.text_wrapped(state.status)
@@ -105,7 +112,18 @@ class ParametersPanel(Panel):
         new = value
         imgui.push_id(name)
         no_ctrl_input = imgui.SliderFlags_.no_input  # Ctrl-click resets instead of typing; the field types
-        if kind == "int":
+        labels = method_labels(state.material) if name == "method" else {}
+        if labels:  # the methods by name (explorer.materials.methods), not a bare integer slider
+            imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.75)
+            current = round_integer(value)
+            if imgui.begin_combo(name, labels.get(current, str(current))):
+                for key, label in labels.items():
+                    clicked, _ = imgui.selectable(label, key == current)
+                    record(state, f"method:{key}")
+                    if clicked:
+                        new = float(key)
+                imgui.end_combo()
+        elif kind == "int":
             imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.55)
             changed, v = imgui.slider_int(name, round_integer(value), int(parameter.min), int(parameter.max), "%d", no_ctrl_input)
             if changed:
@@ -129,7 +147,7 @@ class ParametersPanel(Panel):
         if imgui.is_item_hovered():
             bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
             imgui.set_tooltip(f"{name}: {parameter.type}{bounds}, default {parameter.default}; Ctrl-click resets")
-        if kind in ("int", "float"):
+        if kind in ("int", "float") and not labels:
             imgui.same_line()
             imgui.set_next_item_width(-1)
             typed, text = imgui.input_text("##typed", f"{float(new):g}", imgui.InputTextFlags_.enter_returns_true | imgui.InputTextFlags_.chars_scientific)

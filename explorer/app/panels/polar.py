@@ -1,4 +1,4 @@
-"""The Polar window: the BRDF in the plane of incidence (the scatter view's middle row)."""
+"""The Polar window: the BRDF in the plane of incidence (the scatter view's middle row), of every visible material."""
 
 from __future__ import annotations
 
@@ -9,6 +9,8 @@ from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel
 
 POLAR_SAMPLES = 181
+#: Linear sRGB's luminance weights (ITU-R BT.709): one curve per material when several are overlaid.
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
 class PolarPanel(Panel):
@@ -18,29 +20,50 @@ class PolarPanel(Panel):
 
     def __init__(self, app):
         super().__init__(app)
-        self._curve = None
-        self._generation = -1  # the scatter row the curve was computed from
+        self._curves: dict = {}  # job name -> (generation, (theta, brdf))
+        self._jobs: list = []  # this frame's job names, in drawing order
+
+    def _job_name(self, entry) -> str:
+        return "polar" if entry is None or entry.material is self.state.material else f"polar:{id(entry.material)}"
 
     def draw(self, imgui) -> None:
         from imgui_bundle import implot
 
         state = self.state
-        job = self.scheduler.job("polar")
-        job.request(state.material, state.values, "scatter", (POLAR_SAMPLES, 1), light=light_vector(state.light, state.camera), dragging=False)
-        if job.complete and job.generation != self._generation:
-            self._curve = data.polar_curve(job.read())
-            self._generation = job.generation
-        imgui.text(f"plane of incidence (light theta = {state.light[0]:.1f} deg); radius = BRDF (1/sr)")
-        if self._curve is None:
+        entries = state.visible_entries() or [None]
+        light = light_vector(state.light, state.camera)
+        curves, self._jobs = [], []
+        for entry in entries:
+            name = self._job_name(entry)
+            material, values = (state.material, state.values) if entry is None else (entry.material, entry.values)
+            job = self.scheduler.job(name)
+            job.request(material, values, "scatter", (POLAR_SAMPLES, 1), light=light, dragging=False)
+            self._jobs.append(name)
+            cached = self._curves.get(name)
+            if job.complete and (cached is None or cached[0] != job.generation):
+                cached = (job.generation, data.polar_curve(job.read()))
+                self._curves[name] = cached
+            if cached is not None:
+                curves.append((entry, cached[1]))
+        imgui.text(f"plane of incidence (light theta = {state.light[0]:.1f} deg); radius = BRDF (1/sr)"
+                   + ("; luminance per material" if len(curves) > 1 else ""))
+        state.plotted["Polar"] = [entry.name if entry is not None else state.material_path.name for entry, _ in curves]
+        if not curves:
             return
-        theta, brdf = self._curve
         if implot.begin_plot("polar", imgui.ImVec2(-1, -1), implot.Flags_.equal):
-            implot.setup_axes("", "")
-            radians = np.radians(theta)
-            for channel, colour in enumerate(((1, 0.3, 0.3, 1), (0.3, 1, 0.3, 1), (0.4, 0.5, 1, 1))):
-                r = np.clip(brdf[:, channel], 0.0, None)
-                implot.plot_line("RGB"[channel], r * np.sin(radians), r * np.cos(radians), implot.Spec(line_color=imgui.ImVec4(*colour)))
+            fit = implot.AxisFlags_.auto_fit  # the axes follow the lobes: another material, another light
+            implot.setup_axes("", "", fit, fit)
+            for entry, (theta, brdf) in curves:
+                radians = np.radians(theta)
+                if len(curves) == 1:
+                    for channel, colour in enumerate(((1, 0.3, 0.3, 1), (0.3, 1, 0.3, 1), (0.4, 0.5, 1, 1))):
+                        r = np.clip(brdf[:, channel], 0.0, None)
+                        implot.plot_line("RGB"[channel], r * np.sin(radians), r * np.cos(radians), implot.Spec(line_color=imgui.ImVec4(*colour)))
+                else:
+                    r = np.clip(brdf @ LUMINANCE, 0.0, None)
+                    implot.plot_line(f"{entry.name}##{id(entry)}", r * np.sin(radians), r * np.cos(radians),
+                                     implot.Spec(line_color=imgui.ImVec4(*entry.colour, 1.0), line_weight=2.0))
             implot.end_plot()
 
     def gl_jobs(self) -> list:
-        return [self.scheduler.job("polar")]
+        return [self.scheduler.job(name) for name in self._jobs]

@@ -24,10 +24,12 @@ class SpectrumPanel(Panel):
         self._key = None  # the values and angle of the spectrum shown (None: its structure is outdated)
         self._time = 0.0
         self._structure: data.Spectrum | None = None  # the last spectrum with its gaps, landmarks and boxes
+        self._others: dict = {}  # id(material) -> (key, spectrum) of the other visible materials
 
     def draw(self, imgui) -> None:
         state = self.state
-        if state.material.model not in data.BRAGG_MODELS:
+        others = [e for e in state.visible_entries() if e.material is not state.material and e.material.model in data.BRAGG_MODELS]
+        if state.material.model not in data.BRAGG_MODELS and not others:
             imgui.text("the spectrum needs a Bragg mirror material (n1, n2, Lambda, delta, N)")
             return
         _, state.spectrum_theta = imgui.slider_float("theta", state.spectrum_theta, 0.0, 89.0, "%.1f deg")
@@ -36,8 +38,23 @@ class SpectrumPanel(Panel):
             _, state.spectrum_show[key] = imgui.checkbox(key, state.spectrum_show[key])
             imgui.same_line()
         imgui.new_line()
-        self._update()
-        self._plot(imgui, self._spectrum, state.spectrum_show)
+        selected = state.materials[state.selected] if state.materials else None
+        shown = selected is None or (selected.visible and state.material.model in data.BRAGG_MODELS)
+        if shown:
+            self._update()
+        overlays = [(entry, self._other(entry)) for entry in others]
+        state.plotted["Spectrum"] = ([state.material_path.name] if shown else []) + [entry.name for entry in others]
+        self._plot(imgui, self._spectrum if shown else None, state.spectrum_show, overlays,
+                   selected.colour if selected is not None and overlays else None)
+
+    def _other(self, entry) -> data.Spectrum:
+        """Another visible Bragg material's curves (no structure), cached on its values and the angle."""
+        key = (tuple(sorted(entry.values.items())), self.state.spectrum_theta)
+        cached = self._others.get(id(entry.material))
+        if cached is None or cached[0] != key:
+            cached = (key, data.spectrum(entry.values, self.state.spectrum_theta, structure=False))
+            self._others[id(entry.material)] = cached
+        return cached[1]
 
     def _update(self) -> None:
         state, dragging = self.state, self.app.dragging
@@ -60,13 +77,20 @@ class SpectrumPanel(Panel):
             self._structure = self._spectrum
 
     @staticmethod
-    def _plot(imgui, sp: data.Spectrum, show: dict) -> None:
+    def _plot(imgui, sp: data.Spectrum | None, show: dict, overlays=(), colour=None) -> None:
+        """The selected material's curves (``sp``; its average in ``colour`` beside others), then each overlay's average."""
         from imgui_bundle import implot
 
         if not implot.begin_plot("R(lambda)", imgui.ImVec2(-1, -1)):
             return
         implot.setup_axes("wavelength (nm)", "reflectance")
         implot.setup_axes_limits(360, 830, 0, 1.05)
+        for entry, other in overlays:
+            implot.plot_line(f"{entry.name} average##{id(entry)}", other.wavelengths, 0.5 * (other.R["s"] + other.R["p"]),
+                             implot.Spec(line_color=imgui.ImVec4(*entry.colour, 1.0), line_weight=2.0))
+        if sp is None:
+            implot.end_plot()
+            return
         if show["gaps"]:
             for low, high in sp.gaps:
                 xs = np.array([low, high])
@@ -79,7 +103,8 @@ class SpectrumPanel(Panel):
         if show["p"]:
             implot.plot_line("R_p", sp.wavelengths, sp.R["p"])
         if show["average"]:
-            implot.plot_line("average", sp.wavelengths, average, implot.Spec(line_weight=2.0))
+            spec = implot.Spec(line_weight=2.0) if colour is None else implot.Spec(line_weight=2.0, line_color=imgui.ImVec4(*colour, 1.0))
+            implot.plot_line("average", sp.wavelengths, average, spec)
         if show["envelope"]:
             implot.plot_line("envelope", sp.wavelengths, 0.5 * (sp.envelope["s"] + sp.envelope["p"]))
         if show["boxes"]:

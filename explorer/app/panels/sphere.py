@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from explorer.app.camera import light_vector
 from explorer.app.scheduler import model_mesh
-from explorer.app.state import ENV_TARGETS, MODES, SPHERE_MODELS, has_reflectance
+from explorer.app.state import ENV_TARGETS, MODES, SPHERE_MODELS, auto_view_size, has_reflectance
 from explorer.app.panels.base import Panel, record, show_image
 
 
@@ -20,10 +20,23 @@ class SpherePanel(Panel):
                 state.mode = mode
             record(state, f"mode:{mode}")
             imgui.same_line()
+        if len(state.materials) > 1:  # which loaded material the sphere shows (as a click in the Materials list)
+            imgui.set_next_item_width(min(imgui.get_content_region_avail().x, 220.0))
+            if imgui.begin_combo("##shown", state.material_path.name):
+                for index, entry in enumerate(state.materials):
+                    clicked, _ = imgui.selectable(f"{entry.name}##{index}", index == state.selected)
+                    record(state, f"shown:{index}")
+                    if clicked:
+                        self.app.select(index)
+                imgui.end_combo()
+            record(state, "shown")
         imgui.new_line()
         if state.mode == "sphere" and not has_reflectance(state.material):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
         self._model_and_environment(imgui)
+        if state.view_size_auto:  # the sphere fills the window, less its status line
+            avail = imgui.get_content_region_avail()
+            state.view_size = auto_view_size(avail.x, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
         if state.mode == "env":

@@ -16,10 +16,11 @@ class StripsPanel(Panel):
 
     def __init__(self, app):
         super().__init__(app)
-        self._methods: list = []  # the methods a strip was requested for (their views stay in the scheduler)
+        self._methods: list = []  # the strips' job names drawn this frame (their views stay in the scheduler)
 
     def draw(self, imgui) -> None:
         state = self.state
+        self._methods = []
         names = data.method_names(state.material)
         if not has_reflectance(state.material):
             imgui.text("this material has no reflectance(cos_theta)")
@@ -30,17 +31,32 @@ class StripsPanel(Panel):
             methods = list(names) or [None]
         imgui.text("theta from 0 deg (left) to 90 deg (right)")
         for method in methods:
-            if method not in self._methods:
-                self._methods.append(method)
-            job = self.scheduler.job(f"strip{method}")
             values = state.values if method is None else {**state.values, "method": float(method)}
-            job.request(state.material, values, "gradient", (STRIP_WIDTH, 1), dragging=self.app.dragging)
-            texture = self.scheduler.show(f"strip{method}", (STRIP_WIDTH, 1), job)
-            avail = imgui.get_content_region_avail().x
             label = "" if method is None else f"{method} {names.get(method, '')}"
-            imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(max(avail - 110, 32), 22), imgui.ImVec2(0, 1), imgui.ImVec2(1, 0))
-            imgui.same_line()
+            self._strip(imgui, f"strip{method}", state.material, values, label)
+        # The other visible materials with a reflectance: one strip each, at their own method, in their colour.
+        others = [e for e in state.visible_entries() if e.material is not state.material and has_reflectance(e.material)]
+        if others:
+            imgui.separator()
+        for entry in others:
+            method = entry.values.get("method")
+            label = entry.name + ("" if method is None else f" ({data.method_names(entry.material).get(int(method), int(method))})")
+            self._strip(imgui, f"strip:{id(entry.material)}", entry.material, entry.values, label, entry.colour)
+        state.plotted["Strips"] = [state.material_path.name] + [entry.name for entry in others]
+
+    def _strip(self, imgui, name, material, values, label, colour=None) -> None:
+        if name not in self._methods:
+            self._methods.append(name)
+        job = self.scheduler.job(name)
+        job.request(material, values, "gradient", (STRIP_WIDTH, 1), dragging=self.app.dragging)
+        texture = self.scheduler.show(name, (STRIP_WIDTH, 1), job)
+        avail = imgui.get_content_region_avail().x
+        imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(max(avail - 110, 32), 22), imgui.ImVec2(0, 1), imgui.ImVec2(1, 0))
+        imgui.same_line()
+        if colour is None:
             imgui.text(label)
+        else:
+            imgui.text_colored(imgui.ImVec4(*colour, 1.0), label)
 
     def gl_jobs(self) -> list:
-        return [self.scheduler.job(f"strip{method}") for method in self._methods]
+        return [self.scheduler.job(name) for name in self._methods]
