@@ -65,8 +65,7 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
         data = np.frombuffer(colour.read(), dtype=np.float32).reshape(height, width, 4)
         return data.copy()
     finally:
-        for obj in (framebuffer, depth, colour, array, indices, vertices):
-            obj.release()
+        renderer.resources.release(framebuffer, depth, colour, array, indices, vertices)
 
 
 def render_mesh(renderer, material, values, view: str, mesh: Mesh, width: int, height: int, *, light=None) -> np.ndarray:

@@ -112,9 +112,15 @@ class GLResources:
                 continue
             if hasattr(obj, "color_attachments") and id(obj) not in self._wrappers:
                 self.release(*obj.color_attachments)
+            if obj is self.ctx.fbo:  # GL unbinds a deleted framebuffer, moderngl's ctx.fbo would still name it
+                self.default_framebuffer().use()
             self._wrappers.discard(id(obj))
             self._owned.pop(id(obj), None)
             obj.release()
+
+    def default_framebuffer(self):
+        """The window's framebuffer, or GL's framebuffer 0 in a standalone context."""
+        return self.ctx.screen if self.ctx.screen is not None else self.ctx.detect_framebuffer(0)
 
     def owned(self) -> int:
         """How many objects are still owned (tests, leak checks)."""
