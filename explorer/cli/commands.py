@@ -21,6 +21,7 @@ from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path
+from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
@@ -104,11 +105,13 @@ def parse_exposure(text: str | None, out: Path) -> float:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
+    plot=None,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
-    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view.
+    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view;
+    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) for the plot views.
     """
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
@@ -134,7 +137,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, plot=plot)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
@@ -145,7 +148,48 @@ def render_material(
             material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
             uniforms={"prefilter": thickness.prefilter},
         )
+    if view_named(view).plot is not None:
+        from explorer.views.plots import gl_uniforms
+
+        return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
     return renderer.render(material, values, view, width, height, light=light)
+
+
+def parse_plot(view: str, **options):
+    """
+    The plot views' settings (:class:`explorer.views.plots.PlotSettings`) from the options given (None: not
+    given), or None for the other views; an option a view does not take is a one-line usage error.
+    """
+    from explorer.views.geometry import PLOT_VIEWS
+    from explorer.views.plots import PLOT_SETTINGS, PlotSettings
+
+    given = {name: value for name, value in options.items() if value not in (None, False)}
+    if view not in PLOT_VIEWS:
+        if given:
+            flags = ", ".join(f"--{name.replace('_', '-')}" for name in given)
+            raise click.BadParameter(f"{flags}: for the plot views ({', '.join(PLOT_VIEWS)})", param_hint="--view")
+        return None
+    for name in ("theta_d", "theta_h", "phi_v"):
+        if name in given and name not in PLOT_SETTINGS[view]:
+            takes = [v for v, settings in PLOT_SETTINGS.items() if name in settings]
+            raise click.BadParameter(f"--{name.replace('_', '-')} is for the {', '.join(takes)} plot, not {view}", param_hint="--view")
+    try:
+        return PlotSettings(**given)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--view") from None
+
+
+def _write_plot(loaded, view: str, image, plot, out: Path, light, engine: str) -> None:
+    """A plot view's chart or values (:mod:`explorer.views.plot_images`), the values as :func:`explorer.views.plots.plotted` has them."""
+    from explorer.views.geometry import light_direction
+    from explorer.views.plot_images import write_plot
+    from explorer.views.plots import cos_light, plotted
+
+    height, width = image.shape[:2]
+    values = plotted(image, plot, cos_light(view, width, height, light_direction(light), plot))
+    shown_light = (light or DEFAULT_LIGHT) if view_named(view).takes_light else None
+    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light)
+    click.echo(f"wrote {out} ({view} plot, {width}x{height} samples, {engine})")
 
 
 def check_numpy_size(width: int, height: int) -> None:
@@ -267,7 +311,7 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(["gradient", "sphere", "lit", "slice", "scatter", "textured", "env"]), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(list(VIEWS)), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
@@ -283,9 +327,15 @@ def _errors(function):
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
+@click.option("--theta-d", "theta_d", type=float, help="theta_h plot: the difference angle theta_d in degrees (default 0).")
+@click.option("--theta-h", "theta_h", type=float, help="theta_d plot: the half-vector angle theta_h in degrees (default 0).")
+@click.option("--phi-v", "phi_v", type=float, help="theta_v plot: the view's azimuth phi_v in degrees (default 0).")
+@click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
+@click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
+@click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant):
+           prefilter, env_file, spp, variant, theta_d, theta_h, phi_v, log_scale, channel, ndotl):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
@@ -294,7 +344,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y);
     textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range;
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
-    (--engine numpy: the exact integral, slow; use a small --size).
+    (--engine numpy: the exact integral, slow; use a small --size). BRDF Explorer's plots: theta_v (with
+    --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
+    as a chart (.png) or their values (.npy); --size W sets their samples.
     """
     from explorer.views.geometry import scatter_circles, view_named
 
@@ -304,6 +356,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     loaded = _load(material)
     values = resolve_values(loaded, preset, params_file, assignments)
     width, height = parse_size(size, view)
+    plot = parse_plot(view, theta_d=theta_d, theta_h=theta_h, phi_v=phi_v, log=log_scale, channel=channel, ndotl=ndotl)
+    if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
+        raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
     thickness = None
     if view == "textured":
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
@@ -330,7 +385,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant)
+                                variant=variant, plot=plot)
+    if plot is not None:
+        _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
+        return
     circles = scatter_circles(width, height) if view_named(view).circles else None
     write_image(image, Path(out), circles, exposure_factor)
     bad = int((~np.isfinite(image)).sum())

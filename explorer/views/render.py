@@ -29,7 +29,7 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None,
+    environment=None, plot=None,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -39,8 +39,14 @@ def render_numpy(
     texture over the default D_inc range, without prefiltering).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
+    ``plot`` (the plots, :mod:`explorer.views.plots`): a :class:`explorer.views.plots.PlotSettings` (default: its defaults).
     """
     evaluates = view_named(view).evaluates
+    if view_named(view).plot is not None:
+        from explorer.views.geometry import light_direction
+        from explorer.views.plots import PlotSettings, plot_numpy
+
+        return plot_numpy(model, view, width, height, light_direction(light), plot or PlotSettings())
     if evaluates == "environment":
         from explorer.views.env import EnvironmentMap, env_integral_numpy
 
