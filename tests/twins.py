@@ -108,7 +108,7 @@ def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, 
         light = LIGHTS.get(view)
     gl_inputs = {}
     if thickness is not None:
-        gl_inputs = {"inputs": thickness.gl_inputs(width, height), "uniforms": {"prefilter": thickness.prefilter}}
+        gl_inputs = thickness.gl_arguments(material, values, width, height)
         numpy_inputs = {"thickness": thickness}
     else:
         numpy_inputs = {}

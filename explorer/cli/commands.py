@@ -120,11 +120,12 @@ def render_material(
     if view == "env":
         return _render_env(material, values, width, height, engine, environment, spp)
     if view == "textured":
-        from explorer.views.thickness import ThicknessTexture, check_prefilter
+        from explorer.views.surface_texture import check_texture_kind, default_texture
+        from explorer.views.thickness import check_prefilter
 
-        if material.model != "thin_film":
-            raise MaterialError(material.path, None, "the textured view needs a thin-film material (# model: thin_film)")
-        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        # What the texture varies is the material's declaration ('# texture:'), not its name.
+        check_texture_kind(material)
+        thickness = default_texture(material) if thickness is None else thickness
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":
         from explorer.materials.models import model_for
@@ -144,10 +145,8 @@ def render_material(
     renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
-        return renderer.render(
-            material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
-            uniforms={"prefilter": thickness.prefilter},
-        )
+        return renderer.render(material, values, view, width, height, light=light,
+                               **thickness.gl_arguments(material, values, width, height))
     if view_named(view).plot is not None:
         from explorer.views.plots import gl_uniforms
 
@@ -324,6 +323,8 @@ def _errors(function):
 @click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
+@click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
+              help="textured view of a Bragg mirror: which of Lambda (0.5 + 0.5 T) and delta^T follow the texture T (default both; supplemental Fig. 7).")
 @click.option("--env", "env_file", metavar="FILE", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr).")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
@@ -335,14 +336,15 @@ def _errors(function):
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant, theta_d, theta_h, phi_v, log_scale, channel, ndotl):
+           prefilter, env_file, spp, variant, theta_d, theta_h, phi_v, log_scale, channel, ndotl, mapping):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
     (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y);
-    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range;
+    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range, or of a
+    Bragg mirror whose Lambda and/or delta follow it (--mapping);
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
     (--engine numpy: the exact integral, slow; use a small --size). BRDF Explorer's plots: theta_v (with
     --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
@@ -361,13 +363,22 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
     thickness = None
     if view == "textured":
+        from explorer.views.surface_texture import BraggTexture, check_texture_kind
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
 
-        thickness = ThicknessTexture.from_file(
-            texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
-        )
-    elif texture is not None or dinc_range is not None or prefilter == "on":
-        raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
+        if check_texture_kind(loaded) == "bragg":
+            if dinc_range is not None or prefilter == "on":
+                raise click.BadParameter("a Bragg mirror's texture maps Lambda and delta (--mapping), not D_inc", param_hint="--dinc-range/--prefilter")
+            thickness = BraggTexture.from_file(texture if texture is not None else DEFAULT_TEXTURE, mapping or "both")
+        else:
+            if mapping is not None:
+                raise click.BadParameter(f"--mapping is a Bragg mirror's; {display_path(loaded.path)}'s texture is its D_inc (--dinc-range)",
+                                         param_hint="--mapping")
+            thickness = ThicknessTexture.from_file(
+                texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
+            )
+    elif texture is not None or dinc_range is not None or prefilter == "on" or mapping is not None:
+        raise click.BadParameter("--texture, --dinc-range, --prefilter and --mapping are for the textured view", param_hint="--view")
     environment = None
     if view == "env":
         from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap

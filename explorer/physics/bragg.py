@@ -1259,3 +1259,81 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     spectra, _ = windowed_converged_spectra(cos_theta, mirror, **kwargs)
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
+
+
+# --------------------------------------------------------------------------------------------------
+# Spatially varying mirrors (supplemental Figure 7): Lambda and delta from a texture value T in [0, 1]
+
+#: Supplemental Figure 7's mappings of a texture value ``T``: which of ``Lambda(x) = Lambda (0.5 + 0.5 T(x))`` and
+#: ``delta(x) = delta^T(x)`` apply; the shaders' ``texture_mapping`` is its bits (1: Lambda, 2: delta).
+TEXTURE_MAPPINGS = {"none": 0, "lambda": 1, "delta": 2, "both": 3}
+#: The tabulated method's textured table: rows of ``T = k / (rows - 1)``, columns of ``cos theta = i / (columns - 1)``.
+TEXTURE_TABLE_ROWS = 33
+TEXTURE_TABLE_COLUMNS = 129
+
+
+def textured_mirror(mirror: BraggMirror, T: ArrayLike, mapping: str) -> BraggMirror:
+    """
+    The mirror at texture values ``T`` (per sample) under ``mapping`` (:data:`TEXTURE_MAPPINGS`): ``Lambda`` and
+    ``delta`` become arrays of ``T``'s shape, ``Lambda (0.5 + 0.5 T)`` and ``delta^T`` where the mapping says so
+    (supplemental Figure 7; ``delta^0 = 1``: the whole cell is n1).
+    """
+    bits = TEXTURE_MAPPINGS[mapping]
+    T = np.clip(np.asarray(T, dtype=np.float64), 0.0, 1.0)
+    Lambda = mirror.Lambda * (0.5 + 0.5 * T) if bits & 1 else np.full(T.shape, float(mirror.Lambda))
+    delta = np.power(float(mirror.delta), T) if bits & 2 else np.full(T.shape, float(mirror.delta))
+    return BraggMirror(mirror.n1, mirror.n2, Lambda, delta, mirror.N, mirror.nh)
+
+
+def _mirror_rows(mirror: BraggMirror, rows) -> BraggMirror:
+    """A per-sample mirror's samples ``rows``."""
+    return BraggMirror(mirror.n1, mirror.n2, np.asarray(mirror.Lambda)[rows], np.asarray(mirror.delta)[rows], mirror.N, mirror.nh)
+
+
+def textured_reference_rgb(cos_theta: ArrayLike, mirror: BraggMirror, step: float) -> np.ndarray:
+    """:func:`reference_rgb` at a fixed ``step`` of a per-sample mirror (:func:`textured_mirror`, ``cos_theta``'s shape)."""
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    flat = cos_theta.ravel()
+    flat_mirror = BraggMirror(mirror.n1, mirror.n2, np.ravel(mirror.Lambda), np.ravel(mirror.delta), mirror.N, mirror.nh)
+    spectra = colorimetry.fixed_step_spectra(
+        lambda wavelengths, rows: _spectra(flat[rows], _mirror_rows(flat_mirror, rows), wavelengths, fast=False), flat.size, step
+    )
+    return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
+
+
+@functools.lru_cache(maxsize=8)
+def textured_rgb_table(mirror: BraggMirror, mapping: str, rows: int = TEXTURE_TABLE_ROWS,
+                       columns: int = TEXTURE_TABLE_COLUMNS) -> np.ndarray:
+    """
+    The tabulated method's table of a textured mirror, ``(rows, columns, 3)`` float32: the converged reference
+    (:func:`_converged_rgb`, as :func:`tabulated_rgb_table`) at ``T = k / (rows - 1)`` and ``cos theta = i /
+    (columns - 1)``. Every mapping makes ``Lambda`` and ``delta`` functions of the one value ``T``, so the colour
+    is a function of ``(cos theta, T)`` alone: one bilinear lookup a pixel (:func:`textured_tabulated_rgb`),
+    built once per mirror and mapping (a row per ``T``; one row when nothing varies).
+    """
+    cos_theta = np.linspace(0.0, 1.0, columns)
+    T = np.linspace(0.0, 1.0, rows)
+    if TEXTURE_MAPPINGS[mapping] == 0:
+        table = np.broadcast_to(_converged_rgb(cos_theta, mirror)[None], (rows, columns, 3))
+    else:
+        table = np.stack([
+            _converged_rgb(cos_theta, BraggMirror(mirror.n1, mirror.n2, float(m.Lambda), float(m.delta), mirror.N, mirror.nh))
+            for m in (textured_mirror(mirror, t, mapping) for t in T)
+        ])
+    table = np.ascontiguousarray(table, dtype=np.float32)
+    table.setflags(write=False)
+    return table
+
+
+def textured_tabulated_rgb(table: np.ndarray, cos_theta: ArrayLike, T: ArrayLike) -> np.ndarray:
+    """Bilinear interpolation in :func:`textured_rgb_table` at ``(cos theta, T)``: the twin of ``textured_tabulated_rgb`` (lib/bragg.glsl)."""
+    rows, columns = table.shape[:2]
+    x = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0) * (columns - 1)
+    y = np.clip(np.asarray(T, dtype=np.float64), 0.0, 1.0) * (rows - 1)
+    i = np.minimum(np.floor(x).astype(np.int64), columns - 2)
+    j = np.minimum(np.floor(y).astype(np.int64), rows - 2)
+    fx, fy = (x - i)[..., None], (y - j)[..., None]
+    t = table.astype(np.float64)
+    top = t[j, i] * (1.0 - fx) + t[j, i + 1] * fx
+    bottom = t[j + 1, i] * (1.0 - fx) + t[j + 1, i + 1] * fx
+    return top * (1.0 - fy) + bottom * fy

@@ -36,7 +36,8 @@ def render_numpy(
 
     ``light`` (``lit``, ``scatter``, ``textured``): ``(theta, phi)`` in degrees, default :data:`explorer.views.geometry.DEFAULT_LIGHT`.
     ``thickness`` (``textured``): an :class:`explorer.views.thickness.ThicknessTexture` (default: the default
-    texture over the default D_inc range, without prefiltering).
+    texture over the default D_inc range, without prefiltering) or, for a Bragg mirror, an
+    :class:`explorer.views.surface_texture.BraggTexture` (default: the default texture, both mappings).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
     ``plot`` (the plots, :mod:`explorer.views.plots`): a :class:`explorer.views.plots.PlotSettings` (default: its defaults).
@@ -58,7 +59,10 @@ def render_numpy(
 
         if not callable(getattr(model, "textured_brdf", None)):
             raise ValueError(f"the textured view needs the model's textured_brdf(); {type(model).__name__} has none")
-        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        if thickness is None:  # the default texture of what the model varies
+            from explorer.views.surface_texture import BraggTexture
+
+            thickness = BraggTexture.from_file() if callable(getattr(model, "texture_table", None)) else ThicknessTexture.from_file()
         L, V, N, X, Y, inside, factor = brdf_view_geometry("lit", width, height, light)
         x, y, _ = disc(width, height)
         d_inc, sigma = thickness.per_pixel(x, y, width, height)
@@ -66,7 +70,7 @@ def render_numpy(
         vectors = [a[inside] for a in (L, V, N, X, Y)]
 
         def textured_brdf(L, V, N, X, Y, d_inc, sigma):
-            return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter)
+            return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter, **thickness.model_options())
 
         rgb = _chunked(lambda *a: view_brdf(textured_brdf, *a), *vectors, d_inc[inside], sigma[inside])
         image[inside] = rgb * factor[inside][:, None]
