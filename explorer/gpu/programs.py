@@ -40,6 +40,8 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
         builder.define(name, value)
     for name, value in constants:
         builder.define(f"SPECIALISED_{name}", value)
+    # The view, for code only one view reads (a textured mirror's table: no sampler left in a .brdf export).
+    builder.define(f"VIEW_{view.upper()}", 1)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
     builder.add_source(material.shader, str(material.path), material.shader_line)
     builder.add_file(template)

@@ -504,6 +504,8 @@ BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
     return mirror;
 }
 
+// Only in the textured view (the host defines VIEW_<name>): no sampler left in other views or a .brdf export.
+#ifdef VIEW_TEXTURED
 // The tabulated method of a textured mirror: the table over (cos theta across, T down), rows at T = k / (rows - 1),
 // bilinear between four texels in float (as tabulated_rgb). Twin: explorer.physics.bragg.textured_tabulated_rgb.
 vec3 textured_tabulated_rgb(sampler2D table, float cos_theta, float T) {
@@ -516,3 +518,4 @@ vec3 textured_tabulated_rgb(sampler2D table, float cos_theta, float T) {
     vec3 bottom = mix(texelFetch(table, ivec2(i, min(j + 1, last.y)), 0).rgb, texelFetch(table, ivec2(min(i + 1, last.x), min(j + 1, last.y)), 0).rgb, x - float(i));
     return mix(top, bottom, y - float(j));
 }
+#endif

@@ -1,0 +1,64 @@
+"""
+Supplemental Figure 7 of Fourneau et al. (2024) by ``render``: a smooth Bragg mirror (n1 = 1, n2 = 1.5,
+Lambda = 500 nm, delta = 0.15) homogeneous, with Lambda(x) = Lambda (0.5 + 0.5 T(x)), with delta(x) = delta^T(x),
+and with both, T the shipped noise texture; the textured view (the lit sphere, light head-on) on the GPU.
+Writes ``docs/figures/figure7_textured_bragg.png`` (the texture, then the four spheres), and prints the
+``render`` commands it runs (their images are the same).
+
+    python -m explorer.dev.figure7 [--method 3] [--size 256] [--out docs/figures/figure7_textured_bragg.png]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+FIGURE7 = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.15}
+MAPPINGS = (("none", "(a) homogeneous"), ("lambda", "(c) Lambda mapped"), ("delta", "(d) delta mapped"), ("both", "(e) both"))
+LIGHT = (0.0, 0.0)
+
+
+def main(argv=None) -> None:
+    from PIL import Image, ImageDraw
+
+    from explorer.cli.commands import render_material
+    from explorer.files import atomic_output
+    from explorer.materials.brd import load_material
+    from explorer.physics.colorimetry import encode_srgb8
+    from explorer.resources import DEFAULT_TEXTURE, SHADER_DIR
+    from explorer.views.surface_texture import BraggTexture
+    from explorer.views.thickness import load_grey
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument("--method", type=int, default=3)
+    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--out", type=Path, default=Path("docs/figures/figure7_textured_bragg.png"))
+    args = parser.parse_args(argv)
+    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    values = material.resolve({**FIGURE7, "method": args.method})
+    size, label = args.size, 24
+    texture = np.round(255 * load_grey(DEFAULT_TEXTURE)).astype(np.uint8)
+    panels = [("(b) texture T", Image.fromarray(texture, "L").convert("RGB").resize((size, size), Image.BILINEAR))]
+    sets = " ".join(f"--set {k}={v:g}" for k, v in {**FIGURE7, "method": args.method}.items())
+    for mapping, caption in MAPPINGS:
+        start = time.perf_counter()
+        image = render_material(material, values, "textured", size, size, "gl", LIGHT, BraggTexture.from_file(DEFAULT_TEXTURE, mapping))
+        print(f"python3 -m explorer render bragg_mirror --view textured --mapping {mapping} {sets} --light 0,0 "
+              f"--size {size} --out {mapping}.png  # {time.perf_counter() - start:.2f} s")
+        panels.append((caption, Image.fromarray(encode_srgb8(image), "RGB")))
+    sheet = Image.new("RGB", (len(panels) * size, size + label), "white")
+    draw = ImageDraw.Draw(sheet)
+    for k, (caption, panel) in enumerate(panels):
+        sheet.paste(panel, (k * size, label))
+        draw.text((k * size + 6, 5), caption, fill="black")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(args.out, (".png",)) as temporary:
+        sheet.save(temporary, format="PNG")
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
