@@ -84,7 +84,7 @@ def accuracy(size: int = 128) -> None:
     start = time.perf_counter()
     bragg.textured_rgb_table(bragg.BraggMirror(1.0, 1.5, 500.0 + 1e-6, 0.15, 20), "both")
     print(f"(cos theta, T) table {bragg.TEXTURE_TABLE_COLUMNS}x{bragg.TEXTURE_TABLE_ROWS}: built in {time.perf_counter() - start:.2f} s")
-    print(f"| mapping | method | ΔE2000 median | p99 | max |\n|---|---|---|---|---|")
+    print("| mapping | method | ΔE2000 median | p99 | max |\n|---|---|---|---|---|")
     for mapping in ("lambda", "delta", "both"):
         texture = BraggTexture.from_file(DEFAULT_TEXTURE, mapping)
         images = {m: render_material(material, material.resolve({**FIGURE7, "method": m, "wavelength_step": 0.25 if m == 0 else 1.0}),

@@ -1,10 +1,12 @@
-// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a film
-// thickness that varies over it (Belcour & Barla 2017, Section 5, Figures 12-15). The material must
-// define textured_BRDF(L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered) (shaders/thin_film.brd).
-// Planar parametrisation (explorer/views/thickness.py): pixel p = (x, y) reads D_inc (nm) from surface_texture at
+// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a material
+// parameter that varies over it, as the material declares ('# texture:', explorer/views/surface_texture.py): a
+// thin film's D_inc (Belcour & Barla 2017, Section 5, Figures 12-15; surface_texture holds D_inc in nm) or a Bragg
+// mirror's Lambda and delta (supplemental Figure 7; surface_texture holds T in [0, 1]). The material defines
+// textured_BRDF(L, V, N, X, Y, value, sigma_value, prefiltered) (shaders/thin_film.brd, shaders/bragg_mirror.brd).
+// Planar parametrisation (explorer/views/thickness.py): pixel p = (x, y) reads surface_texture at
 // u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinearly between texel centres, clamped.
-// prefilter: D_inc's mean and variance over the pixel's footprint come from surface_moments (computed by the
-// host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
+// prefilter (the film only): the value's mean and variance over the pixel's footprint come from surface_moments
+// (computed by the host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
 // The rule of lib/views.glsl's view_brdf applies: 0 unless N.L > 0 and N.V > 0, non-finite channels 0.
 // Twin: explorer.views.render.render_numpy(model, 'textured', ..., thickness=...).
 #include "lib/views.glsl"
