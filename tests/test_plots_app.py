@@ -1,0 +1,31 @@
+"""The app's Plots window (explorer/app/panels/plots.py) in a scripted session under Xvfb: the registry's plots chosen in its combo."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from conftest import BRAGG_MATERIAL
+from test_app import run_session, x_display  # noqa: F401  (the session's Xvfb fixture)
+
+
+def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material):  # noqa: F811
+    """theta_h chosen in the combo: the window's curve is the numpy twin's at the app's values (light irrelevant)."""
+    from explorer.materials.models import model_for
+    from explorer.views.geometry import light_direction
+    from explorer.views.plots import PlotSettings, cos_light, plot_numpy, plotted
+
+    actions = [{"wait": 2}, {"wait_complete": True}, {"focus": "Plots"}, {"wait": 3}, {"click": "plot_combo"}, {"wait": 2},
+               {"click": "plot:theta_h"}, {"wait": 5}, {"wait_complete": True}, {"wait": 5}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert "clicked plot:theta_h" in report["script_log"], report["script_log"]
+    plots = report["plots"]
+    assert plots is not None and plots["view"] == "theta_h", plots and plots["view"]
+    settings = PlotSettings(**plots["settings"])
+    width, height = plots["size"]
+    model = model_for(bragg_material, bragg_material.resolve(report["values"]))
+    direction = light_direction(tuple(plots["light"]))
+    expected = plotted(plot_numpy(model, "theta_h", width, height, direction, settings),
+                       settings, cos_light("theta_h", width, height, direction, settings))
+    shown = np.asarray(plots["values"])
+    assert shown.shape == expected.shape
+    np.testing.assert_allclose(shown, expected, rtol=2e-3, atol=1e-5)
