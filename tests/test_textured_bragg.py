@@ -142,3 +142,61 @@ def test_cli_textured_needs_a_declared_texture_and_its_own_options(tmp_path):
         line = one_line_error(run_cli("render", *args, "--engine", "numpy", "--size", "8", "--out", out))
         assert named in line, f"{name}: {line}"
         assert not out.exists(), name
+
+
+# -- under an environment (the env view) -------------------------------------------------------------------
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("method", [1, 3])
+def test_textured_mirror_under_an_environment_gl_equals_numpy(gl_renderer, mirror, method):
+    """A smooth mirror's env view is its Dirac alone (no sampling): GL equals the exact integral, texture and all."""
+    from explorer.gpu.env import render_env
+    from explorer.materials.models import model_for
+    from explorer.views.env import EnvironmentMap, env_integral_numpy
+    from explorer.views.surface_texture import BraggTexture
+
+    values = mirror.resolve({**FIGURE7, "method": method})
+    texture = BraggTexture(stripes(), "both")
+    environment = EnvironmentMap.default()
+    gl = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer, surface=texture)
+    reference = env_integral_numpy(model_for(mirror, values), environment, *SIZE, surface=texture)
+    assert_twins_equal(Twins.of(gl, reference, "env"), f"textured env method {method}")
+    plain = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer)
+    assert np.abs(plain - gl).max() > 0.02  # the texture shows
+
+
+@pytest.mark.gl
+def test_textured_film_under_an_environment_at_a_constant_texture_is_the_film(gl_renderer):
+    """A constant D_inc = 2 eta2 d: the same film, the same random numbers, the same Monte Carlo image."""
+    from explorer.gpu.env import render_env
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import model_for
+    from explorer.views.thickness import ThicknessTexture
+
+    film = load_material(REPO_ROOT / "shaders" / "thin_film.brd")
+    values = film.resolve({"method": 2, "alpha": 0.2})
+    d_inc = 2.0 * values["eta2"] * values["d"]
+    model = model_for(film, values)
+    cos_theta = np.linspace(0.1, 1.0, 5)
+    np.testing.assert_allclose(model.textured_reflectance(cos_theta, np.full(5, d_inc), 0.0, False), model.reflectance(cos_theta), atol=1e-9)
+    texture = ThicknessTexture(np.full((4, 4), d_inc, np.float32))
+    textured = render_env(film, values, *SIZE, spp=8, renderer=gl_renderer, surface=texture)
+    plain = render_env(film, values, *SIZE, spp=8, renderer=gl_renderer)
+    assert np.abs(plain).max() > 0.01
+    np.testing.assert_allclose(textured, plain, rtol=1e-3, atol=1e-5)
+    varied = render_env(film, values, *SIZE, spp=8, renderer=gl_renderer, surface=ThicknessTexture(np.asarray(stripes() * 1500.0, np.float32)))
+    assert np.abs(varied - plain).max() > 0.01
+
+
+def test_cli_env_texture_options(tmp_path):
+    out = tmp_path / "out.png"
+    cases = {
+        "prefilter under env": (["thin_film", "--view", "env", "--texture", REPO_ROOT / "shaders" / "textures" / "thickness_noise.png",
+                                 "--prefilter", "on"], "--prefilter"),
+        "texture on a material without one": (["ggx_schlick", "--view", "env", "--mapping", "both"], "# texture:"),
+    }
+    for name, (args, named) in cases.items():
+        line = one_line_error(run_cli("render", *args, "--engine", "numpy", "--size", "8", "--out", out))
+        assert named in line, f"{name}: {line}"
+        assert not out.exists(), name

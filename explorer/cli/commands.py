@@ -116,9 +116,12 @@ def render_material(
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
 
+        if thickness is not None:
+            raise LocatedError("--engine", None, "the Mitsuba plugins have no surface texture: --engine gl or numpy")
+
         return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp)
+        return _render_env(material, values, width, height, engine, environment, spp, surface=thickness)
     if view == "textured":
         from explorer.views.surface_texture import check_texture_kind, default_texture
         from explorer.views.thickness import check_prefilter
@@ -201,7 +204,8 @@ def check_numpy_size(width: int, height: int) -> None:
                                            f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
 
 
-def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int) -> np.ndarray:
+def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int,
+                surface=None) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
@@ -228,7 +232,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         click.echo(f"{PROG}: warning: {message}", err=True)
 
     return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn)
+                      progress=progress, warn=warn, surface=surface)
 
 
 @click.group(invoke_without_command=True, context_settings={"help_option_names": ["-h", "--help"]})
@@ -362,9 +366,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
         raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
     thickness = None
-    if view == "textured":
+    surface_given = texture is not None or dinc_range is not None or mapping is not None
+    if view == "textured" or (view == "env" and surface_given):
         from explorer.views.surface_texture import BraggTexture, check_texture_kind
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
+
+        if view == "env" and prefilter == "on":
+            raise click.BadParameter("prefiltering is the textured view's (the env view reads the texture unfiltered)", param_hint="--prefilter")
 
         if check_texture_kind(loaded) == "bragg":
             if dinc_range is not None or prefilter == "on":
@@ -378,7 +386,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
                 texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
             )
     elif texture is not None or dinc_range is not None or prefilter == "on" or mapping is not None:
-        raise click.BadParameter("--texture, --dinc-range, --prefilter and --mapping are for the textured view", param_hint="--view")
+        raise click.BadParameter("--texture, --dinc-range, --prefilter and --mapping are for the textured and env views", param_hint="--view")
     environment = None
     if view == "env":
         from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap

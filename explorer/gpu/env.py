@@ -72,7 +72,7 @@ class ProgressiveEnvRender:
 
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
-        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS,
+        *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, surface=None,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -94,6 +94,11 @@ class ProgressiveEnvRender:
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
+        #: The material's surface texture (explorer.views.surface_texture), or None.
+        self.surface = surface
+        self._surface_textures: dict = {}
+        # A program keeps its uniforms between renders: an untextured render must say so.
+        self._surface_uniforms: dict = {"textured": False}
         self.reset()
 
     def reset(self, values: Mapping[str, object] | None = None) -> None:
@@ -101,6 +106,12 @@ class ProgressiveEnvRender:
         if values is not None:
             self.values = dict(values)
         self.program = self.renderer.program(self.material, "env", self.values)
+        if self.surface is not None:  # uploaded once per reset (a textured mirror's table follows its values)
+            self.renderer.resources.release(*self._surface_textures.values())
+            arguments = self.surface.gl_arguments(self.material, self.values, self.width, self.height)
+            self._surface_textures = {name: self.renderer.resources.texture(array, origin=name)
+                                      for name, array in arguments["inputs"].items()}
+            self._surface_uniforms = {**arguments["uniforms"], "textured": True}
         self._framebuffer.use()
         self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
         #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
@@ -112,6 +123,8 @@ class ProgressiveEnvRender:
         """The program's uniforms and textures for :meth:`_pass` (the material's, the environment, the seed)."""
         uniforms, textures = self.renderer.bindings(self.program, self.material, self.values)
         uniforms["seed"] = self.seed
+        uniforms.update(self._surface_uniforms)
+        textures.update(self._surface_textures)
         textures["environment"] = self._texture
         return {"uniforms": uniforms, "textures": textures}
 
@@ -214,19 +227,21 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture)
+        self.renderer.resources.release(self._framebuffer, self._texture, *self._surface_textures.values())
+        self._surface_textures = {}
 
 
 def render_env(
     material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
     environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
-    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None, surface=None,
 ) -> np.ndarray:
     """
     The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
     (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
-    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite.
+    pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite. ``surface``: the
+    material's surface texture (:mod:`explorer.views.surface_texture`; no prefiltering), or None.
     """
     if not 1 <= spp <= MAX_SPP:
         raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
@@ -235,9 +250,9 @@ def render_env(
         from explorer.materials.models import model_for
 
         model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress)
+        return env_integral_numpy(model, environment, width, height, progress=progress, surface=surface)
     renderer = Renderer() if renderer is None else renderer
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, surface=surface)
     try:
         while render.samples < spp:
             render.step(min(spp - render.samples, max(1, render.samples_per_pass)))

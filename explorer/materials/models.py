@@ -100,6 +100,11 @@ class BraggMirrorModel:
         variant = {"variant": "improved"} if self.method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
 
+    def textured_mirror_reflection(self, V, N, T, mapping: str = "both") -> np.ndarray:
+        """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
+        cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)
+        return self.textured_reflectance(cos_theta, T, mapping)
+
     def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both") -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`textured_reflectance` at the half-vector angle (no prefiltering)."""
         if prefiltered:
@@ -162,6 +167,7 @@ class BraggLayerModel(BraggMirrorModel):
     mirror_reflection = None
     mirror_only = False
     textured_brdf = None
+    textured_mirror_reflection = None
 
     def __init__(self, values: Mapping[str, object]):
         super().__init__(values)

@@ -37,6 +37,8 @@ class View:
     #: A plot (:mod:`explorer.views.plots`): ``curve`` (one value per column, every row the same) or
     #: ``lobe`` (a value per outgoing direction); its PNG is a chart, its ``.npy`` the plotted values.
     plot: str | None = None
+    #: Reads the surface texture of a material that declares ``# texture:`` (the host #defines SURFACE_TEXTURE).
+    surface_texture: bool = False
 
     @property
     def takes_light(self) -> bool:
@@ -50,8 +52,8 @@ VIEW_REGISTRY: dict[str, View] = {view.name: view for view in (
     View("lit", "brdf", light_theta_max=180.0),
     View("slice", "brdf"),
     View("scatter", "brdf", light_theta_max=90.0, circles=True),
-    View("textured", "textured_brdf", light_theta_max=180.0),
-    View("env", "environment"),
+    View("textured", "textured_brdf", light_theta_max=180.0, surface_texture=True),
+    View("env", "environment", surface_texture=True),
     # BRDF Explorer's plots (explorer/views/plots.py): curves W samples wide, the lobe over (phi_o, theta_o).
     View("theta_v", "brdf_plot", default_size=(512, 1), square=False, light_theta_max=90.0, plot="curve"),
     View("theta_h", "brdf_plot", default_size=(512, 1), square=False, plot="curve"),

@@ -504,8 +504,8 @@ BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
     return mirror;
 }
 
-// Only in the textured view (the host defines VIEW_<name>): no sampler left in other views or a .brdf export.
-#ifdef VIEW_TEXTURED
+// Only in the views that read a surface texture (the host defines SURFACE_TEXTURE): no sampler in a .brdf export.
+#ifdef SURFACE_TEXTURE
 // The tabulated method of a textured mirror: the table over (cos theta across, T down), rows at T = k / (rows - 1),
 // bilinear between four texels in float (as tabulated_rgb). Twin: explorer.physics.bragg.textured_tabulated_rgb.
 vec3 textured_tabulated_rgb(sampler2D table, float cos_theta, float T) {

@@ -58,3 +58,23 @@ void rusinkiewicz_directions(float theta_h, float theta_d, float phi_d, out vec3
     L = vec3(D.x * c + D.z * s, D.y, -D.x * s + D.z * c);
     V = 2.0 * dot(H, L) * H - L;
 }
+
+// -- The surface texture (textured and env views; the host #defines SURFACE_TEXTURE): what a material's
+// '# texture:' varies (explorer/views/surface_texture.py). Planar parametrisation of the disc point p:
+// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped.
+#ifdef SURFACE_TEXTURE
+uniform sampler2D surface_texture;
+
+float surface_bilinear(vec2 uv) {
+    ivec2 size = textureSize(surface_texture, 0);
+    vec2 t = clamp(uv * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    ivec2 i = min(ivec2(floor(t)), max(size - 2, ivec2(0)));
+    vec2 f = t - vec2(i);
+    ivec2 i1 = min(i + 1, size - 1);
+    float top = mix(texelFetch(surface_texture, i, 0).r, texelFetch(surface_texture, ivec2(i1.x, i.y), 0).r, f.x);
+    float bottom = mix(texelFetch(surface_texture, ivec2(i.x, i1.y), 0).r, texelFetch(surface_texture, i1, 0).r, f.x);
+    return mix(top, bottom, f.y);
+}
+
+float surface_value(vec2 p) { return surface_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y))); }
+#endif

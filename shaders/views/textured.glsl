@@ -13,21 +13,9 @@
 
 uniform vec2 resolution;
 uniform vec3 light_direction;
-uniform sampler2D surface_texture;
 uniform sampler2D surface_moments;
 uniform bool prefilter;
 out vec4 frag_colour;
-
-float dinc_bilinear(vec2 uv) {
-    ivec2 size = textureSize(surface_texture, 0);
-    vec2 t = clamp(uv * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
-    ivec2 i = min(ivec2(floor(t)), max(size - 2, ivec2(0)));
-    vec2 f = t - vec2(i);
-    ivec2 i1 = min(i + 1, size - 1);
-    float top = mix(texelFetch(surface_texture, i, 0).r, texelFetch(surface_texture, ivec2(i1.x, i.y), 0).r, f.x);
-    float bottom = mix(texelFetch(surface_texture, ivec2(i.x, i1.y), 0).r, texelFetch(surface_texture, i1, 0).r, f.x);
-    return mix(top, bottom, f.y);
-}
 
 void main() {
     vec2 p;
@@ -46,7 +34,7 @@ void main() {
         D_inc_ = moments.x;
         sigma = sqrt(max(moments.y, 0.0));
     } else {
-        D_inc_ = dinc_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y)));
+        D_inc_ = surface_value(p);
     }
     vec3 f = above_surface(light_direction, view, normal)
         ? finite_or_zero(textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter))
