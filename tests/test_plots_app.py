@@ -29,3 +29,23 @@ def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material)
     shown = np.asarray(plots["values"])
     assert shown.shape == expected.shape
     np.testing.assert_allclose(shown, expected, rtol=2e-3, atol=1e-5)
+
+
+def test_texture_window_shows_the_textured_mirror(x_display, tmp_path, gl_renderer, bragg_material):  # noqa: F811
+    """The Texture window on the default mirror, mapping delta chosen: its image is the headless textured render."""
+    from explorer.views.surface_texture import BraggTexture
+
+    actions = [{"wait": 2}, {"wait_complete": True}, {"focus": "Texture"}, {"wait": 3}, {"click": "mapping_combo"}, {"wait": 2},
+               {"click": "mapping:delta"}, {"wait": 5}, {"wait_complete": True}, {"wait": 8}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    assert "clicked mapping:delta" in report["script_log"], report["script_log"]
+    shown = report["texture_view"]
+    assert shown is not None and shown["mapping"] == "delta", shown
+    values = bragg_material.resolve(shown["values"])
+    width, height = shown["size"]
+    texture = BraggTexture.from_file(shown["path"], "delta")
+    theta = np.degrees(np.arccos(np.clip(shown["light"][2], -1.0, 1.0)))
+    phi = np.degrees(np.arctan2(shown["light"][1], shown["light"][0]))
+    image = gl_renderer.render(bragg_material, values, "textured", width, height, light=(theta, phi),
+                               **texture.gl_arguments(bragg_material, values, width, height))
+    np.testing.assert_allclose(shown["mean_rgb"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)

@@ -224,7 +224,7 @@ class App:
             "frames": s.frame_times, "screenshots": s.screenshots, "screenshot_info": s.screenshot_info,
             "error": s.error, "status": s.status, "script_log": self.robot.log if self.robot else [],
             "mean_delta_e": s.mean_delta_e, "inverse": s.inverse, "design": s.design, "accuracy": s.accuracy,
-            "plots": s.plots,
+            "plots": s.plots, "texture_view": s.texture_view,
         }
         from explorer.files import write_text_atomic
 

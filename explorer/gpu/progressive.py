@@ -85,17 +85,23 @@ class ProgressiveView:
     def request(
         self, material: Material, values: Mapping[str, object], view: str, size: tuple[int, int], *,
         light: tuple[float, float, float] | None = None, uniforms: Mapping[str, object] | None = None,
-        dragging: bool = False,
+        dragging: bool = False, inputs: Mapping[str, object] | None = None,
     ) -> None:
-        """What to show; a change restarts the image (``dragging``: stay on the preview)."""
+        """
+        What to show; a change restarts the image (``dragging``: stay on the preview). ``inputs``: a view's own
+        textures (the textured view's), as :meth:`explorer.gpu.Renderer.bindings` takes them; a new mapping
+        object is a change.
+        """
         self.dragging = dragging
-        key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}))
+        key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}),
+               id(inputs))
         if key == self._key:
             return
         self._key = key
         self.material, self.values, self.view = material, dict(values), view
         self.light = None if light is None else tuple(float(c) for c in light)
         self.uniforms = dict(uniforms or {})
+        self.inputs = inputs
         if tuple(size) != self.size:
             self._allocate(tuple(size))
         self.has_preview = False
@@ -124,7 +130,7 @@ class ProgressiveView:
     def _draw(self, framebuffer, size, rows: tuple[int, int] | None = None) -> float:
         """Draw into ``framebuffer`` (rows ``[top, bottom)`` from the top only); returns ms (glFinish-bounded)."""
         program = self._program()
-        uniforms, textures = self.renderer.bindings(program, self.material, self.values, None, self.uniforms)
+        uniforms, textures = self.renderer.bindings(program, self.material, self.values, getattr(self, "inputs", None), self.uniforms)
         if self.light is not None:
             uniforms["light_direction"] = self.light
         elapsed = self.renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures, rows=rows)
