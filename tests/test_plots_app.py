@@ -15,7 +15,7 @@ def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material)
     from explorer.views.plots import PlotSettings, cos_light, plot_numpy, plotted
 
     actions = [{"wait": 2}, {"wait_complete": True}, {"focus": "Plots"}, {"wait": 3}, {"click": "plot_combo"}, {"wait": 2},
-               {"click": "plot:theta_h"}, {"wait": 5}, {"wait_complete": True}, {"wait": 5}, {"quit": True}]
+               {"click": "plot:theta_h"}, {"wait": 3}, {"wait_for": "plots"}, {"quit": True}]
     _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
     assert "clicked plot:theta_h" in report["script_log"], report["script_log"]
     plots = report["plots"]
@@ -36,7 +36,7 @@ def test_texture_window_shows_the_textured_mirror(x_display, tmp_path, gl_render
     from explorer.views.surface_texture import BraggTexture
 
     actions = [{"wait": 2}, {"wait_complete": True}, {"focus": "Texture"}, {"wait": 3}, {"click": "mapping_combo"}, {"wait": 2},
-               {"click": "mapping:delta"}, {"wait": 5}, {"wait_complete": True}, {"wait": 8}, {"quit": True}]
+               {"click": "mapping:delta"}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
     _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
     assert "clicked mapping:delta" in report["script_log"], report["script_log"]
     shown = report["texture_view"]

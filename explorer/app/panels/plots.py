@@ -74,7 +74,9 @@ class PlotsPanel(Panel):
         job.request(self.state.material, self.state.values, self.view, size, light=tuple(float(c) for c in light_direction(light)),
                     uniforms=gl_uniforms(self.view, settings), dragging=self.app.dragging)
         key = (self.view, settings, light)
-        if job.complete and (job.generation != self._generation or key != self._key):
+        if not job.complete:  # a new curve on its way (scripts wait_for it)
+            self.state.plots = {"running": True}
+        elif job.generation != self._generation or key != self._key:
             image = job.read().astype(np.float64)
             self._values = plotted(image, settings, cos_light(self.view, size[0], size[1], light_direction(light), settings))
             self._generation, self._key = job.generation, key

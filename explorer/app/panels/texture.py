@@ -34,6 +34,8 @@ class TexturePanel(Panel):
         self._arguments = None
         self._arguments_key = None
         self._generation = -1
+        self._pending = None  # (key, values, future) of the arguments being built on the worker thread
+        self._executor = None
 
     def _texture(self, kind: str):
         """The surface texture of the current settings (loaded again only when they change)."""
@@ -79,16 +81,32 @@ class TexturePanel(Panel):
         job = self.scheduler.job("textured")
         values = self.scheduler.prefetcher.values(state.material, state.values, self.app.dragging)
         key = (id(state.material), tuple(sorted((k, str(v)) for k, v in values.items())), self._surface_key)
-        # The textured mirror's tabulated table takes seconds: rebuilt once a slider is released.
-        if key != self._arguments_key and not (self.app.dragging and self._arguments is not None):
-            self._arguments = surface.gl_arguments(state.material, values, *size)
-            self._arguments_key = key
-            self._values = dict(values)
+        # The textured mirror's tabulated table takes seconds: built on a worker thread once a slider is
+        # released, the last image shown meanwhile.
+        if self._pending is not None and self._pending[2].done():
+            pending_key, pending_values, future = self._pending
+            self._pending = None
+            try:
+                self._arguments, self._arguments_key, self._values = future.result(), pending_key, pending_values
+            except Exception as error:  # noqa: BLE001 - a material's own error, shown in the window
+                self.message = f"{type(error).__name__}: {error}"
+        wanted = key != self._arguments_key and not (self.app.dragging and self._arguments is not None)
+        if wanted and (self._pending is None or self._pending[0] != key):
+            import concurrent.futures
+
+            if self._executor is None:
+                self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="texture")
+            self._pending = (key, dict(values), self._executor.submit(surface.gl_arguments, state.material, dict(values), *size))
+        if self._arguments is None:
+            imgui.text("building the texture's tables…")
+            return
         job.request(state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
                     uniforms=self._arguments["uniforms"], inputs=self._arguments["inputs"], dragging=self.app.dragging)
         show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
         imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + (f"  {job.error}" if job.error else ""))
-        if job.complete and job.generation != self._generation:
+        if not (job.complete and self._arguments_key == key):  # a new image on its way (scripts wait_for it)
+            state.texture_view = {"running": True}
+        elif job.generation != self._generation or not state.texture_view or state.texture_view.get("running"):
             self._generation = job.generation
             image = job.read()
             state.texture_view = {"kind": kind, "path": self.path, "mapping": self.mapping, "dinc_range": list(self.dinc_range),
