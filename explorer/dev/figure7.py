@@ -1,9 +1,10 @@
 """
 Supplemental Figure 7 of Fourneau et al. (2024) by ``render``: a smooth Bragg mirror (n1 = 1, n2 = 1.5,
 Lambda = 500 nm, delta = 0.15) homogeneous, with Lambda(x) = Lambda (0.5 + 0.5 T(x)), with delta(x) = delta^T(x),
-and with both, T the shipped noise texture; the textured view (the lit sphere, light head-on) on the GPU.
-Writes ``docs/figures/figure7_textured_bragg.png`` (the texture, then the four spheres), and prints the
-``render`` commands it runs (their images are the same).
+and with both, T the shipped noise texture, on the GPU: the textured view (the lit sphere, light head-on)
+in the first row, the env view (the mirror reflecting the shipped environment, as the paper's figure) in
+the second. Writes ``docs/figures/figure7_textured_bragg.png`` (the texture, then the four spheres), and
+prints the ``render`` commands it runs (their images are the same).
 
     python -m explorer.dev.figure7 [--method 3] [--size 256] [--out docs/figures/figure7_textured_bragg.png]
     python -m explorer.dev.figure7 --accuracy   # ΔE2000 of methods 1, 3, 4 against the reference (docs/textured_bragg.md)
@@ -47,18 +48,24 @@ def main(argv=None) -> None:
     size, label = args.size, 24
     texture = np.round(255 * load_grey(DEFAULT_TEXTURE)).astype(np.uint8)
     panels = [("(b) texture T", Image.fromarray(texture, "L").convert("RGB").resize((size, size), Image.BILINEAR))]
+    env_panels = [("under the environment (env view)", Image.new("RGB", (size, size), "white"))]
     sets = " ".join(f"--set {k}={v:g}" for k, v in {**FIGURE7, "method": args.method}.items())
     for mapping, caption in MAPPINGS:
-        start = time.perf_counter()
-        image = render_material(material, values, "textured", size, size, "gl", LIGHT, BraggTexture.from_file(DEFAULT_TEXTURE, mapping))
-        print(f"python3 -m explorer render bragg_mirror --view textured --mapping {mapping} {sets} --light 0,0 "
-              f"--size {size} --out {mapping}.png  # {time.perf_counter() - start:.2f} s")
-        panels.append((caption, Image.fromarray(encode_srgb8(image), "RGB")))
-    sheet = Image.new("RGB", (len(panels) * size, size + label), "white")
+        surface = BraggTexture.from_file(DEFAULT_TEXTURE, mapping)
+        for view, row in (("textured", panels), ("env", env_panels)):
+            start = time.perf_counter()
+            light = LIGHT if view == "textured" else None
+            image = render_material(material, values, view, size, size, "gl", light, surface, spp=1)
+            options = "--light 0,0" if view == "textured" else "--texture shaders/textures/thickness_noise.png --spp 1"
+            print(f"python3 -m explorer render bragg_mirror --view {view} --mapping {mapping} {sets} {options} "
+                  f"--size {size} --out {mapping}_{view}.png  # {time.perf_counter() - start:.2f} s")
+            row.append((caption if view == "textured" else "", Image.fromarray(encode_srgb8(image), "RGB")))
+    sheet = Image.new("RGB", (len(panels) * size, 2 * (size + label)), "white")
     draw = ImageDraw.Draw(sheet)
-    for k, (caption, panel) in enumerate(panels):
-        sheet.paste(panel, (k * size, label))
-        draw.text((k * size + 6, 5), caption, fill="black")
+    for r, row in enumerate((panels, env_panels)):
+        for k, (caption, panel) in enumerate(row):
+            sheet.paste(panel, (k * size, label + r * (size + label)))
+            draw.text((k * size + 6, 5 + r * (size + label)), caption, fill="black")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(args.out, (".png",)) as temporary:
         sheet.save(temporary, format="PNG")
