@@ -16,6 +16,8 @@ from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
 
 TEXTURE_VIEW_SIZE = 256
+#: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
+ENV_SAMPLES = 256
 
 
 class TexturePanel(Panel):
@@ -36,6 +38,9 @@ class TexturePanel(Panel):
         self._generation = -1
         self._pending = None  # (key, values, future) of the arguments being built on the worker thread
         self._executor = None
+        #: Under the environment: the env view's progressive Monte Carlo with the surface texture.
+        self.environment = False
+        self._env = None  # (key, ProgressiveEnvRender, AccumulatedImage)
 
     def _texture(self, kind: str):
         """The surface texture of the current settings (loaded again only when they change)."""
@@ -72,6 +77,8 @@ class TexturePanel(Panel):
         else:
             _, self.dinc_range = imgui.slider_float2("D_inc range (nm)", self.dinc_range, 0.0, DINC_MAX, "%.0f")
             self.dinc_range = list(self.dinc_range)
+        _, self.environment = imgui.checkbox("under the environment (env view)", self.environment)
+        record(state, "texture_env")
         surface = self._texture(kind)
         if self.message:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), self.message)
@@ -100,6 +107,12 @@ class TexturePanel(Panel):
         if self._arguments is None:
             imgui.text("building the texture's tables…")
             return
+        if self.environment:
+            source = self._env_source(surface, size)
+            show_image(state, self.scheduler.show("textured_env", size, source), size, "textured_image")
+            done = "done" if source.render.samples >= self._env_samples else "refining"
+            imgui.text(f"env: {source.render.samples} samples per pixel ({done})")
+            return
         job.request(state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
                     uniforms=self._arguments["uniforms"], inputs=self._arguments["inputs"], dragging=self.app.dragging)
         show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
@@ -114,5 +127,45 @@ class TexturePanel(Panel):
                                   "light": list(light_vector(state.light, state.camera)), "size": list(size),
                                   "mean_rgb": np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()}
 
+    def _env_source(self, surface, size):
+        """The env render of the current arguments' values under ``surface`` (a new one when they change)."""
+        from explorer.gpu.display import AccumulatedImage
+        from explorer.gpu.env import ProgressiveEnvRender
+
+        if self._env is None or self._env[0] != self._arguments_key:
+            if self._env is not None:
+                self._env[1].release()
+            self.scheduler.env.environment = self.scheduler.env.environment or _default_environment()
+            # The tables are those the worker built for these values (cached): no wait here.
+            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values,
+                                          self.scheduler.env.environment, *size, surface=surface)
+            from explorer.materials.models import model_for
+
+            model = model_for(self.state.material, self._values)
+            self._env_samples = 1 if getattr(model, "mirror_only", False) else ENV_SAMPLES
+            self._env = (self._arguments_key, render, AccumulatedImage(render))
+        return self._env[2]
+
     def gl_jobs(self) -> list:
-        return [self.scheduler.job("textured")] if self.state.material.texture in TEXTURE_KINDS else []
+        if self.state.material.texture not in TEXTURE_KINDS:
+            return []
+        if self.environment and self._env is not None:
+            return [] if self._env[1].samples >= self._env_samples else [_EnvWork(self._env[1])]
+        return [self.scheduler.job("textured")]
+
+
+def _default_environment():
+    from explorer.views.env import EnvironmentMap
+
+    return EnvironmentMap.default()
+
+
+class _EnvWork:
+    """A progressive env render as one of the frame's GL jobs (``work(budget_ms)``)."""
+
+    def __init__(self, render):
+        self.render = render
+
+    def work(self, budget_ms: float) -> float:
+        self.render.advance(max(0.5 * budget_ms, 5.0))
+        return budget_ms
