@@ -175,3 +175,15 @@ def test_cli_plot_options_belong_to_their_views(tmp_path):
         line = one_line_error(run_cli("render", SHADERS / "ggx_schlick.brd", *args, "--engine", "numpy", "--out", out))
         assert line, name
         assert not out.exists(), name
+
+
+def test_polar_window_draws_the_light_where_the_curve_puts_its_angle():
+    """The Polar window's incident segment lies at the light's signed theta of the curve (x toward phi = 0)."""
+    from explorer.app.data import polar_incident
+    from explorer.views.geometry import light_direction
+
+    for theta, phi, signed in ((30.0, 0.0, 30.0), (50.0, 180.0, -50.0), (0.0, 0.0, 0.0)):
+        xs, ys = polar_incident(light_direction((theta, phi)), 2.0)
+        assert xs[0] == ys[0] == 0.0
+        assert np.hypot(xs[1], ys[1]) == pytest.approx(2.0)
+        assert np.degrees(np.arctan2(xs[1], ys[1])) == pytest.approx(signed, abs=1e-4)

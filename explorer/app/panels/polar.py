@@ -46,11 +46,8 @@ class PolarPanel(Panel):
                 r = np.clip(brdf[:, channel], 0.0, None)
                 implot.plot_line("RGB"[channel], r * np.sin(radians), r * np.cos(radians), implot.Spec(line_color=imgui.ImVec4(*colour)))
             # The incident direction, projected on the plane (x toward phi = 0, as the curve's signed theta).
-            reach = float(max(np.clip(brdf, 0.0, None).max(), 1e-6))
-            x, _, z = light
-            norm = max(float(np.hypot(x, z)), 1e-9)
-            implot.plot_line("light", np.array([0.0, reach * x / norm]), np.array([0.0, reach * z / norm]),
-                             implot.Spec(line_color=imgui.ImVec4(1.0, 0.85, 0.2, 1.0), line_weight=2.0))
+            xs, ys = data.polar_incident(light, float(max(np.clip(brdf, 0.0, None).max(), 1e-6)))
+            implot.plot_line("light", xs, ys, implot.Spec(line_color=imgui.ImVec4(1.0, 0.85, 0.2, 1.0), line_weight=2.0))
             implot.end_plot()
 
     def gl_jobs(self) -> list:
