@@ -1267,7 +1267,8 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
 #: Supplemental Figure 7's mappings of a texture value ``T``: which of ``Lambda(x) = Lambda (0.5 + 0.5 T(x))`` and
 #: ``delta(x) = delta^T(x)`` apply; the shaders' ``texture_mapping`` is its bits (1: Lambda, 2: delta).
 TEXTURE_MAPPINGS = {"none": 0, "lambda": 1, "delta": 2, "both": 3}
-#: The tabulated method's textured table: rows of ``T = k / (rows - 1)``, columns of ``cos theta = i / (columns - 1)``.
+#: The tabulated method's textured table: at least this many rows of ``T = k / (rows - 1)`` (refined in T up to
+#: TEXTURE_TABLE_MAX_ROWS), columns of ``cos theta = i / (columns - 1)``.
 TEXTURE_TABLE_ROWS = 33
 TEXTURE_TABLE_COLUMNS = 129
 
@@ -1301,25 +1302,62 @@ def textured_reference_rgb(cos_theta: ArrayLike, mirror: BraggMirror, step: floa
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
 
 
+#: The textured table's refinement in T: first rows, the most rows (a uniform grid, so that the lookup stays one
+#: bilinear fetch), and the (cos theta, T) entries computed in all (the others interpolated along T).
+TEXTURE_TABLE_FIRST_ROWS = 17
+TEXTURE_TABLE_MAX_ROWS = 129
+TEXTURE_TABLE_BUDGET = 2 * TEXTURE_TABLE_COLUMNS * 33
+
+
+def _textured_row(mirror: BraggMirror, T: float, mapping: str, cos_theta: np.ndarray) -> np.ndarray:
+    """The converged colours (:func:`_converged_rgb`) of the mirror at texture value ``T``, at ``cos_theta``."""
+    m = textured_mirror(mirror, T, mapping)
+    return _converged_rgb(cos_theta, BraggMirror(mirror.n1, mirror.n2, float(m.Lambda), float(m.delta), mirror.N, mirror.nh))
+
+
 @functools.lru_cache(maxsize=8)
 def textured_rgb_table(mirror: BraggMirror, mapping: str, rows: int = TEXTURE_TABLE_ROWS,
-                       columns: int = TEXTURE_TABLE_COLUMNS) -> np.ndarray:
+                       columns: int = TEXTURE_TABLE_COLUMNS, max_rows: int = TEXTURE_TABLE_MAX_ROWS,
+                       budget: int = TEXTURE_TABLE_BUDGET) -> np.ndarray:
     """
-    The tabulated method's table of a textured mirror, ``(rows, columns, 3)`` float32: the converged reference
-    (:func:`_converged_rgb`, as :func:`tabulated_rgb_table`) at ``T = k / (rows - 1)`` and ``cos theta = i /
+    The tabulated method's table of a textured mirror, ``(R, columns, 3)`` float32: the converged reference
+    (:func:`_converged_rgb`, as :func:`tabulated_rgb_table`) at ``T = k / (R - 1)`` and ``cos theta = i /
     (columns - 1)``. Every mapping makes ``Lambda`` and ``delta`` functions of the one value ``T``, so the colour
     is a function of ``(cos theta, T)`` alone: one bilinear lookup a pixel (:func:`textured_tabulated_rgb`),
-    built once per mirror and mapping (a row per ``T``; one row when nothing varies).
+    built once per mirror and mapping.
+
+    Refined in ``T`` as :func:`tabulated_rgb_table` is in ``cos theta``: :data:`TEXTURE_TABLE_FIRST_ROWS` rows first,
+    then, while the table has fewer than ``rows`` rows or some entry's interpolation between two rows may be off by
+    more than :data:`TABLE_TOLERANCE` (:func:`_interpolation_error_estimate` along ``T``), every row interval is
+    halved (up to ``max_rows``): the new row's entries computed where the estimate says so, interpolated elsewhere
+    (which leaves the lookups unchanged there), within ``budget`` computed entries in all. One row when
+    nothing varies.
     """
     cos_theta = np.linspace(0.0, 1.0, columns)
-    T = np.linspace(0.0, 1.0, rows)
     if TEXTURE_MAPPINGS[mapping] == 0:
-        table = np.broadcast_to(_converged_rgb(cos_theta, mirror)[None], (rows, columns, 3))
+        table = np.broadcast_to(_converged_rgb(cos_theta, mirror)[None], (2, columns, 3))
     else:
-        table = np.stack([
-            _converged_rgb(cos_theta, BraggMirror(mirror.n1, mirror.n2, float(m.Lambda), float(m.delta), mirror.N, mirror.nh))
-            for m in (textured_mirror(mirror, t, mapping) for t in T)
-        ])
+        count = min(TEXTURE_TABLE_FIRST_ROWS, rows)
+        table = np.stack([_textured_row(mirror, t, mapping, cos_theta) for t in np.linspace(0.0, 1.0, count)])
+        left = budget - table.shape[0] * columns
+        while 2 * table.shape[0] - 1 <= max_rows:
+            # Per entry, the error estimate of its two neighbouring rows' interpolation (along T, per column).
+            estimate = np.stack([_interpolation_error_estimate(table[:, i]) for i in range(columns)], axis=1)
+            refine = estimate > TABLE_TOLERANCE
+            if refine.sum() > left:  # the budget goes to the largest estimates
+                worst = np.argsort(np.where(refine, estimate, -1.0), axis=None)[::-1][:max(left, 0)]
+                refine = np.zeros_like(refine)
+                refine.flat[worst] = True
+            if table.shape[0] >= rows and not refine.any():
+                break
+            left -= int(refine.sum())
+            T = np.linspace(0.0, 1.0, table.shape[0])
+            middle = 0.5 * (table[:-1] + table[1:])
+            for j in np.flatnonzero(refine.any(axis=1)):
+                middle[j, refine[j]] = _textured_row(mirror, 0.5 * (T[j] + T[j + 1]), mapping, cos_theta[refine[j]])
+            finer = np.empty((2 * table.shape[0] - 1, columns, 3))
+            finer[0::2], finer[1::2] = table, middle
+            table = finer
     table = np.ascontiguousarray(table, dtype=np.float32)
     table.setflags(write=False)
     return table
