@@ -170,9 +170,12 @@ def test_cli_plot_options_belong_to_their_views(tmp_path):
         "log on sphere": ["--view", "sphere", "--log"],
         "bad channel": ["--view", "theta_v", "--channel", "alpha"],
         "theta-h out of range": ["--view", "theta_d", "--theta-h", "120"],
+        "exposure on a plot": ["--view", "albedo", "--exposure", "2"],
+        "exr plot": ["--view", "theta_v", "--out", str(tmp_path / "plot.exr")],
     }
     for name, args in cases.items():
-        line = one_line_error(run_cli("render", SHADERS / "ggx_schlick.brd", *args, "--engine", "numpy", "--out", out))
+        args = args if "--out" in args else [*args, "--out", out]
+        line = one_line_error(run_cli("render", SHADERS / "ggx_schlick.brd", *args, "--engine", "numpy"))
         assert line, name
         assert not out.exists(), name
 

@@ -324,7 +324,7 @@ def _errors(function):
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
 @click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter).")
-@click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
+@click.option("--texture", metavar="FILE", help="textured and env views: grey image of a film's D_inc or a mirror's T (default shaders/textures/thickness_noise.png; env: none).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
@@ -365,6 +365,8 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     plot = parse_plot(view, theta_d=theta_d, theta_h=theta_h, phi_v=phi_v, log=log_scale, channel=channel, ndotl=ndotl)
     if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
         raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
+    if plot is not None and exposure is not None:
+        raise click.BadParameter("a plot's values are not exposed (use --log)", param_hint="--exposure")
     thickness = None
     surface_given = texture is not None or dinc_range is not None or mapping is not None
     if view == "textured" or (view == "env" and surface_given):
