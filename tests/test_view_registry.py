@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from explorer.resources import SHADER_DIR
-from explorer.views.geometry import BRDF_VIEWS, LIGHT_VIEWS, VIEW_REGISTRY, VIEWS, view_named
+from explorer.views.geometry import BRDF_VIEWS, LIGHT_VIEWS, PLOT_VIEWS, VIEW_REGISTRY, VIEWS, view_named
 
 
 def test_every_template_is_a_registered_view_and_back():
@@ -16,7 +16,8 @@ def test_every_template_is_a_registered_view_and_back():
 def test_derived_lists_follow_the_registry():
     assert VIEWS == tuple(VIEW_REGISTRY)
     assert set(BRDF_VIEWS) == {"lit", "slice", "scatter"}
-    assert set(LIGHT_VIEWS) == {"lit", "scatter", "textured"}
+    assert set(LIGHT_VIEWS) == {"lit", "scatter", "textured", "theta_v", "lobe3d"}
+    assert set(PLOT_VIEWS) == {"theta_v", "theta_h", "theta_d", "lobe3d", "albedo"}
     assert view_named("scatter").light_theta_max == 90.0  # an outgoing hemisphere: the light stays above it
     assert not view_named("gradient").square and view_named("gradient").default_size == (256, 32)
 

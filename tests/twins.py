@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.materials.models import model_for
-from explorer.views.geometry import brdf_view_geometry, rim_distance, view_cos_theta
+from explorer.views.geometry import brdf_view_geometry, rim_distance, view_cos_theta, view_named
 from explorer.views.render import render_numpy
 
 #: Per linear RGB channel, absolute: the specular colour views.
@@ -96,21 +96,27 @@ class Twins:
 _VIEW_LIGHT = object()
 
 
-def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, thickness=None) -> Twins:
+def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, thickness=None, plot=None) -> Twins:
     """
     ``material`` at ``values`` (as given: resolve them first, or not) in ``view`` at ``size = (W, H)``, on
     the GPU and in numpy. ``light`` defaults to the view's in :data:`LIGHTS` (none for the colour
-    views); ``thickness`` (an :class:`explorer.views.thickness.ThicknessTexture`) is the textured view's.
+    views); ``thickness`` (an :class:`explorer.views.thickness.ThicknessTexture`) is the textured view's,
+    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) the plot views'.
     """
     width, height = size
     if light is _VIEW_LIGHT:
         light = LIGHTS.get(view)
     gl_inputs = {}
     if thickness is not None:
-        gl_inputs = {"inputs": thickness.gl_inputs(width, height), "uniforms": {"prefilter": thickness.prefilter}}
+        gl_inputs = thickness.gl_arguments(material, values, width, height)
         numpy_inputs = {"thickness": thickness}
     else:
         numpy_inputs = {}
+    if view_named(view).plot is not None:
+        from explorer.views.plots import gl_uniforms
+
+        gl_inputs = {"uniforms": gl_uniforms(view, plot)}
+        numpy_inputs = {"plot": plot}
     gl = renderer.render(material, values, view, width, height, light=light, **gl_inputs)
     reference = render_numpy(model_for(material, values), view, width, height, light=light, **numpy_inputs)
     assert gl.shape == reference.shape == (height, width, 3), (gl.shape, reference.shape)

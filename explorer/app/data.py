@@ -174,3 +174,14 @@ def slice_display(image: np.ndarray, exposure: float = 1.0, gamma: float = 2.2, 
     shown = np.clip(rgb, 0.0, 1.0) ** (1.0 / gamma)
     rgba = np.concatenate([shown, np.ones(shown.shape[:-1] + (1,))], axis=-1)
     return np.round(rgba * 255.0).astype(np.uint8)
+
+
+def polar_incident(light, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The Polar window's incident direction: a segment from the origin to ``reach`` along the light ``(x, y, z)``
+    projected on the plane of the curve (:func:`polar_curve`: x toward phi = 0, up the normal), as the curve's
+    ``(r sin theta, r cos theta)``.
+    """
+    x, _, z = (float(c) for c in light)
+    norm = max(float(np.hypot(x, z)), 1e-9)
+    return np.array([0.0, reach * x / norm]), np.array([0.0, reach * z / norm])

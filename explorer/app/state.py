@@ -135,6 +135,8 @@ class AppState:
     status: str = ""
     inverse: dict | None = None  # the Inverse window's lobes, class points and error (reported with screenshots)
     design: dict | None = None  # the Design window's targets, progress and result (reported)
+    plots: dict | None = None  # the Plots window's plot, settings, light and plotted values (reported)
+    texture_view: dict | None = None  # the Texture window's settings and its image's mean RGB (reported)
     error: str = ""  # the material's load/compile error, shown in red; the last good shader stays
     # Requests, served when the frame allows.
     pending_screenshot: str | None = None

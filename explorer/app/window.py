@@ -309,6 +309,7 @@ class App:
             "view_size_auto": s.view_size_auto, "materials": [entry.report() for entry in s.materials], "selected": s.selected,
             "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted, "plotted_log": s.plotted_log,
             "first_screen": s.first_screen, "items": sorted(s.rects), "dialog": self.dialog.log,
+            "plots": s.plots, "texture_view": s.texture_view,
         }
         from explorer.files import write_text_atomic
 

@@ -610,8 +610,10 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
         App(DEFAULT_MATERIAL, script=app_bench_script(frames), report=report, view_size=size, is_default=True).run()
         document = json.loads(report.read_text())
     rows = summarise_app_frames(document["frames"])
+    _progress(f"bench --app: the plot and textured views, {size} wide, Lambda moving")
+    views = run_view_frames(size)
     if as_json:
-        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows}, indent=2))
+        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows, "views": views}, indent=2))
         return rows
     print(f"Explorer frame times while dragging Lambda ({size}x{size} sphere, 1280x800 window, {os.cpu_count()} CPUs):")
     print(f"{'method':<22} {'median':>8} {'p90':>8} {'max':>8} {'fps':>6} {'sphere/s':>9}  {'GL work':>8} {'UI':>6}  shown while dragging")
@@ -619,6 +621,58 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
         print(f"{row['method']} {row['name']:<20} {row['median_ms']:7.1f}ms {row['p90_ms']:7.1f}ms {row['max_ms']:7.1f}ms "
               f"{row['fps']:6.1f} {row['sphere_updates_per_s']:9.1f}  {row['gl_ms']:7.1f}ms {row['ui_ms']:5.1f}ms  {row['while_dragging']}")
     print("fps: frames while the slider moves; sphere/s: frames that show new parameter values on the sphere")
+    print_view_frames(views)
+    return rows
+
+
+def print_view_frames(views: list[dict]) -> None:
+    """The table of :func:`run_view_frames`."""
+    print("Views (headless, default mirror, tabulated method, Lambda moving): GL draw, and the whole update with its tables")
+    print(f"{'view':<10} {'size':>9} {'draw':>9} {'update':>10}")
+    for row in views:
+        print(f"{row['view']:<10} {row['size'][0]:>4}x{row['size'][1]:<4} {row['draw_ms']:7.1f}ms {row['update_ms']:8.1f}ms")
+
+
+#: The views ``bench --app`` times besides the app's sphere: BRDF Explorer's plots and the textured view.
+def app_extra_views() -> tuple[str, ...]:
+    from explorer.views.geometry import PLOT_VIEWS
+
+    return PLOT_VIEWS + ("textured",)
+
+
+def run_view_frames(size: int = 512, repeats: int = 3) -> list[dict]:
+    """
+    Per view of :func:`app_extra_views`, on the default mirror at the app's default method (tabulated), Lambda
+    moving by 0.37 nm a frame as under a dragged slider: the median GL draw (``time_frame``, tables bound) and
+    the median whole update (its tables rebuilt, drawn, read back), at ``size`` wide (the curves one row, the
+    lobe and the textured sphere ``size``²).
+    """
+    from explorer.gpu import Renderer
+    from explorer.resources import DEFAULT_MATERIAL
+    from explorer.views.geometry import view_named
+    from explorer.views.plots import gl_uniforms
+    from explorer.views.surface_texture import BraggTexture
+
+    renderer = Renderer()
+    material = load_material(DEFAULT_MATERIAL)
+    rows = []
+    for index, view in enumerate(app_extra_views()):
+        height = 1 if view_named(view).plot == "curve" else size
+        draws, updates = [], []
+        for k in range(repeats + 1):
+            # A mirror no other view or repeat has drawn: its tables are rebuilt, as under a slider.
+            values = material.resolve({"method": int(BraggMethod.TABULATED), "Lambda": 500.0 + 0.37 * k + 0.01 * index})
+            start = time.perf_counter()
+            if view == "textured":
+                arguments = BraggTexture.from_file().gl_arguments(material, values, size, height)
+            else:
+                arguments = {"uniforms": gl_uniforms(view, None)}
+            renderer.render(material, values, view, size, height, **arguments)
+            updates.append(1e3 * (time.perf_counter() - start))
+            draws.append(renderer.time_frame(material, values, view, size, height, **arguments))
+        # The first frame compiles the program: left out.
+        rows.append({"view": view, "size": [size, height], "draw_ms": float(np.median(draws[1:])),
+                     "update_ms": float(np.median(updates[1:]))})
     return rows
 
 

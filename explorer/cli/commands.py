@@ -20,8 +20,8 @@ import numpy as np
 from explorer.materials.brd import Material, MaterialError, round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
-from explorer.views.geometry import VIEWS
 from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
+from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
@@ -142,13 +142,14 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
-    mesh=None, background: bool = False,
+    mesh=None, background: bool = False, plot=None,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
     :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view; ``mesh``
     (an :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views.
+    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) for the plot views.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -159,15 +160,19 @@ def render_material(
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
 
+        if thickness is not None:
+            raise LocatedError("--engine", None, "the Mitsuba plugins have no surface texture: --engine gl or numpy")
+
         return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
     if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp, mesh, background)
+        return _render_env(material, values, width, height, engine, environment, spp, mesh, background, surface=thickness)
     if view == "textured":
-        from explorer.views.thickness import ThicknessTexture, check_prefilter
+        from explorer.views.surface_texture import check_texture_kind, default_texture
+        from explorer.views.thickness import check_prefilter
 
-        if material.model != "thin_film":
-            raise MaterialError(material.path, None, "the textured view needs a thin-film material (# model: thin_film)")
-        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        # What the texture varies is the material's declaration ('# texture:'), not its name.
+        check_texture_kind(material)
+        thickness = default_texture(material) if thickness is None else thickness
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":
         from explorer.materials.models import model_for
@@ -180,22 +185,61 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
     renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
-        return renderer.render(
-            material, values, view, width, height, light=light, inputs=thickness.gl_inputs(width, height),
-            uniforms={"prefilter": thickness.prefilter},
-        )
+        return renderer.render(material, values, view, width, height, light=light,
+                               **thickness.gl_arguments(material, values, width, height))
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 
         return render_mesh(renderer, material, values, view, mesh, width, height, light=light)
+    if view_named(view).plot is not None:
+        from explorer.views.plots import gl_uniforms
+
+        return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
     return renderer.render(material, values, view, width, height, light=light)
+
+
+def parse_plot(view: str, **options):
+    """
+    The plot views' settings (:class:`explorer.views.plots.PlotSettings`) from the options given (None: not
+    given), or None for the other views; an option a view does not take is a one-line usage error.
+    """
+    from explorer.views.geometry import PLOT_VIEWS
+    from explorer.views.plots import PLOT_SETTINGS, PlotSettings
+
+    given = {name: value for name, value in options.items() if value not in (None, False)}
+    if view not in PLOT_VIEWS:
+        if given:
+            flags = ", ".join(f"--{name.replace('_', '-')}" for name in given)
+            raise click.BadParameter(f"{flags}: for the plot views ({', '.join(PLOT_VIEWS)})", param_hint="--view")
+        return None
+    for name in ("theta_d", "theta_h", "phi_v"):
+        if name in given and name not in PLOT_SETTINGS[view]:
+            takes = [v for v, settings in PLOT_SETTINGS.items() if name in settings]
+            raise click.BadParameter(f"--{name.replace('_', '-')} is for the {', '.join(takes)} plot, not {view}", param_hint="--view")
+    try:
+        return PlotSettings(**given)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--view") from None
+
+
+def _write_plot(loaded, view: str, image, plot, out: Path, light, engine: str) -> None:
+    """A plot view's chart or values (:mod:`explorer.views.plot_images`), the values as :func:`explorer.views.plots.plotted` has them."""
+    from explorer.views.geometry import light_direction
+    from explorer.views.plot_images import write_plot
+    from explorer.views.plots import cos_light, plotted
+
+    height, width = image.shape[:2]
+    values = plotted(image, plot, cos_light(view, width, height, light_direction(light), plot))
+    shown_light = (light or DEFAULT_LIGHT) if view_named(view).takes_light else None
+    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light)
+    click.echo(f"wrote {out} ({view} plot, {width}x{height} samples, {engine})")
 
 
 def check_numpy_size(width: int, height: int) -> None:
@@ -209,7 +253,7 @@ def check_numpy_size(width: int, height: int) -> None:
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None,
-                background: bool = False) -> np.ndarray:
+                background: bool = False, surface=None) -> np.ndarray:
     """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
     import time
 
@@ -236,7 +280,7 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
         click.echo(f"{PROG}: warning: {message}", err=True)
 
     return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn, mesh=mesh, background=background)
+                      progress=progress, warn=warn, mesh=mesh, background=background, surface=surface)
 
 
 def summary(command: click.Command) -> str:
@@ -349,7 +393,7 @@ def _errors(function):
 
 @cli.command()
 @click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(VIEWS), default="sphere", show_default=True)
+@click.option("--view", type=click.Choice(list(VIEWS)), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
@@ -359,7 +403,7 @@ def _errors(function):
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
 @click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter), or auto: the bright end of the object to white.")
-@click.option("--texture", metavar="FILE", help="textured view: grey image of the film's D_inc (default shaders/textures/thickness_noise.png).")
+@click.option("--texture", metavar="FILE", help="textured and env views: grey image of a film's D_inc or a mirror's T (default shaders/textures/thickness_noise.png; env: none).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
 @click.option("--env", "env_file", metavar="FILE|NAME", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
@@ -368,18 +412,30 @@ def _errors(function):
 @click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
 @click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env view: the environment turned about the vertical.")
 @click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
+@click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
+              help="textured view of a Bragg mirror: which of Lambda (0.5 + 0.5 T) and delta^T follow the texture T (default both; supplemental Fig. 7).")
+@click.option("--theta-d", "theta_d", type=float, help="theta_h plot: the difference angle theta_d in degrees (default 0).")
+@click.option("--theta-h", "theta_h", type=float, help="theta_d plot: the half-vector angle theta_h in degrees (default 0).")
+@click.option("--phi-v", "phi_v", type=float, help="theta_v plot: the view's azimuth phi_v in degrees (default 0).")
+@click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
+@click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
+@click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
-           prefilter, env_file, spp, variant, mesh, env_rotation, background):
+           prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
+           ndotl, mapping):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
     (scatterogram, circles at 5, 30, 60 and 90 degrees in the PNG only) call its BRDF(L, V, N, X, Y);
-    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range;
+    textured is the lit sphere of a thin film whose D_inc comes from --texture over --dinc-range, or of a
+    Bragg mirror whose Lambda and/or delta follow it (--mapping);
     env is the sphere under an environment map (--env), a Monte Carlo mean of --spp samples per pixel
-    (--engine numpy: the exact integral, slow; use a small --size).
+    (--engine numpy: the exact integral, slow; use a small --size). BRDF Explorer's plots: theta_v (with
+    --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
+    as a chart (.png) or their values (.npy); --size W sets their samples.
     """
     from explorer.views.geometry import scatter_circles, view_named
 
@@ -393,15 +449,33 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 
     values = resolve_values(loaded, preset, params_file, assignments, opening=opening_values(loaded))  # as the app opens it
     width, height = parse_size(size, view)
+    plot = parse_plot(view, theta_d=theta_d, theta_h=theta_h, phi_v=phi_v, log=log_scale, channel=channel, ndotl=ndotl)
+    if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
+        raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
+    if plot is not None and exposure is not None:
+        raise click.BadParameter("a plot's values are not exposed (use --log)", param_hint="--exposure")
     thickness = None
-    if view == "textured":
+    surface_given = texture is not None or dinc_range is not None or mapping is not None
+    if view == "textured" or (view == "env" and surface_given):
+        from explorer.views.surface_texture import BraggTexture, check_texture_kind
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
 
-        thickness = ThicknessTexture.from_file(
-            texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
-        )
-    elif texture is not None or dinc_range is not None or prefilter == "on":
-        raise click.BadParameter("--texture, --dinc-range and --prefilter are for the textured view", param_hint="--view")
+        if view == "env" and prefilter == "on":
+            raise click.BadParameter("prefiltering is the textured view's (the env view reads the texture unfiltered)", param_hint="--prefilter")
+
+        if check_texture_kind(loaded) == "bragg":
+            if dinc_range is not None or prefilter == "on":
+                raise click.BadParameter("a Bragg mirror's texture maps Lambda and delta (--mapping), not D_inc", param_hint="--dinc-range/--prefilter")
+            thickness = BraggTexture.from_file(texture if texture is not None else DEFAULT_TEXTURE, mapping or "both")
+        else:
+            if mapping is not None:
+                raise click.BadParameter(f"--mapping is a Bragg mirror's; {display_path(loaded.path)}'s texture is its D_inc (--dinc-range)",
+                                         param_hint="--mapping")
+            thickness = ThicknessTexture.from_file(
+                texture if texture is not None else DEFAULT_TEXTURE, parse_dinc_range(dinc_range), prefilter == "on"
+            )
+    elif texture is not None or dinc_range is not None or prefilter == "on" or mapping is not None:
+        raise click.BadParameter("--texture, --dinc-range, --prefilter and --mapping are for the textured and env views", param_hint="--view")
     environment = None
     if view == "env":
         from explorer.views.env import DEFAULT_ENVIRONMENT, environment_named
@@ -431,7 +505,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant, mesh=mesh_shape, background=background)
+                                variant=variant, mesh=mesh_shape, background=background, plot=plot)
+    if plot is not None:
+        _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
+        return
     circles = scatter_circles(width, height) if view_named(view).circles else None
     if exposure_factor is None:  # --exposure auto
         from explorer.views.exposure import auto_exposure

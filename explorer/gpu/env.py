@@ -76,10 +76,12 @@ class ProgressiveEnvRender:
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
         *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None, background: bool = False,
-        environment_sampling: float = ENVIRONMENT_SAMPLING_WEIGHT,
+        environment_sampling: float = ENVIRONMENT_SAMPLING_WEIGHT, surface=None,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
+        if mesh is not None and surface is not None:
+            raise LocatedError("--mesh", None, "a surface texture is mapped on the sphere, not on a mesh")
         self.renderer = renderer
         self.ctx = renderer.ctx
         self.material = material
@@ -104,22 +106,33 @@ class ProgressiveEnvRender:
         self._conditional = renderer.resources.texture(conditional, origin=environment.name)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
         #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals, read by views/mesh/env.glsl.
-        self._surface = None
+        self._mesh_normals = None
         if mesh is not None:
             from explorer.gpu.mesh import mesh_normals
 
-            self._surface = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
+            self._mesh_normals = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
         #: Off the object, the environment behind it (exact, no samples needed), else black.
         self.background = bool(background)
+        #: The material's surface texture (explorer.views.surface_texture), or None.
+        self.surface = surface
+        self._surface_textures: dict = {}
+        # A program keeps its uniforms between renders: an untextured render must say so.
+        self._surface_uniforms: dict = {"textured": False}
         self.reset()
 
     def reset(self, values: Mapping[str, object] | None = None) -> None:
         """Drop every sample; with ``values``, render the material with those parameters from now on."""
         if values is not None:
             self.values = dict(values)
-        self.program = self.renderer.program(self.material, "env" if self._surface is None else "mesh/env", self.values)
+        self.program = self.renderer.program(self.material, "env" if self._mesh_normals is None else "mesh/env", self.values)
+        if self.surface is not None:  # uploaded once per reset (a textured mirror's table follows its values)
+            self.renderer.resources.release(*self._surface_textures.values())
+            arguments = self.surface.gl_arguments(self.material, self.values, self.width, self.height)
+            self._surface_textures = {name: self.renderer.resources.texture(array, origin=name)
+                                      for name, array in arguments["inputs"].items()}
+            self._surface_uniforms = {**arguments["uniforms"], "textured": True}
         self._framebuffer.use()
         self._framebuffer.clear(0.0, 0.0, 0.0, 0.0)
         #: Samples per pixel so far (complete ones: rows of a band hold one more, see :meth:`advance`).
@@ -136,9 +149,11 @@ class ProgressiveEnvRender:
         uniforms["environment_sampling_weight"] = self.environment_sampling
         textures["environment_marginal"] = self._marginal
         textures["environment_conditional"] = self._conditional
+        uniforms.update(self._surface_uniforms)
+        textures.update(self._surface_textures)
         textures["environment"] = self._texture
-        if self._surface is not None:
-            textures["mesh_normals"] = self._surface
+        if self._mesh_normals is not None:
+            textures["mesh_normals"] = self._mesh_normals
         return {"uniforms": uniforms, "textures": textures}
 
     def _pass(self, bindings: dict, count: int, rows: tuple[int, int] | None = None) -> float:
@@ -240,21 +255,24 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture, self._surface, self._marginal, self._conditional)
+        self.renderer.resources.release(self._framebuffer, self._texture, self._mesh_normals, self._marginal, self._conditional,
+                                        *self._surface_textures.values())
+        self._surface_textures = {}
 
 
 def render_env(
     material, values: Mapping[str, object], width: int, height: int, *, engine: str = "gl",
     environment: EnvironmentMap | None = None, spp: int = 64, renderer=None, seed: int = 0,
     progress: Callable[[int, int], None] | None = None, warn: Callable[[str], None] | None = None, mesh=None,
-    background: bool = False,
+    background: bool = False, surface=None,
 ) -> np.ndarray:
     """
     The env view of ``material`` as an image: the GPU's Monte Carlo mean after ``spp`` samples per pixel
     (``engine="gl"``), or the numpy twin's exact integral (``engine="numpy"``, :func:`env_integral_numpy`;
     tens of milliseconds per pixel, ``spp`` unused). ``progress(done, total)`` reports samples per
     pixel (gl) or pixels (numpy); ``warn(message)`` is told of samples dropped as non-finite. ``mesh`` (an
-    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere; ``background``: the environment behind it.
+    :class:`explorer.views.mesh.Mesh`) is drawn instead of the sphere; ``background``: the environment behind it. ``surface``: the
+    material's surface texture (:mod:`explorer.views.surface_texture`; no prefiltering), or None (not with a mesh).
     """
     if not 1 <= spp <= MAX_SPP:
         raise LocatedError("--spp", None, f"{spp} samples per pixel: at least 1 and at most {MAX_SPP} (a float32 count)")
@@ -263,7 +281,8 @@ def render_env(
         from explorer.materials.models import model_for
 
         model = model_for(material, values)
-        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh, background=background)
+        return env_integral_numpy(model, environment, width, height, progress=progress, mesh=mesh, background=background,
+                                  surface=surface)
     renderer = Renderer() if renderer is None else renderer
     render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh,
                                   background=background)

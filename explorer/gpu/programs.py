@@ -40,6 +40,13 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
         builder.define(name, value)
     for name, value in constants:
         builder.define(f"SPECIALISED_{name}", value)
+    # The view, and whether it reads a surface texture: code only those views read (a textured mirror's
+    # table) is left out of the others and of a .brdf export (no sampler).
+    builder.define(f"VIEW_{view.upper()}", 1)
+    from explorer.views.geometry import VIEW_REGISTRY
+
+    if view in VIEW_REGISTRY and VIEW_REGISTRY[view].surface_texture:
+        builder.define("SURFACE_TEXTURE", 1)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
     builder.add_source(material.shader, str(material.path), material.shader_line)
     builder.add_file(template)

@@ -85,22 +85,24 @@ class ProgressiveView:
     def request(
         self, material: Material, values: Mapping[str, object], view: str, size: tuple[int, int], *,
         light: tuple[float, float, float] | None = None, uniforms: Mapping[str, object] | None = None,
-        dragging: bool = False, inputs: Mapping[str, np.ndarray] | None = None, inputs_key=None,
+        dragging: bool = False, inputs: Mapping[str, object] | None = None, inputs_key=None,
     ) -> None:
         """
-        What to show; a change restarts the image (``dragging``: stay on the preview). ``inputs``: the view's
-        textures (a mesh's normals, :mod:`explorer.gpu.mesh`), which ``inputs_key`` names (arrays are not compared).
+        What to show; a change restarts the image (``dragging``: stay on the preview). ``inputs``: a view's own
+        textures (a mesh's normals, :mod:`explorer.gpu.mesh`; the textured view's), as
+        :meth:`explorer.gpu.Renderer.bindings` takes them, named by ``inputs_key`` (arrays are not compared;
+        without a key, a new mapping object is a change).
         """
         self.dragging = dragging
-        self.inputs = dict(inputs) if inputs else None
         key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}),
-               inputs_key if inputs else None)
+               (inputs_key if inputs_key is not None else id(inputs)) if inputs else None)
         if key == self._key:
             return
         self._key = key
         self.material, self.values, self.view = material, dict(values), view
         self.light = None if light is None else tuple(float(c) for c in light)
         self.uniforms = dict(uniforms or {})
+        self.inputs = dict(inputs) if inputs else None
         if tuple(size) != self.size:
             self._allocate(tuple(size))
         self.has_preview = False

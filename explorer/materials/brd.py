@@ -81,6 +81,8 @@ _NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
 _IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _MODEL_RE = re.compile(r"#\s*model\s*:\s*(.*?)\s*\Z", re.IGNORECASE)
 _SPECIALISE_RE = re.compile(r"#\s*speciali[sz]e\s*:\s*(.*?)\s*\Z", re.IGNORECASE)
+#: ``# texture: KIND``: what the textured view's grey texture varies (explorer.views.surface_texture).
+_TEXTURE_RE = re.compile(r"#\s*texture\s*:\s*([A-Za-z_][A-Za-z0-9_]*)\s*\Z", re.IGNORECASE)
 _MODEL_NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*\Z")
 # Preprocessor directives a GLSL compiler understands, plus our own #include.
 _GLSL_DIRECTIVE_RE = re.compile(
@@ -377,6 +379,9 @@ class Material:
     #: A measured material's data (a MERL table, :class:`explorer.materials.merl.MerlTable`), which makes
     #: its numpy twin (``measured.twin(values)``); None for an analytic file.
     measured: Any = field(default=None, compare=False, repr=False)
+    #: The textured view's mapping of a grey texture, from ``# texture: KIND`` (``thickness``: a film's D_inc;
+    #: ``bragg``: a Bragg mirror's Lambda and delta); None: no textured view.
+    texture: str | None = None
 
     def parameter(self, name: str) -> Parameter:
         """Return the parameter called `name`.
@@ -481,6 +486,7 @@ class _Parser:
         self.names: dict[str, int] = {}
         self.model: str | None = None
         self.model_line = 0
+        self.texture: str | None = None
         self.specialised: list[tuple[str, int]] = []
         self.header_seen = False
         self.section: str | None = None
@@ -521,6 +527,7 @@ class _Parser:
             model=self.model,
             specialised=self._check_specialised(),
             warnings=self.warnings,
+            texture=self.texture,
         )
 
     def line(self, number: int, line: str) -> None:
@@ -547,6 +554,10 @@ class _Parser:
         # else: a line of an unknown section, skipped (warned at ::begin)
 
     def comment(self, number: int, stripped: str) -> None:
+        texture = _TEXTURE_RE.match(stripped)
+        if texture is not None:
+            self.texture = texture.group(1).lower()
+            return
         special = _SPECIALISE_RE.match(stripped)
         if special is not None:
             self.specialised += [(name, number) for name in special.group(1).replace(",", " ").split()]

@@ -80,6 +80,37 @@ class BraggMirrorModel:
     #: The env view integrates no finite BRDF: a smooth mirror is a Dirac (``MIRROR_ONLY`` in the shader).
     mirror_only = True
 
+    def texture_table(self, mapping: str) -> np.ndarray:
+        """The tabulated method's table over ``(cos theta, T)`` under ``mapping`` (:func:`explorer.physics.bragg.textured_rgb_table`)."""
+        return bragg.textured_rgb_table(self.mirror, mapping)
+
+    def textured_reflectance(self, cos_theta, T, mapping: str = "both") -> np.ndarray:
+        """
+        The twin of the shader's ``textured_reflectance``: the mirror at texture values ``T`` (per sample, in [0, 1])
+        under ``mapping`` (supplemental Figure 7, :func:`explorer.physics.bragg.textured_mirror`), by ``method``.
+        """
+        cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        T = np.broadcast_to(np.asarray(T, dtype=np.float64), cos_theta.shape)
+        if self.method == BraggMethod.TABULATED:
+            return bragg.textured_tabulated_rgb(self.texture_table(mapping), cos_theta, T)
+        mirror = bragg.textured_mirror(self.mirror, T, mapping)
+        if self.method == BraggMethod.REFERENCE:
+            return bragg.textured_reference_rgb(cos_theta, mirror, self.wavelength_step)
+        s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[self.method]
+        variant = {"variant": "improved"} if self.method == BraggMethod.IMPROVED else {}
+        return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
+
+    def textured_mirror_reflection(self, V, N, T, mapping: str = "both") -> np.ndarray:
+        """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
+        cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)
+        return self.textured_reflectance(cos_theta, T, mapping)
+
+    def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both") -> np.ndarray:
+        """The shader's ``textured_BRDF``: :meth:`textured_reflectance` at the half-vector angle (no prefiltering)."""
+        if prefiltered:
+            raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
+        return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
@@ -132,9 +163,11 @@ class BraggLayerModel(BraggMirrorModel):
     """
 
     name = "bragg_layer"
-    # A rough layer is no Dirac: the env view integrates its BRDF.
+    # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
+    textured_brdf = None
+    textured_mirror_reflection = None
 
     def __init__(self, values: Mapping[str, object]):
         super().__init__(values)

@@ -58,6 +58,13 @@ def check_theta(theta_deg) -> np.ndarray:
     return theta
 
 
+def theta_h_nodes() -> tuple[np.ndarray, np.ndarray]:
+    """The quadrature's ``theta_h`` nodes and weights (radians): Gauss-Legendre on each cell of :data:`THETA_H_EDGES`."""
+    x, w = np.polynomial.legendre.leggauss(THETA_H_NODES)
+    a, b = THETA_H_EDGES[:-1, None], THETA_H_EDGES[1:, None]
+    return (0.5 * (b - a) * x + 0.5 * (a + b)).ravel(), (0.5 * (b - a) * w).ravel()
+
+
 def half_vector_quadrature(theta_i: float) -> tuple[np.ndarray, np.ndarray]:
     """
     Outgoing directions ``o`` and weights ``w`` such that ``sum w g(o) ~ int g(o) d omega_o`` over the upper
@@ -66,10 +73,7 @@ def half_vector_quadrature(theta_i: float) -> tuple[np.ndarray, np.ndarray]:
     ``4 (i.h) sin theta_h d theta_h d phi_h`` (the Jacobian of the reflection); ``h`` whose ``o`` falls
     below the horizon are dropped.
     """
-    x, w = np.polynomial.legendre.leggauss(THETA_H_NODES)
-    a, b = THETA_H_EDGES[:-1, None], THETA_H_EDGES[1:, None]
-    theta_h = (0.5 * (b - a) * x + 0.5 * (a + b)).ravel()
-    d_theta = (0.5 * (b - a) * w).ravel()
+    theta_h, d_theta = theta_h_nodes()
     phi_h = (np.arange(PHI_H_NODES) + 0.5) * (2.0 * np.pi / PHI_H_NODES)
     T, P = np.meshgrid(theta_h, phi_h, indexing="ij")
     h = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], axis=-1).reshape(-1, 3)

@@ -503,7 +503,7 @@ def backdrop(environment: EnvironmentMap, width: int, height: int) -> np.ndarray
 
 def env_integral_numpy(
     model, environment: EnvironmentMap, width: int, height: int, pixels=None, subdivisions: int | None = None,
-    progress: Callable[[int, int], None] | None = None, mesh=None, background: bool = False,
+    progress: Callable[[int, int], None] | None = None, mesh=None, background: bool = False, surface=None,
 ) -> np.ndarray:
     """
     The env view's exact value, ``int f(L, V) cos theta_L L_e(L) d omega_L`` per pixel, ``f`` under the
@@ -530,6 +530,9 @@ def env_integral_numpy(
         Drawn instead of the sphere (its normals by :func:`explorer.views.mesh.rasterise`).
     background : bool
         Off the object, the environment behind it (:func:`backdrop`) instead of 0.
+    surface : optional
+        The material's surface texture (:mod:`explorer.views.surface_texture`): each pixel evaluates the model's
+        ``textured_brdf`` (and ``textured_mirror_reflection``) at its texture value instead, unfiltered.
 
     Returns
     -------
@@ -538,13 +541,23 @@ def env_integral_numpy(
     """
     from explorer.views.geometry import brdf_view_geometry, view_brdf
 
+    if mesh is not None and surface is not None:
+        raise ValueError("a surface texture is mapped on the sphere, not on a mesh")
     if mesh is not None:
         from explorer.views.mesh import mesh_view_geometry, rasterise
 
-        surface = rasterise(mesh, width, height)
-        _, V, N, X, Y, inside, _ = mesh_view_geometry(surface.normals, surface.covered)
+        raster = rasterise(mesh, width, height)
+        _, V, N, X, Y, inside, _ = mesh_view_geometry(raster.normals, raster.covered)
     else:
         _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
+    brdf, mirror = model.brdf, getattr(model, "mirror_reflection", None)
+    value = None
+    if surface is not None:  # the texture value per pixel, as the shader reads it (surface_value)
+        from explorer.views.geometry import disc
+
+        x, y, _ = disc(width, height)
+        value = surface.per_pixel(x, y, width, height)[0]
+        options = surface.model_options()
     if pixels is None:
         rows, columns = np.nonzero(inside)
     else:
@@ -558,6 +571,9 @@ def env_integral_numpy(
     values = np.zeros((rows.size, 3))
     mirror_only = bool(getattr(model, "mirror_only", False))  # a smooth mirror: the Dirac below, nothing else
     for k, (r, c) in enumerate(zip(rows, columns)):
+        if value is not None:
+            def brdf(L, V, N, X, Y, t=float(value[r, c])):
+                return model.textured_brdf(L, V, N, X, Y, np.full(L.shape[:-1], t), np.zeros(L.shape[:-1]), False, **options)
         if inside[r, c] and not mirror_only:
             n = N[r, c].astype(np.float64)
             frame = [a[r, c].astype(np.float64) for a in (V, N, X, Y)]
@@ -568,16 +584,19 @@ def env_integral_numpy(
                 if not above.any():
                     continue
                 L = block[above]
-                f = view_brdf(model.brdf, L, *(np.broadcast_to(a, L.shape) for a in frame))
+                f = view_brdf(brdf, L, *(np.broadcast_to(a, L.shape) for a in frame))
                 values[k] += np.sum(f * (cos_l[above, None] * weighted[start:start + QUADRATURE_BLOCK][above]), axis=0)
         if progress is not None:
             progress(k + 1, rows.size)
-    mirror = getattr(model, "mirror_reflection", None)
     if mirror is not None:  # a Dirac (a smooth coating): its weight times the radiance of the mirror direction
         hit = inside[rows, columns]
         v, n = V[rows, columns][hit].astype(np.float64), N[rows, columns][hit].astype(np.float64)
         reflected = 2.0 * np.sum(v * n, axis=-1, keepdims=True) * n - v
-        values[hit] += mirror(v, n) * environment.radiance(reflected)
+        if value is not None and callable(getattr(model, "textured_mirror_reflection", None)):
+            weight = model.textured_mirror_reflection(v, n, value[rows, columns][hit], **options)
+        else:
+            weight = mirror(v, n)
+        values[hit] += weight * environment.radiance(reflected)
     if background:
         off = ~inside[rows, columns]
         values[off] = backdrop(environment, width, height)[rows[off], columns[off]]

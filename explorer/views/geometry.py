@@ -34,6 +34,11 @@ class View:
     light_theta_max: float | None = None
     #: Circles of constant theta_o drawn on PNG output (the paper's Figure 9).
     circles: bool = False
+    #: A plot (:mod:`explorer.views.plots`): ``curve`` (one value per column, every row the same) or
+    #: ``lobe`` (a value per outgoing direction); its PNG is a chart, its ``.npy`` the plotted values.
+    plot: str | None = None
+    #: Reads the surface texture of a material that declares ``# texture:`` (the host #defines SURFACE_TEXTURE).
+    surface_texture: bool = False
 
     @property
     def takes_light(self) -> bool:
@@ -47,14 +52,22 @@ VIEW_REGISTRY: dict[str, View] = {view.name: view for view in (
     View("lit", "brdf", light_theta_max=180.0),
     View("slice", "brdf"),
     View("scatter", "brdf", light_theta_max=90.0, circles=True),
-    View("textured", "textured_brdf", light_theta_max=180.0),
-    View("env", "environment"),
+    View("textured", "textured_brdf", light_theta_max=180.0, surface_texture=True),
+    View("env", "environment", surface_texture=True),
+    # BRDF Explorer's plots (explorer/views/plots.py): curves W samples wide, the lobe over (phi_o, theta_o).
+    View("theta_v", "brdf_plot", default_size=(512, 1), square=False, light_theta_max=90.0, plot="curve"),
+    View("theta_h", "brdf_plot", default_size=(512, 1), square=False, plot="curve"),
+    View("theta_d", "brdf_plot", default_size=(512, 1), square=False, plot="curve"),
+    View("lobe3d", "brdf_plot", default_size=(128, 32), square=False, light_theta_max=90.0, plot="lobe"),
+    View("albedo", "albedo", default_size=(90, 1), square=False, plot="curve"),
 )}
 VIEWS = tuple(VIEW_REGISTRY)
 DEFAULT_SIZES = {name: view.default_size for name, view in VIEW_REGISTRY.items()}
 #: Views that evaluate the material's BRDF(L, V, N, X, Y); those that take a light direction.
 BRDF_VIEWS = tuple(name for name, view in VIEW_REGISTRY.items() if view.evaluates == "brdf")
 LIGHT_VIEWS = tuple(name for name, view in VIEW_REGISTRY.items() if view.takes_light)
+#: BRDF Explorer's plots (:mod:`explorer.views.plots`).
+PLOT_VIEWS = tuple(name for name, view in VIEW_REGISTRY.items() if view.plot is not None)
 
 
 def view_named(name: str) -> View:

@@ -29,23 +29,30 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None, mesh=None, slice_phi_d: float = 90.0,
+    environment=None, mesh=None, slice_phi_d: float = 90.0, plot=None,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
 
     ``light`` (``lit``, ``scatter``, ``textured``): ``(theta, phi)`` in degrees, default :data:`explorer.views.geometry.DEFAULT_LIGHT`.
     ``thickness`` (``textured``): an :class:`explorer.views.thickness.ThicknessTexture` (default: the default
-    texture over the default D_inc range, without prefiltering).
+    texture over the default D_inc range, without prefiltering) or, for a Bragg mirror, an
+    :class:`explorer.views.surface_texture.BraggTexture` (default: the default texture, both mappings).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
     image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
     ``mesh`` (``lit``, ``env``): an :class:`explorer.views.mesh.Mesh` drawn instead of the sphere, its normals
     by :func:`explorer.views.mesh.rasterise`.
     ``slice_phi_d`` (``slice``): phi_d in degrees (the app's Slice window; 90 as BRDF Explorer).
+    ``plot`` (the plots, :mod:`explorer.views.plots`): a :class:`explorer.views.plots.PlotSettings` (default: its defaults).
     """
     evaluates = view_named(view).evaluates
     if mesh is not None and view not in ("lit", "env"):
         raise ValueError(f"a mesh is drawn in the lit and env views, not {view}")
+    if view_named(view).plot is not None:
+        from explorer.views.geometry import light_direction
+        from explorer.views.plots import PlotSettings, plot_numpy
+
+        return plot_numpy(model, view, width, height, light_direction(light), plot or PlotSettings())
     if evaluates == "environment":
         from explorer.views.env import EnvironmentMap, env_integral_numpy
 
@@ -57,7 +64,10 @@ def render_numpy(
 
         if not callable(getattr(model, "textured_brdf", None)):
             raise ValueError(f"the textured view needs the model's textured_brdf(); {type(model).__name__} has none")
-        thickness = ThicknessTexture.from_file() if thickness is None else thickness
+        if thickness is None:  # the default texture of what the model varies
+            from explorer.views.surface_texture import BraggTexture
+
+            thickness = BraggTexture.from_file() if callable(getattr(model, "texture_table", None)) else ThicknessTexture.from_file()
         L, V, N, X, Y, inside, factor = brdf_view_geometry("lit", width, height, light)
         x, y, _ = disc(width, height)
         d_inc, sigma = thickness.per_pixel(x, y, width, height)
@@ -65,7 +75,7 @@ def render_numpy(
         vectors = [a[inside] for a in (L, V, N, X, Y)]
 
         def textured_brdf(L, V, N, X, Y, d_inc, sigma):
-            return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter)
+            return model.textured_brdf(L, V, N, X, Y, d_inc, sigma, thickness.prefilter, **thickness.model_options())
 
         rgb = _chunked(lambda *a: view_brdf(textured_brdf, *a), *vectors, d_inc[inside], sigma[inside])
         image[inside] = rgb * factor[inside][:, None]

@@ -170,7 +170,15 @@ class ThicknessTexture:
     def gl_inputs(self, width: int, height: int) -> dict[str, np.ndarray]:
         """The textures of ``shaders/views/textured.glsl`` (rows from the top)."""
         moments = self.moments(width, height) if self.prefilter else np.zeros((1, 1, 2), np.float32)
-        return {"dinc_texture": self.d_inc[..., None], "dinc_moments": moments}
+        return {"surface_texture": self.d_inc[..., None], "surface_moments": moments}
+
+    def model_options(self) -> dict:
+        """Keyword arguments of the model's ``textured_brdf`` besides the per-pixel values: none."""
+        return {}
+
+    def gl_arguments(self, material, values, width: int, height: int) -> dict:
+        """``inputs`` and ``uniforms`` of :meth:`explorer.gpu.Renderer.render` for the textured view."""
+        return {"inputs": self.gl_inputs(width, height), "uniforms": {"prefilter": self.prefilter}}
 
     def per_pixel(self, x: np.ndarray, y: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """``(D_inc, sigma)`` at the pixels ``p = (x, y)`` (float32, as ``_disc``) of a ``(height, width)`` image."""

@@ -494,3 +494,28 @@ vec3 tabulated_rgb(sampler2D table, float cos_theta) {
     int i = clamp(int(x), 0, max(last - 1, 0));  // a 1-texel placeholder reads its texel
     return mix(texelFetch(table, ivec2(i, 0), 0).rgb, texelFetch(table, ivec2(min(i + 1, last), 0), 0).rgb, x - float(i));
 }
+
+// Supplemental Figure 7: a mirror whose Lambda and delta follow a texture value T in [0, 1], mapping's bits
+// 1: Lambda (0.5 + 0.5 T), 2: delta^T (delta^0 = 1; GLSL's pow(0, 0) is undefined). Twin: explorer.physics.bragg.textured_mirror.
+BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
+    T = clamp(T, 0.0, 1.0);
+    if ((mapping & 1) != 0) mirror.Lambda *= 0.5 + 0.5 * T;
+    if ((mapping & 2) != 0) mirror.delta = T <= 0.0 ? 1.0 : pow(mirror.delta, T);
+    return mirror;
+}
+
+// Only in the views that read a surface texture (the host defines SURFACE_TEXTURE): no sampler in a .brdf export.
+#ifdef SURFACE_TEXTURE
+// The tabulated method of a textured mirror: the table over (cos theta across, T down), rows at T = k / (rows - 1),
+// bilinear between four texels in float (as tabulated_rgb). Twin: explorer.physics.bragg.textured_tabulated_rgb.
+vec3 textured_tabulated_rgb(sampler2D table, float cos_theta, float T) {
+    ivec2 last = textureSize(table, 0) - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last.x);
+    float y = clamp(T, 0.0, 1.0) * float(last.y);
+    int i = clamp(int(x), 0, max(last.x - 1, 0));
+    int j = clamp(int(y), 0, max(last.y - 1, 0));
+    vec3 top = mix(texelFetch(table, ivec2(i, j), 0).rgb, texelFetch(table, ivec2(min(i + 1, last.x), j), 0).rgb, x - float(i));
+    vec3 bottom = mix(texelFetch(table, ivec2(i, min(j + 1, last.y)), 0).rgb, texelFetch(table, ivec2(min(i + 1, last.x), min(j + 1, last.y)), 0).rgb, x - float(i));
+    return mix(top, bottom, y - float(j));
+}
+#endif

@@ -63,3 +63,44 @@ vec3 finite_or_zero(vec3 f) { return vec3(finite_or_zero(f.x), finite_or_zero(f.
 vec3 view_brdf(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {
     return above_surface(L, V, N) ? finite_or_zero(BRDF(L, V, N, X, Y)) : vec3(0.0);
 }
+
+// -- BRDF Explorer's plots (shaders/views/{theta_v,theta_h,theta_d,lobe3d,albedo}.glsl; twins in explorer/views/plots.py)
+
+// Column i's angle (radians) of a plot over [first, first + span]: first + span (i + 0.5) / W.
+float plot_column_angle(float first, float span, float width) {
+    return first + span * gl_FragCoord.x / width;
+}
+
+vec3 unit_direction(float theta, float phi) {
+    return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+}
+
+// L and V of half-vector angle theta_h (phi_h = 0) and difference angles theta_d, phi_d (Rusinkiewicz
+// 1998): D rotated by theta_h about Y, V the reflection of L about H (the slice view's construction).
+void rusinkiewicz_directions(float theta_h, float theta_d, float phi_d, out vec3 L, out vec3 V) {
+    vec3 H = unit_direction(theta_h, 0.0);
+    vec3 D = unit_direction(theta_d, phi_d);
+    float c = cos(theta_h), s = sin(theta_h);
+    L = vec3(D.x * c + D.z * s, D.y, -D.x * s + D.z * c);
+    V = 2.0 * dot(H, L) * H - L;
+}
+
+// -- The surface texture (textured and env views; the host #defines SURFACE_TEXTURE): what a material's
+// '# texture:' varies (explorer/views/surface_texture.py). Planar parametrisation of the disc point p:
+// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped.
+#ifdef SURFACE_TEXTURE
+uniform sampler2D surface_texture;
+
+float surface_bilinear(vec2 uv) {
+    ivec2 size = textureSize(surface_texture, 0);
+    vec2 t = clamp(uv * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    ivec2 i = min(ivec2(floor(t)), max(size - 2, ivec2(0)));
+    vec2 f = t - vec2(i);
+    ivec2 i1 = min(i + 1, size - 1);
+    float top = mix(texelFetch(surface_texture, i, 0).r, texelFetch(surface_texture, ivec2(i1.x, i.y), 0).r, f.x);
+    float bottom = mix(texelFetch(surface_texture, ivec2(i.x, i1.y), 0).r, texelFetch(surface_texture, i1, 0).r, f.x);
+    return mix(top, bottom, f.y);
+}
+
+float surface_value(vec2 p) { return surface_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y))); }
+#endif

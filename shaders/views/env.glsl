@@ -54,6 +54,11 @@ uniform sampler2D environment_conditional;
 uniform uint first_sample;
 uniform int samples_per_pass;
 uniform uint seed;
+#ifdef HAS_TEXTURED_BRDF
+// A material that declares '# texture:' under its surface texture (explorer/views/surface_texture.py): its
+// textured_BRDF (and a mirror's textured_mirror_reflection) at the pixel's texture value.
+uniform bool textured;
+#endif
 layout(location = 0) out vec4 sum_out;
 layout(location = 1) out vec4 square_out;
 
@@ -100,9 +105,20 @@ void main() {
     }
 #endif
 
+    bool use_texture = false;
+    float surface = 0.0;
+#ifdef HAS_TEXTURED_BRDF
+    use_texture = textured;
+    if (use_texture) surface = surface_value(p);
+#endif
     vec3 mirror = vec3(0.0);
 #ifdef HAS_MIRROR_REFLECTION
-    mirror = mirror_reflection(view, normal) * environment_radiance(reflect(-view, normal));
+#ifdef HAS_TEXTURED_MIRROR
+    vec3 mirror_weight = use_texture ? textured_mirror_reflection(view, normal, surface) : mirror_reflection(view, normal);
+#else
+    vec3 mirror_weight = mirror_reflection(view, normal);
+#endif
+    mirror = mirror_weight * environment_radiance(reflect(-view, normal));
 #endif
     uvec2 pixel = uvec2(gl_FragCoord.xy);
     vec3 sum = vec3(0.0), square = vec3(0.0);
@@ -146,7 +162,12 @@ void main() {
             }
             if (pdf > 0.0 && above_surface(light, view, normal)) {
                 // lib/views.glsl's rule (view_brdf), the non-finite channels counted so the host can report them.
+#ifdef HAS_TEXTURED_BRDF
+                vec3 f = use_texture ? textured_BRDF(light, view, normal, tangent, bitangent, surface, 0.0, false)
+                                     : BRDF(light, view, normal, tangent, bitangent);
+#else
                 vec3 f = BRDF(light, view, normal, tangent, bitangent);
+#endif
                 if (any(isnan(f)) || any(isinf(f))) dropped += 1.0;
                 value = finite_or_zero(f) * (cos_light / pdf) * environment_radiance(light);
             }

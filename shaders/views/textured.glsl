@@ -1,31 +1,21 @@
-// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a film
-// thickness that varies over it (Belcour & Barla 2017, Section 5, Figures 12-15). The material must
-// define textured_BRDF(L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered) (shaders/thin_film.brd).
-// Planar parametrisation (explorer/views/thickness.py): pixel p = (x, y) reads D_inc (nm) from dinc_texture at
+// The textured view: the lit view's sphere (same pixels, light, N, X, Y; explorer.views.render) with a material
+// parameter that varies over it, as the material declares ('# texture:', explorer/views/surface_texture.py): a
+// thin film's D_inc (Belcour & Barla 2017, Section 5, Figures 12-15; surface_texture holds D_inc in nm) or a Bragg
+// mirror's Lambda and delta (supplemental Figure 7; surface_texture holds T in [0, 1]). The material defines
+// textured_BRDF(L, V, N, X, Y, value, sigma_value, prefiltered) (shaders/thin_film.brd, shaders/bragg_mirror.brd).
+// Planar parametrisation (explorer/views/thickness.py): pixel p = (x, y) reads surface_texture at
 // u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinearly between texel centres, clamped.
-// prefilter: D_inc's mean and variance over the pixel's footprint come from dinc_moments (computed by the
-// host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
+// prefilter (the film only): the value's mean and variance over the pixel's footprint come from surface_moments
+// (computed by the host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
 // The rule of lib/views.glsl's view_brdf applies: 0 unless N.L > 0 and N.V > 0, non-finite channels 0.
 // Twin: explorer.views.render.render_numpy(model, 'textured', ..., thickness=...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;
 uniform vec3 light_direction;
-uniform sampler2D dinc_texture;
-uniform sampler2D dinc_moments;
+uniform sampler2D surface_moments;
 uniform bool prefilter;
 out vec4 frag_colour;
-
-float dinc_bilinear(vec2 uv) {
-    ivec2 size = textureSize(dinc_texture, 0);
-    vec2 t = clamp(uv * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
-    ivec2 i = min(ivec2(floor(t)), max(size - 2, ivec2(0)));
-    vec2 f = t - vec2(i);
-    ivec2 i1 = min(i + 1, size - 1);
-    float top = mix(texelFetch(dinc_texture, i, 0).r, texelFetch(dinc_texture, ivec2(i1.x, i.y), 0).r, f.x);
-    float bottom = mix(texelFetch(dinc_texture, ivec2(i.x, i1.y), 0).r, texelFetch(dinc_texture, i1, 0).r, f.x);
-    return mix(top, bottom, f.y);
-}
 
 void main() {
     vec2 p;
@@ -40,11 +30,11 @@ void main() {
     float D_inc_, sigma = 0.0;
     if (prefilter) {
         ivec2 pixel = ivec2(int(gl_FragCoord.x), int(resolution.y) - 1 - int(gl_FragCoord.y));
-        vec2 moments = texelFetch(dinc_moments, pixel, 0).rg;
+        vec2 moments = texelFetch(surface_moments, pixel, 0).rg;
         D_inc_ = moments.x;
         sigma = sqrt(max(moments.y, 0.0));
     } else {
-        D_inc_ = dinc_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y)));
+        D_inc_ = surface_value(p);
     }
     vec3 f = above_surface(light_direction, view, normal)
         ? finite_or_zero(textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter))

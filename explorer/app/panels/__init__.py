@@ -12,6 +12,8 @@ from explorer.app.panels.files import FilesPanel
 from explorer.app.panels.inverse import InversePanel
 from explorer.app.panels.materials import MaterialsPanel
 from explorer.app.panels.parameters import ParametersPanel
+from explorer.app.panels.plots import PlotsPanel
+from explorer.app.panels.texture import TexturePanel
 from explorer.app.panels.polar import PolarPanel
 from explorer.app.panels.spectrum import SpectrumPanel
 from explorer.app.panels.sphere import SpherePanel
@@ -20,7 +22,7 @@ from explorer.app.panels.strips import StripsPanel
 #: The windows, in the order they are drawn (a docked window's first tab is the first of its dock here).
 PANELS: tuple[type[Panel], ...] = (
     MaterialsPanel, ParametersPanel, FilesPanel, SpherePanel, ComparePanel, SlicePanel, ScatterPanel, SpectrumPanel, PolarPanel,
-    StripsPanel, InversePanel, DesignPanel,
+    StripsPanel, InversePanel, DesignPanel, PlotsPanel, TexturePanel,
 )
 
 

@@ -45,8 +45,8 @@ class PolarPanel(Panel):
                 self._curves[name] = cached
             if cached is not None:
                 curves.append((entry, cached[1]))
-        imgui.text(f"plane of incidence (light theta = {state.light[0]:.1f} deg); radius = BRDF (1/sr)"
-                   + ("; luminance per material" if len(curves) > 1 else ""))
+        imgui.text_wrapped(f"plane of incidence (light theta = {state.light[0]:.1f} deg); radius = BRDF (1/sr)"
+                           + ("; luminance per material" if len(curves) > 1 else ""))
         state.plotted["Polar"] = [entry.name if entry is not None else state.material_path.name for entry, _ in curves]
         if not curves:
             return
@@ -63,6 +63,10 @@ class PolarPanel(Panel):
                     r = np.clip(brdf @ LUMINANCE, 0.0, None)
                     implot.plot_line(f"{entry.name}##{id(entry)}", r * np.sin(radians), r * np.cos(radians),
                                      implot.Spec(line_color=imgui.ImVec4(*entry.colour, 1.0), line_weight=2.0))
+            # The incident direction, projected on the plane (x toward phi = 0, as the curve's signed theta).
+            reach = max(float(np.clip(brdf, 0.0, None).max()) for _, (_, brdf) in curves)
+            xs, ys = data.polar_incident(light, max(reach, 1e-6))
+            implot.plot_line("light", xs, ys, implot.Spec(line_color=imgui.ImVec4(1.0, 0.85, 0.2, 1.0), line_weight=2.0))
             implot.end_plot()
 
     def gl_jobs(self) -> list:

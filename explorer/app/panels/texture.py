@@ -1,0 +1,171 @@
+"""
+The Texture window: the textured view (:mod:`explorer.views.surface_texture`) of a material that declares
+``# texture:``: a thin film's D_inc over a range, or a Bragg mirror's Lambda and/or delta (supplemental
+Figure 7), from a grey image (the shipped noise by default), lit by the app's light.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.app.camera import light_vector
+from explorer.app.panels.base import Panel, record, show_image
+from explorer.errors import LocatedError
+from explorer.resources import DEFAULT_TEXTURE
+from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
+from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
+
+TEXTURE_VIEW_SIZE = 256
+#: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
+ENV_SAMPLES = 256
+
+
+class TexturePanel(Panel):
+    title = "Texture"
+    dock = "right_top"
+    gl_order = 7
+
+    def __init__(self, app):
+        super().__init__(app)
+        self.path = str(DEFAULT_TEXTURE)
+        self.mapping = "both"
+        self.dinc_range = list(DEFAULT_DINC_RANGE)
+        self.message = ""
+        self._surface = None
+        self._surface_key = None
+        self._arguments = None
+        self._arguments_key = None
+        self._generation = -1
+        self._pending = None  # (key, values, future) of the arguments being built on the worker thread
+        self._executor = None
+        #: Under the environment: the env view's progressive Monte Carlo with the surface texture.
+        self.environment = False
+        self._env = None  # (key, ProgressiveEnvRender, AccumulatedImage)
+
+    def _texture(self, kind: str):
+        """The surface texture of the current settings (loaded again only when they change)."""
+        key = (kind, self.path, self.mapping, tuple(self.dinc_range))
+        if key != self._surface_key:
+            self._surface_key = key
+            try:
+                if kind == "bragg":
+                    self._surface = BraggTexture.from_file(self.path, self.mapping)
+                else:
+                    self._surface = ThicknessTexture.from_file(self.path, tuple(sorted(self.dinc_range)))
+                self.message = ""
+            except LocatedError as error:
+                self._surface, self.message = None, str(error)
+        return self._surface
+
+    def draw(self, imgui) -> None:
+        state = self.state
+        kind = state.material.texture
+        if kind not in TEXTURE_KINDS:
+            imgui.text_wrapped(f"this material declares no '# texture: {'|'.join(TEXTURE_KINDS)}' (thin_film and bragg_mirror do)")
+            return
+        _, self.path = imgui.input_text("texture (grey image)", self.path)
+        if kind == "bragg":
+            if imgui.begin_combo("mapping", self.mapping):
+                for name in MAPPINGS:
+                    clicked, _ = imgui.selectable(name, name == self.mapping)
+                    record(state, f"mapping:{name}")
+                    if clicked:
+                        self.mapping = name
+                imgui.end_combo()
+            record(state, "mapping_combo")
+            imgui.text_wrapped("Lambda (0.5 + 0.5 T), delta^T (supplemental Fig. 7)")
+        else:
+            _, self.dinc_range = imgui.slider_float2("D_inc range (nm)", self.dinc_range, 0.0, DINC_MAX, "%.0f")
+            self.dinc_range = list(self.dinc_range)
+        _, self.environment = imgui.checkbox("under the environment (env view)", self.environment)
+        record(state, "texture_env")
+        surface = self._texture(kind)
+        if self.message:
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), self.message)
+        if surface is None:
+            return
+        size = (TEXTURE_VIEW_SIZE, TEXTURE_VIEW_SIZE)
+        job = self.scheduler.job("textured")
+        values = self.scheduler.prefetcher.values(state.material, state.values, self.app.dragging)
+        key = (id(state.material), tuple(sorted((k, str(v)) for k, v in values.items())), self._surface_key)
+        # The textured mirror's tabulated table takes seconds: built on a worker thread once a slider is
+        # released, the last image shown meanwhile.
+        if self._pending is not None and self._pending[2].done():
+            pending_key, pending_values, future = self._pending
+            self._pending = None
+            try:
+                self._arguments, self._arguments_key, self._values = future.result(), pending_key, pending_values
+            except Exception as error:  # noqa: BLE001 - a material's own error, shown in the window
+                self.message = f"{type(error).__name__}: {error}"
+        wanted = key != self._arguments_key and not (self.app.dragging and self._arguments is not None)
+        if wanted and (self._pending is None or self._pending[0] != key):
+            import concurrent.futures
+
+            if self._executor is None:
+                self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="texture")
+            self._pending = (key, dict(values), self._executor.submit(surface.gl_arguments, state.material, dict(values), *size))
+        if self._arguments is None:
+            imgui.text("building the texture's tables…")
+            return
+        if self.environment:
+            source = self._env_source(surface, size)
+            show_image(state, self.scheduler.show("textured_env", size, source), size, "textured_image")
+            done = "done" if source.render.samples >= self._env_samples else "refining"
+            imgui.text(f"env: {source.render.samples} samples per pixel ({done})")
+            return
+        job.request(state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
+                    uniforms=self._arguments["uniforms"], inputs=self._arguments["inputs"], dragging=self.app.dragging)
+        show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
+        imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + (f"  {job.error}" if job.error else ""))
+        if not (job.complete and self._arguments_key == key):  # a new image on its way (scripts wait_for it)
+            state.texture_view = {"running": True}
+        elif job.generation != self._generation or not state.texture_view or state.texture_view.get("running"):
+            self._generation = job.generation
+            image = job.read()
+            state.texture_view = {"kind": kind, "path": self.path, "mapping": self.mapping, "dinc_range": list(self.dinc_range),
+                                  "values": {k: (list(v) if isinstance(v, tuple) else v) for k, v in self._values.items()},
+                                  "light": list(light_vector(state.light, state.camera)), "size": list(size),
+                                  "mean_rgb": np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()}
+
+    def _env_source(self, surface, size):
+        """The env render of the current arguments' values under ``surface`` (a new one when they change)."""
+        from explorer.gpu.display import AccumulatedImage
+        from explorer.gpu.env import ProgressiveEnvRender
+
+        if self._env is None or self._env[0] != self._arguments_key:
+            if self._env is not None:
+                self._env[1].release()
+            self.scheduler.env.environment = self.scheduler.env.environment or _default_environment()
+            # The tables are those the worker built for these values (cached): no wait here.
+            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values,
+                                          self.scheduler.env.environment, *size, surface=surface)
+            from explorer.materials.models import model_for
+
+            model = model_for(self.state.material, self._values)
+            self._env_samples = 1 if getattr(model, "mirror_only", False) else ENV_SAMPLES
+            self._env = (self._arguments_key, render, AccumulatedImage(render))
+        return self._env[2]
+
+    def gl_jobs(self) -> list:
+        if self.state.material.texture not in TEXTURE_KINDS:
+            return []
+        if self.environment and self._env is not None:
+            return [] if self._env[1].samples >= self._env_samples else [_EnvWork(self._env[1])]
+        return [self.scheduler.job("textured")]
+
+
+def _default_environment():
+    from explorer.views.env import EnvironmentMap
+
+    return EnvironmentMap.default()
+
+
+class _EnvWork:
+    """A progressive env render as one of the frame's GL jobs (``work(budget_ms)``)."""
+
+    def __init__(self, render):
+        self.render = render
+
+    def work(self, budget_ms: float) -> float:
+        self.render.advance(max(0.5 * budget_ms, 5.0))
+        return budget_ms

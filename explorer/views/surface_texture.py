@@ -1,0 +1,89 @@
+"""
+The textured view's textures, by what a material declares it varies (``# texture: KIND`` in its file,
+:attr:`explorer.materials.brd.Material.texture`) rather than by its name:
+
+- ``thickness``: a thin film's OPD at normal incidence D_inc (:class:`explorer.views.thickness.ThicknessTexture`,
+  Belcour & Barla 2017, Section 5);
+- ``bragg``: a Bragg mirror's ``Lambda(x) = Lambda (0.5 + 0.5 T(x))`` and/or ``delta(x) = delta^T(x)``, ``T`` the
+  grey texture in [0, 1] (:class:`BraggTexture`; Fourneau et al. 2024, supplemental Figure 7).
+
+Both read the texture with the same planar parametrisation and bilinear filter (``shaders/views/textured.glsl``:
+``surface_texture``), and hand the shader what it needs through :meth:`gl_arguments` and the numpy twin
+through :meth:`model_options`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from explorer.errors import LocatedError
+from explorer.resources import DEFAULT_TEXTURE
+from explorer.views.thickness import ThicknessTexture, load_grey
+
+#: ``--mapping`` choices of a Bragg mirror's texture (:data:`explorer.physics.bragg.TEXTURE_MAPPINGS`).
+MAPPINGS = ("both", "lambda", "delta", "none")
+#: What ``# texture:`` may declare.
+TEXTURE_KINDS = ("thickness", "bragg")
+
+
+@dataclass
+class BraggTexture:
+    """``T``: float32 ``(H_t, W_t)`` grey values in [0, 1], rows from the top; ``mapping``: :data:`MAPPINGS`."""
+
+    T: np.ndarray
+    mapping: str = "both"
+    source: str = "<array>"
+    #: No prefiltering: Section 5's is the thin film's.
+    prefilter = False
+
+    def __post_init__(self):
+        if self.mapping not in MAPPINGS:
+            raise LocatedError("--mapping", None, f"{self.mapping!r} is not one of {', '.join(MAPPINGS)}")
+
+    @classmethod
+    def from_file(cls, path: str | Path = DEFAULT_TEXTURE, mapping: str = "both"):
+        return cls(load_grey(path).astype(np.float32), mapping, str(path))
+
+    @property
+    def d_inc(self) -> np.ndarray:  # the texture's array, as ThicknessTexture names it (size checks)
+        return self.T
+
+    def per_pixel(self, x, y, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(T, 0)`` at the pixels ``p = (x, y)``: the same bilinear read as the film's (:meth:`ThicknessTexture.sample`)."""
+        return ThicknessTexture(self.T).per_pixel(x, y, width, height)
+
+    def model_options(self) -> dict:
+        return {"mapping": self.mapping}
+
+    def gl_arguments(self, material, values, width: int, height: int) -> dict:
+        """``inputs`` and ``uniforms`` of :meth:`explorer.gpu.Renderer.render`: the texture, the mapping, the tabulated method's table."""
+        from explorer.materials.models import model_for
+        from explorer.physics.bragg import TEXTURE_MAPPINGS
+
+        model = model_for(material, values)
+        table = np.zeros((1, 1, 3), np.float32)
+        if model is not None and model.method.needs_table:
+            table = np.asarray(model.texture_table(self.mapping), np.float32)
+        inputs = {"surface_texture": self.T[..., None], "surface_moments": np.zeros((1, 1, 2), np.float32), "bragg_texture_table": table}
+        return {"inputs": inputs, "uniforms": {"prefilter": False, "texture_mapping": int(TEXTURE_MAPPINGS[self.mapping])}}
+
+
+def check_texture_kind(material) -> str:
+    """The material's declared texture kind, or a one-line :class:`LocatedError` saying which materials have a textured view."""
+    from explorer.materials.brd import MaterialError
+
+    kind = getattr(material, "texture", None)
+    if kind is None:
+        raise MaterialError(material.path, None, "the textured view needs a material that declares '# texture: "
+                            f"{'|'.join(TEXTURE_KINDS)}' (thin_film, bragg_mirror)")
+    if kind not in TEXTURE_KINDS:
+        raise MaterialError(material.path, None, f"'# texture: {kind}' is not one of {', '.join(TEXTURE_KINDS)}")
+    return kind
+
+
+def default_texture(material):
+    """The textured view's default texture for ``material`` (the shipped noise, over the default D_inc range for a film)."""
+    return BraggTexture.from_file() if check_texture_kind(material) == "bragg" else ThicknessTexture.from_file()
