@@ -226,6 +226,8 @@ def test_bench_app_measures_drag_frames(x_display, tmp_path):
         assert row["fps"] == pytest.approx(1e3 / row["median_ms"])
         assert row["sphere_updates_per_s"] > 0.0, row  # the sphere followed the slider
     assert rows[3]["while_dragging"] == "128x128 full"
+    mesh = {row["name"]: row for row in document["mesh_rows"]}  # the teapot, lit and under the environment
+    assert set(mesh) == {"teapot lit", "teapot env"} and all(row["frames"] >= 20 for row in mesh.values()), mesh
 
 
 def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):

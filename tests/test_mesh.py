@@ -234,3 +234,21 @@ def test_cli_mesh_render_gl_and_numpy(tmp_path):
     surface = rasterise(teapot(), 64, 64)
     safe = surface.covered & (surface.margin > MESH_EDGE_MARGIN) & (surface.depth_gap > MESH_DEPTH_GAP)
     assert_twins_equal(Twins(np.load(gl), np.load(numpy_out), safe, "lit"), "teapot via the CLI", BRDF_TOLERANCE)
+
+
+@pytest.mark.gl
+def test_the_normals_pass_leaves_no_deleted_framebuffer_bound(gl_renderer):
+    """moderngl rebinds its last bound framebuffer after making one: the pass's own, released, was a GL error."""
+    from explorer.gpu.mesh import mesh_normals
+
+    ctx = gl_renderer.ctx
+    for _ in range(8):  # clear what earlier tests left (glGetError clears one flag a call)
+        if ctx.error == "GL_NO_ERROR":
+            break
+    assert ctx.error == "GL_NO_ERROR"
+    mesh_normals(gl_renderer, cube(), 8, 8)
+    assert ctx.error == "GL_NO_ERROR", "pass"
+    framebuffer = gl_renderer.target(4, 4)
+    assert ctx.error == "GL_NO_ERROR", "target"
+    gl_renderer.resources.release(framebuffer)
+    assert ctx.error == "GL_NO_ERROR"

@@ -117,9 +117,13 @@ class EnvSphere:
             self.environments[name] = ENVIRONMENTS[name]()
         return self.environments[name]
 
-    def request(self, state: AppState, size) -> AccumulatedImage:
-        """The render of ``state``'s material and values at ``size``, as a display source."""
-        key = (id(state.material), tuple(sorted(state.values.items())), size, tuple(state.camera), tuple(state.light),
+    def request(self, state: AppState, size, values: dict | None = None) -> AccumulatedImage:
+        """
+        The render of ``state``'s material at ``size``, as a display source: at ``values`` (while a slider
+        drags, the newest values whose tables are ready, :class:`TablePrefetcher`), else ``state.values``.
+        """
+        values = state.values if values is None else values
+        key = (id(state.material), tuple(sorted(values.items())), size, tuple(state.camera), tuple(state.light),
                state.environment, state.env_rotation, state.env_background, state.model)
         if self._key != key or self.render is None:
             environment = self.environment(state.environment).rotated(state.env_rotation)
@@ -130,12 +134,12 @@ class EnvSphere:
             if self.render is None or self._structure != structure or self.render.material is not state.material:
                 if self.render is not None:
                     self.render.release()
-                self.render = ProgressiveEnvRender(self.renderer, state.material, state.values, environment, *size,
+                self.render = ProgressiveEnvRender(self.renderer, state.material, values, environment, *size,
                                                    mesh=model_mesh(state.model, self.meshes), background=state.env_background)
                 self._structure = structure
             else:
                 self.render.environment = environment
-                self.render.reset(values=state.values)
+                self.render.reset(values=values)
             self._key = key
         self.pending = True
         if self.source is None or self.source.render is not self.render:

@@ -564,11 +564,14 @@ def app_mesh_steps(frames: int) -> list:
     return steps
 
 
-def summarise_app_frames(frames: list[dict]) -> list[dict]:
-    """Per method: frame times (ms) of the frames spent dragging, and the resolution shown meanwhile."""
+def summarise_app_frames(frames: list[dict], cases: list | None = None) -> list[dict]:
+    """
+    Per method (or per ``(method, name, mark)`` of ``cases``: the mesh cases): frame times (ms) of the frames
+    spent dragging, and the resolution shown meanwhile.
+    """
     rows = []
-    cases = [(method, name, f"method {method}") for method, name in APP_METHODS]
-    cases += [(int(BraggMethod.TABULATED), mark, mark) for mark, _ in APP_MESH_CASES]
+    if cases is None:
+        cases = [(method, name, f"method {method}") for method, name in APP_METHODS]
     for method, name, mark in cases:
         # Only frames where the parameter changed: a frame that redraws nothing new is not a drag frame.
         chosen = [f for f in frames if f.get("mark") == mark and f.get("dragging") and f.get("changed")]
@@ -610,14 +613,16 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
         App(DEFAULT_MATERIAL, script=app_bench_script(frames), report=report, view_size=size, is_default=True).run()
         document = json.loads(report.read_text())
     rows = summarise_app_frames(document["frames"])
+    mesh_rows = summarise_app_frames(document["frames"], [(int(BraggMethod.TABULATED), mark, mark) for mark, _ in APP_MESH_CASES])
     _progress(f"bench --app: the plot and textured views, {size} wide, Lambda moving")
     views = run_view_frames(size)
     if as_json:
-        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows, "views": views}, indent=2))
+        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows, "mesh_rows": mesh_rows,
+                          "views": views}, indent=2))
         return rows
     print(f"Explorer frame times while dragging Lambda ({size}x{size} sphere, 1280x800 window, {os.cpu_count()} CPUs):")
     print(f"{'method':<22} {'median':>8} {'p90':>8} {'max':>8} {'fps':>6} {'sphere/s':>9}  {'GL work':>8} {'UI':>6}  shown while dragging")
-    for row in rows:
+    for row in rows + mesh_rows:
         print(f"{row['method']} {row['name']:<20} {row['median_ms']:7.1f}ms {row['p90_ms']:7.1f}ms {row['max_ms']:7.1f}ms "
               f"{row['fps']:6.1f} {row['sphere_updates_per_s']:9.1f}  {row['gl_ms']:7.1f}ms {row['ui_ms']:5.1f}ms  {row['while_dragging']}")
     print("fps: frames while the slider moves; sphere/s: frames that show new parameter values on the sphere")

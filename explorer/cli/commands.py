@@ -156,7 +156,8 @@ def render_material(
 
         if VIEW_REGISTRY[view].evaluates not in ("brdf", "environment"):
             shown = ", ".join(name for name, v in VIEW_REGISTRY.items() if v.evaluates in ("brdf", "environment"))
-            raise MaterialError(material.path, None, f"a measured BRDF (MERL) has no reflectance(cos_theta) for the {view} view; its views: {shown}")
+            raise MaterialError(material.path, None, f"a measured BRDF (MERL) has no {view} view (it has no reflectance(cos_theta) "
+                                                     f"nor film thickness); its views: {shown}")
     if view == "env" and engine == "mitsuba":
         from explorer.cli.export import render_env_with_mitsuba
 

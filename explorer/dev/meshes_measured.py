@@ -18,6 +18,7 @@ from explorer.gpu import Renderer
 from explorer.gpu.env import ProgressiveEnvRender
 from explorer.gpu.mesh import MESH_TEMPLATES, mesh_normals, render_mesh
 from explorer.materials.brd import load_material
+from explorer.materials.methods import BraggMethod
 from explorer.materials.merl import tabulate, write_merl
 from explorer.materials.models import model_for
 from explorer.resources import SHADER_DIR
@@ -41,7 +42,7 @@ def _median_ms(function) -> float:
 
 def mesh_rows(renderer: Renderer) -> list[str]:
     material = load_material(SHADER_DIR / "bragg_mirror.brd")
-    values = material.resolve({"method": 3})
+    values = material.resolve({"method": int(BraggMethod.TABULATED)})
     lines = ["| model | triangles | normals pass (ms) | lit frame (ms) | numpy rasteriser (s) | GL vs numpy: pixels compared, max rel. error |",
              "|---|---|---|---|---|---|"]
     sphere = renderer.time_frame(material, values, "lit", SIZE, SIZE)
@@ -111,7 +112,7 @@ def env_rows(renderer: Renderer) -> list[str]:
 
 def main() -> None:
     renderer = Renderer()
-    print("### Meshes (lit view, bragg_mirror method 3)\n")
+    print("### Meshes (lit view, bragg_mirror tabulated)\n")
     print("\n".join(mesh_rows(renderer)))
     print("\n### MERL tables (an analytic BRDF written as a MERL file)\n")
     print("\n".join(merl_rows(renderer)))

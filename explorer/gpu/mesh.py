@@ -50,6 +50,13 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
     vertices = ctx.buffer(np.ascontiguousarray(np.concatenate([positions, normals], axis=1), dtype="f4").tobytes())
     indices = ctx.buffer(np.ascontiguousarray(mesh.triangles, dtype="i4").tobytes())
     array = ctx.vertex_array(program, [(vertices, "3f 3f", "position", "normal")], index_buffer=indices, index_element_size=4)
+    # moderngl binds its last bound framebuffer again after making one, and binding a deleted one is
+    # GL_INVALID_OPERATION (which the app's ImGui backend raises): a live one is bound first and again at the
+    # end, before ours is released (the last one bound if alive, else the screen, or a standalone's 0).
+    bound = ctx.fbo
+    alive = isinstance(bound, moderngl.Framebuffer) and type(getattr(bound, "mglo", None)).__name__ != "InvalidObject"
+    previous = bound if alive else ctx.screen or ctx.detect_framebuffer(0)
+    previous.use()
     colour = ctx.texture((width, height), 4, dtype="f4")
     depth = ctx.depth_renderbuffer((width, height))
     framebuffer = ctx.framebuffer(color_attachments=[colour], depth_attachment=depth)
@@ -65,6 +72,7 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
         data = np.frombuffer(colour.read(), dtype=np.float32).reshape(height, width, 4)
         return data.copy()
     finally:
+        previous.use()
         renderer.resources.release(framebuffer, depth, colour, array, indices, vertices)
 
 

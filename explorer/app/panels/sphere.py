@@ -40,7 +40,9 @@ class SpherePanel(Panel):
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
         if state.mode == "env":
-            texture = scheduler.show("main", size, scheduler.env.request(state, size))
+            # While a slider drags, the newest values whose tables are ready (built on a worker thread), as lit.
+            values = scheduler.prefetcher.values(state.material, state.values, self.app.dragging)
+            texture = scheduler.show("main", size, scheduler.env.request(state, size, values))
         else:
             dragging = self.app.dragging
             values = scheduler.prefetcher.values(state.material, state.values, dragging)
