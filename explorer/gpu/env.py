@@ -285,7 +285,7 @@ def render_env(
                                   surface=surface)
     renderer = Renderer() if renderer is None else renderer
     render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed, mesh=mesh,
-                                  background=background)
+                                  background=background, surface=surface)
     try:
         while render.samples < spp:
             render.step(min(spp - render.samples, max(1, render.samples_per_pass)))

@@ -42,7 +42,7 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
         builder.define(f"SPECIALISED_{name}", value)
     # The view, and whether it reads a surface texture: code only those views read (a textured mirror's
     # table) is left out of the others and of a .brdf export (no sampler).
-    builder.define(f"VIEW_{view.upper()}", 1)
+    builder.define("VIEW_" + "".join(c if c.isalnum() else "_" for c in view.upper()), 1)  # mesh/lit -> VIEW_MESH_LIT
     from explorer.views.geometry import VIEW_REGISTRY
 
     if view in VIEW_REGISTRY and VIEW_REGISTRY[view].surface_texture:
