@@ -92,10 +92,19 @@ class EnvSphere:
         self._key = None
         self._size = None
         self.pending = False  # requested this frame: advanced by the scheduler
+        self.restarted = False  # the render restarted since its last work: its next work is a first pass
+        self.last_work_ms = 0.0  # the GL time of the last work (ms)
+        self.last_first_pass = False  # whether that work was a restarted render's first pass
 
-    def request(self, state: AppState, size) -> AccumulatedImage:
-        """The render of ``state``'s material and values at ``size``, as a display source."""
-        key = (id(state.material), tuple(sorted(state.values.items())), size, tuple(state.camera), tuple(state.light))
+    def request(self, state: AppState, size, values: dict | None = None) -> AccumulatedImage:
+        """
+        The render of ``state``'s material at ``values`` (default ``state.values``; the app passes those of
+        :class:`TablePrefetcher`, drawn with draft tables while a slider moves) at ``size``, as a display
+        source. Samples drawn with draft tables are dropped once the real tables are ready.
+        """
+        values = state.values if values is None else values
+        ready = self.renderer.model_ready(state.material, values)  # False: draft tables, restarted when real
+        key = (id(state.material), tuple(sorted(values.items())), ready, size, tuple(state.camera), tuple(state.light))
         if self._key != key or self.render is None:
             # Another material (Files > Open, Reload) needs a render of its own: resetting the old one with
             # the new values would bind them to the old material's uniforms.
@@ -103,11 +112,12 @@ class EnvSphere:
                 if self.render is not None:
                     self.render.release()
                 self.environment = self.environment or EnvironmentMap.default()
-                self.render = ProgressiveEnvRender(self.renderer, state.material, state.values, self.environment, *size)
+                self.render = ProgressiveEnvRender(self.renderer, state.material, values, self.environment, *size)
                 self._size = size
             else:
-                self.render.reset(values=state.values)
+                self.render.reset(values=values)
             self._key = key
+            self.restarted = True
         self.pending = True
         if self.source is None or self.source.render is not self.render:
             self.source = AccumulatedImage(self.render)
@@ -115,7 +125,17 @@ class EnvSphere:
 
     def work(self, budget_ms: float) -> None:
         # Bands of rows when one sample costs more than the budget; the display pass divides by the counts.
+        start = time.perf_counter()
         self.render.advance(max(0.5 * budget_ms, 5.0))
+        self.last_work_ms = (time.perf_counter() - start) * 1e3
+        self.last_first_pass, self.restarted = self.restarted, False
+
+    def report(self) -> dict:
+        """The env render's last work, for a frame's record (``bench --app``)."""
+        render = self.render
+        return {"ms": self.last_work_ms, "first_pass": self.last_first_pass,
+                "samples": render.samples if render is not None else 0,
+                "band_rows": render._band_rows if render is not None else 0}
 
 
 class Scheduler:
@@ -148,15 +168,18 @@ class Scheduler:
         order = [job for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
         if state.pending_screenshot and state.mode != "env":
             order.insert(0, self.job("main"))
-        for index, job in enumerate(order):
+        for job in order:
             remaining = budget - (time.perf_counter() - start) * 1e3
             if dragging:
                 # While a slider moves the sphere comes first and gets a preview that fits with the UI's
-                # own ~30 ms in a 15 fps frame; the other views get what little is left.
-                remaining = min(remaining, DRAG_BUDGET_MS) if index == 0 else min(remaining, SIDE_DRAG_BUDGET_MS)
+                # own ~30 ms in a 15 fps frame; the other views get what little is left (in the env mode
+                # the sphere is the env render: every job is another view, whose tables would be built
+                # on the spot).
+                remaining = min(remaining, DRAG_BUDGET_MS) if job is self.jobs.get("main") else min(remaining, SIDE_DRAG_BUDGET_MS)
             if remaining <= 0:
                 break
             job.work(remaining)
+        self.env.last_work_ms, self.env.last_first_pass = 0.0, False
         if self.env.pending and state.mode == "env":
             self.env.work(budget - (time.perf_counter() - start) * 1e3)
         self.env.pending = False

@@ -211,6 +211,7 @@ class App:
             "changed": changed, "ms": frame_s * 1e3, "work_ms": work_s * 1e3, "gl_ms": gl_ms, "ui_ms": ui_s * 1e3,
             "imgui_draw_ms": draw_s * 1e3 - gl_ms, "swap_ms": swap_s * 1e3, "dragging": self.dragging,
             "mark": self.robot.mark if self.robot else None, "main": self.scheduler.main_report(),
+            "env": self.scheduler.env.report(), "mode": self.state.mode,
             "table_ms": self.renderer.last_table_ms,
         })
 

@@ -24,11 +24,12 @@ class SpherePanel(Panel):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
+        # While a slider moves, the tables are built on a worker thread (drafts first): the values shown are the newest ready.
+        dragging = self.app.dragging
+        values = scheduler.prefetcher.values(state.material, state.values, dragging)
         if state.mode == "env":
-            texture = scheduler.show("main", size, scheduler.env.request(state, size))
+            texture = scheduler.show("main", size, scheduler.env.request(state, size, values))
         else:
-            dragging = self.app.dragging
-            values = scheduler.prefetcher.values(state.material, state.values, dragging)
             job.request(state.material, values, state.main_view(), size, light=light_vector(state.light, state.camera), dragging=dragging)
             texture = scheduler.show("main", size, job)
         show_image(state, texture, size, "sphere_image", interactive=True)
