@@ -177,19 +177,21 @@ class ProgressiveEnvRender:
         start = time.perf_counter()
         bindings = self._bindings()  # new tables' uploads count against the budget
         spent = (time.perf_counter() - start) * 1e3
-        while spent < budget_ms:
+        bands = 0
+        while spent < budget_ms or bands == 0:  # at least one row a call: progress whatever the estimate
             top = self._band_rows
             done = self._cumulative_weights[top]
             if self.pixel_ms is None:  # a probe: at most 1/16 of the image
                 wanted = min(BAND_PROBE_PIXELS, self._cumulative_weights[-1] / 16.0)
             else:
                 wanted = (budget_ms - spent) / self.pixel_ms
-                if wanted < self._row_weights[top] and spent > 0.0:
+                if wanted < self._row_weights[top] and bands:
                     break  # the next row would overrun the budget: the next frame's
             bottom = int(np.searchsorted(self._cumulative_weights, done + wanted, side="right")) - 1
             bottom = min(self.height, max(top + 1, bottom))
             elapsed = self._pass(bindings, 1, (top, bottom))
             spent += elapsed
+            bands += 1
             self.pixel_ms = max(elapsed / max(self._cumulative_weights[bottom] - done, 1e-9), 1e-9)
             self._band_rows = bottom
             if bottom >= self.height:
