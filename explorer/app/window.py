@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -21,6 +22,11 @@ from explorer.app.script import ScriptRobot
 from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, has_reflectance, initial_values
 
 DEFAULT_WINDOW = (1280, 800)
+#: The interpreter's thread switch interval while the app runs (Python's default: 5 ms). The table
+#: prefetcher's worker thread holds the GIL between its numpy calls; each of the frame's many GL calls
+#: through PyOpenGL (ImGui's backend) releases it and may wait a whole interval to get it back. At 0.5 ms a
+#: dragged frame of the tabulated method took ~30% less time in bench --app (docs/performance.md).
+SWITCH_INTERVAL_S = 0.0005
 
 
 class AppError(Exception):
@@ -158,6 +164,8 @@ class App:
         from explorer.gpu import Renderer
 
         window = self._open_window()
+        switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(SWITCH_INTERVAL_S)
         try:
             self.ctx = moderngl.create_context(require=330)
             self.renderer = Renderer(self.ctx)
@@ -198,6 +206,7 @@ class App:
             implot.destroy_context()
             imgui.destroy_context()
         finally:
+            sys.setswitchinterval(switch_interval)
             glfw.destroy_window(window)
             glfw.terminate()
             self._write_report()
