@@ -170,14 +170,14 @@ class Scheduler:
         order = [job for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
         if state.pending_screenshot and state.mode != "env":
             order.insert(0, self.job("main"))
+        # While a slider moves the first view (the sphere) gets a preview that fits with the UI's own
+        # ~30 ms in a 15 fps frame; the others get what little is left. In the env mode the sphere is the
+        # env render: every job is another view (whose tables would be built on the spot), none leads.
+        leading = order[0] if order and state.mode != "env" else None
         for job in order:
             remaining = budget - (time.perf_counter() - start) * 1e3
             if dragging:
-                # While a slider moves the sphere comes first and gets a preview that fits with the UI's
-                # own ~30 ms in a 15 fps frame; the other views get what little is left (in the env mode
-                # the sphere is the env render: every job is another view, whose tables would be built
-                # on the spot).
-                remaining = min(remaining, DRAG_BUDGET_MS) if job is self.jobs.get("main") else min(remaining, SIDE_DRAG_BUDGET_MS)
+                remaining = min(remaining, DRAG_BUDGET_MS) if job is leading else min(remaining, SIDE_DRAG_BUDGET_MS)
             if remaining <= 0:
                 break
             job.work(remaining)
