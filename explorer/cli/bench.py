@@ -617,8 +617,10 @@ def summarise_app_frames(frames: list[dict]) -> list[dict]:
             chosen = [f for f in drag if f.get("changed")]
             if not chosen:
                 continue
+            # What most of those frames showed (a draw slowed by other processes may make one a preview).
             previews = [tuple(f["main"]["preview"]) for f in chosen if f["main"]["has_preview"] and not f["main"]["complete"]]
-            shown = f"{previews[-1][0]}x{previews[-1][1]} preview" if previews else f"{chosen[-1]['main']['size'][0]}x{chosen[-1]['main']['size'][1]} full"
+            shown = (f"{previews[-1][0]}x{previews[-1][1]} preview" if 2 * len(previews) > len(chosen)
+                     else f"{chosen[-1]['main']['size'][0]}x{chosen[-1]['main']['size'][1]} full")
             rows.append({"mode": mode, "method": method, "name": name, **_frame_row(chosen, drag), "while_dragging": shown})
     return rows
 
