@@ -25,7 +25,7 @@ DEFAULT_WINDOW = (1280, 800)
 #: The interpreter's thread switch interval while the app runs (Python's default: 5 ms). The table
 #: prefetcher's worker thread holds the GIL between its numpy calls; each of the frame's many GL calls
 #: through PyOpenGL (ImGui's backend) releases it and may wait a whole interval to get it back. At 0.5 ms a
-#: dragged frame of the tabulated method took ~30% less time in bench --app (docs/performance.md).
+#: dragged frame of the tabulated method took ~30% less time on a busy machine (docs/performance.md).
 SWITCH_INTERVAL_S = 0.0005
 
 
