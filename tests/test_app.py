@@ -212,20 +212,29 @@ def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, brag
 
 
 def test_bench_app_measures_drag_frames(x_display, tmp_path):
-    """``bench --app``: the harness drags Lambda through the UI per method and reports the frames that changed it."""
+    """
+    ``bench --app``: the harness drags Lambda through the UI per mode and method and reports the frames that
+    changed it; then the two-layer stack's env mode: its first pass, and the frames of a drag of Lambda_1.
+    """
+    from explorer.cli.bench import APP_MODES
+
     env = {**os.environ, "DISPLAY": x_display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
     process = subprocess.run([sys.executable, "-m", "explorer.cli.commands", "bench", "--app", "--json", "--size", "128"],
                              cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert process.returncode == 0, process.stderr
     document = json.loads(process.stdout)
-    rows = {row["method"]: row for row in document["rows"]}
-    assert set(rows) == {0, 1, 2, 3, 4} and document["size"] == 128
+    rows = {(row["mode"], row["method"]): row for row in document["rows"]}
+    assert set(rows) == {(mode, method) for mode in APP_MODES for method in range(5)} and document["size"] == 128
     for row in rows.values():
         assert row["frames"] >= 20, row  # the slider moved on most of the 60 drag frames
         assert 0.0 < row["median_ms"] <= row["p90_ms"] <= row["max_ms"]
         assert row["fps"] == pytest.approx(1e3 / row["median_ms"])
         assert row["sphere_updates_per_s"] > 0.0, row  # the sphere followed the slider
-    assert rows[3]["while_dragging"] == "128x128 full"
+    assert rows[("sphere", 3)]["while_dragging"] == "128x128 full"
+    stack = document["env"]
+    assert stack is not None and stack["frames"] >= 20, stack
+    assert 0.0 < stack["first_pass_ms"] and 0.0 < stack["drag_first_pass_median_ms"] <= stack["drag_first_pass_max_ms"]
+    assert stack["sphere_updates_per_s"] > 0.0, stack
     mesh = {row["name"]: row for row in document["mesh_rows"]}  # the teapot, lit and under the environment
     assert set(mesh) == {"teapot lit", "teapot env"} and all(row["frames"] >= 20 for row in mesh.values()), mesh
 

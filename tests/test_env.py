@@ -574,6 +574,41 @@ def test_advance_in_bands_equals_whole_passes(gl_renderer):
 
 
 @pytest.mark.gl
+def test_advance_keeps_every_frame_to_its_budget(gl_renderer):
+    """
+    A sample's cost lies in the disc's pixels, not its rows: advance() sizes its bands by them, so that no
+    call (the first, a probe, included) overruns its budget by more than one row, however cheap the top rows.
+    """
+    from explorer.materials.brd import load_material
+    from explorer.views.env import EnvironmentMap
+    from explorer.views.geometry import disc
+    from explorer.gpu.env import ProgressiveEnvRender
+
+    material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
+    size, per_pixel, budget = 64, 0.05, 10.0  # a sample: ~160 ms of pretended work
+    render = ProgressiveEnvRender(gl_renderer, material, material.resolve({}), EnvironmentMap.default(), size, size)
+    inside = (disc(size, size)[2] < np.float32(1.0)).sum(axis=1)
+    real_pass, spent = render._pass, []
+
+    def costly_pass(bindings, count, rows=None):
+        real_pass(bindings, count, rows)
+        top, bottom = rows if rows is not None else (0, size)
+        spent.append(per_pixel * count * float(inside[top:bottom].sum()))
+        return spent[-1]
+
+    render._pass = costly_pass
+    calls = 0
+    while render.samples < 2:
+        spent.clear()
+        render.advance(budget)
+        calls += 1
+        assert sum(spent) <= budget + per_pixel * size, (calls, spent)
+        assert calls < 200
+    assert calls >= 2 * per_pixel * inside.sum() / budget  # no frame did more than its budget's share
+    render.release()
+
+
+@pytest.mark.gl
 def test_coating_mirror_reflection_is_added_exactly(gl_renderer):
     """A coated stack whose layer is invisible (n2 = n1 = nh) and base black shows only the coating's Dirac: F Le(R)."""
     from explorer.materials.brd import load_material

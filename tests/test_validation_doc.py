@@ -76,9 +76,13 @@ def test_thin_film_and_app_markdown():
     accuracy, timing = tables_in(md.thin_film_markdown(document))
     assert accuracy == [["configuration", "rgb", "1-nm sum"], ["figure7", "0.5 / 3", "1 / 3"], ["soap", "0.5 / 3", "1 / 3"]]
     assert timing[1] == ["spectral", "40.00 ms", "×20.00"]
-    rows = [{"method": 3, "name": "tabulated", "median_ms": 15.94, "fps": 62.7, "sphere_updates_per_s": 23.9,
-             "while_dragging": "512x512 full"}]
-    assert tables_in(md.app_markdown(rows))[0][1] == ["3 tabulated", "15.9 ms", "62.7", "23.9", "512x512 full"]
+    rows = [{"mode": "lit", "method": 3, "name": "tabulated", "median_ms": 15.94, "fps": 62.7, "sphere_updates_per_s": 23.9,
+             "while_dragging": "512x512 full"},
+            {"mode": "env", "material": "bragg_stack.brd", "values": {"layers": 2}, "median_ms": 40.0, "fps": 25.0,
+             "sphere_updates_per_s": 3.5, "first_pass_ms": 21.04, "drag_first_pass_median_ms": 30.0}]
+    table = tables_in(md.app_markdown(rows))[0]
+    assert table[1] == ["lit", "3 tabulated", "15.9 ms", "62.7", "23.9", "512x512 full"]
+    assert table[2][0] == "env" and table[2][2:5] == ["40.0 ms", "25.0", "3.5"] and "first pass 21.0 ms" in table[2][5]
 
 
 def test_layers_markdown_three_tables():

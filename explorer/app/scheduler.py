@@ -20,8 +20,10 @@ from explorer.app.state import AppState
 
 #: Per-frame budget of GL work (ms): ~30 ms of drawing plus the UI's own frame keeps >= 15 fps.
 FRAME_BUDGET_MS = 30.0
-#: GL budgets (ms) per frame while a slider is dragged: the active view, and each of the others.
-DRAG_BUDGET_MS = 16.0
+#: GL budgets (ms) per frame while a slider is dragged: the active view, and each of the others. With the
+#: UI (~3 ms), ImGui's drawing (~8 ms), the display pass and the swap on llvmpipe, 12 ms keeps a frame
+#: under 33 ms on a quiet 2-core machine (bench --app).
+DRAG_BUDGET_MS = 12.0
 SIDE_DRAG_BUDGET_MS = 0.0
 
 
@@ -108,6 +110,9 @@ class EnvSphere:
         self._key = None
         self._structure = None
         self.pending = False  # requested this frame: advanced by the scheduler
+        self.restarted = False  # the render restarted since its last work: its next work is a first pass
+        self.last_work_ms = 0.0  # the GL time of the last work (ms)
+        self.last_first_pass = False  # whether that work was a restarted render's first pass
 
     def environment(self, name: str) -> EnvironmentMap:
         """An environment of :data:`explorer.views.env.ENVIRONMENTS` by name, loaded once."""
@@ -119,11 +124,13 @@ class EnvSphere:
 
     def request(self, state: AppState, size, values: dict | None = None) -> AccumulatedImage:
         """
-        The render of ``state``'s material at ``size``, as a display source: at ``values`` (while a slider
-        drags, the newest values whose tables are ready, :class:`TablePrefetcher`), else ``state.values``.
+        The render of ``state``'s material at ``values`` (default ``state.values``; the app passes those of
+        :class:`TablePrefetcher`, drawn with draft tables while a slider moves) at ``size``, as a display
+        source. Samples drawn with draft tables are dropped once the real tables are ready.
         """
         values = state.values if values is None else values
-        key = (id(state.material), tuple(sorted(values.items())), size, tuple(state.camera), tuple(state.light),
+        ready = self.renderer.model_ready(state.material, values)  # False: draft tables, restarted when real
+        key = (id(state.material), tuple(sorted(values.items())), ready, size, tuple(state.camera), tuple(state.light),
                state.environment, state.env_rotation, state.env_background, state.model)
         if self._key != key or self.render is None:
             environment = self.environment(state.environment).rotated(state.env_rotation)
@@ -141,6 +148,7 @@ class EnvSphere:
                 self.render.environment = environment
                 self.render.reset(values=values)
             self._key = key
+            self.restarted = True
         self.pending = True
         if self.source is None or self.source.render is not self.render:
             self.source = AccumulatedImage(self.render)
@@ -155,7 +163,17 @@ class EnvSphere:
         if target is not None and self.render.samples >= target:
             return  # converged: the image stays, nothing more is drawn
         # Bands of rows when one sample costs more than the budget; the display pass divides by the counts.
+        start = time.perf_counter()
         self.render.advance(max(0.5 * budget_ms, 5.0))
+        self.last_work_ms = (time.perf_counter() - start) * 1e3
+        self.last_first_pass, self.restarted = self.restarted, False
+
+    def report(self) -> dict:
+        """The env render's last work, for a frame's record (``bench --app``)."""
+        render = self.render
+        return {"ms": self.last_work_ms, "first_pass": self.last_first_pass,
+                "samples": render.samples if render is not None else 0,
+                "band_rows": render._band_rows if render is not None else 0}
 
 
 class Scheduler:
@@ -188,15 +206,18 @@ class Scheduler:
         order = [job for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
         if state.pending_screenshot and state.mode != "env":
             order.insert(0, self.job("main"))
-        for index, job in enumerate(order):
+        # While a slider moves the first view (the sphere) gets a preview that fits with the UI's own
+        # ~30 ms in a 15 fps frame; the others get what little is left. In the env mode the sphere is the
+        # env render: every job is another view (whose tables would be built on the spot), none leads.
+        leading = order[0] if order and state.mode != "env" else None
+        for job in order:
             remaining = budget - (time.perf_counter() - start) * 1e3
             if dragging:
-                # While a slider moves the sphere comes first and gets a preview that fits with the UI's
-                # own ~30 ms in a 15 fps frame; the other views get what little is left.
-                remaining = min(remaining, DRAG_BUDGET_MS) if index == 0 else min(remaining, SIDE_DRAG_BUDGET_MS)
+                remaining = min(remaining, DRAG_BUDGET_MS) if job is leading else min(remaining, SIDE_DRAG_BUDGET_MS)
             if remaining <= 0:
                 break
             job.work(remaining)
+        self.env.last_work_ms, self.env.last_first_pass = 0.0, False
         if self.env.pending and state.mode == "env":
             self.env.work(budget - (time.perf_counter() - start) * 1e3, state.env_target_spp)
             state.env_progress = self.env.progress(state.env_target_spp)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -24,6 +25,11 @@ from explorer.app.state import DEFAULT_VIEW_SIZE, AppState, CompareState, Materi
 DEFAULT_WINDOW = (1280, 800)
 #: The frame whose windows the report calls the first screen (the layout is done and focused by then).
 FIRST_SCREEN_FRAME = 3
+#: The interpreter's thread switch interval while the app runs (Python's default: 5 ms). The table
+#: prefetcher's worker thread holds the GIL between its numpy calls; each of the frame's many GL calls
+#: through PyOpenGL (ImGui's backend) releases it and may wait a whole interval to get it back. At 0.5 ms a
+#: dragged frame of the tabulated method took ~30% less time on a busy machine (docs/performance.md).
+SWITCH_INTERVAL_S = 0.0005
 
 
 class AppError(Exception):
@@ -233,6 +239,8 @@ class App:
         from explorer.gpu import Renderer
 
         window = self._open_window()
+        switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(SWITCH_INTERVAL_S)
         try:
             self.ctx = moderngl.create_context(require=330)
             self.renderer = Renderer(self.ctx)
@@ -273,6 +281,7 @@ class App:
             implot.destroy_context()
             imgui.destroy_context()
         finally:
+            sys.setswitchinterval(switch_interval)
             glfw.destroy_window(window)
             glfw.terminate()
             self._write_report()
@@ -291,6 +300,7 @@ class App:
             "changed": changed, "ms": frame_s * 1e3, "work_ms": work_s * 1e3, "gl_ms": gl_ms, "ui_ms": ui_s * 1e3,
             "imgui_draw_ms": draw_s * 1e3 - gl_ms, "swap_ms": swap_s * 1e3, "dragging": self.dragging,
             "mark": self.robot.mark if self.robot else None, "main": self.scheduler.main_report(),
+            "env": self.scheduler.env.report(), "mode": self.state.mode,
             "table_ms": self.renderer.last_table_ms,
         })
 

@@ -181,10 +181,13 @@ def layers_markdown(document: dict) -> str:
 
 
 def app_markdown(rows: list[dict]) -> str:
-    """``bench --app``: per method, frame times while Λ is dragged and what the sphere shows meanwhile."""
-    body = [[f"{r['method']} {r['name']}", f"{r['median_ms']:.1f} ms", f"{r['fps']:.1f}", f"{r['sphere_updates_per_s']:.1f}",
-             r["while_dragging"]] for r in rows]
-    return markdown_table(["method", "median frame", "frames per second", "sphere updates per second",
+    """``bench --app``: per mode and method, frame times while Λ is dragged and what the sphere shows meanwhile; the env mode's first pass."""
+    body = [[r.get("mode", "sphere"), f"{r['method']} {r['name']}", f"{r['median_ms']:.1f} ms", f"{r['fps']:.1f}",
+             f"{r['sphere_updates_per_s']:.1f}", r["while_dragging"]] for r in rows if r.get("mode") != "env"]
+    body += [["env", f"{r['material']} {r['values']}, Λ_1 dragged", f"{r['median_ms']:.1f} ms", f"{r['fps']:.1f}",
+              f"{r['sphere_updates_per_s']:.1f}", f"first pass {r['first_pass_ms']:.1f} ms (dragging: {r['drag_first_pass_median_ms']:.1f} ms)"]
+             for r in rows if r.get("mode") == "env"]
+    return markdown_table(["mode", "method", "median frame", "frames per second", "sphere updates per second",
                            "shown while dragging"], body)
 
 

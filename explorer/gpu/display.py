@@ -58,6 +58,17 @@ void main() {{
 """
 
 
+UPSCALE_SHADER = f"""#version {GLSL_VERSION}
+// An 8-bit sRGB preview stretched to the display's size (bilinear): on llvmpipe ~4x cheaper than the
+// display pass at full size, whose float fetches and pow()s per pixel were most of a dragged frame's GL time.
+uniform sampler2D encoded;
+uniform vec2 resolution;
+out vec4 frag_colour;
+
+void main() {{ frag_colour = texture(encoded, gl_FragCoord.xy / resolution); }}
+"""
+
+
 class AccumulatedImage:
     """
     A progressive env render (:class:`explorer.gpu.env.ProgressiveEnvRender`) as a source of
@@ -87,7 +98,9 @@ class DisplayPass:
         self.renderer = renderer
         self.ctx = ctx = renderer.ctx
         self.program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=DISPLAY_SHADER)
+        self.upscale = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=UPSCALE_SHADER)
         self._targets: dict[object, object] = {}
+        self._encoded: dict[object, object] = {}  # per key, a preview encoded at its own size (see draw)
         self._drawn: dict[object, tuple] = {}  # what each target shows: redrawn only when that changes
         self.resources = renderer.resources
         self._blank = self.resources.texture(np.zeros((1, 1, 4), np.float32))
@@ -127,10 +140,25 @@ class DisplayPass:
         textures: dict[str, object] = {}
         self._bindings(a, "a", uniforms, textures)
         self._bindings(b if b is not None else a, "b", uniforms, textures)
+        if b is None and not gamut and uniforms["refined_a"] > 1.0:
+            # Only a preview to show (a slider is moving): encoded at the preview's size, then stretched
+            # (the gamut hatching, drawn per screen pixel, keeps the full-size pass).
+            encoded = self._encoded[key] = self.resources.replace(self._encoded.get(key), size=tuple(a.preview_size), components=4,
+                                                                  dtype="f1", origin="display")
+            import moderngl
+
+            encoded.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            self._pass(self.program, encoded, uniforms, textures)
+            self._pass(self.upscale, texture, {}, {"encoded": encoded})
+            return texture
+        self._pass(self.program, texture, uniforms, textures)
+        return texture
+
+    def _pass(self, program, texture, uniforms: dict, textures: dict) -> None:
+        """One draw of ``program`` into ``texture``, not waited for."""
         # A framebuffer only for this draw: on llvmpipe, sampling a texture that is still attached to a
         # framebuffer makes every ImGui draw that shows it flush the window's whole scene (~25 ms each).
         framebuffer = self.resources.wrap([texture])
-        self.renderer.draw(self.program, framebuffer, uniforms=uniforms, textures=textures, finish=False)
+        self.renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures, finish=False)
         self._parking.use()
         self.resources.release(framebuffer)
-        return texture

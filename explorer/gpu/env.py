@@ -6,12 +6,14 @@ is its numpy twin), every pass through the renderer's draw primitive.
 
 from __future__ import annotations
 
+import time
 from typing import Callable, Mapping
 
 import numpy as np
 
 from explorer.errors import LocatedError
 from explorer.views.env import EnvironmentMap, env_integral_numpy, environment_sampling_tables
+from explorer.views.geometry import disc
 from explorer.gpu.renderer import Renderer
 
 #: The share of samples drawn from the environment (one-sample MIS with the material's own sampling, the
@@ -35,8 +37,22 @@ def environment_texture(resources, environment: EnvironmentMap):
 #: would then be silently wrong.
 MAX_SPP = 1 << 24
 
-#: Rows of the first band of :meth:`ProgressiveEnvRender.advance` when a sample's cost is not yet known.
-BAND_PROBE_ROWS = 8
+#: The first band of :meth:`ProgressiveEnvRender.advance` when a pixel's cost is not yet known: rows
+#: holding at least this many pixels of the disc (about one row through the middle of a 512² sphere).
+BAND_PROBE_PIXELS = 512
+#: A pixel outside the disc costs this fraction of one inside (it returns at once: env.glsl's main).
+OUTSIDE_PIXEL_WEIGHT = 0.02
+
+
+def disc_weights(width: int, height: int) -> np.ndarray:
+    """
+    Per row from the top, the cost of a sample in pixels of the disc: the pixels inside it (as the
+    shader decides, :func:`explorer.views.geometry.disc`) plus :data:`OUTSIDE_PIXEL_WEIGHT` per other pixel.
+    A band's cost is proportional to its weight, not its rows: the top rows of the sphere are cheap.
+    """
+    _, _, r2 = disc(width, height)
+    inside = (r2 < np.float32(1.0)).sum(axis=1)
+    return inside + OUTSIDE_PIXEL_WEIGHT * (width - inside)
 
 
 class ProgressiveEnvRender:
@@ -95,6 +111,8 @@ class ProgressiveEnvRender:
         self.last_pass_ms: float | None = None
         #: Measured cost of one sample over the whole image (ms), None before the first.
         self.sample_ms: float | None = None
+        #: Measured cost of one sample of one pixel of the disc (ms; :func:`disc_weights`), None before the first band.
+        self.pixel_ms: float | None = None
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(renderer.resources, environment)
         if not 0.0 <= float(environment_sampling) < 1.0:
@@ -111,6 +129,8 @@ class ProgressiveEnvRender:
             from explorer.gpu.mesh import mesh_normals
 
             self._mesh_normals = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
+        self._row_weights = disc_weights(self.width, self.height)
+        self._cumulative_weights = np.concatenate([[0.0], np.cumsum(self._row_weights)])
         self._targets = list(self._framebuffer.color_attachments)
         self.values = dict(values)
         #: Off the object, the environment behind it (exact, no samples needed), else black.
@@ -178,32 +198,45 @@ class ProgressiveEnvRender:
             remaining -= count
             per_sample = max(self.last_pass_ms / count, 1e-3)
             self.sample_ms = per_sample
+            self.pixel_ms = per_sample / self._cumulative_weights[-1]
             self.samples_per_pass = int(min(MAX_SAMPLES_PER_PASS, max(1, self.pass_budget_ms // per_sample)))
 
     def advance(self, budget_ms: float) -> None:
         """
         Add samples for about ``budget_ms``: whole passes when one sample of the whole image fits, or else
         one sample in bands of rows, so that an interactive caller never waits much longer than its budget
-        for an expensive material (a stack's 471 wavelengths cost ~1 s per sample at 256² on llvmpipe).
-        Pixels of a band hold one sample more than :attr:`samples` until the sample is complete.
+        for an expensive material (a two-layer stack's 471 wavelengths cost seconds per sample at 512² on
+        llvmpipe). A band's rows are chosen by their pixels inside the disc (:func:`disc_weights`) at the
+        measured cost per pixel: the first band of a render is a probe of :data:`BAND_PROBE_PIXELS` (at most
+        a 16th of the image), so that even its first frame keeps to the budget. Pixels of a band hold one
+        sample more than :attr:`samples` until the sample is complete.
         """
         budget_ms = max(float(budget_ms), 1.0)
         if self._band_rows == 0 and self.sample_ms is not None and self.sample_ms <= budget_ms:
             self.step(max(1, min(MAX_SAMPLES_PER_PASS, int(budget_ms // self.sample_ms))))
             return
-        bindings = self._bindings()
-        row_ms = (self.sample_ms / self.height) if self.sample_ms is not None else None
-        spent = 0.0
-        while spent < budget_ms:
-            rows = BAND_PROBE_ROWS if row_ms is None else max(1, int((budget_ms - spent) / max(row_ms, 1e-6)))
+        start = time.perf_counter()
+        bindings = self._bindings()  # new tables' uploads count against the budget
+        spent = (time.perf_counter() - start) * 1e3
+        bands = 0
+        while spent < budget_ms or bands == 0:  # at least one row a call: progress whatever the estimate
             top = self._band_rows
-            bottom = min(self.height, top + rows)
+            done = self._cumulative_weights[top]
+            if self.pixel_ms is None:  # a probe: at most 1/16 of the image
+                wanted = min(BAND_PROBE_PIXELS, self._cumulative_weights[-1] / 16.0)
+            else:
+                wanted = (budget_ms - spent) / self.pixel_ms
+                if wanted < self._row_weights[top] and bands:
+                    break  # the next row would overrun the budget: the next frame's
+            bottom = int(np.searchsorted(self._cumulative_weights, done + wanted, side="right")) - 1
+            bottom = min(self.height, max(top + 1, bottom))
             elapsed = self._pass(bindings, 1, (top, bottom))
             spent += elapsed
-            row_ms = max(elapsed / (bottom - top), 1e-6)
+            bands += 1
+            self.pixel_ms = max(elapsed / max(self._cumulative_weights[bottom] - done, 1e-9), 1e-9)
             self._band_rows = bottom
             if bottom >= self.height:
-                self.sample_ms = row_ms * self.height
+                self.sample_ms = self.pixel_ms * self._cumulative_weights[-1]
                 self.samples += 1
                 self.passes += 1
                 self._band_rows = 0

@@ -39,13 +39,12 @@ class SpherePanel(Panel):
             state.view_size = auto_view_size(avail.x, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
         size = (state.view_size, state.view_size)
         job = scheduler.job("main")
+        # While a slider moves, the tables are built on a worker thread (drafts first): the values shown are the newest ready.
+        dragging = self.app.dragging
+        values = scheduler.prefetcher.values(state.material, state.values, dragging)
         if state.mode == "env":
-            # While a slider drags, the newest values whose tables are ready (built on a worker thread), as lit.
-            values = scheduler.prefetcher.values(state.material, state.values, self.app.dragging)
             texture = scheduler.show("main", size, scheduler.env.request(state, size, values))
         else:
-            dragging = self.app.dragging
-            values = scheduler.prefetcher.values(state.material, state.values, dragging)
             view, inputs = state.main_view(), None
             mesh = model_mesh(state.model, scheduler.env.meshes) if view == "lit" else None
             if mesh is not None:  # the mesh's rasterised normals (explorer.gpu.mesh), once per model and size

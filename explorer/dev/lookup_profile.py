@@ -1,0 +1,139 @@
+"""
+``python -m explorer.dev.lookup_profile [SIZE] [REPEATS]``: what a per-pixel table lookup costs against
+Schlick's Fresnel on this GL (issue 22 item 3; docs/performance.md, *Tabulated shading, re-profiled*).
+
+Each variant is the sphere view's pixel (``shaders/views/sphere.glsl``: ``reflectance(sqrt(1 - r^2))``
+inside the disc) with one way of reading a 257-entry RGB table over cos theta: the tabulated method's own
+(two ``texelFetch`` and a float ``mix``, ``shaders/lib/bragg.glsl``'s ``tabulated_rgb``), the other exact
+ones (two nearest ``texture`` reads, a uniform block, hardware filtering of RGBA32F and of 16-bit
+fixed point) and, for the floor, one nearest read (not exact). Frames are interleaved and bounded by
+``glFinish``; the minimum over the repeats is printed with the median CPU time, as ratios to Schlick's.
+The minimum is the least disturbed by other processes on a shared machine.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from explorer.gpu.context import GLSL_VERSION, VERTEX_SHADER, create_context
+
+ENTRIES = 257
+
+_HEAD = f"""#version {GLSL_VERSION}
+uniform vec2 resolution;
+uniform float F0;
+out vec4 frag_colour;
+"""
+_MAIN = """
+void main() {
+    vec2 p = 2.0 * gl_FragCoord.xy / resolution - 1.0;
+    float r2 = dot(p, p);
+    frag_colour = r2 < 1.0 ? vec4(reflectance(sqrt(1.0 - r2)), 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+}
+"""
+_INDEX = """int last = textureSize(table, 0).x - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, max(last - 1, 0));"""
+#: name -> (description, table texture: (dtype, filter) or "block", the reflectance function).
+VARIANTS = {
+    "schlick": ("Schlick's Fresnel (the baseline)", None, """
+vec3 reflectance(float c) { float m = 1.0 - c; float m2 = m * m; return vec3(F0 + (1.0 - F0) * m2 * m2 * m); }"""),
+    "fetch2": ("two texelFetch + mix, RGBA32F (the tabulated method)", ("f4", "nearest"), f"""
+uniform sampler2D table;
+vec3 reflectance(float cos_theta) {{
+    {_INDEX}
+    return mix(texelFetch(table, ivec2(i, 0), 0).rgb, texelFetch(table, ivec2(min(i + 1, last), 0), 0).rgb, x - float(i));
+}}"""),
+    "texture2": ("two nearest texture() + mix, RGBA32F", ("f4", "nearest"), f"""
+uniform sampler2D table;
+vec3 reflectance(float cos_theta) {{
+    {_INDEX}
+    float w = float(last + 1);
+    return mix(texture(table, vec2((float(i) + 0.5) / w, 0.5)).rgb, texture(table, vec2((float(i) + 1.5) / w, 0.5)).rgb, x - float(i));
+}}"""),
+    "block2": ("two entries of a uniform block + mix", "block", f"""
+layout(std140) uniform Table {{ vec4 entries[{ENTRIES}]; }};
+vec3 reflectance(float cos_theta) {{
+    int last = {ENTRIES - 1};
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, last - 1);
+    return mix(entries[i].rgb, entries[i + 1].rgb, x - float(i));
+}}"""),
+    "linear32f": ("texture() LINEAR, RGBA32F", ("f4", "linear"), """
+uniform sampler2D table;
+vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
+    "linear16": ("texture() LINEAR, RGBA16 fixed point (16 bits, the GPU's filter weights)", ("u2", "linear"), """
+uniform sampler2D table;
+vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
+    "nearest1": ("one nearest texture(), RGBA32F (not exact: the floor of any lookup)", ("f4", "nearest"), """
+uniform sampler2D table;
+vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
+}
+
+
+def profile(size: int = 512, repeats: int = 61) -> dict[str, dict]:
+    """Per variant of :data:`VARIANTS`: ``min_ms``, ``cpu_ms`` (median) and their ratios to Schlick's."""
+    import moderngl
+
+    ctx = create_context()
+    table = np.random.default_rng(0).random((ENTRIES, 4)).astype(np.float32)
+    data = {"f4": table, "u2": np.round(table * 65535).astype(np.uint16)}
+    framebuffer = ctx.framebuffer(color_attachments=[ctx.renderbuffer((size, size), 4, dtype="f4")])
+    block = ctx.buffer(table.tobytes())
+    programs = {}
+    for name, (_, texture, source) in VARIANTS.items():
+        program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=_HEAD + source + _MAIN)
+        for uniform, value in (("resolution", (float(size), float(size))), ("F0", 0.04), ("table", 0)):
+            if uniform in program:
+                program[uniform].value = value
+        bound = None
+        if texture == "block":
+            program["Table"].binding = 0
+        elif texture is not None:
+            dtype, filtering = texture
+            bound = ctx.texture((ENTRIES, 1), 4, data[dtype].tobytes(), dtype=dtype)
+            bound.filter = (moderngl.LINEAR, moderngl.LINEAR) if filtering == "linear" else (moderngl.NEAREST, moderngl.NEAREST)
+            bound.repeat_x = bound.repeat_y = False
+        programs[name] = (program, ctx.vertex_array(program, []), bound)
+
+    def frame(name: str) -> tuple[float, float]:
+        program, vertex_array, texture = programs[name]
+        if texture is not None:
+            texture.use(location=0)
+        block.bind_to_uniform_block(0)
+        framebuffer.use()
+        ctx.finish()
+        start, cpu = time.perf_counter(), time.process_time()
+        vertex_array.render(vertices=3)
+        ctx.finish()
+        return 1e3 * (time.perf_counter() - start), 1e3 * (time.process_time() - cpu)
+
+    times: dict[str, list] = {name: [] for name in VARIANTS}
+    for round_ in range(repeats + 2):  # two warm-up rounds
+        for name in VARIANTS:
+            measured = frame(name)
+            if round_ >= 2:
+                times[name].append(measured)
+    base_min = min(t[0] for t in times["schlick"])
+    base_cpu = float(np.median([t[1] for t in times["schlick"]]))
+    return {name: {"min_ms": min(t[0] for t in v), "cpu_ms": float(np.median([t[1] for t in v])),
+                   "min_ratio": min(t[0] for t in v) / base_min,
+                   "cpu_ratio": float(np.median([t[1] for t in v])) / base_cpu} for name, v in times.items()}
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    size = int(argv[0]) if argv else 512
+    repeats = int(argv[1]) if len(argv) > 1 else 61
+    result = profile(size, repeats)
+    print(f"{size}x{size} sphere, {repeats} interleaved frames; minimum wall-clock and median CPU time, x Schlick's")
+    for name, row in result.items():
+        print(f"{name:<10} {row['min_ms']:7.2f} ms  x{row['min_ratio']:.2f}   CPU {row['cpu_ms']:7.2f} ms  x{row['cpu_ratio']:.2f}   {VARIANTS[name][0]}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
