@@ -88,7 +88,7 @@ GOOD_ENOUGH = 0.05
 #: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
 BATCH = 32
 #: Evaluations of each local refinement, and whether it starts on the screening model.
-REFINE_NFEV = 20
+REFINE_NFEV = 40
 SCREEN_REFINE = 1
 
 
