@@ -58,7 +58,7 @@ FIRST_PASS_SAMPLES = 2048
 #: model's scale parameter (the period, the film's thickness), geometrically spaced over its range. A
 #: mirror's spectrum shifts by about lambda dLambda / Lambda when Lambda moves: its colour turns as fast
 #: in log Lambda everywhere, and high-order mirrors (Lambda ~ 1 um) have many narrow basins in Lambda.
-SCAN_SHAPES = 512
+SCAN_SHAPES = 256
 SCAN_VALUES = 640
 #: The scan's spectra: samples at this relative step in s / lambda (~3 nm at 600 nm).
 SCAN_RELATIVE_STEP = 0.005
@@ -68,7 +68,7 @@ SCAN_BATCH = 8
 #: CPU time, not wall time: a design's result must not depend on how busy the machine is.
 POLISH_SECONDS = 2.0
 #: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
-LOCAL_STARTS = 4
+LOCAL_STARTS = 6
 POLISHED = 2
 #: Two starts closer than this in the unit box (max norm) are the same basin.
 DISTINCT_STARTS = 0.08
@@ -78,18 +78,15 @@ COARSE_DIFF_STEP = 1e-4
 FINE_DIFF_STEP = 2e-3
 #: The second scan: counts tried, perturbed shapes, their spread, and the starts refined from them.
 SECOND_COUNTS = 48
-SECOND_PERTURBED = 32
+SECOND_PERTURBED = 48
 SECOND_SPREAD = 0.05
-SECOND_STARTS = 2
+SECOND_STARTS = 3
 #: The polish's Jacobian: the batch model at this wavelength step (nm), fringes smoothed as the step says.
 POLISH_STEP = 1.0
 #: Above this median CIEDE2000 the coarse stage has not found the basin: more starts are refined.
 GOOD_ENOUGH = 0.05
 #: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
 BATCH = 32
-#: Evaluations of each local refinement, and whether it starts on the screening model.
-REFINE_NFEV = 40
-SCREEN_REFINE = 1
 
 
 class DesignError(ValueError):
@@ -586,8 +583,7 @@ class _Problem:
         m = np.broadcast_to(np.arange(s.size)[:, None], i.shape)
         np.add.at(kernel, (i, m), (1.0 - t)[..., None] * weights[None, :, :])
         np.add.at(kernel, (i + 1, m), t[..., None] * weights[None, :, :])
-        # float32: the scan only ranks shapes, and the product is most of its cost.
-        kernel = kernel.reshape(x.size, -1).astype(np.float32)
+        kernel = kernel.reshape(x.size, -1)
         scores = np.empty((shapes.shape[0], s.size))
         for start in range(0, shapes.shape[0], SCAN_BATCH):
             self._check()
@@ -595,9 +591,9 @@ class _Problem:
             values = self.values(U, scale_value=reference)
             R = self.model.spectra(values, self.cos_theta, reference / x, SCREEN_SMOOTH / 600.0)  # (B, A, X)
             self.evaluations += U.shape[0] * s.size
-            xyz = (R.astype(np.float32) @ kernel).astype(np.float64).reshape(R.shape[:2] + (s.size, 3))  # (B, A, G, 3)
+            xyz = (R @ kernel).reshape(R.shape[:2] + (s.size, 3))  # (B, A, G, 3)
             rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
-            score = self.score_of(rgb)
+            score = np.sum(self.residuals_of(rgb) ** 2, axis=-1)
             if self.optical:
                 per_period = values["Lambda"] / reference
                 Lambda = s[None, :] * per_period[:, None]
@@ -618,11 +614,6 @@ class _Problem:
         e00 = delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
         scale = np.where(e76 > 1e-9, e00 / np.maximum(e76, 1e-300), 1.0)
         return (difference * scale[..., None]).reshape(rgb.shape[:-2] + (-1,))
-
-    def score_of(self, rgb: np.ndarray) -> np.ndarray:
-        """``(..., A, 3)`` colours -> the sum over targets of CIEDE2000^2 (the residuals' squared norm)."""
-        lab = rgb_to_lab(np.maximum(rgb, -1.0))
-        return np.sum(delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape)) ** 2, axis=-1)
 
     def delta_e(self, rgb) -> np.ndarray:
         lab = rgb_to_lab(rgb)
@@ -670,7 +661,7 @@ def _host_bounds(problem: _Problem, u: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _refine_coarse(problem: _Problem, u0: np.ndarray, max_nfev: int) -> tuple[np.ndarray, float]:
     """The screening model's refinement, then the coarse model's (a continuation: smooth landscape first)."""
-    u = _refine_level(problem, u0, max_nfev, SCREEN_STEP, SCREEN_SMOOTH)[0] if SCREEN_REFINE else u0
+    u, _ = _refine_level(problem, u0, max_nfev, SCREEN_STEP, SCREEN_SMOOTH)
     return _refine_level(problem, u, max_nfev, COARSE_STEP, None)
 
 
@@ -784,29 +775,6 @@ def _distinct(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DI
     return chosen
 
 
-def _scale_minimum(scores: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Per row of ``scores`` ``(B, G)`` (a shape's score at each scale of ``grid``), the scale and score of its
-    best minimum between the grid's nodes: a parabola through each local minimum and its neighbours. The
-    colour turns by ΔE2000 ~1 for a 0.3 % change of scale, about half the grid's step, so the raw grid
-    ranks a basin by where its minimum falls between nodes; the parabola's vertex does not.
-    """
-    left, middle, right = scores[:, :-2], scores[:, 1:-1], scores[:, 2:]
-    with np.errstate(invalid="ignore"):  # infinite scores (outside the box) are no minima
-        curvature = left - 2.0 * middle + right
-        minimum = (middle <= left) & (middle <= right) & np.isfinite(left + right) & (curvature > 0)
-        offset = np.where(minimum, 0.5 * (left - right) / np.where(minimum, curvature, 1.0), 0.0)  # nodes, |.| <= 1/2
-        # Elsewhere (flat, or not a minimum) the node's own value.
-        vertex = np.where(minimum, np.maximum(middle - 0.25 * (left - right) * offset, 0.0), middle)
-    ends = np.concatenate([scores[:, :1], vertex, scores[:, -1:]], axis=1)
-    offsets = np.concatenate([np.zeros((len(scores), 1)), offset, np.zeros((len(scores), 1))], axis=1)
-    best = np.argmin(ends, axis=1)
-    rows = np.arange(len(scores))
-    t = offsets[rows, best]
-    step = np.where(t >= 0.0, np.diff(grid, append=grid[-1])[best], np.diff(grid, prepend=grid[0])[best])
-    return np.clip(grid[best] + t * step, 0.0, 1.0), ends[rows, best]
-
-
 def _scale_grid(p: DesignParameter) -> np.ndarray:
     """:data:`SCAN_VALUES` unit-box values of a scale parameter, geometrically spaced (and its low end)."""
     if p.log:
@@ -821,8 +789,8 @@ def design(
     ranges: Mapping[str, tuple[float, float]],
     fixed: Mapping[str, float] | None = None,
     seed: int = 0,
-    samples: int | None = None,
-    starts: int | None = None,
+    samples: int = FIRST_PASS_SAMPLES,
+    starts: int = LOCAL_STARTS,
     progress: Callable[[float, str], None] | None = None,
     cancelled: Callable[[], bool] | None = None,
 ) -> DesignResult:
@@ -855,8 +823,6 @@ def design(
         search used.
     """
     start_time, start_cpu = time.perf_counter(), time.process_time()
-    samples = FIRST_PASS_SAMPLES if samples is None else samples
-    starts = LOCAL_STARTS if starts is None else starts
     model = design_model(model_name)
     fixed = dict(fixed or {})
     if not targets:
@@ -895,7 +861,9 @@ def design(
             for start in range(0, len(U), chunk // 4):
                 scores[start : start + chunk // 4] = problem.scale_profile(U[start : start + chunk // 4], grid)
                 report(0.6 * min(1.0, (start + chunk // 4) / len(U)), "scale scan")
-            U[:, scale], scores = _scale_minimum(scores, grid)
+            best = np.argmin(scores, axis=1)
+            U[:, scale] = grid[best]
+            scores = scores[np.arange(len(U)), best]
             stages["scan"] = time.perf_counter() - start_time
         else:
             # 1. Space-filling first pass (Sobol) on the screening model.
@@ -910,7 +878,7 @@ def design(
         refined = []
         for k, u0 in enumerate(chosen):
             report(0.6 + 0.2 * k / len(chosen), "local refinement")
-            u, cost = _refine_coarse(problem, u0, max_nfev=REFINE_NFEV)
+            u, cost = _refine_coarse(problem, u0, max_nfev=40)
             refined.append((cost, k, u))
             # A start that already matches every target to a small fraction of a unit needs no others.
             if k >= 1 and math.sqrt(cost / len(targets)) < GOOD_ENOUGH:
@@ -923,9 +891,11 @@ def design(
             report(0.75, "second scan")
             variants = _variants(problem, refined[0][2], np.random.default_rng(seed))
             variant_scores = problem.scale_profile(variants, grid)
-            variants[:, scale], variant_scores = _scale_minimum(variant_scores, grid)
+            best = np.argmin(variant_scores, axis=1)
+            variants[:, scale] = grid[best]
+            variant_scores = variant_scores[np.arange(len(variants)), best]
             for k, u0 in enumerate(_distinct(variants, variant_scores, SECOND_STARTS, spacing=0.005)):
-                u, cost = _refine_coarse(problem, u0, max_nfev=REFINE_NFEV)
+                u, cost = _refine_coarse(problem, u0, max_nfev=40)
                 refined.append((cost, len(refined), u))
             refined.sort(key=lambda item: item[0])
         stages["coarse refinement"] = time.perf_counter() - start_time
