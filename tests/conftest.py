@@ -111,9 +111,8 @@ def running_in_ci() -> bool:
     return os.environ.get("CI", "").strip().lower() == "true"
 
 
-@pytest.fixture(scope="session")
-def gl_renderer():
-    """One :class:`explorer.gpu.Renderer` for the whole session (compiled programs are cached in it)."""
+def _new_renderer():
+    """A renderer on a new GL context, or skip/fail (CI) without one."""
     from explorer.gpu import GLUnavailable, Renderer, create_context
 
     try:
@@ -124,9 +123,29 @@ def gl_renderer():
         if running_in_ci():
             pytest.fail(f"CI=true and no OpenGL context: {reason}", pytrace=False)
         pytest.skip(reason)
-    renderer = Renderer(ctx)
-    yield renderer
-    ctx.release()
+    return Renderer(ctx)
+
+
+#: The renderer the modules share (compiled programs are cached in it); replaced by :func:`renew_gl_renderer`.
+SESSION_RENDERERS: list = []
+
+
+def renew_gl_renderer() -> None:
+    """
+    Drop the shared renderer and its context: the next module gets a new one. tests/test_mitsuba.py calls it:
+    Dr.Jit's LLVM backend (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled
+    before it in that context (measured: later draws read their uniforms as 0 and some tables wrong).
+    """
+    while SESSION_RENDERERS:
+        SESSION_RENDERERS.pop().ctx.release()
+
+
+@pytest.fixture(scope="module")
+def gl_renderer():
+    """The shared :class:`explorer.gpu.Renderer` (one for the session, unless :func:`renew_gl_renderer` was called)."""
+    if not SESSION_RENDERERS:
+        SESSION_RENDERERS.append(_new_renderer())
+    return SESSION_RENDERERS[0]
 
 
 @pytest.fixture(scope="session")

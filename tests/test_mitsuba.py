@@ -30,6 +30,21 @@ ROUGH = {  # the roughness parameter of each rough BSDF, and values that make ev
 }
 
 
+
+@pytest.fixture(scope="module", autouse=True)
+def _gl_renderer_renewed_afterwards():
+    """
+    Dr.Jit's LLVM backend (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's own LLVM)
+    compiled before it: measured, later draws of such programs read their uniforms as 0 (the full suite's GL
+    tests after this module failed, alone they pass). The modules after this one get a renderer on a new
+    context (conftest.renew_gl_renderer).
+    """
+    yield
+    from conftest import renew_gl_renderer
+
+    renew_gl_renderer()
+
+
 @pytest.fixture(scope="module")
 def mi_llvm():
     from explorer.mitsuba import register

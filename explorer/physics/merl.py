@@ -22,6 +22,7 @@ Rusinkiewicz (1998). A New Change of Variables for Efficient BRDF Representation
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 #: Bins in theta_h, theta_d and phi_d (the file header holds these three int32).
 THETA_H_BINS, THETA_D_BINS, PHI_D_BINS = 90, 90, 180
@@ -29,7 +30,7 @@ THETA_H_BINS, THETA_D_BINS, PHI_D_BINS = 90, 90, 180
 CHANNEL_SCALES = np.array([1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0])
 
 
-def merl_half_diff(L, V) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def merl_half_diff(L: ArrayLike, V: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     ``(theta_h, theta_d, phi_d)`` in radians of light ``L`` and view ``V`` (unit vectors ``(..., 3)`` in
     the surface's local frame, normal ``+z``): ``H = normalize(L + V)``, then ``D`` = ``L`` rotated by
@@ -52,7 +53,7 @@ def merl_half_diff(L, V) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return theta_h, theta_d, phi_d
 
 
-def merl_index(theta_h, theta_d, phi_d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def merl_index(theta_h: ArrayLike, theta_d: ArrayLike, phi_d: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     The bins ``(i_h, i_d, i_phi)`` of half/difference angles (radians), as MERL's ``BRDFRead.cpp``:
     ``i_h = floor(sqrt(theta_h / (pi / 2) 90 x 90))`` (0 for ``theta_h <= 0``), ``i_d = floor(theta_d / (pi / 2) 90)``,
@@ -80,7 +81,7 @@ def merl_bin_centres() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return theta_h, theta_d, phi_d
 
 
-def merl_directions(theta_h, theta_d, phi_d, phi_h=0.0) -> tuple[np.ndarray, np.ndarray]:
+def merl_directions(theta_h: ArrayLike, theta_d: ArrayLike, phi_d: ArrayLike, phi_h: ArrayLike = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """
     ``(L, V)``, unit ``(..., 3)``, of half/difference angles (the inverse of :func:`merl_half_diff`):
     ``D`` at ``(theta_d, phi_d)`` rotated by ``theta_h`` about ``y`` and ``phi_h`` about ``z`` is ``L``;
@@ -98,7 +99,7 @@ def merl_directions(theta_h, theta_d, phi_d, phi_h=0.0) -> tuple[np.ndarray, np.
     return L, V
 
 
-def merl_lookup(table, L, V) -> np.ndarray:
+def merl_lookup(table: np.ndarray, L: ArrayLike, V: ArrayLike) -> np.ndarray:
     """
     The BRDF of a MERL ``table`` (``(90, 90, 180, 3)`` linear RGB, the scales applied) for local ``L``,
     ``V`` (``(..., 3)``): the nearest bin's value, ``(..., 3)`` float64.
