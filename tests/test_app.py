@@ -214,9 +214,11 @@ def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, brag
 def test_bench_app_measures_drag_frames(x_display, tmp_path):
     """
     ``bench --app``: the harness drags Lambda through the UI per mode and method and reports the frames that
-    changed it; then the two-layer stack's env mode: its first pass, and the frames of a drag of Lambda_1.
+    changed it, and with each new view (the Plots window's plots, the Texture window) beside the sphere; then the
+    two-layer stack's env mode: its first pass, and the frames of a drag of Lambda_1.
     """
     from explorer.cli.bench import APP_MODES
+    from explorer.views.geometry import PLOT_VIEWS
 
     env = {**os.environ, "DISPLAY": x_display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}
     process = subprocess.run([sys.executable, "-m", "explorer.cli.commands", "bench", "--app", "--json", "--size", "128"],
@@ -237,6 +239,12 @@ def test_bench_app_measures_drag_frames(x_display, tmp_path):
     assert stack["sphere_updates_per_s"] > 0.0, stack
     mesh = {row["name"]: row for row in document["mesh_rows"]}  # the teapot, lit and under the environment
     assert set(mesh) == {"teapot lit", "teapot env"} and all(row["frames"] >= 20 for row in mesh.values()), mesh
+    # The new views (issue 18) in their windows while Lambda is dragged: each followed the slider; the textured one on drafts.
+    views = {row["view"]: row for row in document["views"]}
+    assert set(views) == set(PLOT_VIEWS) | {"textured"}, views
+    for row in views.values():
+        assert row["frames"] >= 20 and 0.0 < row["median_ms"] <= row["max_ms"] and row["view_updates_per_s"] > 0.0, row
+    assert views["textured"]["size"] == [128, 128] and views["textured"]["draft_fraction"] > 0.0, views["textured"]
 
 
 def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):

@@ -24,6 +24,8 @@ FRAME_BUDGET_MS = 30.0
 #: UI (~3 ms), ImGui's drawing (~8 ms), the display pass and the swap on llvmpipe, 12 ms keeps a frame
 #: under 33 ms on a quiet 2-core machine (bench --app).
 DRAG_BUDGET_MS = 12.0
+#: The other views' budget while dragging, unless their panel sets ``drag_budget_ms`` (the Plots and Texture
+#: windows, whose views draw from the prefetcher's values and so build no table on the spot).
 SIDE_DRAG_BUDGET_MS = 0.0
 
 
@@ -187,6 +189,7 @@ class Scheduler:
         self.env = EnvSphere(renderer)
         self.jobs: dict[str, ProgressiveView] = {}
         self._requests: dict = {}  # display key -> (source a, source b or None), drawn after the views advance
+        self.drafts: set[str] = set()  # the views shown with draft tables now (the Texture window's while dragging)
 
     def job(self, name: str) -> ProgressiveView:
         """The progressive view called ``name`` (made on first use)."""
@@ -203,17 +206,18 @@ class Scheduler:
         """Advance the visible panels' views within the frame's budget (the sphere first), then display them; ms."""
         start = time.perf_counter()
         budget = FRAME_BUDGET_MS
-        order = [job for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
+        order = [(job, getattr(panel, "drag_budget_ms", SIDE_DRAG_BUDGET_MS))
+                 for panel in sorted(panels, key=lambda p: p.gl_order) for job in panel.gl_jobs()]
         if state.pending_screenshot and state.mode != "env":
-            order.insert(0, self.job("main"))
+            order.insert(0, (self.job("main"), SIDE_DRAG_BUDGET_MS))
         # While a slider moves the first view (the sphere) gets a preview that fits with the UI's own
         # ~30 ms in a 15 fps frame; the others get what little is left. In the env mode the sphere is the
         # env render: every job is another view (whose tables would be built on the spot), none leads.
-        leading = order[0] if order and state.mode != "env" else None
-        for job in order:
+        leading = order[0][0] if order and state.mode != "env" else None
+        for job, side_budget in order:
             remaining = budget - (time.perf_counter() - start) * 1e3
             if dragging:
-                remaining = min(remaining, DRAG_BUDGET_MS) if job is leading else min(remaining, SIDE_DRAG_BUDGET_MS)
+                remaining = min(remaining, DRAG_BUDGET_MS) if job is leading else min(remaining, side_budget)
             if remaining <= 0:
                 break
             job.work(remaining)
@@ -233,5 +237,8 @@ class Scheduler:
     def main_report(self) -> dict:
         """The sphere's progress, for a frame's record."""
         main = self.job("main")
+        # The other views (Plots, Texture: bench --app's rows of the new views) by job name.
+        views = {name: {"size": list(job.size), "generation": job.generation, "complete": job.complete, "has_preview": job.has_preview,
+                        "draft": name in self.drafts} for name, job in self.jobs.items() if name != "main"}
         return {"size": list(main.size), "preview": list(main.preview_size), "has_preview": main.has_preview,
-                "complete": main.complete, "generation": main.generation}
+                "complete": main.complete, "generation": main.generation, "views": views}

@@ -558,7 +558,7 @@ def app_bench_script(frames: int = 60) -> list:
         script += [{"click": f"mode:{mode}"}, {"wait": 3}]
         for method, _name in APP_METHODS:
             script += [{"set": {"method": method}}, {"wait": 8}] + _drag(f"{mode} {method}", "param:Lambda", frames)
-    return script + app_mesh_steps(frames) + [{"quit": True}]
+    return script + app_view_steps(frames) + app_mesh_steps(frames) + [{"quit": True}]
 
 
 def app_env_script(frames: int = 60) -> list:
@@ -634,8 +634,9 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     """
     Open the explorer (on a virtual display when there is none) on the default mirror with a ``size``²
     sphere, drag the Lambda slider through the UI for ``frames`` frames per mode (:data:`APP_MODES`) and
-    method, then on the two-layer stack in the env mode (its first pass on opening, then a drag of
-    Lambda_1), and print the frame times (wall clock between frames: UI, drawing, table rebuilds and all).
+    method, with each new view (:func:`app_view_cases`: the Plots window's plots, the Texture window's textured
+    mirror) beside the sphere, then on the two-layer stack in the env mode (its first pass on opening, then a
+    drag of Lambda_1), and print the frame times (wall clock between frames: UI, drawing, table rebuilds and all).
     """
     from explorer.resources import DEFAULT_MATERIAL
     from explorer.app.xvfb import display_environment
@@ -648,8 +649,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     rows = summarise_app_frames(document["frames"])
     env = summarise_env_frames(env_document["frames"])
     mesh_rows = summarise_mesh_frames(document["frames"])
-    _progress(f"bench --app: the plot and textured views, {size} wide, Lambda moving")
-    views = run_view_frames(size)
+    views = summarise_view_frames(document["frames"])
     if as_json:
         print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows, "env": env,
                           "mesh_rows": mesh_rows, "views": views}, indent=2))
@@ -665,58 +665,57 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
         print(f"env first pass: {env['first_pass_ms']:.1f} ms on opening; while dragging median {env['drag_first_pass_median_ms']:.1f} ms, "
               f"max {env['drag_first_pass_max_ms']:.1f} ms (goal <= {APP_GOAL_FIRST_PASS_MS:g} ms)")
     print("fps: frames while the slider moves; sphere/s: frames that show new parameter values on the sphere")
-    print_view_frames(views)
+    print_view_frames(views, size)
     return rows + ([env] if env else [])
 
 
-def print_view_frames(views: list[dict]) -> None:
-    """The table of :func:`run_view_frames`."""
-    print("Views (headless, default mirror, tabulated method, Lambda moving): GL draw, and the whole update with its tables")
-    print(f"{'view':<10} {'size':>9} {'draw':>9} {'update':>10}")
+def print_view_frames(views: list[dict], size: int) -> None:
+    """The table of :func:`summarise_view_frames`."""
+    print(f"New views (issue 18) in their windows beside the {size}x{size} sphere, tabulated method, Lambda dragged "
+          f"(goal >= {APP_GOAL_FPS:g} fps; the textured view shows draft tables while dragging):")
+    print(f"{'view':<10} {'shown':>9} {'median':>8} {'p90':>8} {'max':>8} {'fps':>6} {'sphere/s':>9} {'view/s':>7} {'draft':>6}")
     for row in views:
-        print(f"{row['view']:<10} {row['size'][0]:>4}x{row['size'][1]:<4} {row['draw_ms']:7.1f}ms {row['update_ms']:8.1f}ms")
+        print(f"{row['view']:<10} {row['size'][0]:>4}x{row['size'][1]:<4} {row['median_ms']:7.1f}ms {row['p90_ms']:7.1f}ms "
+              f"{row['max_ms']:7.1f}ms {row['fps']:6.1f} {row['sphere_updates_per_s']:9.1f} {row['view_updates_per_s']:7.1f} "
+              f"{100 * row['draft_fraction']:5.0f}%")
+    print("view/s: frames that show new parameter values in the view's window; draft: drag frames showing a draft table")
 
 
-#: The views ``bench --app`` times besides the app's sphere: BRDF Explorer's plots and the textured view.
-def app_extra_views() -> tuple[str, ...]:
+#: ``bench --app``'s new views (issue 18): the Plots window's plots (:data:`explorer.views.geometry.PLOT_VIEWS`),
+#: then the Texture window's textured mirror, as (mark, window, the scheduler's job, plot to choose or None).
+def app_view_cases() -> tuple[tuple[str, str, str, str | None], ...]:
     from explorer.views.geometry import PLOT_VIEWS
 
-    return PLOT_VIEWS + ("textured",)
+    return tuple((view, "Plots", "plot", view) for view in PLOT_VIEWS) + (("textured", "Texture", "textured", None),)
 
 
-def run_view_frames(size: int = 512, repeats: int = 3) -> list[dict]:
-    """
-    Per view of :func:`app_extra_views`, on the default mirror at the app's default method (tabulated), Lambda
-    moving by 0.37 nm a frame as under a dragged slider: the median GL draw (``time_frame``, tables bound) and
-    the median whole update (its tables rebuilt, drawn, read back), at ``size`` wide (the curves one row, the
-    lobe and the textured sphere ``size``²).
-    """
-    from explorer.gpu import Renderer
-    from explorer.resources import DEFAULT_MATERIAL
-    from explorer.views.geometry import view_named
-    from explorer.views.plots import gl_uniforms
-    from explorer.views.surface_texture import BraggTexture
+def app_view_steps(frames: int) -> list:
+    """Drag Lambda (tabulated method, sphere mode) with each plot shown in the Plots window, then the Texture window."""
+    steps: list = [{"click": "mode:sphere"}, {"set": {"method": int(BraggMethod.TABULATED)}}, {"wait": 3}]
+    for mark, window, _job, plot in app_view_cases():
+        steps += [{"focus": window}, {"wait": 3}]
+        if plot is not None:
+            steps += [{"click": "plot_combo"}, {"wait": 2}, {"click": f"plot:{plot}"}, {"wait": 3}]
+        report = "plots" if window == "Plots" else "texture_view"
+        steps += [{"wait_for": report}] + _drag(f"view {mark}", "param:Lambda", frames) + [{"wait_for": report}]
+    return steps
 
-    renderer = Renderer()
-    material = load_material(DEFAULT_MATERIAL)
+
+def summarise_view_frames(frames: list[dict]) -> list[dict]:
+    """Per case of :func:`app_view_cases`: the frame times while dragging, how often the view followed, and its drafts."""
     rows = []
-    for index, view in enumerate(app_extra_views()):
-        height = 1 if view_named(view).plot == "curve" else size
-        draws, updates = [], []
-        for k in range(repeats + 1):
-            # A mirror no other view or repeat has drawn: its tables are rebuilt, as under a slider.
-            values = material.resolve({"method": int(BraggMethod.TABULATED), "Lambda": 500.0 + 0.37 * k + 0.01 * index})
-            start = time.perf_counter()
-            if view == "textured":
-                arguments = BraggTexture.from_file().gl_arguments(material, values, size, height)
-            else:
-                arguments = {"uniforms": gl_uniforms(view, None)}
-            renderer.render(material, values, view, size, height, **arguments)
-            updates.append(1e3 * (time.perf_counter() - start))
-            draws.append(renderer.time_frame(material, values, view, size, height, **arguments))
-        # The first frame compiles the program: left out.
-        rows.append({"view": view, "size": [size, height], "draw_ms": float(np.median(draws[1:])),
-                     "update_ms": float(np.median(updates[1:]))})
+    for mark, _window, job, _plot in app_view_cases():
+        drag = [f for f in frames if f.get("mark") == f"view {mark}" and f.get("dragging")]
+        chosen = [f for f in drag if f.get("changed")]
+        if not chosen:
+            continue
+        views = [f["main"].get("views", {}).get(job, {}) for f in drag]
+        generations = [v.get("generation", 0) for v in views]
+        seconds = 1e-3 * sum(f["ms"] for f in drag[1:])
+        updates = sum(1 for a, b in zip(generations, generations[1:]) if b != a)
+        rows.append({"view": mark, "job": job, "size": views[-1].get("size", [0, 0]), **_frame_row(chosen, drag),
+                     "view_updates_per_s": updates / seconds if seconds > 0 else 0.0,
+                     "draft_fraction": float(np.mean([bool(v.get("draft")) for v in views]))})
     return rows
 
 

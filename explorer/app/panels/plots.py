@@ -30,6 +30,8 @@ class PlotsPanel(Panel):
     title = "Plots"
     dock = "right_top"
     gl_order = 6
+    #: GL time (ms) a frame gives the plot while a slider moves: a curve (256 x 1) or the lobe (64 x 24) draws whole.
+    drag_budget_ms = 4.0
 
     def __init__(self, app):
         super().__init__(app)
@@ -71,7 +73,9 @@ class PlotsPanel(Panel):
         light = self._light()
         job = self.scheduler.job("plot")
         size = plot_size(self.view)
-        job.request(self.state.material, self.state.values, self.view, size, light=tuple(float(c) for c in light_direction(light)),
+        # The values whose tables are ready (draft ones while dragging), as the sphere's: none built on the spot.
+        values = self.scheduler.prefetcher.values(self.state.material, self.state.values, self.app.dragging)
+        job.request(self.state.material, values, self.view, size, light=tuple(float(c) for c in light_direction(light)),
                     uniforms=gl_uniforms(self.view, settings), dragging=self.app.dragging)
         key = (self.view, settings, light)
         if not job.complete:  # a new curve on its way (scripts wait_for it)

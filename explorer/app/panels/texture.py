@@ -15,7 +15,6 @@ from explorer.resources import DEFAULT_TEXTURE
 from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
 
-TEXTURE_VIEW_SIZE = 256
 #: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
 ENV_SAMPLES = 256
 
@@ -24,6 +23,8 @@ class TexturePanel(Panel):
     title = "Texture"
     dock = "right_top"
     gl_order = 7
+    #: GL time (ms) a frame gives the view while a slider moves (the sphere's: DRAG_BUDGET_MS): a preview that fits.
+    drag_budget_ms = 6.0
 
     def __init__(self, app):
         super().__init__(app)
@@ -36,7 +37,8 @@ class TexturePanel(Panel):
         self._arguments = None
         self._arguments_key = None
         self._generation = -1
-        self._pending = None  # (key, values, future) of the arguments being built on the worker thread
+        self._pending = None  # (key, values, draft, future) of the arguments being built on the worker thread
+        self._draft = False  # the arguments hold the draft table (textured_draft_table), not the exact one
         self._executor = None
         #: Under the environment: the env view's progressive Monte Carlo with the surface texture.
         self.environment = False
@@ -84,26 +86,34 @@ class TexturePanel(Panel):
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), self.message)
         if surface is None:
             return
-        size = (TEXTURE_VIEW_SIZE, TEXTURE_VIEW_SIZE)
+        size = (state.view_size, state.view_size)  # the sphere's resolution (View size), as bench --app times it
         job = self.scheduler.job("textured")
-        values = self.scheduler.prefetcher.values(state.material, state.values, self.app.dragging)
+        dragging = self.app.dragging
+        values = self.scheduler.prefetcher.values(state.material, state.values, dragging)
         key = (id(state.material), tuple(sorted((k, str(v)) for k, v in values.items())), self._surface_key)
-        # The textured mirror's tabulated table takes seconds: built on a worker thread once a slider is
-        # released, the last image shown meanwhile.
-        if self._pending is not None and self._pending[2].done():
-            pending_key, pending_values, future = self._pending
+        if self._pending is not None and self._pending[3].done():
+            pending_key, pending_values, draft, future = self._pending
             self._pending = None
             try:
-                self._arguments, self._arguments_key, self._values = future.result(), pending_key, pending_values
+                self._arguments, self._arguments_key, self._values, self._draft = future.result(), pending_key, pending_values, draft
             except Exception as error:  # noqa: BLE001 - a material's own error, shown in the window
                 self.message = f"{type(error).__name__}: {error}"
-        wanted = key != self._arguments_key and not (self.app.dragging and self._arguments is not None)
-        if wanted and (self._pending is None or self._pending[0] != key):
+        # The tabulated method's (cos theta, T) table takes seconds: while a slider moves the worker thread builds
+        # drafts (textured_draft_table, ~0.2 s) of the newest values, the last image shown meanwhile; on release,
+        # the exact table. One build at a time: the newest values go next.
+        draft = dragging and _needs_table(state.material, values)
+        shown = self._arguments_key == key and not (self._draft and not dragging)
+        if not shown and self._pending is None:
             import concurrent.futures
 
             if self._executor is None:
                 self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="texture")
-            self._pending = (key, dict(values), self._executor.submit(surface.gl_arguments, state.material, dict(values), *size))
+            future = self._executor.submit(surface.gl_arguments, state.material, dict(values), *size, draft=draft)
+            self._pending = (key, dict(values), draft, future)
+        if self._draft:  # for a frame's record (bench --app)
+            self.scheduler.drafts.add("textured")
+        else:
+            self.scheduler.drafts.discard("textured")
         if self._arguments is None:
             imgui.text("building the texture's tables…")
             return
@@ -116,15 +126,16 @@ class TexturePanel(Panel):
         job.request(state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
                     uniforms=self._arguments["uniforms"], inputs=self._arguments["inputs"], dragging=self.app.dragging)
         show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
-        imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + (f"  {job.error}" if job.error else ""))
-        if not (job.complete and self._arguments_key == key):  # a new image on its way (scripts wait_for it)
-            state.texture_view = {"running": True}
+        imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + ("  (draft table)" if self._draft else "")
+                   + (f"  {job.error}" if job.error else ""))
+        if not (job.complete and self._arguments_key == key and not self._draft):  # a new image on its way (scripts wait_for it)
+            state.texture_view = {"running": True, "draft": self._draft}
         elif job.generation != self._generation or not state.texture_view or state.texture_view.get("running"):
             self._generation = job.generation
             image = job.read()
             state.texture_view = {"kind": kind, "path": self.path, "mapping": self.mapping, "dinc_range": list(self.dinc_range),
                                   "values": {k: (list(v) if isinstance(v, tuple) else v) for k, v in self._values.items()},
-                                  "light": list(light_vector(state.light, state.camera)), "size": list(size),
+                                  "light": list(light_vector(state.light, state.camera)), "size": list(size), "draft": False,
                                   "mean_rgb": np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()}
 
     def _env_source(self, surface, size):
@@ -152,6 +163,14 @@ class TexturePanel(Panel):
         if self.environment and self._env is not None:
             return [] if self._env[1].samples >= self._env_samples else [_EnvWork(self._env[1])]
         return [self.scheduler.job("textured")]
+
+
+def _needs_table(material, values) -> bool:
+    """Whether ``material`` at ``values`` draws the textured view from a table (the tabulated method's; drafts while dragging)."""
+    from explorer.materials.models import model_for
+
+    model = model_for(material, values)
+    return bool(model is not None and getattr(getattr(model, "method", None), "needs_table", False))
 
 
 def _default_environment():
