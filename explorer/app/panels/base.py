@@ -49,6 +49,26 @@ def record(state, label: str) -> None:
     state.rects[label] = (lo.x, lo.y, hi.x, hi.y)
 
 
+def combo(state, label: str, shown: str, options, current, item: str, recorded_as: str):
+    """
+    An ImGui combo of ``options`` (``(key, text)`` pairs, ``current`` selected) showing ``shown``; each entry
+    is recorded as ``item:key`` and the combo as ``recorded_as`` (scripted input). Returns the key clicked,
+    or None.
+    """
+    from imgui_bundle import imgui
+
+    chosen = None
+    if imgui.begin_combo(label, shown):
+        for key, text in options:
+            clicked, _ = imgui.selectable(text, key == current)
+            record(state, f"{item}:{key}")
+            if clicked:
+                chosen = key
+        imgui.end_combo()
+    record(state, recorded_as)
+    return chosen
+
+
 def show_image(state, texture, size, label: str, interactive: bool = False, side: float = 0.0) -> None:
     """
     An image fitted to the window (less ``side`` pixels on its right, for a colour bar), flipped to

@@ -10,7 +10,7 @@ import numpy as np
 
 from explorer.app import data
 from explorer.app.camera import light_vector
-from explorer.app.panels.base import Panel, record, show_image
+from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.app.state import has_reflectance
 
 #: The heat-map's colour bar (pixels wide).
@@ -44,14 +44,10 @@ class ComparePanel(Panel):
             others = [i for i in range(len(state.materials)) if i != state.selected]
             if c.material_b not in others:
                 c.material_b = others[0] if others else state.selected
-            if imgui.begin_combo("B (right)", state.materials[c.material_b].name):
-                for i in others:
-                    clicked, _ = imgui.selectable(f"{state.materials[i].name}##{i}", i == c.material_b)
-                    record(state, f"compare_b:{i}")
-                    if clicked:
-                        c.material_b = i
-                imgui.end_combo()
-            record(state, "compare_b")
+            chosen = combo(state, "B (right)", state.materials[c.material_b].name,
+                           [(i, f"{state.materials[i].name}##{i}") for i in others], c.material_b, "compare_b", "compare_b")
+            if chosen is not None:
+                c.material_b = chosen
             if not others:
                 imgui.text("(open a second material: File > Open...)")
         elif c.kind == "methods" and names:

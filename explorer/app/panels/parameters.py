@@ -7,7 +7,7 @@ from explorer.materials.methods import method_labels
 from explorer.app.parameter_files import inactive_parameters, slider_format, widget_kind
 from explorer.app.state import VIEW_SIZES
 from explorer.app.badge import BadgeWorker
-from explorer.app.panels.base import Panel, record
+from explorer.app.panels.base import Panel, combo, record
 
 
 class ParametersPanel(Panel):
@@ -31,14 +31,9 @@ class ParametersPanel(Panel):
             imgui.pop_text_wrap_pos()
         presets = app.presets()
         if presets:
-            if imgui.begin_combo("Preset", state.preset or "(none)"):
-                for name in presets:
-                    clicked, _ = imgui.selectable(name, state.preset == name)
-                    record(state, f"preset:{name}")
-                    if clicked:
-                        app.apply_preset(name)
-                imgui.end_combo()
-            record(state, "preset_combo")
+            chosen = combo(state, "Preset", state.preset or "(none)", [(n, n) for n in presets], state.preset, "preset", "preset_combo")
+            if chosen is not None:
+                app.apply_preset(chosen)
         imgui.separator()
         io = imgui.get_io()
         inactive = inactive_parameters(state.material, state.values)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.app.panels.base import Panel
+from explorer.app.panels.base import Panel, combo
 from explorer.views.geometry import PLOT_VIEWS, light_direction, view_named
 from explorer.views.plots import CHANNELS, PLOT_SETTINGS, PlotSettings, abscissa, cos_light, gl_uniforms, plotted
 
@@ -48,16 +48,7 @@ class PlotsPanel(Panel):
     def draw(self, imgui) -> None:
         from dataclasses import replace
 
-        from explorer.app.panels.base import record
-
-        if imgui.begin_combo("plot", self.view):
-            for name in PLOT_VIEWS:  # the registry's plot views
-                clicked, _ = imgui.selectable(name, name == self.view)
-                record(self.state, f"plot:{name}")
-                if clicked:
-                    self.view = name
-            imgui.end_combo()
-        record(self.state, "plot_combo")
+        self.view = combo(self.state, "plot", self.view, [(n, n) for n in PLOT_VIEWS], self.view, "plot", "plot_combo") or self.view
         settings = self.settings
         for name in PLOT_SETTINGS[self.view]:
             label, low, high = SLIDERS[name]

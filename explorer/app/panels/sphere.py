@@ -5,7 +5,7 @@ from __future__ import annotations
 from explorer.app.camera import light_vector
 from explorer.app.scheduler import model_mesh
 from explorer.app.state import ENV_TARGETS, MODES, SPHERE_MODELS, auto_view_size, has_reflectance
-from explorer.app.panels.base import Panel, record, show_image
+from explorer.app.panels.base import Panel, combo, record, show_image
 
 
 class SpherePanel(Panel):
@@ -22,14 +22,11 @@ class SpherePanel(Panel):
             imgui.same_line()
         if len(state.materials) > 1:  # which loaded material the sphere shows (as a click in the Materials list)
             imgui.set_next_item_width(min(imgui.get_content_region_avail().x, 220.0))
-            if imgui.begin_combo("##shown", state.material_path.name):
-                for index, entry in enumerate(state.materials):
-                    clicked, _ = imgui.selectable(f"{entry.name}##{index}", index == state.selected)
-                    record(state, f"shown:{index}")
-                    if clicked:
-                        self.app.select(index)
-                imgui.end_combo()
-            record(state, "shown")
+            chosen = combo(state, "##shown", state.material_path.name,
+                           [(index, f"{entry.name}##{index}") for index, entry in enumerate(state.materials)],
+                           state.selected, "shown", "shown")
+            if chosen is not None:
+                self.app.select(chosen)
         imgui.new_line()
         if state.mode == "sphere" and not has_reflectance(state.material):
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "this material has no reflectance(cos_theta): showing lit")
@@ -82,28 +79,15 @@ class SpherePanel(Panel):
 
         state = self.state
         imgui.set_next_item_width(120)
-        if imgui.begin_combo("model", state.model):
-            for name in SPHERE_MODELS:
-                clicked, _ = imgui.selectable(name, state.model == name)
-                record(state, f"model:{name}")
-                if clicked:
-                    state.model = name
-            imgui.end_combo()
-        record(state, "model_combo")
+        state.model = combo(state, "model", state.model, [(n, n) for n in SPHERE_MODELS], state.model, "model", "model_combo") or state.model
         if state.mode == "sphere" and state.model != "sphere":
             imgui.same_line()
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "(the white furnace shows the sphere)")
         if state.mode != "env":
             return
         imgui.set_next_item_width(140)
-        if imgui.begin_combo("environment", state.environment):
-            for name in ENVIRONMENTS:
-                clicked, _ = imgui.selectable(name, state.environment == name)
-                record(state, f"environment:{name}")
-                if clicked:
-                    state.environment = name
-            imgui.end_combo()
-        record(state, "environment_combo")
+        state.environment = combo(state, "environment", state.environment, [(n, n) for n in ENVIRONMENTS], state.environment,
+                                  "environment", "environment_combo") or state.environment
         imgui.same_line()
         _, state.env_background = imgui.checkbox("background", state.env_background)
         record(state, "env_background")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.app.camera import light_vector
-from explorer.app.panels.base import Panel, record, show_image
+from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.errors import LocatedError
 from explorer.resources import DEFAULT_TEXTURE
 from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
@@ -67,14 +67,8 @@ class TexturePanel(Panel):
             return
         _, self.path = imgui.input_text("texture (grey image)", self.path)
         if kind == "bragg":
-            if imgui.begin_combo("mapping", self.mapping):
-                for name in MAPPINGS:
-                    clicked, _ = imgui.selectable(name, name == self.mapping)
-                    record(state, f"mapping:{name}")
-                    if clicked:
-                        self.mapping = name
-                imgui.end_combo()
-            record(state, "mapping_combo")
+            self.mapping = combo(state, "mapping", self.mapping, [(n, n) for n in MAPPINGS], self.mapping, "mapping",
+                                 "mapping_combo") or self.mapping
             imgui.text_wrapped("Lambda (0.5 + 0.5 T), delta^T (supplemental Fig. 7)")
         else:
             _, self.dinc_range = imgui.slider_float2("D_inc range (nm)", self.dinc_range, 0.0, DINC_MAX, "%.0f")
