@@ -263,15 +263,20 @@ def parse_bparam(text: str, where: str) -> tuple[str | None, dict[str, object], 
     return material_file, raw, lines
 
 
+def _read_text(path: os.PathLike[str] | str, where: str) -> str:
+    """A parameter file's text, or :class:`ParameterFileError` (unreadable, not text)."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise ParameterFileError(where, None, f"cannot read ({error.strerror or error})") from None
+    except UnicodeDecodeError:
+        raise ParameterFileError(where, None, "not a text file") from None
+
+
 def load_bparam(path: os.PathLike[str] | str, material: Material) -> LoadedValues:
     """Read a BRDF Explorer ``.bparam`` file and apply the parameters ``material`` has."""
     where = _display(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as error:
-        raise ParameterFileError(where, None, f"cannot read ({error.strerror})") from None
-    except UnicodeDecodeError:
-        raise ParameterFileError(where, None, "not a text file") from None
+    text = _read_text(path, where)
     material_file, raw, lines = parse_bparam(text, where)
     result = _apply(material, raw, where, lines)
     result.material = material_file
@@ -316,12 +321,7 @@ def load_values(path: os.PathLike[str] | str, material: Material) -> LoadedValue
 def load_view(path: os.PathLike[str] | str) -> dict | None:
     """The view saved in a parameter set (JSON ``"view"``, ``.bparam``'s ``::begin view``), checked; None without one."""
     where = _display(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as error:
-        raise ParameterFileError(where, None, f"cannot read ({error.strerror or error})") from None
-    except UnicodeDecodeError:
-        raise ParameterFileError(where, None, "not a text file") from None
+    text = _read_text(path, where)
     if str(path).lower().endswith(".bparam"):
         return parse_bparam_view(text, where)
     try:
