@@ -68,3 +68,29 @@ def test_lit_mesh_and_a_merl_file_in_the_app(x_display, tmp_path, gl_renderer): 
     image = np.load(shot.with_suffix(".npy"))
     np.testing.assert_allclose(image, headless, rtol=1e-4, atol=1e-5)
     assert image.max() > 0.1 and (image == 0).all(axis=-1).mean() > 0.3  # a lit teapot on black
+
+
+def test_a_smooth_mirror_in_the_lit_mode_reflects_the_chosen_environment(x_display, tmp_path, gl_renderer):  # noqa: F811
+    """bragg_mirror in the lit mode: the environment combo and probe turn are offered, and the image is the headless lit mirror."""
+    shot = tmp_path / "mirror.png"
+    actions = [
+        {"wait": 2}, {"view_size": SIZE}, {"click": "mode:lit"}, {"wait": 1},
+        {"click": "environment_combo"}, {"click": "environment:studio"}, {"wait": 1},
+        {"drag": "env_rotation", "from": 0.33, "to": 0.5, "frames": 4}, {"wait": 2},
+        {"wait_complete": True}, {"screenshot": str(shot)}, {"quit": True},
+    ]
+    _, report = run_session(x_display, REPO_ROOT / "shaders" / "bragg_mirror.brd", actions, tmp_path)
+    log = report["script_log"]
+    assert report["error"] == "" and "clicked environment:studio" in log and "dragged env_rotation" in log, log
+    env = report["env"]
+    assert env["environment"] == "studio" and 10.0 < env["rotation"] < 180.0, env
+    info = report["screenshot_info"][str(shot)]
+    assert info["view"] == "lit"
+    from explorer.views.env import ENVIRONMENTS
+
+    material = load_material(REPO_ROOT / "shaders" / "bragg_mirror.brd")
+    headless = gl_renderer.render(material, material.resolve(info["values"]), "lit", SIZE, SIZE,
+                                  environment=ENVIRONMENTS["studio"]().rotated(env["rotation"]))
+    np.testing.assert_allclose(np.load(shot.with_suffix(".npy")), headless, rtol=1e-4, atol=1e-5)
+    default = gl_renderer.render(material, material.resolve(info["values"]), "lit", SIZE, SIZE)
+    assert np.abs(headless - default).max() > 0.1  # the studio, not the sky

@@ -186,7 +186,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
@@ -198,12 +198,12 @@ def render_material(
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 
-        return render_mesh(renderer, material, values, view, mesh, width, height, light=light)
+        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment)
     if view_named(view).plot is not None:
         from explorer.views.plots import gl_uniforms
 
         return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
-    return renderer.render(material, values, view, width, height, light=light)
+    return renderer.render(material, values, view, width, height, light=light, environment=environment)
 
 
 def parse_plot(view: str, **options):
@@ -407,11 +407,11 @@ def _errors(function):
 @click.option("--texture", metavar="FILE", help="textured and env views: grey image of a film's D_inc or a mirror's T (default shaders/textures/thickness_noise.png; env: none).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
-@click.option("--env", "env_file", metavar="FILE|NAME", help="env view: equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
+@click.option("--env", "env_file", metavar="FILE|NAME", help="env view (and lit: what a smooth mirror reflects): equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
 @click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
-@click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env view: the environment turned about the vertical.")
+@click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env and lit views: the environment turned about the vertical.")
 @click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
 @click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
               help="textured view of a Bragg mirror: which of Lambda (0.5 + 0.5 T) and delta^T follow the texture T (default both; supplemental Fig. 7).")
@@ -478,7 +478,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     elif texture is not None or dinc_range is not None or prefilter == "on" or mapping is not None:
         raise click.BadParameter("--texture, --dinc-range, --prefilter and --mapping are for the textured and env views", param_hint="--view")
     environment = None
-    if view == "env":
+    from explorer.views.mirror import is_mirror_only
+
+    mirror_lit = view == "lit" and is_mirror_only(loaded) and (env_file is not None or env_rotation is not None) and not background
+    if view == "env" or (mirror_lit and (spp is None or engine == "position-free")):  # lit: what a smooth mirror reflects
         from explorer.views.env import DEFAULT_ENVIRONMENT, environment_named
 
         environment = environment_named(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
@@ -487,7 +490,8 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         if env_rotation is not None:
             environment = environment.rotated(env_rotation)
     elif env_file is not None or (spp is not None and engine != "position-free") or env_rotation is not None or background:
-        raise click.BadParameter("--env, --spp, --env-rotation and --background are for the env view", param_hint="--view")
+        raise click.BadParameter("--env, --spp, --env-rotation and --background are for the env view (--env and --env-rotation "
+                                 "also for a smooth mirror's lit view)", param_hint="--view")
     mesh_shape = None
     if mesh is not None:
         from explorer.views.mesh import mesh_named

@@ -85,17 +85,19 @@ class ProgressiveView:
     def request(
         self, material: Material, values: Mapping[str, object], view: str, size: tuple[int, int], *,
         light: tuple[float, float, float] | None = None, uniforms: Mapping[str, object] | None = None,
-        dragging: bool = False, inputs: Mapping[str, object] | None = None, inputs_key=None,
+        dragging: bool = False, inputs: Mapping[str, object] | None = None, inputs_key=None, environment=None,
     ) -> None:
         """
         What to show; a change restarts the image (``dragging``: stay on the preview). ``inputs``: a view's own
         textures (a mesh's normals, :mod:`explorer.gpu.mesh`; the textured view's), as
         :meth:`explorer.gpu.Renderer.bindings` takes them, named by ``inputs_key`` (arrays are not compared;
-        without a key, a new mapping object is a change).
+        without a key, a new mapping object is a change). ``environment``: what a smooth mirror reflects in the
+        lit view (an :class:`explorer.views.env.EnvironmentMap`, default the env view's; :meth:`explorer.gpu.Renderer.bindings`).
         """
         self.dragging = dragging
         key = (id(material), material.shader, _freeze(values), view, tuple(size), _freeze(light), _freeze(uniforms or {}),
-               (inputs_key if inputs_key is not None else id(inputs)) if inputs else None)
+               (inputs_key if inputs_key is not None else id(inputs)) if inputs else None,
+               None if environment is None else (environment.name, id(environment.pixels), environment.rotation))
         if key == self._key:
             return
         self._key = key
@@ -103,6 +105,7 @@ class ProgressiveView:
         self.light = None if light is None else tuple(float(c) for c in light)
         self.uniforms = dict(uniforms or {})
         self.inputs = dict(inputs) if inputs else None
+        self.environment = environment
         if tuple(size) != self.size:
             self._allocate(tuple(size))
         self.has_preview = False
@@ -128,7 +131,8 @@ class ProgressiveView:
     def _draw(self, framebuffer, size, rows: tuple[int, int] | None = None) -> float:
         """Draw into ``framebuffer`` (rows ``[top, bottom)`` from the top only); returns ms (glFinish-bounded)."""
         program = self._program()
-        uniforms, textures = self.renderer.bindings(program, self.material, self.values, getattr(self, "inputs", None), self.uniforms)
+        uniforms, textures = self.renderer.bindings(program, self.material, self.values, getattr(self, "inputs", None), self.uniforms,
+                                                    getattr(self, "environment", None))
         if self.light is not None:
             uniforms["light_direction"] = self.light
         elapsed = self.renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures, rows=rows)

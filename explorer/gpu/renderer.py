@@ -44,6 +44,9 @@ class Renderer:
         self.models = ModelCache()
         #: Milliseconds the last :meth:`bindings` spent on the model's tables (None: no model yet).
         self.last_table_ms: float | None = None
+        #: What a smooth mirror reflects in the lit view (:meth:`mirror_environment`): (pixels, texture), or None.
+        self._mirror_environment: tuple | None = None
+        self._default_environment = None
 
     # -- resources ---------------------------------------------------------------------------------
 
@@ -100,6 +103,26 @@ class Renderer:
             self._programs[key] = program
         return self._programs[key]
 
+    def mirror_environment(self, environment=None):
+        """
+        The texture of what a smooth mirror reflects in the lit view (``shaders/views/lit.glsl``'s ``mirror_environment``):
+        ``environment`` (an :class:`explorer.views.env.EnvironmentMap`), or the env view's default; one texture
+        kept, made again only for other texels.
+        """
+        from explorer.views.env import EnvironmentMap
+
+        if environment is None:
+            if self._default_environment is None:
+                self._default_environment = EnvironmentMap.default()
+            environment = self._default_environment
+        kept = self._mirror_environment
+        if kept is None or kept[0] is not environment.pixels:
+            if kept is not None:
+                self.resources.release(kept[1])
+            texture = self.resources.texture(environment.pixels, linear=True, repeat_x=True, origin=environment.name)  # as the env view's
+            self._mirror_environment = kept = (environment.pixels, texture)
+        return kept[1]
+
     # -- the model cache ---------------------------------------------------------------------------
 
     def model_ready(self, material: Material, values: Mapping[str, object]) -> bool:
@@ -126,13 +149,14 @@ class Renderer:
 
     def bindings(
         self, program, material: Material, values: Mapping[str, object],
-        inputs: Mapping[str, np.ndarray] | None = None, uniforms: Mapping[str, object] | None = None,
+        inputs: Mapping[str, np.ndarray] | None = None, uniforms: Mapping[str, object] | None = None, environment=None,
     ) -> tuple[dict[str, object], dict[str, object]]:
         """
         ``(uniforms, textures)`` of ``material`` at ``values`` for ``program``, as :meth:`draw` takes them:
         the parameters (``int`` ones as :meth:`explorer.materials.brd.Material.physical_values` has them, exact
         integers), the colour matrix, the library and model tables; ``inputs`` (a view's textures, e.g.
-        the textured view's D_inc) and ``uniforms`` (a view's flags) added.
+        the textured view's D_inc) and ``uniforms`` (a view's flags) added. A smooth mirror's lit view
+        (``MIRROR_ONLY``) gets ``environment`` (default: the env view's) and its glint (:mod:`explorer.views.mirror`).
         """
         values = material.physical_values(values)
         bound: dict[str, object] = {}
@@ -159,6 +183,12 @@ class Renderer:
             textures["sensitivity_fourier_prefiltered"] = self._library["sensitivity_fourier_prefiltered"]
         if inputs:
             textures.update(self._input_textures(inputs))
+        if "mirror_environment" in program:
+            from explorer.views.mirror import GLINT_PEAK, GLINT_SIN2
+
+            textures["mirror_environment"] = self.mirror_environment(environment)
+            turn = environment.turn if environment is not None else self._default_environment.turn
+            bound.update(mirror_environment_turn=turn, glint_sin2=GLINT_SIN2, glint_peak=GLINT_PEAK)
         start = time.perf_counter()
         key, entry = self.models.entry(material, values, normalised=True)  # values normalised once, above
         if entry is not None:
@@ -241,12 +271,12 @@ class Renderer:
 
     # -- whole images ------------------------------------------------------------------------------
 
-    def _headless(self, material, values, view, width, height, light, inputs, uniforms):
+    def _headless(self, material, values, view, width, height, light, inputs, uniforms, environment=None):
         """The program and a float framebuffer of one headless render, bound: ``(program, framebuffer, bindings)``."""
         self.limits.check_target(width, height)  # before the program, the tables and the target
         direction = light_direction(light)
         program = self.program(material, view, values)
-        bound, textures = self.bindings(program, material, values, inputs, uniforms)
+        bound, textures = self.bindings(program, material, values, inputs, uniforms, environment)
         bound["light_direction"] = tuple(float(c) for c in direction)
         framebuffer = self.target(width, height)
         return program, framebuffer, {"uniforms": bound, "textures": textures}
@@ -261,7 +291,7 @@ class Renderer:
     def render(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
         *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
-        uniforms: Mapping[str, object] | None = None,
+        uniforms: Mapping[str, object] | None = None, environment=None,
     ) -> np.ndarray:
         """
         ``(height, width, 3)`` float32 linear RGB, rows from the top, unclamped.
@@ -269,9 +299,10 @@ class Renderer:
         ``light``: ``(theta, phi)`` in degrees of the ``lit`` and ``scatter`` views' directional light
         (default :data:`explorer.views.geometry.DEFAULT_LIGHT`); the other views ignore it. ``inputs`` and
         ``uniforms``: a view's own textures and flags (the ``textured`` view's, from
-        :meth:`explorer.views.thickness.ThicknessTexture.gl_inputs`).
+        :meth:`explorer.views.thickness.ThicknessTexture.gl_inputs`). ``environment``: what a smooth mirror reflects
+        in the ``lit`` view (an :class:`explorer.views.env.EnvironmentMap`; default the env view's).
         """
-        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms)
+        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms, environment)
         try:
             framebuffer.use()
             framebuffer.clear(0.0, 0.0, 0.0, 1.0)
@@ -285,13 +316,13 @@ class Renderer:
     def time_frame(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,
         *, light: tuple[float, float] | None = None, inputs: Mapping[str, np.ndarray] | None = None,
-        uniforms: Mapping[str, object] | None = None,
+        uniforms: Mapping[str, object] | None = None, environment=None,
     ) -> float:
         """
         Time of one frame in ms, bounded by ``glFinish`` on both sides (tables already bound): on a
-        software rasteriser such as llvmpipe this is the rendering time. ``light``: as in :meth:`render`.
+        software rasteriser such as llvmpipe this is the rendering time. ``light``, ``environment``: as in :meth:`render`.
         """
-        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms)
+        program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms, environment)
         try:
             return self.draw(program, framebuffer, **bindings)
         finally:

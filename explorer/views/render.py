@@ -39,7 +39,9 @@ def render_numpy(
     texture over the default D_inc range, without prefiltering) or, for a Bragg mirror, an
     :class:`explorer.views.surface_texture.BraggTexture` (default: the default texture, both mappings).
     ``environment`` (``env``): an :class:`explorer.views.env.EnvironmentMap` (default: the shipped one); the
-    image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes).
+    image is the exact integral :func:`explorer.views.env.env_integral_numpy` (slow: use small sizes). In the
+    ``lit`` view, what a smooth mirror (a model whose ``mirror_only`` is true) reflects, with the light as a
+    glint (:func:`explorer.views.mirror.mirror_lit`); other materials ignore it.
     ``mesh`` (``lit``, ``env``): an :class:`explorer.views.mesh.Mesh` drawn instead of the sphere, its normals
     by :func:`explorer.views.mesh.rasterise`.
     ``slice_phi_d`` (``slice``): phi_d in degrees (the app's Slice window; 90 as BRDF Explorer).
@@ -91,6 +93,15 @@ def render_numpy(
         else:
             L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light, slice_phi_d)
         image = np.zeros((height, width, 3), dtype=np.float32)
+        if view == "lit" and getattr(model, "mirror_only", False):  # a Dirac: the mirror ball (explorer.views.mirror)
+            from explorer.views.env import EnvironmentMap
+            from explorer.views.geometry import light_direction
+            from explorer.views.mirror import mirror_lit
+
+            environment = EnvironmentMap.default() if environment is None else environment
+            direction = light_direction(light).astype(np.float64)
+            image[inside] = _chunked(lambda v, n: mirror_lit(model, v, n, direction, environment), V[inside], N[inside])
+            return image
         vectors = [a[inside] for a in (L, V, N, X, Y)]
         image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]
         return image

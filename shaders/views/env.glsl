@@ -31,14 +31,11 @@
 // else from the material's mixture above; the density divided by is the whole mixture's,
 // (1 - w) (sum_k w_k pdf_k + w_c cos / pi) + w pdf_env (one-sample MIS, balance heuristic; Veach 1997, 9.2).
 //
-// Environment: equirectangular, linear RGB, texture row 0 (v = 0) at the zenith +y (the sphere's screen
-// up), v = theta / pi with theta the angle from +y; the centre column u = 0.5 faces away from the viewer
-// (-z) and u = 0.75 is +x: u = 0.5 + atan(x, -z) / 2 pi. Both angles come from atan, not acos: Mesa's
-// inverse trigonometry is a polynomial with errors near 1e-4 rad at worst, a small fraction of a texel of
-// any environment up to 8k wide, and atan(length(d.xz), d.y) stays accurate at the poles where acos(d.y)
-// loses digits. Linear filtering, repeat in u, clamp in v, level 0. Twin: explorer.views.env.EnvironmentMap.
+// Environment: equirectangular, linear RGB, looked up as lib/environment.glsl describes (its convention,
+// linear filtering, repeat in u, clamp in v). Twin: explorer.views.env.EnvironmentMap.
 #include "lib/views.glsl"
 #include "lib/sampling.glsl"
+#include "lib/environment.glsl"
 
 uniform vec2 resolution;
 uniform sampler2D environment;
@@ -62,11 +59,7 @@ uniform bool textured;
 layout(location = 0) out vec4 sum_out;
 layout(location = 1) out vec4 square_out;
 
-vec3 environment_radiance(vec3 d) {
-    float u = 0.5 + atan(d.x, -d.z) * (0.5 / PI) - environment_turn;
-    float v = atan(length(d.xz), d.y) * (1.0 / PI);
-    return textureLod(environment, vec2(u, v), 0.0).rgb;
-}
+vec3 environment_radiance(vec3 d) { return environment_radiance(environment, environment_turn, d); }
 
 // x > 0, false for NaN (GLSL's max() is undefined for NaN).
 float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }

@@ -52,7 +52,7 @@ class SpherePanel(Panel):
                     self._normals_key = (state.model, size)
                 view, inputs = MESH_TEMPLATES["lit"], {"mesh_normals": self._normals}
             job.request(state.material, values, view, size, light=light_vector(state.light, state.camera), dragging=dragging,
-                        inputs=inputs, inputs_key=state.model)
+                        inputs=inputs, inputs_key=state.model, environment=self._mirror_environment())
             texture = scheduler.show("main", size, job)
         show_image(state, texture, size, "sphere_image", interactive=True)
         if state.mode == "env":  # the env mode's own progress: samples per pixel, converged at the target
@@ -73,6 +73,15 @@ class SpherePanel(Panel):
     _normals_key = None
     _normals = None
 
+    def _mirror_environment(self):
+        """What a smooth mirror reflects in the lit mode (the env mode's environment and turn), else None."""
+        from explorer.views.mirror import is_mirror_only
+
+        state = self.state
+        if state.main_view() != "lit" or not is_mirror_only(state.material):
+            return None
+        return self.scheduler.env.environment(state.environment).rotated(state.env_rotation)
+
     def _model_and_environment(self, imgui) -> None:
         """Switch model (the sphere or a mesh), and in the env mode the environment, its turn, backdrop and target."""
         from explorer.views.env import ENVIRONMENTS
@@ -83,19 +92,22 @@ class SpherePanel(Panel):
         if state.mode == "sphere" and state.model != "sphere":
             imgui.same_line()
             imgui.text_colored(imgui.ImVec4(1, 0.7, 0.3, 1), "(the white furnace shows the sphere)")
-        if state.mode != "env":
-            return
+        if state.mode != "env" and self._mirror_environment() is None:
+            return  # a smooth mirror in the lit mode reflects the environment: its choice and turn, no more
         imgui.set_next_item_width(140)
         state.environment = combo(state, "environment", state.environment, [(n, n) for n in ENVIRONMENTS], state.environment,
                                   "environment", "environment_combo") or state.environment
-        imgui.same_line()
-        _, state.env_background = imgui.checkbox("background", state.env_background)
-        record(state, "env_background")
+        if state.mode == "env":
+            imgui.same_line()
+            _, state.env_background = imgui.checkbox("background", state.env_background)
+            record(state, "env_background")
         imgui.set_next_item_width(200)
         changed, turn = imgui.slider_float("probe rotation", state.env_rotation, -180.0, 180.0, "%.0f deg")
         record(state, "env_rotation")
         if changed:
             state.env_rotation = float(turn)
+        if state.mode != "env":
+            return
         imgui.same_line()
         imgui.set_next_item_width(90)
         targets = [str(t) for t in ENV_TARGETS]
