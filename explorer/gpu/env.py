@@ -12,12 +12,16 @@ from typing import Callable, Mapping
 import numpy as np
 
 from explorer.errors import LocatedError
-from explorer.views.env import EnvironmentMap, env_integral_numpy, environment_sampling_tables
+from explorer.views.env import (
+    ENVIRONMENT_SHARE_MAX, ENVIRONMENT_SHARE_SCALE, EnvironmentMap, env_integral_numpy, environment_sampling_tables,
+    environment_solid_angle,
+)
 from explorer.views.geometry import disc
 from explorer.gpu.renderer import Renderer
 
-#: The share of samples drawn from the environment (one-sample MIS with the material's own sampling, the
-#: balance heuristic: shaders/views/env.glsl); 0 turns environment sampling off.
+#: The share of samples drawn from the environment before it followed the material (one-sample MIS with the
+#: material's own sampling, the balance heuristic: shaders/views/env.glsl); ``environment_sampling=`` this
+#: fixes it. By default each pixel's share follows its lobes (:func:`explorer.views.env.environment_share`).
 ENVIRONMENT_SAMPLING_WEIGHT = 0.5
 #: A pass of ProgressiveEnvRender aims at this many milliseconds (a UI stays responsive).
 PASS_BUDGET_MS = 50.0
@@ -92,7 +96,7 @@ class ProgressiveEnvRender:
     def __init__(
         self, renderer, material, values: Mapping[str, object], environment: EnvironmentMap, width: int, height: int,
         *, seed: int = 0, pass_budget_ms: float = PASS_BUDGET_MS, mesh=None, background: bool = False,
-        environment_sampling: float = ENVIRONMENT_SAMPLING_WEIGHT, surface=None,
+        environment_sampling: float | None = None, surface=None,
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
@@ -115,10 +119,12 @@ class ProgressiveEnvRender:
         self.pixel_ms: float | None = None
         renderer.limits.check_target(self.width, self.height)  # before the environment's texture
         self._texture = environment_texture(renderer.resources, environment)
-        if not 0.0 <= float(environment_sampling) < 1.0:
+        if environment_sampling is not None and not 0.0 <= float(environment_sampling) < 1.0:
             raise ValueError(f"environment_sampling must be in [0, 1), got {environment_sampling}")
-        #: The share of samples drawn from the environment's luminance (explorer.views.env.environment_sampling_tables).
-        self.environment_sampling = float(environment_sampling)
+        #: The share of samples drawn from the environment's luminance (explorer.views.env.environment_sampling_tables):
+        #: None, each pixel's own (explorer.views.env.environment_share, at most ENVIRONMENT_SHARE_MAX); a number, fixed.
+        self.environment_sampling = None if environment_sampling is None else float(environment_sampling)
+        self._share_scale = ENVIRONMENT_SHARE_SCALE / environment_solid_angle(environment)
         marginal, conditional = environment_sampling_tables(environment)
         self._marginal = renderer.resources.texture(marginal, origin=environment.name)
         self._conditional = renderer.resources.texture(conditional, origin=environment.name)
@@ -166,7 +172,9 @@ class ProgressiveEnvRender:
         uniforms["seed"] = self.seed
         uniforms["environment_turn"] = self.environment.turn
         uniforms["show_background"] = self.background
-        uniforms["environment_sampling_weight"] = self.environment_sampling
+        adaptive = self.environment_sampling is None
+        uniforms["environment_sampling_weight"] = ENVIRONMENT_SHARE_MAX if adaptive else self.environment_sampling
+        uniforms["environment_share_scale"] = self._share_scale if adaptive else -1.0
         textures["environment_marginal"] = self._marginal
         textures["environment_conditional"] = self._conditional
         uniforms.update(self._surface_uniforms)

@@ -26,10 +26,16 @@
 //   #define MIRROR_ONLY
 // and its BRDF (what the slice view shows) is not sampled.
 //
-// Environment sampling (lib/sampling.glsl's sample_environment): with probability environment_sampling_weight a
-// sample is drawn from the environment's luminance (its CDFs environment_marginal, environment_conditional),
-// else from the material's mixture above; the density divided by is the whole mixture's,
+// Environment sampling (lib/sampling.glsl's sample_environment): with probability w a sample is drawn from
+// the environment's luminance (its CDFs environment_marginal, environment_conditional), else from the
+// material's mixture above; the density divided by is the whole mixture's,
 // (1 - w) (sum_k w_k pdf_k + w_c cos / pi) + w pdf_env (one-sample MIS, balance heuristic; Veach 1997, 9.2).
+// The share w is the pixel's (environment_share): the lobes' shares weighted as the lobes are chosen, a lobe's
+// w_max x / (1 + x) with x = environment_share_scale Omega, Omega its solid angle (4 pi alpha^2 for GGX, at
+// most 2 pi; 2 pi for the cosine lobe) and environment_share_scale = 3 / the environment's effective solid
+// angle (explorer.views.env.environment_share, its twin): a lobe narrower than the environment's bright
+// parts takes mostly its own samples, a broad one mostly the environment's. Constant over a pixel's
+// samples, so the estimator stays unbiased; a negative scale fixes w = w_max (environment_sampling_weight).
 //
 // Environment: equirectangular, linear RGB, looked up as lib/environment.glsl describes (its convention,
 // linear filtering, repeat in u, clamp in v). Twin: explorer.views.env.EnvironmentMap.
@@ -44,7 +50,8 @@ uniform float environment_turn;
 // Off the object: the environment behind it (a pinhole's view along -z, BACKDROP_TAN the tangent of its
 // half field; twin: explorer.views.env.backdrop), else black.
 uniform bool show_background;
-uniform float environment_sampling_weight;  // 0: the material's sampling only
+uniform float environment_sampling_weight;  // w_max, the largest share; 0: the material's sampling only
+uniform float environment_share_scale;  // 1 / sr; negative: the share is w_max everywhere
 uniform sampler2D environment_marginal;
 uniform sampler2D environment_conditional;
 #define BACKDROP_TAN 0.57735026918962576
@@ -63,6 +70,22 @@ vec3 environment_radiance(vec3 d) { return environment_radiance(environment, env
 
 // x > 0, false for NaN (GLSL's max() is undefined for NaN).
 float positive_or_zero(float x) { return x > 0.0 ? x : 0.0; }
+
+// The share of environment samples for a lobe of solid angle omega (sr): w_max x / (1 + x), x = scale omega.
+float lobe_environment_share(float omega) {
+    float x = environment_share_scale * omega;
+    return environment_sampling_weight * x / (1.0 + x);
+}
+
+// The pixel's share: the lobes' (GGX: omega = min(4 pi alpha^2, 2 pi); the cosine lobe: 2 pi) by their weights.
+float environment_share(vec4 alphas, vec4 weights, float cosine_weight) {
+    if (environment_share_scale < 0.0) return environment_sampling_weight;
+    float share = cosine_weight * lobe_environment_share(2.0 * PI);
+    for (int j = 0; j < 4; ++j) {
+        if (weights[j] > 0.0) share += weights[j] * lobe_environment_share(min(4.0 * PI * alphas[j] * alphas[j], 2.0 * PI));
+    }
+    return share;
+}
 
 void main() {
     vec3 normal, tangent, bitangent;
@@ -119,12 +142,12 @@ void main() {
     mirror = mirror_weight * environment_radiance(reflect(-view, normal));
 #endif
     uvec2 pixel = uvec2(gl_FragCoord.xy);
+    float env_weight = environment_share(alphas, weights, cosine_weight);  // the same for every sample of the pixel
     vec3 sum = vec3(0.0), square = vec3(0.0);
     float dropped = 0.0;
     for (int s = 0; s < samples_per_pass; ++s) {
         vec4 u = uniform_floats(pcg4d(uvec4(pixel, first_sample + uint(s), seed)));
         vec3 light;
-        float env_weight = environment_sampling_weight;
         float choice = (u.x - env_weight) / (1.0 - env_weight) - cosine_weight;  // u.x past the environment's share
         if (u.x < env_weight) {
             light = sample_environment(environment_marginal, environment_conditional, environment_turn, u.yz);

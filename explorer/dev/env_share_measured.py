@@ -1,0 +1,73 @@
+"""
+The env view's share of environment samples, measured (docs/meshes.md): the RMS error against a converged render
+at equal samples, with the share fixed at one half (before), the material's sampling alone, and each pixel's
+share following its lobes (:func:`explorer.views.env.environment_share`, after); printed as Markdown
+(``python -m explorer.dev.env_share_measured``; about a minute on llvmpipe).
+
+Measured, not asserted. The converged render is the GL estimate at :data:`CONVERGED_SPP` samples per pixel
+(per-pixel shares, another seed): its own RMS error is 1/16 of the 64-sample renders', and adds under 0.2 %
+to theirs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.gpu import Renderer
+from explorer.gpu.env import ProgressiveEnvRender
+from explorer.materials.brd import load_material
+from explorer.resources import SHADER_DIR
+from explorer.views.env import ENVIRONMENTS, environment_solid_angle
+from explorer.views.geometry import brdf_view_geometry
+
+SIZE, SPP, SEEDS, CONVERGED_SPP = 32, 64, (1, 2, 3, 4), 16384
+#: (label, material file, overrides): a sharp, a medium and a rough GGX lobe, and a Bragg layer over a base.
+CASES = (
+    ("ggx alpha 0.05 (sharp)", "ggx_schlick.brd", {"alpha": 0.05, "F0": 0.9}),
+    ("ggx alpha 0.2 (medium)", "ggx_schlick.brd", {"alpha": 0.2, "F0": 0.9}),
+    ("ggx alpha 0.6 (rough)", "ggx_schlick.brd", {"alpha": 0.6, "F0": 0.9}),
+    ("bragg_layer alpha 0.1, rho_d 0.5", "bragg_layer.brd", {"alpha": 0.1, "method": 3, "rho_d": 0.5}),
+)
+#: The shares compared: fixed at one half (before), the material's sampling alone, per pixel (after).
+SHARES = {"0.5 fixed": 0.5, "0 (BRDF only)": 0.0, "per pixel": None}
+
+
+def _render(renderer, material, values, environment, spp: int, share, seed: int) -> np.ndarray:
+    render = ProgressiveEnvRender(renderer, material, values, environment, SIZE, SIZE, environment_sampling=share, seed=seed)
+    try:
+        render.step(spp)
+        return render.image().astype(np.float64)
+    finally:
+        render.release()
+
+
+def rows(renderer: Renderer) -> list[str]:
+    inside = brdf_view_geometry("lit", SIZE, SIZE)[5]
+    lines = ["| environment | material | " + " | ".join(f"RMS error, share {name}" for name in SHARES) + " | after / before |",
+             "|---|---|" + "---|" * (len(SHARES) + 1)]
+    for env_name in ("sky", "studio"):
+        environment = ENVIRONMENTS[env_name]()
+        for label, path, overrides in CASES:
+            material = load_material(SHADER_DIR / path)
+            values = material.resolve(overrides)
+            converged = _render(renderer, material, values, environment, CONVERGED_SPP, None, seed=99)
+            errors = {}
+            for name, share in SHARES.items():
+                squares = [np.mean((_render(renderer, material, values, environment, SPP, share, seed) - converged)[inside] ** 2)
+                           for seed in SEEDS]
+                errors[name] = float(np.sqrt(np.mean(squares)))
+            cells = " | ".join(f"{errors[name]:.4f}" for name in SHARES)
+            lines.append(f"| {env_name} | {label} | {cells} | {errors['per pixel'] / errors['0.5 fixed']:.2f} |")
+    return lines
+
+
+def main() -> None:
+    renderer = Renderer()
+    solid_angles = ", ".join(f"{name} {environment_solid_angle(ENVIRONMENTS[name]()):.2f} sr" for name in ("sky", "studio"))
+    print(f"RMS error against a {CONVERGED_SPP}-spp render, {SPP} spp at {SIZE}², {len(SEEDS)} seeds; "
+          f"effective solid angles: {solid_angles}\n")
+    print("\n".join(rows(renderer)))
+
+
+if __name__ == "__main__":
+    main()
