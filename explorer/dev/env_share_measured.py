@@ -2,7 +2,8 @@
 The env view's share of environment samples, measured (docs/meshes.md): the RMS error against a converged render
 at equal samples, with the share fixed at one half (before), the material's sampling alone, and each pixel's
 share following its lobes (:func:`explorer.views.env.environment_share`, after); printed as Markdown
-(``python -m explorer.dev.env_share_measured``; about a minute on llvmpipe).
+(``python -m explorer.dev.env_share_measured``; about a minute on llvmpipe), and the sweep the share's
+constants were fitted on (the best fixed share per GGX lobe and environment).
 
 Measured, not asserted. The converged render is the GL estimate at :data:`CONVERGED_SPP` samples per pixel
 (per-pixel shares, another seed): its own RMS error is 1/16 of the 64-sample renders', and adds under 0.2 %
@@ -16,6 +17,7 @@ import numpy as np
 from explorer.gpu import Renderer
 from explorer.gpu.env import ProgressiveEnvRender
 from explorer.materials.brd import load_material
+from explorer.materials.methods import BraggMethod
 from explorer.resources import SHADER_DIR
 from explorer.views.env import ENVIRONMENTS, environment_solid_angle
 from explorer.views.geometry import brdf_view_geometry
@@ -26,7 +28,7 @@ CASES = (
     ("ggx alpha 0.05 (sharp)", "ggx_schlick.brd", {"alpha": 0.05, "F0": 0.9}),
     ("ggx alpha 0.2 (medium)", "ggx_schlick.brd", {"alpha": 0.2, "F0": 0.9}),
     ("ggx alpha 0.6 (rough)", "ggx_schlick.brd", {"alpha": 0.6, "F0": 0.9}),
-    ("bragg_layer alpha 0.1, rho_d 0.5", "bragg_layer.brd", {"alpha": 0.1, "method": 3, "rho_d": 0.5}),
+    ("bragg_layer alpha 0.1, rho_d 0.5", "bragg_layer.brd", {"alpha": 0.1, "method": int(BraggMethod.TABULATED), "rho_d": 0.5}),
 )
 #: The shares compared: fixed at one half (before), the material's sampling alone, per pixel (after).
 SHARES = {"0.5 fixed": 0.5, "0 (BRDF only)": 0.0, "per pixel": None}
@@ -61,12 +63,47 @@ def rows(renderer: Renderer) -> list[str]:
     return lines
 
 
+#: The fit's sweep: GGX lobes (F0 0.9) and the fixed shares tried, the RMS standard error at 512 spp, 24².
+SWEEP_ALPHAS = (0.02, 0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 1.0)
+SWEEP_SHARES = (0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+
+
+def sweep_rows(renderer: Renderer) -> list[str]:
+    """Per GGX lobe and environment: the best fixed share and the per-pixel share's error relative to it."""
+    size, spp = 24, 512
+    inside = brdf_view_geometry("lit", size, size)[5]
+    material = load_material(SHADER_DIR / "ggx_schlick.brd")
+
+    def rms(values, environment, share) -> float:
+        render = ProgressiveEnvRender(renderer, material, values, environment, size, size, environment_sampling=share, seed=3)
+        try:
+            render.step(spp)
+            return float(np.sqrt(np.mean(render.standard_error()[inside].astype(np.float64) ** 2)))
+        finally:
+            render.release()
+
+    lines = ["| environment | alpha | best fixed share | per pixel / best fixed | per pixel / fixed 0.5 |", "|---|---|---|---|---|"]
+    for env_name in ("sky", "studio"):
+        environment = ENVIRONMENTS[env_name]()
+        for alpha in SWEEP_ALPHAS:
+            values = material.resolve({"alpha": alpha, "F0": 0.9})
+            fixed = [rms(values, environment, share) for share in SWEEP_SHARES]
+            best = int(np.argmin(fixed))
+            adaptive = rms(values, environment, None)
+            lines.append(f"| {env_name} | {alpha} | {SWEEP_SHARES[best]} | {adaptive / fixed[best]:.2f} | "
+                         f"{adaptive / fixed[SWEEP_SHARES.index(0.5)]:.2f} |")
+    return lines
+
+
 def main() -> None:
     renderer = Renderer()
     solid_angles = ", ".join(f"{name} {environment_solid_angle(ENVIRONMENTS[name]()):.2f} sr" for name in ("sky", "studio"))
     print(f"RMS error against a {CONVERGED_SPP}-spp render, {SPP} spp at {SIZE}², {len(SEEDS)} seeds; "
           f"effective solid angles: {solid_angles}\n")
     print("\n".join(rows(renderer)))
+    print("\nThe fit's sweep: RMS standard error at 512 spp, 24², GGX lobes (F0 0.9), fixed shares "
+          f"{', '.join(map(str, SWEEP_SHARES))}\n")
+    print("\n".join(sweep_rows(renderer)))
 
 
 if __name__ == "__main__":
