@@ -81,8 +81,10 @@ class ComparePanel(Panel):
             if not (has_reflectance(state.material) and has_reflectance(material_b)):
                 view = "lit"
         a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
-        a.request(state.material, values_a, view, size, light=light, dragging=dragging)
-        b.request(material_b, values_b, view, size, light=light, dragging=dragging)
+        # What a smooth mirror reflects in the lit view: the Sphere window's environment and probe turn.
+        environment = self.scheduler.env.environment(state.environment).rotated(state.env_rotation)
+        a.request(state.material, values_a, view, size, light=light, dragging=dragging, environment=environment)
+        b.request(material_b, values_b, view, size, light=light, dragging=dragging, environment=environment)
         if c.heat and self._heat_texture is not None:
             show_image(state, self._heat_texture, size, "compare_image", side=COLOUR_BAR_WIDTH + 8)
             imgui.same_line()
