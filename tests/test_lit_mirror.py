@@ -141,3 +141,31 @@ def test_cli_lit_mirror_environment(tmp_path, gl_renderer):
         assert "--view" in line, line
     line = one_line_error(run_cli("render", GGX, "--view", "lit", "--env", "studio", "--out", tmp_path / "x.png"))
     assert "smooth mirror" in line, line  # a rough material reflects no environment in the lit view
+
+
+def test_saved_view_holds_a_mirrors_environment(tmp_path):
+    """The app saves the environment and its turn for a lit mirror (and the env mode), not for a rough lit material;
+    render --params reproduces the lit mirror under them."""
+    from explorer.app.parameter_files import load_view, save_values
+    from explorer.app.state import AppState, CompareState
+
+    mirror = load_material(MIRROR)
+    values = mirror.resolve({"method": 1})
+    state = AppState(MIRROR, mirror, values, CompareState({}), mode="lit", environment="studio", env_rotation=30.0)
+    settings = state.view_settings()
+    assert settings["view"] == "lit" and settings["environment"] == "studio" and settings["env_rotation"] == 30.0
+    rough = load_material(GGX)
+    settings_rough = AppState(GGX, rough, rough.resolve({}), CompareState({}), mode="lit", environment="studio", env_rotation=30.0).view_settings()
+    assert settings_rough["environment"] is None and settings_rough["env_rotation"] is None
+    for name in ("v.json", "v.bparam"):
+        save_values(tmp_path / name, mirror, values, settings)
+        assert load_view(tmp_path / name)["env_rotation"] == 30.0 and load_view(tmp_path / name)["environment"] == "studio"
+        out = tmp_path / f"{name}.npy"
+        run = run_cli("render", MIRROR, "--params", tmp_path / name, "--engine", "numpy", "--size", "16", "--out", out)
+        assert run.returncode == 0, run.stderr
+        light = tuple(float(c) for c in state.light)
+        expected = render_numpy(model_for(mirror, values), "lit", 16, 16, light=light, environment=ENVIRONMENTS["studio"]().rotated(30.0))
+        np.testing.assert_allclose(np.load(out), expected, rtol=1e-6, atol=1e-7)
+    bad = (tmp_path / "v.bparam").read_text().replace("env_rotation 30.0", "env_rotation sideways")
+    (tmp_path / "bad.bparam").write_text(bad)
+    assert "env_rotation" in one_line_error(run_cli("render", MIRROR, "--params", tmp_path / "bad.bparam", "--out", tmp_path / "x.png"))

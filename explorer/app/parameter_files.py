@@ -80,14 +80,15 @@ class LoadedValues:
 
 
 #: What a parameter set may save beside the values: the app's view, so that ``render --params`` shows it.
-VIEW_KEYS = ("view", "light", "camera", "exposure", "environment")
+VIEW_KEYS = ("view", "light", "camera", "exposure", "environment", "env_rotation")
 
 
 def check_view(raw, where: str, line: int | None = None) -> dict:
     """
     A saved view, checked: ``view`` (a view's name), ``light`` ``[theta, phi]`` (degrees, theta in
     [0, 180]), ``camera`` ``[yaw, pitch]`` (degrees, pitch in [-89, 89]), ``exposure`` (> 0),
-    ``environment`` (a file, or None). Missing keys are absent from the result; unknown ones are errors.
+    ``environment`` (a file or a name of :data:`explorer.views.env.ENVIRONMENTS`, or None), ``env_rotation`` (degrees,
+    finite). Missing keys are absent from the result; unknown ones are errors.
     """
     import math
 
@@ -128,6 +129,14 @@ def check_view(raw, where: str, line: int | None = None) -> dict:
         view["exposure"] = exposure
     if raw.get("environment") is not None:
         view["environment"] = str(raw["environment"])
+    if raw.get("env_rotation") is not None:
+        try:
+            rotation = float(raw["env_rotation"])
+        except (TypeError, ValueError):
+            rotation = math.nan
+        if not math.isfinite(rotation):
+            raise ParameterFileError(where, line, f"view 'env_rotation': {raw['env_rotation']!r} is not a finite angle in degrees")
+        view["env_rotation"] = rotation
     return view
 
 

@@ -184,11 +184,14 @@ class AppState:
 
     def view_settings(self) -> dict:
         """What a parameter set saves beside the values so that ``render --params`` shows this view."""
-        from explorer.resources import DEFAULT_ENVIRONMENT
+        from explorer.views.mirror import is_mirror_only
 
+        # The environment (its name: render --env takes it) and its turn, where the view shows one: the env
+        # mode, and a smooth mirror in the lit mode.
+        reflects = self.mode == "env" or (self.main_view() == "lit" and is_mirror_only(self.material))
         return {"view": "env" if self.mode == "env" else self.main_view(), "light": list(self.light),
                 "camera": list(self.camera), "exposure": float(self.exposure),
-                "environment": str(DEFAULT_ENVIRONMENT) if self.mode == "env" else None}
+                "environment": self.environment if reflects else None, "env_rotation": float(self.env_rotation) if reflects and self.env_rotation else None}
 
     def main_view(self) -> str:
         """The sphere's view: ``sphere`` when chosen and the material has a reflectance, else ``lit``."""

@@ -112,7 +112,7 @@ def parse_exposure(text: str | None, out: Path) -> float | None:
 def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     """
     What ``--params FILE`` saved of the app's view (:func:`explorer.app.parameter_files.check_view`), as
-    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment`` and ``light``
+    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment``, ``env_rotation`` and ``light``
     (``(theta, phi)``: the app's light turned by its orbit camera into view space). Only for the options
     the command line leaves unset; ``{}`` without a file or a saved view.
     """
@@ -121,15 +121,17 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     from explorer.app.parameter_files import load_view
 
     view = load_view(params_file) or {}
-    given = {name for name in ("view", "light", "exposure", "env_file")
+    given = {name for name in ("view", "light", "exposure", "env_file", "env_rotation")
              if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE}
     result: dict = {}
     if "view" in view and "view" not in given:
         result["view"] = view["view"]
     if "exposure" in view and "exposure" not in given:
         result["exposure"] = repr(view["exposure"])
-    if "environment" in view and "env_file" not in given and result.get("view") == "env":
+    if "environment" in view and "env_file" not in given and result.get("view") in ("env", "lit"):  # lit: a smooth mirror's
         result["environment"] = view["environment"]
+    if "env_rotation" in view and "env_rotation" not in given and result.get("view") in ("env", "lit"):
+        result["env_rotation"] = view["env_rotation"]
     if ("light" in view or "camera" in view) and "light" not in given:
         from explorer.app.camera import light_vector
         from explorer.views.geometry import DEFAULT_LIGHT
@@ -443,6 +445,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     check_output(Path(out))
     saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
     view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
+    env_rotation = saved.get("env_rotation", env_rotation)
     exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
     light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
