@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.gpu import Renderer
-from explorer.gpu.env import ProgressiveEnvRender
+from explorer.gpu.env import ENVIRONMENT_SAMPLING_WEIGHT, ProgressiveEnvRender
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.resources import SHADER_DIR
@@ -31,7 +31,7 @@ CASES = (
     ("bragg_layer alpha 0.1, rho_d 0.5", "bragg_layer.brd", {"alpha": 0.1, "method": int(BraggMethod.TABULATED), "rho_d": 0.5}),
 )
 #: The shares compared: fixed at one half (before), the material's sampling alone, per pixel (after).
-SHARES = {"0.5 fixed": 0.5, "0 (BRDF only)": 0.0, "per pixel": None}
+SHARES = {"0.5 fixed": ENVIRONMENT_SAMPLING_WEIGHT, "0 (BRDF only)": 0.0, "per pixel": None}
 
 
 def _render(renderer, material, values, environment, spp: int, share, seed: int) -> np.ndarray:
@@ -91,7 +91,7 @@ def sweep_rows(renderer: Renderer) -> list[str]:
             best = int(np.argmin(fixed))
             adaptive = rms(values, environment, None)
             lines.append(f"| {env_name} | {alpha} | {SWEEP_SHARES[best]} | {adaptive / fixed[best]:.2f} | "
-                         f"{adaptive / fixed[SWEEP_SHARES.index(0.5)]:.2f} |")
+                         f"{adaptive / fixed[SWEEP_SHARES.index(ENVIRONMENT_SAMPLING_WEIGHT)]:.2f} |")
     return lines
 
 

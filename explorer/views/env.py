@@ -14,7 +14,9 @@ centres, wrapping in ``u`` and clamped in ``v`` (GL's ``LINEAR`` with ``REPEAT``
 
 The GPU estimator is unbiased for any material: cosine sampling, or with a material's optional
 ``sampling_lobes`` hook one-sample MIS over GGX visible-normal lobes (Heitz 2018) and a cosine lobe,
-the mixture density in the denominator (balance heuristic). The layered material's hook chooses
+the mixture density in the denominator (balance heuristic), and the environment's own luminance sampling in the
+same mixture at each pixel's share (:func:`environment_share`: by its lobes' solid angles against the
+environment's). The layered material's hook chooses
 lobes by the layer probabilities of Eq. 35 (Fourneau et al. 2024); ``shaders/bragg_layer.brd`` uses
 Eq. 31 for its one layer over the base.
 
