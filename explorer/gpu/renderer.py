@@ -19,7 +19,7 @@ from explorer.views.geometry import light_direction
 from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
-from explorer.gpu.resources import GLResources
+from explorer.gpu.resources import GL_SAMPLER_BUFFER, GLResources, buffer_textures_supported
 
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
@@ -35,10 +35,12 @@ class Renderer:
         self.limits: GLLimits = gl_limits(self.ctx)
         #: The owner of every texture and framebuffer made for this context (explorer.gpu.resources).
         self.resources = GLResources(self.ctx, self.limits)
+        #: Whether programs may read 1D tables from buffer textures (``TABLE_BUFFERS``; needs PyOpenGL here).
+        self.buffer_tables = buffer_textures_supported(self.ctx)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
-        self._model_textures: dict[str, object] = {}
-        self._model_texture_keys: dict[str, tuple] = {}  # which model's table each model texture holds
+        self._model_textures: dict[tuple[str, bool], object] = {}  # (name, buffer texture?) -> texture
+        self._model_texture_keys: dict[tuple[str, bool], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
         self._vertex_arrays: dict[int, tuple[object, object]] = {}  # id(program) -> (program, its vertex array)
         self.models = ModelCache()
@@ -51,10 +53,11 @@ class Renderer:
         """A float RGB(A) texture of ``(height, width, 3 or 4)`` data (row 0 = texel row 0), clamped."""
         return self.resources.texture(data, linear=linear)
 
-    def _model_texture(self, name: str, table: np.ndarray):
+    def _model_texture(self, name: str, table: np.ndarray, buffer: bool = False):
         """
-        The linearly filtered texture of a model's table, rewritten in place when its shape is unchanged:
-        ``(width, 3)`` is a row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0).
+        The texture of a model's table, rewritten in place when its shape is unchanged: ``(width, 3)`` is a
+        row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0). ``buffer``: a row as a
+        buffer texture (the program reads it as a ``samplerBuffer``), else a linearly filtered texture.
         """
         data = np.ascontiguousarray(table, dtype=np.float32)
         if data.ndim == 2:
@@ -62,7 +65,9 @@ class Renderer:
         # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones (llvmpipe:
         # the tabulated method's sphere ~10% faster; bench --tables).
         data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
-        texture = self._model_textures[name] = self.resources.replace(self._model_textures.get(name), data, linear=True, origin=name)
+        options = {"buffer": True} if buffer else {"linear": True}
+        key = (name, buffer)
+        texture = self._model_textures[key] = self.resources.replace(self._model_textures.get(key), data, origin=name, **options)
         return texture
 
     def _library_textures(self) -> dict[str, object]:
@@ -92,7 +97,7 @@ class Renderer:
         if key not in self._programs:
             import moderngl
 
-            source = build_program_source(material, view, constants)
+            source = build_program_source(material, view, constants, self.buffer_tables)
             try:
                 program = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=source.code)
             except moderngl.Error as error:
@@ -164,12 +169,14 @@ class Renderer:
         if entry is not None:
             for name, table in entry.ensure_tables().items():
                 if name in program:
+                    # As the program declares it: a samplerBuffer (TABLE_BUFFERS) or a sampler2D.
+                    slot = (name, program[name].gl_type == GL_SAMPLER_BUFFER)
                     # A draft and the real tables share the values' key: the texture's key tells them apart.
                     texture_key = None if key is None else (key, entry.draft)
-                    if texture_key is None or self._model_texture_keys.get(name) != texture_key or name not in self._model_textures:
-                        self._model_texture(name, table)
-                        self._model_texture_keys[name] = texture_key
-                    textures[name] = self._model_textures[name]
+                    if texture_key is None or self._model_texture_keys.get(slot) != texture_key or slot not in self._model_textures:
+                        self._model_texture(name, table, buffer=slot[1])
+                        self._model_texture_keys[slot] = texture_key
+                    textures[name] = self._model_textures[slot]
             self.last_table_ms = (time.perf_counter() - start) * 1e3
         return bound, textures
 

@@ -495,6 +495,18 @@ vec3 tabulated_rgb(sampler2D table, float cos_theta) {
     return mix(texelFetch(table, ivec2(i, 0), 0).rgb, texelFetch(table, ivec2(min(i + 1, last), 0), 0).rgb, x - float(i));
 }
 
+#ifdef TABLE_BUFFERS
+// The same table in a buffer texture (the host defines TABLE_BUFFERS where it uploads one): the same two
+// texels and float mix, ~13% cheaper on llvmpipe, which skips the 2D path's coordinate work
+// (docs/performance.md, Tabulated shading). No .brdf export: BRDF Explorer reads the sampler2D form.
+vec3 tabulated_rgb(samplerBuffer table, float cos_theta) {
+    int last = textureSize(table) - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, max(last - 1, 0));
+    return mix(texelFetch(table, i).rgb, texelFetch(table, min(i + 1, last)).rgb, x - float(i));
+}
+#endif
+
 // Supplemental Figure 7: a mirror whose Lambda and delta follow a texture value T in [0, 1], mapping's bits
 // 1: Lambda (0.5 + 0.5 T), 2: delta^T (delta^0 = 1; GLSL's pow(0, 0) is undefined). Twin: explorer.physics.bragg.textured_mirror.
 BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
