@@ -19,12 +19,23 @@ from explorer.views.geometry import light_direction
 from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
-from explorer.gpu.resources import GL_SAMPLER_BUFFER, GLResources, buffer_textures_supported
+from explorer.gpu.resources import GL_SAMPLER_BUFFER, BufferTexture, GLResources, buffer_textures_supported, set_buffer_sampler
 
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
 #: program is shared: the app's Slice window may have set another phi_d on it).
 VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2)}
+
+#: GL's sampler types (1D ... 2D rectangle shadow, the array/buffer/integer ones, the multisample ones).
+SAMPLER_TYPES = frozenset([*range(0x8B5D, 0x8B65), *range(0x8DC0, 0x8DD9), *range(0x9108, 0x910E)])
+
+
+def _buffer_samplers(program) -> dict[str, int]:
+    """``{name: GL type}`` of ``program``'s samplers if one is a ``samplerBuffer`` (else {}): unbound, they
+    would all read unit 0, and GL refuses a draw whose samplers of two types share a unit."""
+    samplers = {name: program[name].gl_type for name in program if program[name].gl_type in SAMPLER_TYPES}
+    return samplers if GL_SAMPLER_BUFFER in samplers.values() else {}
+
 
 class Renderer:
     """Renders material views into float32 images; caches programs, library textures and model tables."""
@@ -42,7 +53,8 @@ class Renderer:
         self._model_textures: dict[tuple[str, bool], object] = {}  # (name, buffer texture?) -> texture
         self._model_texture_keys: dict[tuple[str, bool], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
-        self._vertex_arrays: dict[int, tuple[object, object]] = {}  # id(program) -> (program, its vertex array)
+        # id(program) -> (program, its vertex array, its samplers by GL type where one is a samplerBuffer, else {})
+        self._vertex_arrays: dict[int, tuple[object, object, dict]] = {}
         self.models = ModelCache()
         #: Milliseconds the last :meth:`bindings` spent on the model's tables (None: no model yet).
         self.last_table_ms: float | None = None
@@ -218,12 +230,24 @@ class Renderer:
             if name in program:
                 program[name].value = value
         bound = sorted((name, texture) for name, texture in (textures or {}).items() if name in program)
-        for unit, (name, texture) in enumerate(bound):
-            texture.use(location=unit)
-            program[name].value = unit
         cached = self._vertex_arrays.get(id(program))
         if cached is None or cached[0] is not program:
-            cached = self._vertex_arrays[id(program)] = (program, self.ctx.vertex_array(program, []))
+            cached = self._vertex_arrays[id(program)] = (program, self.ctx.vertex_array(program, []), _buffer_samplers(program))
+        for unit, (name, texture) in enumerate(bound):
+            texture.use(location=unit)
+            if isinstance(texture, BufferTexture):
+                set_buffer_sampler(program, name, unit)
+            else:
+                program[name].value = unit
+        if cached[2]:  # samplers left unbound: one spare unit per type (GL refuses two types on one unit)
+            names = {name for name, _ in bound}
+            for name, gl_type in cached[2].items():
+                if name not in names:
+                    unit = len(bound) + (gl_type == GL_SAMPLER_BUFFER)
+                    if gl_type == GL_SAMPLER_BUFFER:
+                        set_buffer_sampler(program, name, unit)
+                    else:
+                        program[name].value = unit
         framebuffer.use()
         if rows is not None:
             top, bottom = rows  # GL rows count from the bottom

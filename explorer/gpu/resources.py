@@ -66,6 +66,14 @@ class BufferTexture:
             self.buffer.release()
 
 
+def set_buffer_sampler(program, name: str, location: int) -> None:
+    """Point ``program``'s ``samplerBuffer`` ``name`` at texture unit ``location``: moderngl (5.13) does not
+    write such a uniform (its value setter leaves it at unit 0)."""
+    GL = _opengl(program.ctx)
+    GL.glUseProgram(program.glo)  # moderngl binds its program before every draw
+    GL.glUniform1i(program[name].location, location)
+
+
 def buffer_textures_supported(ctx) -> bool:
     """Whether :class:`BufferTexture` works in ``ctx`` (PyOpenGL reaches its GL: one made and released)."""
     try:
