@@ -96,3 +96,23 @@ def test_env_view_with_unbound_samplers_beside_a_buffer_table(gl_renderer):
         assert np.abs(render.image()).max() > 0.05
     finally:
         render.release()
+
+
+def test_lookup_profile_reads_every_table_it_times(gl_renderer):
+    """explorer.dev.lookup_profile's exact variants show the table's linear interpolation (its 16-bit table
+    was once an integer texture, incomplete under LINEAR filtering: it read 0 and timed as one fetch)."""
+    from explorer.dev import lookup_profile
+
+    images: dict = {}
+    result = lookup_profile.profile(size=24, repeats=1, images=images)
+    assert set(result) == set(images) == set(lookup_profile.VARIANTS)
+    # The sphere's cos theta at each pixel centre (rows from the bottom, as GL reads them).
+    p = 2.0 * (np.arange(24) + 0.5) / 24 - 1.0
+    r2 = p[None, :] ** 2 + p[:, None] ** 2
+    inside = r2 < 0.99
+    x = np.sqrt(1.0 - r2[inside]) * (lookup_profile.ENTRIES - 1)
+    i = np.minimum(x.astype(int), lookup_profile.ENTRIES - 2)
+    table = lookup_profile.lookup_table()[:, :3].astype(np.float64)
+    expected = table[i] + (x - i)[:, None] * (table[i + 1] - table[i])
+    for name in ("buffer2", "fetch2", "texture2", "block2", "linear32f", "linear16"):
+        np.testing.assert_allclose(images[name][inside], expected, atol=2e-4, err_msg=name)
