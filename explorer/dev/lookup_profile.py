@@ -4,9 +4,10 @@ Schlick's Fresnel on this GL (issue 22 item 3; docs/performance.md, *Tabulated s
 
 Each variant is the sphere view's pixel (``shaders/views/sphere.glsl``: ``reflectance(sqrt(1 - r^2))``
 inside the disc) with one way of reading a 257-entry RGB table over cos theta: the tabulated method's own
-(two ``texelFetch`` of a buffer texture and a float ``mix``, ``shaders/lib/bragg.glsl``'s ``tabulated_rgb``),
-the other exact ones (the same from a 2D texture, two nearest ``texture`` reads, a uniform block, hardware
-filtering of RGBA32F and of 16-bit normalised fixed point) and, for the floor, one read (not exact).
+(one ``texelFetch`` of a packed interval, ``shaders/lib/bragg.glsl``'s ``packed_tabulated_rgb``), the other
+exact ones (two float texels and a ``mix`` from a buffer or a 2D texture, two nearest ``texture`` reads, a
+uniform block, hardware filtering of RGBA32F and of 16-bit normalised fixed point) and, for the floor, one
+read (not exact).
 Frames are interleaved and bounded by ``glFinish``; the minimum over the repeats is printed with the median
 CPU time, as ratios to Schlick's. The minimum is the least disturbed by other processes on a shared machine.
 """
@@ -19,6 +20,7 @@ import time
 import numpy as np
 
 from explorer.gpu.context import GLSL_VERSION, VERTEX_SHADER, create_context
+from explorer.gpu.packed_tables import pack_table_intervals
 from explorer.gpu.resources import BufferTexture, set_buffer_sampler
 
 ENTRIES = 257
@@ -41,11 +43,20 @@ _INDEX = """int last = textureSize(table, 0).x - 1;
 _BUFFER_INDEX = """int last = textureSize(table) - 1;
     float x = clamp(cos_theta, 0.0, 1.0) * float(last);
     int i = clamp(int(x), 0, max(last - 1, 0));"""
-#: name -> (description, table texture: (dtype, filter), "block" or "buffer", the reflectance function).
+#: name -> (description, table texture: (dtype, filter), "block", "buffer" or "packed", the reflectance function).
 VARIANTS = {
     "schlick": ("Schlick's Fresnel (the baseline)", None, """
 vec3 reflectance(float c) { float m = 1.0 - c; float m2 = m * m; return vec3(F0 + (1.0 - F0) * m2 * m2 * m); }"""),
-    "buffer2": ("two texelFetch + mix, RGBA32F buffer texture (the tabulated method)", "buffer", f"""
+    "packed": ("one texelFetch of a packed interval, RGBA32UI buffer, 16-bit codes (the tabulated method)", "packed", """
+uniform usamplerBuffer table;
+vec3 reflectance(float cos_theta) {
+    int intervals = textureSize(table);
+    float x = clamp(cos_theta, 0.0, 1.0) * float(intervals);
+    int i = min(int(x), intervals - 1);
+    uvec4 texel = texelFetch(table, i);
+    return uintBitsToFloat(texel.w) * mix(vec3(ivec3(texel.xyz << 16) >> 16), vec3(ivec3(texel.xyz) >> 16), x - float(i));
+}"""),
+    "buffer2": ("two texelFetch + mix, RGBA32F buffer texture", "buffer", f"""
 uniform samplerBuffer table;
 vec3 reflectance(float cos_theta) {{
     {_BUFFER_INDEX}
@@ -95,14 +106,15 @@ def lookup_table() -> np.ndarray:
     return np.random.default_rng(0).random((ENTRIES, 4)).astype(np.float32)
 
 
-def profile(size: int = 512, repeats: int = 61, images: dict | None = None) -> dict[str, dict]:
+def profile(size: int = 512, repeats: int = 61, images: dict | None = None, ctx=None) -> dict[str, dict]:
     """
     Per variant of :data:`VARIANTS`: ``min_ms``, ``cpu_ms`` (median) and their ratios to Schlick's.
     ``images``: filled with each variant's frame, ``(size, size, 3)`` rows from the bottom (tests).
+    ``ctx``: the moderngl context to use (default: a new one); what is made in it is released.
     """
     import moderngl
 
-    ctx = create_context()
+    ctx = create_context() if ctx is None else ctx
     table = lookup_table()
     # "nu2": normalised 16-bit (GL_RGBA16). moderngl's "u2" is an integer texture, which no LINEAR filter
     # completes: it read (0, 0, 0, 1) and looked as cheap as one fetch (docs/performance.md).
@@ -120,6 +132,8 @@ def profile(size: int = 512, repeats: int = 61, images: dict | None = None) -> d
             program["Table"].binding = 0
         elif texture == "buffer":
             bound = BufferTexture(ctx, table.reshape(1, ENTRIES, 4))
+        elif texture == "packed":
+            bound = BufferTexture(ctx, pack_table_intervals(table[:, :3])[None])
         elif texture is not None:
             dtype, filtering = texture
             bound = ctx.texture((ENTRIES, 1), 4, data[dtype].tobytes(), dtype=dtype)
@@ -151,6 +165,15 @@ def profile(size: int = 512, repeats: int = 61, images: dict | None = None) -> d
     for name in VARIANTS if images is not None else ():
         frame(name)
         images[name] = np.frombuffer(framebuffer.read(components=3, dtype="f4"), np.float32).reshape(size, size, 3)
+    for program, vertex_array, texture in programs.values():
+        for made in (vertex_array, program, texture):
+            if made is not None:
+                made.release()
+    block.release()
+    attachments = framebuffer.color_attachments
+    framebuffer.release()
+    for attachment in attachments:
+        attachment.release()
     base_min = min(t[0] for t in times["schlick"])
     base_cpu = float(np.median([t[1] for t in times["schlick"]]))
     return {name: {"min_ms": min(t[0] for t in v), "cpu_ms": float(np.median([t[1] for t in v])),

@@ -19,7 +19,11 @@ from explorer.views.geometry import light_direction
 from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
-from explorer.gpu.resources import GL_SAMPLER_BUFFER, BufferTexture, GLResources, buffer_textures_supported, set_buffer_sampler
+from explorer.gpu.packed_tables import pack_table_intervals
+from explorer.gpu.resources import (
+    BUFFER_SAMPLERS, GL_SAMPLER_BUFFER, GL_UNSIGNED_INT_SAMPLER_BUFFER, BufferTexture, GLResources,
+    buffer_textures_supported, set_buffer_sampler,
+)
 
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
@@ -30,11 +34,15 @@ VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2)}
 SAMPLER_TYPES = frozenset([*range(0x8B5D, 0x8B65), *range(0x8DC0, 0x8DD9), *range(0x9108, 0x910E)])
 
 
+#: How a model's table is uploaded for a sampler of each GL type (others: "2d", a filtered 2D texture).
+TABLE_KINDS = {GL_SAMPLER_BUFFER: "buffer", GL_UNSIGNED_INT_SAMPLER_BUFFER: "packed"}
+
+
 def _buffer_samplers(program) -> dict[str, int]:
-    """``{name: GL type}`` of ``program``'s samplers if one is a ``samplerBuffer`` (else {}): unbound, they
+    """``{name: GL type}`` of ``program``'s samplers if one is a buffer sampler (else {}): unbound, they
     would all read unit 0, and GL refuses a draw whose samplers of two types share a unit."""
     samplers = {name: program[name].gl_type for name in program if program[name].gl_type in SAMPLER_TYPES}
-    return samplers if GL_SAMPLER_BUFFER in samplers.values() else {}
+    return samplers if BUFFER_SAMPLERS & set(samplers.values()) else {}
 
 
 class Renderer:
@@ -46,12 +54,13 @@ class Renderer:
         self.limits: GLLimits = gl_limits(self.ctx)
         #: The owner of every texture and framebuffer made for this context (explorer.gpu.resources).
         self.resources = GLResources(self.ctx, self.limits)
-        #: Whether programs may read 1D tables from buffer textures (``TABLE_BUFFERS``; needs PyOpenGL here).
+        #: Whether programs may read 1D tables from buffer textures (``TABLE_BUFFERS``; needs PyOpenGL here):
+        #: the tabulated methods then read packed tables (one fetch a lookup).
         self.buffer_tables = buffer_textures_supported(self.ctx)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
-        self._model_textures: dict[tuple[str, bool], object] = {}  # (name, buffer texture?) -> texture
-        self._model_texture_keys: dict[tuple[str, bool], tuple] = {}  # which model's table each model texture holds
+        self._model_textures: dict[tuple[str, str], object] = {}  # (name, kind: "2d", "buffer", "packed") -> texture
+        self._model_texture_keys: dict[tuple[str, str], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
         # id(program) -> (program, its vertex array, its samplers by GL type where one is a samplerBuffer, else {})
         self._vertex_arrays: dict[int, tuple[object, object, dict]] = {}
@@ -65,20 +74,27 @@ class Renderer:
         """A float RGB(A) texture of ``(height, width, 3 or 4)`` data (row 0 = texel row 0), clamped."""
         return self.resources.texture(data, linear=linear)
 
-    def _model_texture(self, name: str, table: np.ndarray, buffer: bool = False):
+    def _model_texture(self, name: str, table: np.ndarray, kind: str = "2d"):
         """
-        The texture of a model's table, rewritten in place when its shape is unchanged: ``(width, 3)`` is a
-        row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0). ``buffer``: a row as a
-        buffer texture (the program reads it as a ``samplerBuffer``), else a linearly filtered texture.
+        The texture of a model's table as the program reads it, rewritten in place when its shape is
+        unchanged. ``kind`` ``"2d"``: a linearly filtered texture, ``(width, 3)`` a row (height 1),
+        ``(height, width, 3)`` a 2D table (row 0 = texel row 0); ``"buffer"``: a row's float texels in a
+        buffer texture (``samplerBuffer``); ``"packed"``: a row packed one interval a texel
+        (:func:`explorer.gpu.packed_tables.pack_table_intervals`, ``usamplerBuffer``).
         """
         data = np.ascontiguousarray(table, dtype=np.float32)
-        if data.ndim == 2:
-            data = data.reshape(1, -1, 3)
-        # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones (llvmpipe:
-        # the tabulated method's sphere ~10% faster; bench --tables).
-        data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
-        options = {"buffer": True} if buffer else {"linear": True}
-        key = (name, buffer)
+        if kind != "2d" and data.ndim != 2:
+            raise ValueError(f"{name}: a buffer texture holds a row, not a {data.shape} table")
+        if kind == "packed":
+            data, options = pack_table_intervals(data)[None], {"buffer": True, "dtype": "u4"}
+        else:
+            if data.ndim == 2:
+                data = data.reshape(1, -1, 3)
+            # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones
+            # (llvmpipe: the tabulated method's sphere ~10% faster; bench --tables).
+            data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
+            options = {"buffer": True} if kind == "buffer" else {"linear": True}
+        key = (name, kind)
         texture = self._model_textures[key] = self.resources.replace(self._model_textures.get(key), data, origin=name, **options)
         return texture
 
@@ -181,12 +197,12 @@ class Renderer:
         if entry is not None:
             for name, table in entry.ensure_tables().items():
                 if name in program:
-                    # As the program declares it: a samplerBuffer (TABLE_BUFFERS) or a sampler2D.
-                    slot = (name, program[name].gl_type == GL_SAMPLER_BUFFER)
+                    # As the program declares it: a usamplerBuffer or samplerBuffer (TABLE_BUFFERS), or a sampler2D.
+                    slot = (name, TABLE_KINDS.get(program[name].gl_type, "2d"))
                     # A draft and the real tables share the values' key: the texture's key tells them apart.
                     texture_key = None if key is None else (key, entry.draft)
                     if texture_key is None or self._model_texture_keys.get(slot) != texture_key or slot not in self._model_textures:
-                        self._model_texture(name, table, buffer=slot[1])
+                        self._model_texture(name, table, slot[1])
                         self._model_texture_keys[slot] = texture_key
                     textures[name] = self._model_textures[slot]
             self.last_table_ms = (time.perf_counter() - start) * 1e3
@@ -241,10 +257,11 @@ class Renderer:
                 program[name].value = unit
         if cached[2]:  # samplers left unbound: one spare unit per type (GL refuses two types on one unit)
             names = {name for name, _ in bound}
+            types = sorted(set(cached[2].values()))
             for name, gl_type in cached[2].items():
                 if name not in names:
-                    unit = len(bound) + (gl_type == GL_SAMPLER_BUFFER)
-                    if gl_type == GL_SAMPLER_BUFFER:
+                    unit = len(bound) + types.index(gl_type)
+                    if gl_type in BUFFER_SAMPLERS:
                         set_buffer_sampler(program, name, unit)
                     else:
                         program[name].value = unit

@@ -17,6 +17,10 @@ from explorer.gpu.context import GLLimitError, GLLimits, gl_limits
 
 #: ``GL_SAMPLER_BUFFER``: the type (moderngl's ``Uniform.gl_type``) of a program's ``samplerBuffer`` uniform.
 GL_SAMPLER_BUFFER = 0x8DC2
+#: ``GL_UNSIGNED_INT_SAMPLER_BUFFER``: a ``usamplerBuffer`` uniform's.
+GL_UNSIGNED_INT_SAMPLER_BUFFER = 0x8DD8
+#: The buffer sampler types (moderngl leaves their uniforms unwritten: :func:`set_buffer_sampler`).
+BUFFER_SAMPLERS = frozenset({GL_SAMPLER_BUFFER, GL_UNSIGNED_INT_SAMPLER_BUFFER})
 
 
 def _opengl(ctx):
@@ -30,14 +34,14 @@ def _opengl(ctx):
 
 class BufferTexture:
     """
-    A buffer texture (GL 3.1 core; GLSL ``samplerBuffer``, read by ``texelFetch(table, i)``): float RGBA
-    texels in a moderngl buffer. moderngl makes no such texture, so its texture object is made and bound
+    A buffer texture (GL 3.1 core; GLSL ``samplerBuffer`` or ``usamplerBuffer``, read by
+    ``texelFetch(table, i)``): RGBA texels, float32 or uint32, in a moderngl buffer. moderngl makes no such texture, so its texture object is made and bound
     through PyOpenGL; it has the ``size``, ``components``, ``use``, ``write`` and ``release`` of a
     moderngl texture, which is all :class:`GLResources` and the renderer's draw ask of one.
 
-    Why (issue 22, docs/performance.md *Tabulated shading, buffer textures*): on Mesa's llvmpipe its
-    ``texelFetch`` skips the 2D path's wrap and coordinate work; two fetches and a float ``mix`` cost ~13%
-    less than from a 2D texture, with the same float32 texels and arithmetic.
+    Why (issue 22, docs/performance.md *Tabulated shading*): on Mesa's llvmpipe its ``texelFetch`` skips
+    the 2D path's wrap and coordinate work (two float fetches and a ``mix``: ~13% less CPU than from a 2D
+    texture), and a packed table (:mod:`explorer.gpu.packed_tables`) needs one fetch a lookup.
     """
 
     def __init__(self, ctx, data: np.ndarray):
@@ -46,9 +50,11 @@ class BufferTexture:
         self.buffer = ctx.buffer(data.tobytes())
         self.glo = int(GL.glGenTextures(1))
         GL.glBindTexture(GL.GL_TEXTURE_BUFFER, self.glo)
-        GL.glTexBuffer(GL.GL_TEXTURE_BUFFER, GL.GL_RGBA32F, self.buffer.glo)
+        texel_format = GL.GL_RGBA32UI if data.dtype == np.uint32 else GL.GL_RGBA32F
+        GL.glTexBuffer(GL.GL_TEXTURE_BUFFER, texel_format, self.buffer.glo)
         GL.glBindTexture(GL.GL_TEXTURE_BUFFER, 0)
         self.size, self.components = (int(data.shape[1]), 1), 4
+        self.dtype = "u4" if data.dtype == np.uint32 else "f4"
 
     def use(self, location: int = 0) -> None:
         GL = _opengl(self.ctx)
@@ -103,12 +109,13 @@ class GLResources:
         or an empty one of ``size = (width, height)`` and ``components``. ``dtype``: ``"f4"`` (float) or
         ``"f1"`` (8 bits, ``data`` in bytes). Nearest or linear filtering, clamped unless repeated.
         Checked against the context's limits first (``origin`` names the input in the error).
-        ``buffer``: a :class:`BufferTexture` of ``data``, one row of float RGBA texels (a ``samplerBuffer``).
+        ``buffer``: a :class:`BufferTexture` of ``data``, one row of RGBA texels, ``dtype`` ``"f4"`` (float, a
+        ``samplerBuffer``) or ``"u4"`` (uint32, a ``usamplerBuffer``).
         """
         import moderngl
 
         if buffer:
-            return self._buffer_texture(data, origin)
+            return self._buffer_texture(data, dtype, origin)
         if data is not None:
             data = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
             if data.ndim == 2:
@@ -123,8 +130,8 @@ class GLResources:
         self._owned[id(texture)] = texture
         return texture
 
-    def _buffer_texture(self, data: np.ndarray, origin: str) -> BufferTexture:
-        data = np.ascontiguousarray(data, dtype=np.float32)
+    def _buffer_texture(self, data: np.ndarray, dtype: str, origin: str) -> BufferTexture:
+        data = np.ascontiguousarray(data, dtype=np.uint32 if dtype == "u4" else np.float32)
         if data.ndim != 3 or data.shape[0] != 1 or data.shape[2] != 4:
             raise ValueError(f"{origin}: a buffer texture takes one row of RGBA texels, not {data.shape}")
         self.limits.check_buffer_texture(data.shape[1], origin)
@@ -139,10 +146,11 @@ class GLResources:
         """
         dtype = options.get("dtype", "f4")
         if data is not None:
-            array = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
+            array = np.ascontiguousarray(data, dtype={"f4": np.float32, "u4": np.uint32}.get(dtype, np.uint8))
             shape = (array.shape[1], array.shape[0])
             components = array.shape[2] if array.ndim == 3 else 1
-            same_kind = isinstance(texture, BufferTexture) == bool(options.get("buffer"))
+            same_kind = (isinstance(texture, BufferTexture) == bool(options.get("buffer"))
+                         and getattr(texture, "dtype", dtype) == dtype)
             if texture is not None and same_kind and texture.size == shape and texture.components == components:
                 texture.write(array.tobytes())
                 return texture
