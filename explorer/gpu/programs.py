@@ -32,8 +32,9 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
     can branch at compile time on a parameter such as ``method`` (one smaller program per value). The
     methods' names (:func:`explorer.materials.methods.glsl_defines`, ``BRAGG_TABULATED`` …) are defined
     in every program: the one place their numbers come from. ``buffer_tables``: the host uploads a
-    table its shader declares as ``samplerBuffer`` as a buffer texture (``#define TABLE_BUFFERS``; a
-    shader declares ``sampler2D`` otherwise, as in a ``.brdf`` export, which has no such define).
+    table its shader declares as ``usamplerBuffer`` (packed, one interval a texel) or ``samplerBuffer`` as
+    a buffer texture (``#define TABLE_BUFFERS``; a shader declares ``sampler2D`` otherwise, as in a
+    ``.brdf`` export, which has no such define).
     """
     template = SHADER_DIR / "views" / f"{view}.glsl"
     if not template.exists():

@@ -62,7 +62,7 @@ class Renderer:
         self._model_textures: dict[tuple[str, str], object] = {}  # (name, kind: "2d", "buffer", "packed") -> texture
         self._model_texture_keys: dict[tuple[str, str], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
-        # id(program) -> (program, its vertex array, its samplers by GL type where one is a samplerBuffer, else {})
+        # id(program) -> (program, its vertex array, its samplers' GL types if one is a buffer sampler, else {})
         self._vertex_arrays: dict[int, tuple[object, object, dict]] = {}
         self.models = ModelCache()
         #: Milliseconds the last :meth:`bindings` spent on the model's tables (None: no model yet).

@@ -4,9 +4,10 @@ The one owner of the package's GL textures and framebuffers (after moderngl-wind
 Every texture and framebuffer the host makes comes from a :class:`GLResources` (the renderer's, shared
 by the app's passes and panels): one factory for textures (float or 8-bit, from an array or empty,
 filtered and wrapped as asked, or a buffer texture; checked against the context's limits), one for
-framebuffers with their attachments, and one way to release both. What it made it releases: :meth:`release` frees an object
-(a framebuffer with its attachments), :meth:`replace` rewrites a texture in place or swaps it for a new
-one of another shape, and :meth:`close` (or leaving a ``with`` block) frees everything still owned.
+framebuffers with their attachments, and one way to release both. What it made it releases:
+:meth:`release` frees an object (a framebuffer with its attachments), :meth:`replace` rewrites a texture
+in place or swaps it for a new one of another shape, and :meth:`close` (or leaving a ``with`` block)
+frees everything still owned.
 """
 
 from __future__ import annotations
@@ -35,9 +36,10 @@ def _opengl(ctx):
 class BufferTexture:
     """
     A buffer texture (GL 3.1 core; GLSL ``samplerBuffer`` or ``usamplerBuffer``, read by
-    ``texelFetch(table, i)``): RGBA texels, float32 or uint32, in a moderngl buffer. moderngl makes no such texture, so its texture object is made and bound
-    through PyOpenGL; it has the ``size``, ``components``, ``use``, ``write`` and ``release`` of a
-    moderngl texture, which is all :class:`GLResources` and the renderer's draw ask of one.
+    ``texelFetch(table, i)``): RGBA texels, float32 or uint32, in a moderngl buffer. moderngl makes no
+    such texture, so its texture object is made and bound through PyOpenGL; it has the ``size``,
+    ``components``, ``dtype``, ``use``, ``write`` and ``release`` of a moderngl texture, which is all
+    :class:`GLResources` and the renderer's draw ask of one.
 
     Why (issue 22, docs/performance.md *Tabulated shading*): on Mesa's llvmpipe its ``texelFetch`` skips
     the 2D path's wrap and coordinate work (two float fetches and a ``mix``: ~13% less CPU than from a 2D
@@ -73,7 +75,7 @@ class BufferTexture:
 
 
 def set_buffer_sampler(program, name: str, location: int) -> None:
-    """Point ``program``'s ``samplerBuffer`` ``name`` at texture unit ``location``: moderngl (5.13) does not
+    """Point ``program``'s buffer sampler ``name`` at texture unit ``location``: moderngl (5.13) does not
     write such a uniform (its value setter leaves it at unit 0)."""
     GL = _opengl(program.ctx)
     GL.glUseProgram(program.glo)  # moderngl binds its program before every draw
