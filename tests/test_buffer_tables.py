@@ -18,8 +18,6 @@ from explorer.physics import bragg
 from explorer.views.geometry import view_cos_theta
 from explorer.materials.brd import load_material
 
-pytestmark = pytest.mark.gl
-
 MIRROR = REPO_ROOT / "shaders" / "bragg_mirror.brd"
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
 
@@ -33,6 +31,7 @@ def texture_renderer(gl_renderer):
     renderer.resources.close()
 
 
+@pytest.mark.gl
 def test_this_gl_makes_buffer_tables(gl_renderer):
     # llvmpipe (GL 4.5) and PyOpenGL (a dependency): the tabulated path the bench measures.
     assert gl_renderer.buffer_tables
@@ -40,6 +39,7 @@ def test_this_gl_makes_buffer_tables(gl_renderer):
     assert program["bragg_table"].gl_type == GL_UNSIGNED_INT_SAMPLER_BUFFER
 
 
+@pytest.mark.gl
 def test_buffer_texture_is_owned_replaced_in_place_and_released(gl_renderer):
     resources = gl_renderer.resources
     owned = resources.owned()
@@ -79,6 +79,7 @@ def test_packing_rounds_each_entry_to_half_a_code_of_its_interval():
         pack_table_intervals(np.array([[0.1, np.nan, 0.2], [0.0, 0.0, 0.0]]))
 
 
+@pytest.mark.gl
 def test_a_table_beyond_the_buffer_limit_is_a_one_line_error(gl_renderer):
     limit = gl_renderer.limits.max_texture_buffer_texels
     with pytest.raises(GLLimitError) as caught:
@@ -86,6 +87,7 @@ def test_a_table_beyond_the_buffer_limit_is_a_one_line_error(gl_renderer):
     assert str(caught.value).startswith("bragg_table: ") and "\n" not in str(caught.value)
 
 
+@pytest.mark.gl
 @pytest.mark.parametrize("view", ["sphere", "gradient", "lit", "scatter"])
 def test_tabulated_mirror_reads_the_packed_table_as_the_2d_texture_within_its_rounding(gl_renderer, texture_renderer, view):
     material = load_material(MIRROR)
@@ -98,6 +100,7 @@ def test_tabulated_mirror_reads_the_packed_table_as_the_2d_texture_within_its_ro
     np.testing.assert_allclose(packed, from_texture, rtol=0, atol=2e-5 * np.abs(from_texture).max())
 
 
+@pytest.mark.gl
 def test_gl_packed_lookup_is_its_numpy_twin(gl_renderer):
     """The gradient view shows the reflectance at each pixel's cos theta: GLSL's packed_tabulated_rgb there
     equals explorer.gpu.packed_tables.packed_tabulated_rgb of the same texels, to float32 rounding."""
@@ -110,6 +113,7 @@ def test_gl_packed_lookup_is_its_numpy_twin(gl_renderer):
     np.testing.assert_allclose(image, expected, rtol=0, atol=2e-6)
 
 
+@pytest.mark.gl
 @pytest.mark.parametrize("method", [1, 3])
 def test_layer_with_a_buffer_table_beside_2d_textures(gl_renderer, texture_renderer, method):
     """The lit layer binds the CMF texture (sampler2D) and its T_rgb table (samplerBuffer): units apart."""
@@ -121,6 +125,7 @@ def test_layer_with_a_buffer_table_beside_2d_textures(gl_renderer, texture_rende
     np.testing.assert_allclose(from_buffer, from_texture, rtol=0, atol=2e-5 * np.abs(from_texture).max())
 
 
+@pytest.mark.gl
 def test_env_view_with_unbound_samplers_beside_a_buffer_table(gl_renderer):
     """The env program declares samplers it is not given here (a textured mirror's): they must not share
     unit 0 with the buffer table, or GL refuses the draw."""
@@ -137,6 +142,7 @@ def test_env_view_with_unbound_samplers_beside_a_buffer_table(gl_renderer):
         render.release()
 
 
+@pytest.mark.gl
 def test_lookup_profile_reads_every_table_it_times(gl_renderer):
     """explorer.dev.lookup_profile's exact variants show the table's linear interpolation (its 16-bit table
     was once an integer texture, incomplete under LINEAR filtering: it read 0 and timed as one fetch)."""
