@@ -16,8 +16,11 @@ def test_bench_tables_json(gl_renderer):
     document = json.loads(run.stdout)
     assert set(document["table_ms"]) == set(document["table_cpu_ms"]) == {"20", "100", "1000"}
     assert set(document["tabulated_over_schlick"]) == set(document["tabulated_over_schlick_cpu"]) == {"244", "500", "988"}
+    # The same run times the table in a 2D texture (the path before buffer tables): before/after in one document.
+    assert set(document["tabulated_2d_over_schlick"]) == set(document["tabulated_2d_over_schlick_cpu"]) == {"244", "500", "988"}
     values = [*document["table_ms"].values(), *document["table_cpu_ms"].values(), document["layer_tables_ms"],
-              document["layer_tables_cpu_ms"], *document["tabulated_over_schlick"].values()]
+              document["layer_tables_cpu_ms"], *document["tabulated_over_schlick"].values(),
+              *document["tabulated_2d_over_schlick"].values()]
     assert all(v > 0.0 for v in values)
 
 

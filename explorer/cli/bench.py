@@ -872,42 +872,51 @@ def table_timings(repeats: int = 5) -> dict:
     }
 
 
-def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, dict, str]:
+def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, str]:
     """
     Per Lambda of :data:`BENCH_LAMBDAS`: the median frame time of a ``size``-square sphere of
     ``bragg_mirror.brd``'s tabulated method (N = 20) over that of ``schlick_fresnel.brd`` in the same run
-    (interleaved repeats, finish-bounded, tables built and programs compiled before timing). Returns the
-    wall-clock ratios, the CPU-time ratios (llvmpipe renders on the CPU: robust to other processes) and
+    (interleaved repeats, finish-bounded, tables built and programs compiled before timing), as
+    ``tabulated_over_schlick``, and with the table in a 2D texture instead of a buffer texture (the path
+    before buffer tables, and a .brdf export's) as ``tabulated_2d_over_schlick``; wall-clock ratios, and
+    CPU-time ratios (``..._cpu``: llvmpipe renders on the CPU, robust to other processes). Returns them and
     the renderer's name.
     """
     from explorer.gpu import Renderer
 
     renderer = Renderer()
+    texture_renderer = Renderer(renderer.ctx)  # the same context, tables as 2D textures
+    texture_renderer.buffer_tables = False
     mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
     schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
     schlick_values = schlick_material.resolve({})
-    ratios, cpu_ratios = {}, {}
+    ratios: dict[str, dict] = {key: {} for key in ("tabulated_over_schlick", "tabulated_over_schlick_cpu",
+                                                   "tabulated_2d_over_schlick", "tabulated_2d_over_schlick_cpu")}
     for Lambda in BENCH_LAMBDAS:
         values = mirror_material.resolve({**TABLES_MIRROR, "Lambda": Lambda, "N": 20, "method": int(BraggMethod.TABULATED)})
-        cases = [(mirror_material, values), (schlick_material, schlick_values)]
-        for material, v in cases:  # compile, build the table, warm up
-            renderer.time_frame(material, v, "sphere", size, size)
-        times: dict[int, list] = {0: [], 1: []}
+        cases = [(renderer, mirror_material, values), (renderer, schlick_material, schlick_values),
+                 (texture_renderer, mirror_material, values)]
+        for r, material, v in cases:  # compile, build the table, warm up
+            r.time_frame(material, v, "sphere", size, size)
+        times: dict[int, list] = {0: [], 1: [], 2: []}
         for _ in range(repeats):
-            for i, (material, v) in enumerate(cases):
-                times[i].append(_timed_frame(renderer, material, v, size))
+            for i, (r, material, v) in enumerate(cases):
+                times[i].append(_timed_frame(r, material, v, size))
         wall, cpu = _medians(times)
-        ratios[f"{Lambda:g}"] = wall[0] / wall[1]
-        cpu_ratios[f"{Lambda:g}"] = cpu[0] / cpu[1]
-        _progress(f"bench --tables: tabulated / schlick at Lambda = {Lambda:g} nm: x{ratios[f'{Lambda:g}']:.2f} "
-                  f"(CPU time x{cpu_ratios[f'{Lambda:g}']:.2f})")
-    return ratios, cpu_ratios, renderer.ctx.info.get("GL_RENDERER", "unknown")
+        key = f"{Lambda:g}"
+        ratios["tabulated_over_schlick"][key], ratios["tabulated_over_schlick_cpu"][key] = wall[0] / wall[1], cpu[0] / cpu[1]
+        ratios["tabulated_2d_over_schlick"][key], ratios["tabulated_2d_over_schlick_cpu"][key] = wall[2] / wall[1], cpu[2] / cpu[1]
+        _progress(f"bench --tables: tabulated / schlick at Lambda = {Lambda:g} nm: x{wall[0] / wall[1]:.2f} "
+                  f"(CPU time x{cpu[0] / cpu[1]:.2f}; 2D texture x{wall[2] / wall[1]:.2f}, CPU x{cpu[2] / cpu[1]:.2f})")
+    texture_renderer.resources.close()
+    return ratios, renderer.ctx.info.get("GL_RENDERER", "unknown")
 
 
 def run_tables_bench(as_json: bool = False, size: int = 512, repeats: int = 5) -> dict:
     """``bragg-explorer bench --tables``: :func:`table_timings` and :func:`tabulated_over_schlick` from one run."""
     document = table_timings(repeats)
-    document["tabulated_over_schlick"], document["tabulated_over_schlick_cpu"], device = tabulated_over_schlick(size, repeats)
+    shading, device = tabulated_over_schlick(size, repeats)
+    document.update(shading)
     if as_json:
         print(json.dumps(document, indent=2))
     else:
@@ -918,7 +927,9 @@ def run_tables_bench(as_json: bool = False, size: int = 512, repeats: int = 5) -
               f"(CPU {document['layer_tables_cpu_ms']:.1f} ms)")
         print(f"Tabulated method over Schlick's Fresnel, {size}x{size} sphere on {device}:")
         for Lambda, ratio in document["tabulated_over_schlick"].items():
-            print(f"  Lambda = {Lambda:>3} nm: x{ratio:.2f}  (CPU time x{document['tabulated_over_schlick_cpu'][Lambda]:.2f})")
+            print(f"  Lambda = {Lambda:>3} nm: x{ratio:.2f}  (CPU time x{document['tabulated_over_schlick_cpu'][Lambda]:.2f}; "
+                  f"table in a 2D texture x{document['tabulated_2d_over_schlick'][Lambda]:.2f}, "
+                  f"CPU x{document['tabulated_2d_over_schlick_cpu'][Lambda]:.2f})")
     return document
 
 

@@ -4,11 +4,12 @@ Schlick's Fresnel on this GL (issue 22 item 3; docs/performance.md, *Tabulated s
 
 Each variant is the sphere view's pixel (``shaders/views/sphere.glsl``: ``reflectance(sqrt(1 - r^2))``
 inside the disc) with one way of reading a 257-entry RGB table over cos theta: the tabulated method's own
-(two ``texelFetch`` and a float ``mix``, ``shaders/lib/bragg.glsl``'s ``tabulated_rgb``), the other exact
-ones (two nearest ``texture`` reads, a uniform block, hardware filtering of RGBA32F and of 16-bit
-fixed point) and, for the floor, one nearest read (not exact). Frames are interleaved and bounded by
-``glFinish``; the minimum over the repeats is printed with the median CPU time, as ratios to Schlick's.
-The minimum is the least disturbed by other processes on a shared machine.
+(one ``texelFetch`` of a packed interval, ``shaders/lib/bragg.glsl``'s ``packed_tabulated_rgb``), the other
+exact ones (two float texels and a ``mix`` from a buffer or a 2D texture, two nearest ``texture`` reads, a
+uniform block, hardware filtering of RGBA32F and of 16-bit normalised fixed point) and, for the floor, one
+read (not exact).
+Frames are interleaved and bounded by ``glFinish``; the minimum over the repeats is printed with the median
+CPU time, as ratios to Schlick's. The minimum is the least disturbed by other processes on a shared machine.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import time
 import numpy as np
 
 from explorer.gpu.context import GLSL_VERSION, VERTEX_SHADER, create_context
+from explorer.gpu.packed_tables import pack_table_intervals
+from explorer.gpu.resources import BufferTexture, set_buffer_sampler
 
 ENTRIES = 257
 
@@ -37,11 +40,29 @@ void main() {
 _INDEX = """int last = textureSize(table, 0).x - 1;
     float x = clamp(cos_theta, 0.0, 1.0) * float(last);
     int i = clamp(int(x), 0, max(last - 1, 0));"""
-#: name -> (description, table texture: (dtype, filter) or "block", the reflectance function).
+_BUFFER_INDEX = """int last = textureSize(table) - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, max(last - 1, 0));"""
+#: name -> (description, table texture: (dtype, filter), "block", "buffer" or "packed", the reflectance function).
 VARIANTS = {
     "schlick": ("Schlick's Fresnel (the baseline)", None, """
 vec3 reflectance(float c) { float m = 1.0 - c; float m2 = m * m; return vec3(F0 + (1.0 - F0) * m2 * m2 * m); }"""),
-    "fetch2": ("two texelFetch + mix, RGBA32F (the tabulated method)", ("f4", "nearest"), f"""
+    "packed": ("one texelFetch of a packed interval, RGBA32UI buffer, 16-bit codes (the tabulated method)", "packed", """
+uniform usamplerBuffer table;
+vec3 reflectance(float cos_theta) {
+    int intervals = textureSize(table);
+    float x = clamp(cos_theta, 0.0, 1.0) * float(intervals);
+    int i = min(int(x), intervals - 1);
+    uvec4 texel = texelFetch(table, i);
+    return uintBitsToFloat(texel.w) * mix(vec3(ivec3(texel.xyz << 16) >> 16), vec3(ivec3(texel.xyz) >> 16), x - float(i));
+}"""),
+    "buffer2": ("two texelFetch + mix, RGBA32F buffer texture", "buffer", f"""
+uniform samplerBuffer table;
+vec3 reflectance(float cos_theta) {{
+    {_BUFFER_INDEX}
+    return mix(texelFetch(table, i).rgb, texelFetch(table, min(i + 1, last)).rgb, x - float(i));
+}}"""),
+    "fetch2": ("two texelFetch + mix, RGBA32F 2D texture (the tabulated method before; a .brdf export)", ("f4", "nearest"), f"""
 uniform sampler2D table;
 vec3 reflectance(float cos_theta) {{
     {_INDEX}
@@ -65,22 +86,39 @@ vec3 reflectance(float cos_theta) {{
     "linear32f": ("texture() LINEAR, RGBA32F", ("f4", "linear"), """
 uniform sampler2D table;
 vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
-    "linear16": ("texture() LINEAR, RGBA16 fixed point (16 bits, the GPU's filter weights)", ("u2", "linear"), """
+    "linear16": ("texture() LINEAR, RGBA16 normalised (16 bits, the GPU's filter weights)", ("nu2", "linear"), """
 uniform sampler2D table;
 vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
+    "buffer1": ("one texelFetch, RGBA32F buffer texture (not exact: the floor of a buffer lookup)", "buffer", f"""
+uniform samplerBuffer table;
+vec3 reflectance(float cos_theta) {{
+    {_BUFFER_INDEX}
+    return texelFetch(table, i).rgb;
+}}"""),
     "nearest1": ("one nearest texture(), RGBA32F (not exact: the floor of any lookup)", ("f4", "nearest"), """
 uniform sampler2D table;
 vec3 reflectance(float c) { float w = float(textureSize(table, 0).x); return texture(table, vec2((clamp(c, 0.0, 1.0) * (w - 1.0) + 0.5) / w, 0.5)).rgb; }"""),
 }
 
 
-def profile(size: int = 512, repeats: int = 61) -> dict[str, dict]:
-    """Per variant of :data:`VARIANTS`: ``min_ms``, ``cpu_ms`` (median) and their ratios to Schlick's."""
+def lookup_table() -> np.ndarray:
+    """The ``(ENTRIES, 4)`` float32 table every variant reads (random, fixed seed)."""
+    return np.random.default_rng(0).random((ENTRIES, 4)).astype(np.float32)
+
+
+def profile(size: int = 512, repeats: int = 61, images: dict | None = None, ctx=None) -> dict[str, dict]:
+    """
+    Per variant of :data:`VARIANTS`: ``min_ms``, ``cpu_ms`` (median) and their ratios to Schlick's.
+    ``images``: filled with each variant's frame, ``(size, size, 3)`` rows from the bottom (tests).
+    ``ctx``: the moderngl context to use (default: a new one); what is made in it is released.
+    """
     import moderngl
 
-    ctx = create_context()
-    table = np.random.default_rng(0).random((ENTRIES, 4)).astype(np.float32)
-    data = {"f4": table, "u2": np.round(table * 65535).astype(np.uint16)}
+    ctx = create_context() if ctx is None else ctx
+    table = lookup_table()
+    # "nu2": normalised 16-bit (GL_RGBA16). moderngl's "u2" is an integer texture, which no LINEAR filter
+    # completes: it read (0, 0, 0, 1) and looked as cheap as one fetch (docs/performance.md).
+    data = {"f4": table, "nu2": np.round(table * 65535).astype(np.uint16)}
     framebuffer = ctx.framebuffer(color_attachments=[ctx.renderbuffer((size, size), 4, dtype="f4")])
     block = ctx.buffer(table.tobytes())
     programs = {}
@@ -92,6 +130,10 @@ def profile(size: int = 512, repeats: int = 61) -> dict[str, dict]:
         bound = None
         if texture == "block":
             program["Table"].binding = 0
+        elif texture == "buffer":
+            bound = BufferTexture(ctx, table.reshape(1, ENTRIES, 4))
+        elif texture == "packed":
+            bound = BufferTexture(ctx, pack_table_intervals(table[:, :3])[None])
         elif texture is not None:
             dtype, filtering = texture
             bound = ctx.texture((ENTRIES, 1), 4, data[dtype].tobytes(), dtype=dtype)
@@ -101,7 +143,10 @@ def profile(size: int = 512, repeats: int = 61) -> dict[str, dict]:
 
     def frame(name: str) -> tuple[float, float]:
         program, vertex_array, texture = programs[name]
-        if texture is not None:
+        if isinstance(texture, BufferTexture):
+            texture.use(location=0)
+            set_buffer_sampler(program, "table", 0)
+        elif texture is not None:
             texture.use(location=0)
         block.bind_to_uniform_block(0)
         framebuffer.use()
@@ -117,6 +162,18 @@ def profile(size: int = 512, repeats: int = 61) -> dict[str, dict]:
             measured = frame(name)
             if round_ >= 2:
                 times[name].append(measured)
+    for name in VARIANTS if images is not None else ():
+        frame(name)
+        images[name] = np.frombuffer(framebuffer.read(components=3, dtype="f4"), np.float32).reshape(size, size, 3)
+    for program, vertex_array, texture in programs.values():
+        for made in (vertex_array, program, texture):
+            if made is not None:
+                made.release()
+    block.release()
+    attachments = framebuffer.color_attachments
+    framebuffer.release()
+    for attachment in attachments:
+        attachment.release()
     base_min = min(t[0] for t in times["schlick"])
     base_cpu = float(np.median([t[1] for t in times["schlick"]]))
     return {name: {"min_ms": min(t[0] for t in v), "cpu_ms": float(np.median([t[1] for t in v])),

@@ -48,12 +48,16 @@ class GLLimits:
         ``GL_MAX_VIEWPORT_DIMS``.
     max_image_bytes : int
         :data:`MAX_IMAGE_BYTES`.
+    max_texture_buffer_texels : int
+        Texels of a buffer texture: GL 3.3's guaranteed ``GL_MAX_TEXTURE_BUFFER_SIZE`` (moderngl does not
+        query it; the tables it holds have at most 4097).
     """
 
     max_texture_size: int
     max_renderbuffer_size: int
     max_viewport: tuple[int, int]
     max_image_bytes: int = MAX_IMAGE_BYTES
+    max_texture_buffer_texels: int = 65536
 
     @property
     def max_target_side(self) -> tuple[int, int]:
@@ -86,6 +90,11 @@ class GLLimits:
                 f"(GL_MAX_TEXTURE_SIZE) and {pixels} texels (under {self.max_image_bytes >> 20} MiB); "
                 f"downsample it"))
 
+    def check_buffer_texture(self, texels: int, origin: str) -> None:
+        """A buffer texture of ``texels`` texels, or :class:`GLLimitError` naming the limit."""
+        if not 1 <= texels <= self.max_texture_buffer_texels:
+            raise GLLimitError(origin, None, f"a table of {texels} entries is beyond a buffer texture's "
+                                             f"{self.max_texture_buffer_texels} (GL_MAX_TEXTURE_BUFFER_SIZE)")
 
 _LIMITS: "weakref.WeakKeyDictionary[object, GLLimits]" = weakref.WeakKeyDictionary()
 

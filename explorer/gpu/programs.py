@@ -23,14 +23,18 @@ def specialisation(material: Material, values: Mapping[str, object]) -> tuple[tu
     return tuple((name, round_integer(values[name])) for name in material.specialised)
 
 
-def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = ()):
+def build_program_source(material: Material, view: str, constants: tuple[tuple[str, int], ...] = (),
+                         buffer_tables: bool = False):
     """
     The fragment shader of ``material`` in ``view`` (an :class:`explorer.materials.glsl.Program`).
 
     Each ``(name, value)`` of ``constants`` becomes ``#define SPECIALISED_name value``: the shader
     can branch at compile time on a parameter such as ``method`` (one smaller program per value). The
     methods' names (:func:`explorer.materials.methods.glsl_defines`, ``BRAGG_TABULATED`` …) are defined
-    in every program: the one place their numbers come from.
+    in every program: the one place their numbers come from. ``buffer_tables``: the host uploads a
+    table its shader declares as ``usamplerBuffer`` (packed, one interval a texel) or ``samplerBuffer`` as
+    a buffer texture (``#define TABLE_BUFFERS``; a shader declares ``sampler2D`` otherwise, as in a
+    ``.brdf`` export, which has no such define).
     """
     template = SHADER_DIR / "views" / f"{view}.glsl"
     if not template.exists():
@@ -40,6 +44,8 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
         builder.define(name, value)
     for name, value in constants:
         builder.define(f"SPECIALISED_{name}", value)
+    if buffer_tables:
+        builder.define("TABLE_BUFFERS", 1)
     # The view, and whether it reads a surface texture: code only those views read (a textured mirror's
     # table) is left out of the others and of a .brdf export (no sampler).
     builder.define("VIEW_" + "".join(c if c.isalnum() else "_" for c in view.upper()), 1)  # mesh/lit -> VIEW_MESH_LIT

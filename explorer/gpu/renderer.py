@@ -19,12 +19,31 @@ from explorer.views.geometry import light_direction
 from explorer.gpu.context import VERTEX_SHADER, GLLimits, create_context, gl_limits
 from explorer.gpu.programs import build_program_source, first_error, specialisation
 from explorer.gpu.tables import ModelCache
-from explorer.gpu.resources import GLResources
+from explorer.gpu.packed_tables import pack_table_intervals
+from explorer.gpu.resources import (
+    BUFFER_SAMPLERS, GL_SAMPLER_BUFFER, GL_UNSIGNED_INT_SAMPLER_BUFFER, BufferTexture, GLResources,
+    buffer_textures_supported, set_buffer_sampler,
+)
 
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
 #: program is shared: the app's Slice window may have set another phi_d on it).
 VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2)}
+
+#: GL's sampler types (1D ... 2D rectangle shadow, the array/buffer/integer ones, the multisample ones).
+SAMPLER_TYPES = frozenset([*range(0x8B5D, 0x8B65), *range(0x8DC0, 0x8DD9), *range(0x9108, 0x910E)])
+
+
+#: How a model's table is uploaded for a sampler of each GL type (others: "2d", a filtered 2D texture).
+TABLE_KINDS = {GL_SAMPLER_BUFFER: "buffer", GL_UNSIGNED_INT_SAMPLER_BUFFER: "packed"}
+
+
+def _buffer_samplers(program) -> dict[str, int]:
+    """``{name: GL type}`` of ``program``'s samplers if one is a buffer sampler (else {}): unbound, they
+    would all read unit 0, and GL refuses a draw whose samplers of two types share a unit."""
+    samplers = {name: program[name].gl_type for name in program if program[name].gl_type in SAMPLER_TYPES}
+    return samplers if BUFFER_SAMPLERS & set(samplers.values()) else {}
+
 
 class Renderer:
     """Renders material views into float32 images; caches programs, library textures and model tables."""
@@ -35,12 +54,16 @@ class Renderer:
         self.limits: GLLimits = gl_limits(self.ctx)
         #: The owner of every texture and framebuffer made for this context (explorer.gpu.resources).
         self.resources = GLResources(self.ctx, self.limits)
+        #: Whether programs may read 1D tables from buffer textures (``TABLE_BUFFERS``; needs PyOpenGL here):
+        #: the tabulated methods then read packed tables (one fetch a lookup).
+        self.buffer_tables = buffer_textures_supported(self.ctx)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
-        self._model_textures: dict[str, object] = {}
-        self._model_texture_keys: dict[str, tuple] = {}  # which model's table each model texture holds
+        self._model_textures: dict[tuple[str, str], object] = {}  # (name, kind: "2d", "buffer", "packed") -> texture
+        self._model_texture_keys: dict[tuple[str, str], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
-        self._vertex_arrays: dict[int, tuple[object, object]] = {}  # id(program) -> (program, its vertex array)
+        # id(program) -> (program, its vertex array, its samplers' GL types if one is a buffer sampler, else {})
+        self._vertex_arrays: dict[int, tuple[object, object, dict]] = {}
         self.models = ModelCache()
         #: Milliseconds the last :meth:`bindings` spent on the model's tables (None: no model yet).
         self.last_table_ms: float | None = None
@@ -54,18 +77,28 @@ class Renderer:
         """A float RGB(A) texture of ``(height, width, 3 or 4)`` data (row 0 = texel row 0), clamped."""
         return self.resources.texture(data, linear=linear)
 
-    def _model_texture(self, name: str, table: np.ndarray):
+    def _model_texture(self, name: str, table: np.ndarray, kind: str = "2d"):
         """
-        The linearly filtered texture of a model's table, rewritten in place when its shape is unchanged:
-        ``(width, 3)`` is a row (height 1), ``(height, width, 3)`` a 2D table (row 0 = texel row 0).
+        The texture of a model's table as the program reads it, rewritten in place when its shape is
+        unchanged. ``kind`` ``"2d"``: a linearly filtered texture, ``(width, 3)`` a row (height 1),
+        ``(height, width, 3)`` a 2D table (row 0 = texel row 0); ``"buffer"``: a row's float texels in a
+        buffer texture (``samplerBuffer``); ``"packed"``: a row packed one interval a texel
+        (:func:`explorer.gpu.packed_tables.pack_table_intervals`, ``usamplerBuffer``).
         """
         data = np.ascontiguousarray(table, dtype=np.float32)
-        if data.ndim == 2:
-            data = data.reshape(1, -1, 3)
-        # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones (llvmpipe:
-        # the tabulated method's sphere ~10% faster; bench --tables).
-        data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
-        texture = self._model_textures[name] = self.resources.replace(self._model_textures.get(name), data, linear=True, origin=name)
+        if kind != "2d" and data.ndim != 2:
+            raise ValueError(f"{name}: a buffer texture holds a row, not a {data.shape} table")
+        if kind == "packed":
+            data, options = pack_table_intervals(data)[None], {"buffer": True, "dtype": "u4"}
+        else:
+            if data.ndim == 2:
+                data = data.reshape(1, -1, 3)
+            # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones
+            # (llvmpipe: the tabulated method's sphere ~10% faster; bench --tables).
+            data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
+            options = {"buffer": True} if kind == "buffer" else {"linear": True}
+        key = (name, kind)
+        texture = self._model_textures[key] = self.resources.replace(self._model_textures.get(key), data, origin=name, **options)
         return texture
 
     def _library_textures(self) -> dict[str, object]:
@@ -95,7 +128,7 @@ class Renderer:
         if key not in self._programs:
             import moderngl
 
-            source = build_program_source(material, view, constants)
+            source = build_program_source(material, view, constants, self.buffer_tables)
             try:
                 program = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=source.code)
             except moderngl.Error as error:
@@ -194,12 +227,14 @@ class Renderer:
         if entry is not None:
             for name, table in entry.ensure_tables().items():
                 if name in program:
+                    # As the program declares it: a usamplerBuffer or samplerBuffer (TABLE_BUFFERS), or a sampler2D.
+                    slot = (name, TABLE_KINDS.get(program[name].gl_type, "2d"))
                     # A draft and the real tables share the values' key: the texture's key tells them apart.
                     texture_key = None if key is None else (key, entry.draft)
-                    if texture_key is None or self._model_texture_keys.get(name) != texture_key or name not in self._model_textures:
-                        self._model_texture(name, table)
-                        self._model_texture_keys[name] = texture_key
-                    textures[name] = self._model_textures[name]
+                    if texture_key is None or self._model_texture_keys.get(slot) != texture_key or slot not in self._model_textures:
+                        self._model_texture(name, table, slot[1])
+                        self._model_texture_keys[slot] = texture_key
+                    textures[name] = self._model_textures[slot]
             self.last_table_ms = (time.perf_counter() - start) * 1e3
         return bound, textures
 
@@ -241,12 +276,25 @@ class Renderer:
             if name in program:
                 program[name].value = value
         bound = sorted((name, texture) for name, texture in (textures or {}).items() if name in program)
-        for unit, (name, texture) in enumerate(bound):
-            texture.use(location=unit)
-            program[name].value = unit
         cached = self._vertex_arrays.get(id(program))
         if cached is None or cached[0] is not program:
-            cached = self._vertex_arrays[id(program)] = (program, self.ctx.vertex_array(program, []))
+            cached = self._vertex_arrays[id(program)] = (program, self.ctx.vertex_array(program, []), _buffer_samplers(program))
+        for unit, (name, texture) in enumerate(bound):
+            texture.use(location=unit)
+            if isinstance(texture, BufferTexture):
+                set_buffer_sampler(program, name, unit)
+            else:
+                program[name].value = unit
+        if cached[2]:  # samplers left unbound: one spare unit per type (GL refuses two types on one unit)
+            names = {name for name, _ in bound}
+            types = sorted(set(cached[2].values()))
+            for name, gl_type in cached[2].items():
+                if name not in names:
+                    unit = len(bound) + types.index(gl_type)
+                    if gl_type in BUFFER_SAMPLERS:
+                        set_buffer_sampler(program, name, unit)
+                    else:
+                        program[name].value = unit
         framebuffer.use()
         if rows is not None:
             top, bottom = rows  # GL rows count from the bottom

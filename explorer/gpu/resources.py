@@ -3,10 +3,11 @@ The one owner of the package's GL textures and framebuffers (after moderngl-wind
 
 Every texture and framebuffer the host makes comes from a :class:`GLResources` (the renderer's, shared
 by the app's passes and panels): one factory for textures (float or 8-bit, from an array or empty,
-filtered and wrapped as asked, checked against the context's limits), one for framebuffers with their
-attachments, and one way to release both. What it made it releases: :meth:`release` frees an object
-(a framebuffer with its attachments), :meth:`replace` rewrites a texture in place or swaps it for a new
-one of another shape, and :meth:`close` (or leaving a ``with`` block) frees everything still owned.
+filtered and wrapped as asked, or a buffer texture; checked against the context's limits), one for
+framebuffers with their attachments, and one way to release both. What it made it releases:
+:meth:`release` frees an object (a framebuffer with its attachments), :meth:`replace` rewrites a texture
+in place or swaps it for a new one of another shape, and :meth:`close` (or leaving a ``with`` block)
+frees everything still owned.
 """
 
 from __future__ import annotations
@@ -14,6 +15,81 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.gpu.context import GLLimitError, GLLimits, gl_limits
+
+#: ``GL_SAMPLER_BUFFER``: the type (moderngl's ``Uniform.gl_type``) of a program's ``samplerBuffer`` uniform.
+GL_SAMPLER_BUFFER = 0x8DC2
+#: ``GL_UNSIGNED_INT_SAMPLER_BUFFER``: a ``usamplerBuffer`` uniform's.
+GL_UNSIGNED_INT_SAMPLER_BUFFER = 0x8DD8
+#: The buffer sampler types (moderngl leaves their uniforms unwritten: :func:`set_buffer_sampler`).
+BUFFER_SAMPLERS = frozenset({GL_SAMPLER_BUFFER, GL_UNSIGNED_INT_SAMPLER_BUFFER})
+
+
+def _opengl(ctx):
+    """PyOpenGL's GL, ``ctx``'s pending error cleared: PyOpenGL checks glGetError after each call and would
+    blame a moderngl call's unread error on its own."""
+    from OpenGL import GL
+
+    ctx.clear_errors()
+    return GL
+
+
+class BufferTexture:
+    """
+    A buffer texture (GL 3.1 core; GLSL ``samplerBuffer`` or ``usamplerBuffer``, read by
+    ``texelFetch(table, i)``): RGBA texels, float32 or uint32, in a moderngl buffer. moderngl makes no
+    such texture, so its texture object is made and bound through PyOpenGL; it has the ``size``,
+    ``components``, ``dtype``, ``use``, ``write`` and ``release`` of a moderngl texture, which is all
+    :class:`GLResources` and the renderer's draw ask of one.
+
+    Why (issue 22, docs/performance.md *Tabulated shading*): on Mesa's llvmpipe its ``texelFetch`` skips
+    the 2D path's wrap and coordinate work (two float fetches and a ``mix``: ~13% less CPU than from a 2D
+    texture), and a packed table (:mod:`explorer.gpu.packed_tables`) needs one fetch a lookup.
+    """
+
+    def __init__(self, ctx, data: np.ndarray):
+        GL = _opengl(ctx)
+        self.ctx = ctx
+        self.buffer = ctx.buffer(data.tobytes())
+        self.glo = int(GL.glGenTextures(1))
+        GL.glBindTexture(GL.GL_TEXTURE_BUFFER, self.glo)
+        texel_format = GL.GL_RGBA32UI if data.dtype == np.uint32 else GL.GL_RGBA32F
+        GL.glTexBuffer(GL.GL_TEXTURE_BUFFER, texel_format, self.buffer.glo)
+        GL.glBindTexture(GL.GL_TEXTURE_BUFFER, 0)
+        self.size, self.components = (int(data.shape[1]), 1), 4
+        self.dtype = "u4" if data.dtype == np.uint32 else "f4"
+
+    def use(self, location: int = 0) -> None:
+        GL = _opengl(self.ctx)
+        GL.glActiveTexture(GL.GL_TEXTURE0 + location)  # moderngl sets the active unit before each of its own binds
+        GL.glBindTexture(GL.GL_TEXTURE_BUFFER, self.glo)
+
+    def write(self, data: bytes) -> None:
+        self.buffer.write(data)
+
+    def release(self) -> None:
+        if self.glo:
+            GL = _opengl(self.ctx)
+            GL.glDeleteTextures([self.glo])
+            self.glo = 0
+            self.buffer.release()
+
+
+def set_buffer_sampler(program, name: str, location: int) -> None:
+    """Point ``program``'s buffer sampler ``name`` at texture unit ``location``: moderngl (5.13) does not
+    write such a uniform (its value setter leaves it at unit 0)."""
+    GL = _opengl(program.ctx)
+    GL.glUseProgram(program.glo)  # moderngl binds its program before every draw
+    GL.glUniform1i(program[name].location, location)
+
+
+def buffer_textures_supported(ctx) -> bool:
+    """Whether :class:`BufferTexture` works in ``ctx`` (PyOpenGL reaches its GL: one made and released)."""
+    try:
+        probe = BufferTexture(ctx, np.arange(8, dtype=np.float32).reshape(1, 2, 4))
+        probe.release()
+        return ctx.error == "GL_NO_ERROR"
+    except Exception:  # no PyOpenGL, no GL library it can load, no texture buffers: 2D textures then
+        return False
 
 
 class GLResources:
@@ -29,15 +105,19 @@ class GLResources:
 
     def texture(self, data: np.ndarray | None = None, *, size: tuple[int, int] | None = None, components: int = 3,
                 dtype: str = "f4", linear: bool = False, repeat_x: bool = False, repeat_y: bool = False,
-                origin: str = "texture"):
+                origin: str = "texture", buffer: bool = False):
         """
         A texture of ``data`` (``(height, width)`` or ``(height, width, components)``; row 0 = texel row 0),
         or an empty one of ``size = (width, height)`` and ``components``. ``dtype``: ``"f4"`` (float) or
         ``"f1"`` (8 bits, ``data`` in bytes). Nearest or linear filtering, clamped unless repeated.
         Checked against the context's limits first (``origin`` names the input in the error).
+        ``buffer``: a :class:`BufferTexture` of ``data``, one row of RGBA texels, ``dtype`` ``"f4"`` (float, a
+        ``samplerBuffer``) or ``"u4"`` (uint32, a ``usamplerBuffer``).
         """
         import moderngl
 
+        if buffer:
+            return self._buffer_texture(data, dtype, origin)
         if data is not None:
             data = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
             if data.ndim == 2:
@@ -52,6 +132,15 @@ class GLResources:
         self._owned[id(texture)] = texture
         return texture
 
+    def _buffer_texture(self, data: np.ndarray, dtype: str, origin: str) -> BufferTexture:
+        data = np.ascontiguousarray(data, dtype=np.uint32 if dtype == "u4" else np.float32)
+        if data.ndim != 3 or data.shape[0] != 1 or data.shape[2] != 4:
+            raise ValueError(f"{origin}: a buffer texture takes one row of RGBA texels, not {data.shape}")
+        self.limits.check_buffer_texture(data.shape[1], origin)
+        texture = BufferTexture(self.ctx, data)
+        self._owned[id(texture)] = texture
+        return texture
+
     def replace(self, texture, data: np.ndarray | None = None, **options):
         """
         ``texture`` rewritten with ``data`` when the shape is the same, else released and replaced by a new
@@ -59,10 +148,12 @@ class GLResources:
         """
         dtype = options.get("dtype", "f4")
         if data is not None:
-            array = np.ascontiguousarray(data, dtype=np.float32 if dtype == "f4" else np.uint8)
+            array = np.ascontiguousarray(data, dtype={"f4": np.float32, "u4": np.uint32}.get(dtype, np.uint8))
             shape = (array.shape[1], array.shape[0])
             components = array.shape[2] if array.ndim == 3 else 1
-            if texture is not None and texture.size == shape and texture.components == components:
+            same_kind = (isinstance(texture, BufferTexture) == bool(options.get("buffer"))
+                         and getattr(texture, "dtype", dtype) == dtype)
+            if texture is not None and same_kind and texture.size == shape and texture.components == components:
                 texture.write(array.tobytes())
                 return texture
         elif texture is not None and texture.size == tuple(options.get("size", ())):

@@ -495,6 +495,33 @@ vec3 tabulated_rgb(sampler2D table, float cos_theta) {
     return mix(texelFetch(table, ivec2(i, 0), 0).rgb, texelFetch(table, ivec2(min(i + 1, last), 0), 0).rgb, x - float(i));
 }
 
+#ifdef TABLE_BUFFERS
+// The same table in a buffer texture of float texels (the host defines TABLE_BUFFERS where it makes one):
+// the same two texels and float mix, ~13% cheaper on llvmpipe than a 2D texture (docs/performance.md).
+vec3 tabulated_rgb(samplerBuffer table, float cos_theta) {
+    int last = textureSize(table) - 1;
+    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
+    int i = clamp(int(x), 0, max(last - 1, 0));
+    return mix(texelFetch(table, i).rgb, texelFetch(table, min(i + 1, last)).rgb, x - float(i));
+}
+
+// The table packed one interval a texel (what the host uploads for a usamplerBuffer): words 0-2 hold R, G, B
+// of entries i and i + 1 as signed 16-bit codes (low, high half), word 3 the interval's float scale. One
+// fetch a lookup (llvmpipe calls out of line for each), ~20% less CPU than the two above; entries within
+// 1.53e-5 of the interval's largest |channel|, mixed in float. Twin: explorer.gpu.packed_tables.packed_tabulated_rgb.
+vec3 packed_tabulated_rgb(usamplerBuffer table, float cos_theta) {
+    int intervals = textureSize(table);
+    float x = clamp(cos_theta, 0.0, 1.0) * float(intervals);
+    int i = min(int(x), intervals - 1);
+    uvec4 texel = texelFetch(table, i);
+    ivec3 start = ivec3(texel.xyz << 16) >> 16;  // GLSL's >> on int extends the sign
+    ivec3 end = ivec3(texel.xyz) >> 16;
+    return uintBitsToFloat(texel.w) * mix(vec3(start), vec3(end), x - float(i));
+}
+
+vec3 tabulated_rgb(usamplerBuffer table, float cos_theta) { return packed_tabulated_rgb(table, cos_theta); }
+#endif
+
 // Supplemental Figure 7: a mirror whose Lambda and delta follow a texture value T in [0, 1], mapping's bits
 // 1: Lambda (0.5 + 0.5 T), 2: delta^T (delta^0 = 1; GLSL's pow(0, 0) is undefined). Twin: explorer.physics.bragg.textured_mirror.
 BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
