@@ -58,8 +58,9 @@ def test_band_pieces_tile_the_visible_range(monkeypatch):
     points, fringe boundaries and the gaps' closed form neither overlap nor leave holes."""
     low, high = colorimetry.HAT_LOW, colorimetry.HAT_HIGH
     monkeypatch.setattr(bragg, "_line_reflectance", lambda lines, omega, line, kind: np.where(kind == 3, 0.0, 1.0))
-    monkeypatch.setattr(bragg, "_cmf_linear", lambda lam: np.repeat(((lam >= low) & (lam <= high))[:, None], 3, axis=1).astype(float))
-    monkeypatch.setattr(bragg, "_cmf_integral_to", lambda lam: np.repeat((np.clip(lam, low, high) - low)[:, None], 3, axis=1))
+    # Flat CMFs over [low, high] (ones at every 1-nm node) and their cumulative integral, for the nodes and the closed form.
+    nodes = np.arange(int(round(high - low)) + 1, dtype=float)
+    monkeypatch.setattr(bragg, "_cmf_nodes", lambda: (np.ones((nodes.size, 3)), np.repeat(nodes[:, None], 3, axis=1)))
     monkeypatch.setattr(colorimetry, "xyz_to_rgb", lambda xyz: xyz)
     for mirror, cos_theta in random_real_mirrors(5, 12, [1, 3, 20, 64, 100, 300, 1000]):
         width = bragg.band_pieces_rgb(cos_theta, mirror)
