@@ -1011,8 +1011,10 @@ def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
 
 
 #: A midpoint is taken from the cubic through its four neighbouring entries where that cubic's error,
-#: estimated from fourth differences, is below this fraction of the brightest channel.
-TABLE_CUBIC_TOLERANCE = 5e-5
+#: estimated from fourth differences, is below this fraction of the brightest channel. 2e-4 (was 5e-5): computed
+#: colours per table 139 -> 89 (N = 20), 135 -> 96 (N = 100, 1000), the table's error between entries against the
+#: reference 5.0-5.1e-4 -> 5.2-5.8e-4 (linear interpolation's TABLE_TOLERANCE dominates it; docs/performance.md).
+TABLE_CUBIC_TOLERANCE = 2e-4
 
 
 def _cubic_midpoints(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1356,7 +1358,7 @@ GAP_DECAY = 12.0
 ROOT_STEPS = 12
 #: Fringe boundaries: u on this many points of t per piece for first guesses, then Newton steps.
 ROOT_GRID = 17
-ROOT_POLISH = 5
+ROOT_POLISH = 2
 
 
 @functools.lru_cache(maxsize=None)
@@ -1639,7 +1641,7 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         chi = sub_lo[:, None] + sub_width[:, None] * x
         if kind == 3:
             kk = k[sub][:, None]
-            cos_chi, sin_chi = np.cos(chi), np.sin(chi)
+            cos_chi, sin_chi = _cos_sin(chi)
             psi = np.arctan2(sin_chi, kk * cos_chi)  # arctan(tan(chi) / k) in [0, pi / 2]
             jacobian = np.abs(t_span[sub][:, None]) * (2.0 / np.pi) * kk / (kk * kk * cos_chi * cos_chi + sin_chi * sin_chi)
         else:  # k = 1: psi = chi
@@ -1710,10 +1712,13 @@ def _line_reflectance_block(lines: _Lines, omega, line, kind) -> np.ndarray:
     out = np.ones(omega.shape)
     rows = np.flatnonzero(kind != 2)
     omega, line, kind = omega[rows], line[rows], kind[rows]
-    n_plus, delta_p = lines.n_plus[line], lines.delta_p[line]
-    a = lines.alpha[line] * _cos_sin(omega * n_plus)[0] + lines.beta[line] * _cos_sin(omega * delta_p)[0]
+    # Eq. 8 from the layers' own phases (psi = omega p1, phi = omega p2; alpha - beta = Omega / 2): two sines and
+    # cosines per node, sin phi among them.
+    p2 = lines.p2[line]
+    cos_psi, sin_psi = _cos_sin(omega * (lines.n_plus[line] - p2))
+    cos_phi, sin_phi = _cos_sin(omega * p2)
+    a = cos_psi * cos_phi - (lines.alpha[line] - lines.beta[line]) * (sin_psi * sin_phi)
     r12_2 = lines.r12_2[line]
-    sin_phi = _cos_sin(omega * lines.p2[line])[1]
     r1_2 = (4.0 * r12_2) * (sin_phi * sin_phi)
     t1_2 = (1.0 - r12_2) ** 2
     sin2_u = np.maximum(1.0 - a * a, 0.0)
