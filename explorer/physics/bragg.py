@@ -1146,6 +1146,9 @@ def tabulated_rgb(table: np.ndarray, cos_theta: ArrayLike) -> np.ndarray:
 EDGE_FRINGES = 8.0
 #: The sampling (samples per nm) the refinement starts from: the integrand's fringes are ``N``-independent.
 WINDOW_SUBSTEPS_MIN = 4
+#: At or below this fringe floor (:func:`substeps_for`: fringes at least 2 nm wide at 360 nm, ~11 nm at 830 nm) the
+#: integrand is Yeh's R itself: the fringe average's error grows with the fringes' width against the CMFs'.
+WINDOW_EXACT_SUBSTEPS = 2
 
 
 def edge_window(a: np.ndarray, N: int, fringes: float = EDGE_FRINGES) -> np.ndarray:
@@ -1281,8 +1284,10 @@ def windowed_converged_spectra(
     substeps : ndarray of int, shape ``(cos_theta.size,)``
     """
     cos_theta, inverse = np.unique(np.round(np.asarray(cos_theta, dtype=np.float64).ravel(), 12), return_inverse=True)
-    if window_threshold(mirror.N) <= -1.0:
-        # The window covers whole pass bands: the integrand is Yeh's R itself (without the mean's cost).
+    if window_threshold(mirror.N) <= -1.0 or substeps_for(mirror, cos_theta) <= WINDOW_EXACT_SUBSTEPS:
+        # The window covers whole pass bands, or the fringes are so wide (the reference's fringe floor below this
+        # rule's start) that the fringe average misses their colour (Lambda = 50 nm, N = 64-300: 2e-2 to 5e-4) while
+        # Yeh's R costs no more: the integrand is Yeh's R itself.
         function = _spectrum_function(cos_theta, mirror, float64=float64)
     else:
         function = windowed_spectrum_function(cos_theta, mirror, float64=float64)
