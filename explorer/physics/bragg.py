@@ -1351,6 +1351,9 @@ FRINGE_NODES = 6
 #: A pass piece whose fringes are wider than this (nm) at its Airy point is Yeh's R throughout. 3 nm, not 1:
 #: N = 64-300 pieces then take the fringe average beyond their edge fringes (half the nodes), within 1e-4.
 FRINGE_MEAN_NM = 3.0
+#: ... times N / PIECES_EXACT_N, up to this factor: the average's error at a given fringe width falls with N (measured:
+#: 6-nm fringes 2.8e-4 at N = 64, 1.1e-4 at N = 100, against a 1e-5 reference).
+FRINGE_MEAN_GROWTH = 2.0
 #: Dips with k = sqrt(1 + F) above this are integrated as 1 - (1 - R), the dip on squeezed nodes.
 DIP_SHARP = 2.0
 #: Panels of a gap's exact part.
@@ -1522,7 +1525,8 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         return lam * lam / (2.0 * N * np.maximum(du_domega, 1e-300))
 
     fringe_nm = np.maximum(np.maximum(fringe_nm_at(t0[band]), fringe_nm_at(t1[band])), fringe_nm_at(np.ones(band.size)))
-    whole = exact_everywhere | (fringe_nm > FRINGE_MEAN_NM) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
+    mean_nm = FRINGE_MEAN_NM * min(max(N / PIECES_EXACT_N, 1.0), FRINGE_MEAN_GROWTH)
+    whole = exact_everywhere | (fringe_nm > mean_nm) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
     u_cut = np.where(whole, 0.5 * np.pi, BAND_EDGE_FRINGES * np.pi / N)
     def fringe_panels(band, u_cut):
         """The exact part of the pass pieces ``band`` (up to ``u_cut``), as panels; returns the cut in t."""
