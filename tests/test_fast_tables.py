@@ -58,8 +58,9 @@ def test_band_pieces_tile_the_visible_range(monkeypatch):
     points, fringe boundaries and the gaps' closed form neither overlap nor leave holes."""
     low, high = colorimetry.HAT_LOW, colorimetry.HAT_HIGH
     monkeypatch.setattr(bragg, "_line_reflectance", lambda lines, omega, line, kind: np.where(kind == 3, 0.0, 1.0))
-    monkeypatch.setattr(bragg, "_cmf_linear", lambda lam: np.repeat(((lam >= low) & (lam <= high))[:, None], 3, axis=1).astype(float))
-    monkeypatch.setattr(bragg, "_cmf_integral_to", lambda lam: np.repeat((np.clip(lam, low, high) - low)[:, None], 3, axis=1))
+    # Flat CMFs over [low, high] (ones at every 1-nm node) and their cumulative integral, for the nodes and the closed form.
+    nodes = np.arange(int(round(high - low)) + 1, dtype=float)
+    monkeypatch.setattr(bragg, "_cmf_nodes", lambda: (np.ones((nodes.size, 3)), np.repeat(nodes[:, None], 3, axis=1)))
     monkeypatch.setattr(colorimetry, "xyz_to_rgb", lambda xyz: xyz)
     for mirror, cos_theta in random_real_mirrors(5, 12, [1, 3, 20, 64, 100, 300, 1000]):
         width = bragg.band_pieces_rgb(cos_theta, mirror)
@@ -101,3 +102,49 @@ def test_band_pieces_refuse_complex_angles():
         bragg.band_pieces_rgb([0.5], bragg.BraggMirror(n1=1.5, n2=1.0, N=20))  # beyond the critical angle
     with pytest.raises(ValueError, match="real angles only"):
         bragg.band_pieces_rgb([0.5], bragg.BraggMirror(N=20, nh=1.4))
+
+
+# --------------------------------------------------------------------------------------------------
+# The table against the converged reference on random mirrors over bragg_mirror.brd's box (issue 22)
+
+from hypothesis import HealthCheck, Phase, given, seed, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+#: Between the table's entries (linear interpolation), as tests/test_converged.py's TABLE_RTOL.
+TABLE_RTOL = 2e-3
+
+
+# A fixed seed and no shrinking; each example draws its mirror from a numpy generator seeded by hypothesis (hypothesis's
+# own floats cluster on the box's corners and mutate one mirror after a few examples).
+@seed(22)
+@settings(max_examples=20, deadline=None, database=None, phases=[Phase.explicit, Phase.generate],
+          suppress_health_check=[HealthCheck.too_slow])
+@given(draw=st.integers(0, 2**32 - 1), N=st.sampled_from([1, 20, 100, 300, 1000]), host=st.booleans())
+def test_table_equals_converged_reference_on_random_mirrors(draw, N, host):
+    """Any mirror of bragg_mirror.brd's box (indices 1-2.5, a host nh != n1 or none, n2 < n1 with total internal
+    reflection and evanescent layers, Lambda 50-1500 nm, delta 0-1), N from 1 to 1000, at random angles: the table's
+    rule within NODE_RTOL of the converged reference, its lookups (interpolated entries) within TABLE_RTOL."""
+    rng = np.random.default_rng(draw)
+    n1, n2, nh = rng.uniform(1.0, 2.5, 3)
+    mirror = bragg.BraggMirror(float(n1), float(n2), float(rng.uniform(50.0, 1500.0)), float(rng.uniform(0.0, 1.0)), N,
+                               float(nh) if host else None)
+    cos_theta = rng.uniform(0.0, 1.0, 3)
+    reference = bragg.reference_rgb(cos_theta, mirror)
+    error = relative_error(bragg._converged_rgb(cos_theta, mirror), reference)
+    assert error.max() <= NODE_RTOL, (mirror, error.max(), cos_theta[error.argmax()])
+    table = bragg.tabulated_rgb_table(mirror)
+    assert table.dtype == np.float32 and table.shape[1] == 3 and not table.flags.writeable
+    error = relative_error(bragg.tabulated_rgb(table, cos_theta), reference)
+    assert error.max() <= TABLE_RTOL, (mirror, error.max(), cos_theta[error.argmax()])
+
+
+@pytest.mark.parametrize("mirror", [
+    bragg.BraggMirror(1.0, 1.5, 50.0, 0.5, 64),  # fringes ~30 nm wide: the fringe average was off by 2e-2
+    bragg.BraggMirror(2.1666854836047436, 1.6154686637578541, 50.0, 0.32038940770826296, 100),  # the same, evanescent n2
+    bragg.BraggMirror(1.0, 1.5, 50.0, 0.5, 100, nh=1.4),  # the same under a host
+], ids=["Lambda=50,N=64", "Lambda=50,N=100,evanescent", "Lambda=50,N=100,host"])
+def test_table_rule_with_wide_fringes(mirror):
+    """Short periods: few fringes, each wider than the CMFs' features, where averaging over them is wrong."""
+    cos_theta = np.array([0.95, 0.649, 0.3, 0.076])
+    error = relative_error(bragg._converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror))
+    assert error.max() <= NODE_RTOL, (error.max(), cos_theta[error.argmax()])

@@ -1011,8 +1011,10 @@ def _interpolation_error_estimate(table: np.ndarray) -> np.ndarray:
 
 
 #: A midpoint is taken from the cubic through its four neighbouring entries where that cubic's error,
-#: estimated from fourth differences, is below this fraction of the brightest channel.
-TABLE_CUBIC_TOLERANCE = 5e-5
+#: estimated from fourth differences, is below this fraction of the brightest channel. 2e-4 (was 5e-5): computed
+#: colours per table 139 -> 89 (N = 20), 135 -> 96 (N = 100, 1000), the table's error between entries against the
+#: reference 5.0-5.1e-4 -> 5.2-5.8e-4 (linear interpolation's TABLE_TOLERANCE dominates it; docs/performance.md).
+TABLE_CUBIC_TOLERANCE = 2e-4
 
 
 def _cubic_midpoints(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1144,6 +1146,9 @@ def tabulated_rgb(table: np.ndarray, cos_theta: ArrayLike) -> np.ndarray:
 EDGE_FRINGES = 8.0
 #: The sampling (samples per nm) the refinement starts from: the integrand's fringes are ``N``-independent.
 WINDOW_SUBSTEPS_MIN = 4
+#: At or below this fringe floor (:func:`substeps_for`: fringes at least 2 nm wide at 360 nm, ~11 nm at 830 nm) the
+#: integrand is Yeh's R itself: the fringe average's error grows with the fringes' width against the CMFs'.
+WINDOW_EXACT_SUBSTEPS = 2
 
 
 def edge_window(a: np.ndarray, N: int, fringes: float = EDGE_FRINGES) -> np.ndarray:
@@ -1279,8 +1284,10 @@ def windowed_converged_spectra(
     substeps : ndarray of int, shape ``(cos_theta.size,)``
     """
     cos_theta, inverse = np.unique(np.round(np.asarray(cos_theta, dtype=np.float64).ravel(), 12), return_inverse=True)
-    if window_threshold(mirror.N) <= -1.0:
-        # The window covers whole pass bands: the integrand is Yeh's R itself (without the mean's cost).
+    if window_threshold(mirror.N) <= -1.0 or substeps_for(mirror, cos_theta) <= WINDOW_EXACT_SUBSTEPS:
+        # The window covers whole pass bands, or the fringes are so wide (the reference's fringe floor below this
+        # rule's start) that the fringe average misses their colour (Lambda = 50 nm, N = 64-300: 2e-2 to 5e-4) while
+        # Yeh's R costs no more: the integrand is Yeh's R itself.
         function = _spectrum_function(cos_theta, mirror, float64=float64)
     else:
         function = windowed_spectrum_function(cos_theta, mirror, float64=float64)
@@ -1334,14 +1341,19 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
 # Every panel is also cut to at most PANEL_NM nm for the CMFs. The pieces tile the visible range exactly
 # (tests/test_fast_tables.py). References: Section 3.1 (Eqs. 2, 8-10), Appendix A; Yeh (1988), Chapter 6.
 
-#: Fringes from a band edge integrated exactly (Yeh's R); beyond them, the fringe average.
-BAND_EDGE_FRINGES = 4
+#: Fringes from a band edge integrated exactly (Yeh's R); beyond them, the fringe average. 8, not 4: with
+#: fringes up to FRINGE_MEAN_NM wide the average's error at N = 64-100 halved (2e-4 -> 1e-4 of a 1e-5 reference).
+BAND_EDGE_FRINGES = 8
 #: Gauss-Legendre nodes per panel (one panel per fringe near band edges).
 GAUSS_NODES = 8
 #: Nodes per fringe near band edges (clustered at the fringe's ends, where its transmission dip is).
 FRINGE_NODES = 6
-#: A pass piece whose fringes are wider than this (nm) at its Airy point is Yeh's R throughout.
-FRINGE_MEAN_NM = 1.0
+#: A pass piece whose fringes are wider than this (nm) at its Airy point is Yeh's R throughout. 3 nm, not 1:
+#: N = 64-300 pieces then take the fringe average beyond their edge fringes (half the nodes), within 1e-4.
+FRINGE_MEAN_NM = 3.0
+#: ... times N / PIECES_EXACT_N, up to this factor: the average's error at a given fringe width falls with N (measured:
+#: 6-nm fringes 2.8e-4 at N = 64, 1.1e-4 at N = 100, against a 1e-5 reference).
+FRINGE_MEAN_GROWTH = 2.0
 #: Dips with k = sqrt(1 + F) above this are integrated as 1 - (1 - R), the dip on squeezed nodes.
 DIP_SHARP = 2.0
 #: Panels of a gap's exact part.
@@ -1351,10 +1363,10 @@ PANEL_NM = 16.0
 #: N Im[K] Lambda beyond which a gap reflects 1 (to exp(-2 GAP_DECAY)).
 GAP_DECAY = 12.0
 #: Newton steps (bisection-safeguarded) for the Airy points, band edges and the cuts.
-ROOT_STEPS = 12
+ROOT_STEPS = 8
 #: Fringe boundaries: u on this many points of t per piece for first guesses, then Newton steps.
 ROOT_GRID = 17
-ROOT_POLISH = 5
+ROOT_POLISH = 2
 
 
 @functools.lru_cache(maxsize=None)
@@ -1387,6 +1399,24 @@ def _cmf_integral_to(wavelength: np.ndarray) -> np.ndarray:
     return cumulative[i] + c[i] * f + (c[i + 1] - c[i]) * (0.5 * f * f)
 
 
+#: Below this many values :func:`_cos_sin` calls numpy's ``cos`` and ``sin``: per-call overhead dominates there.
+COS_SIN_MIN_SIZE = 2048
+
+
+def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    ``(cos x, sin x)`` from ``tau = tan(r / 2)``, ``r`` = ``x`` reduced to [-pi, pi]: ``((1 - tau^2), 2 tau) / (1 + tau^2)``.
+    numpy's float64 ``tan`` is vectorised where its ``cos`` and ``sin`` are not (1.5 against ~20 ns a value on this
+    machine): 2.5x faster for both, to ~1e-14 for ``|x| <= 100`` (the band pieces' phases stay below ~70).
+    """
+    if np.size(x) < COS_SIN_MIN_SIZE:  # small arrays (root finding): two calls cost less than the ten below
+        return np.cos(x), np.sin(x)
+    tau = np.tan(0.5 * (x - (2.0 * np.pi) * np.rint(x * (0.5 / np.pi))))
+    tau2 = tau * tau
+    inverse = 1.0 / (1.0 + tau2)
+    return (1.0 - tau2) * inverse, 2.0 * tau * inverse
+
+
 @dataclass
 class _Lines:
     """Per (angle, polarisation) line: Eq. 8's trigonometric form and Eq. 10's slab terms (real angles)."""
@@ -1401,10 +1431,10 @@ class _Lines:
 
     def a(self, omega, line):
         """``cos K Lambda`` (Eq. 8) and its derivative in omega."""
-        x, y = omega * self.n_plus[line], omega * self.delta_p[line]
+        n_plus, delta_p = self.n_plus[line], self.delta_p[line]
+        (cos_x, sin_x), (cos_y, sin_y) = _cos_sin(omega * n_plus), _cos_sin(omega * delta_p)
         alpha, beta = self.alpha[line], self.beta[line]
-        return (alpha * np.cos(x) + beta * np.cos(y),
-                -(alpha * self.n_plus[line] * np.sin(x) + beta * self.delta_p[line] * np.sin(y)))
+        return alpha * cos_x + beta * cos_y, -(alpha * n_plus * sin_x + beta * delta_p * sin_y)
 
 
 def _safeguarded_newton(g, lo, hi, guess, positive_at_lo, steps=ROOT_STEPS):
@@ -1454,9 +1484,17 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         return g
 
     airy = _safeguarded_newton(shifted_a(sign_m, 0.0), omega_m, omega_next, 0.5 * (omega_m + omega_next), True)
-    edge_up = _safeguarded_newton(shifted_a(sign_m, 1.0), omega_m, airy, 0.5 * (omega_m + airy), True)
-    edge_up = np.where(m == 0, 0.0, edge_up)
-    edge_down = _safeguarded_newton(shifted_a(-sign_m, 1.0), airy, omega_next, 0.5 * (airy + omega_next), False)
+    # Both band edges in one solve (a is +-1 there): elementwise the same as two, half the numpy calls.
+    both_line, both_sign = np.concatenate([line, line]), np.concatenate([sign_m, -sign_m])
+
+    def edge_g(w):
+        value, slope = lines.a(w, both_line)
+        return both_sign * value - 1.0, both_sign * slope
+
+    edges = _safeguarded_newton(edge_g, np.concatenate([omega_m, airy]), np.concatenate([airy, omega_next]),
+                                np.concatenate([0.5 * (omega_m + airy), 0.5 * (airy + omega_next)]),
+                                np.repeat([True, False], line.size))
+    edge_up, edge_down = np.where(m == 0, 0.0, edges[: line.size]), edges[line.size :]
     # Four pieces per interval, each anchored at a band edge e with omega = e + S t^2: two halves of the pass band
     # (towards the Airy point), two halves of gaps (towards the modes).
     anchor = np.concatenate([edge_up, edge_down, edge_up, edge_down])
@@ -1501,7 +1539,8 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         return lam * lam / (2.0 * N * np.maximum(du_domega, 1e-300))
 
     fringe_nm = np.maximum(np.maximum(fringe_nm_at(t0[band]), fringe_nm_at(t1[band])), fringe_nm_at(np.ones(band.size)))
-    whole = exact_everywhere | (fringe_nm > FRINGE_MEAN_NM) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
+    mean_nm = FRINGE_MEAN_NM * min(max(N / PIECES_EXACT_N, 1.0), FRINGE_MEAN_GROWTH)
+    whole = exact_everywhere | (fringe_nm > mean_nm) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
     u_cut = np.where(whole, 0.5 * np.pi, BAND_EDGE_FRINGES * np.pi / N)
     def fringe_panels(band, u_cut):
         """The exact part of the pass pieces ``band`` (up to ``u_cut``), as panels; returns the cut in t."""
@@ -1593,25 +1632,39 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
     gap_piece, gap_lo, gap_width = _panels(gap, np.zeros(gap.size), cut, np.full(gap.size, GAP_PANELS))
     add(gap_piece, gap_lo, gap_width, np.ones(gap_piece.size), 0, GAUSS_NODES)
     # Nodes: each panel clipped to its piece's visible part (in chi), split for the CMFs (PANEL_NM), Gauss-Legendre.
+    # Panels where R = 1 (kind 2, and the gaps beyond their exact part) integrate the CMFs in closed form instead.
     nodes_t, nodes_w, nodes_piece, nodes_kind = [], [], [], []
+    ones_piece, ones_lo, ones_hi = [], [], []
     for piece, t_a, t_span, k, kind, n, _ in panels:
         with np.errstate(divide="ignore", invalid="ignore"):
             rel_lo = np.clip((t0[piece] - t_a) / t_span, 0.0, 1.0)
             rel_hi = np.clip((t1[piece] - t_a) / t_span, 0.0, 1.0)
         rel_lo, rel_hi = np.nan_to_num(np.minimum(rel_lo, rel_hi)), np.nan_to_num(np.maximum(rel_lo, rel_hi))
+        if kind == 2:
+            inside = (rel_hi > rel_lo) & (t_span != 0.0)
+            ones_piece.append(piece[inside])
+            ones_lo.append((t_a + t_span * rel_lo)[inside])
+            ones_hi.append((t_a + t_span * rel_hi)[inside])
+            continue
         chi_lo, chi_hi = np.arctan(k * np.tan(0.5 * np.pi * rel_lo)), np.arctan(k * np.tan(0.5 * np.pi * np.minimum(rel_hi, 1.0 - 1e-16)))
         chi_hi = np.where(rel_hi >= 1.0, 0.5 * np.pi, chi_hi)
         inside = (chi_hi > chi_lo) & (t_span != 0.0)
         piece, t_a, t_span, k, chi_lo, chi_hi = (v[inside] for v in (piece, t_a, t_span, k, chi_lo, chi_hi))
-        split = np.ceil(nm_between(t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(chi_lo) / k),
-                                   t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(np.minimum(chi_hi, 0.5 * np.pi - 1e-16)) / k), piece)
-                        / PANEL_NM).clip(1, None)
-        sub, sub_lo, sub_width = _panels(np.arange(piece.size), chi_lo, chi_hi, split)
+        if kind == 3:
+            ends_lo = t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(chi_lo) / k)
+            ends_hi = t_a + t_span * (2.0 / np.pi) * np.arctan(np.tan(np.minimum(chi_hi, 0.5 * np.pi - 1e-16)) / k)
+        else:  # k = 1
+            ends_lo, ends_hi = t_a + t_span * (2.0 / np.pi) * chi_lo, t_a + t_span * (2.0 / np.pi) * chi_hi
+        split = np.ceil(nm_between(ends_lo, ends_hi, piece) / PANEL_NM).clip(1, None)
+        if (split == 1).all():
+            sub, sub_lo, sub_width = np.arange(piece.size), chi_lo, chi_hi - chi_lo
+        else:
+            sub, sub_lo, sub_width = _panels(np.arange(piece.size), chi_lo, chi_hi, split)
         x, w = _gauss_legendre(n * scale)
         chi = sub_lo[:, None] + sub_width[:, None] * x
         if kind == 3:
             kk = k[sub][:, None]
-            cos_chi, sin_chi = np.cos(chi), np.sin(chi)
+            cos_chi, sin_chi = _cos_sin(chi)
             psi = np.arctan2(sin_chi, kk * cos_chi)  # arctan(tan(chi) / k) in [0, pi / 2]
             jacobian = np.abs(t_span[sub][:, None]) * (2.0 / np.pi) * kk / (kk * kk * cos_chi * cos_chi + sin_chi * sin_chi)
         else:  # k = 1: psi = chi
@@ -1627,49 +1680,90 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
     weight = np.concatenate(nodes_w) * np.abs(2.0 * span[node_piece] * t) * wavelength / omega
     node_line = piece_line[node_piece]
     value = _line_reflectance(lines, omega, node_line, np.concatenate(nodes_kind))
-    contribution = value * weight
-    cmf = _cmf_linear(wavelength)
-    xyz = np.stack([np.bincount(node_line, contribution * cmf[:, c], minlength=n_lines) for c in range(3)], axis=-1)
-    # Gaps beyond their exact part reflect 1: the CMFs' integral in closed form.
+    xyz = _cmf_weighted_sums(wavelength, value * weight, node_line, n_lines)
+    # Gaps beyond their exact part and the sharp dips' "1" reflect 1: the CMFs' integral in closed form.
     ones = cut < 1.0
-    if ones.any():
-        pieces = gap[ones]
-        t_a, t_b = np.clip(cut[ones], t0[pieces], t1[pieces]), t1[pieces]
+    ones_piece.append(gap[ones])
+    ones_lo.append(np.clip(cut[ones], t0[gap[ones]], t1[gap[ones]]))
+    ones_hi.append(t1[gap[ones]])
+    pieces, t_a, t_b = np.concatenate(ones_piece), np.concatenate(ones_lo), np.concatenate(ones_hi)
+    if pieces.size:
         total = np.abs(_cmf_integral_to(2.0 * np.pi / omega_at(t_a, pieces)) - _cmf_integral_to(2.0 * np.pi / omega_at(t_b, pieces)))
         xyz += np.stack([np.bincount(piece_line[pieces], total[:, c], minlength=n_lines) for c in range(3)], axis=-1)
     return xyz
 
 
+def _cmf_weighted_sums(wavelength: np.ndarray, value: np.ndarray, line: np.ndarray, n_lines: int) -> np.ndarray:
+    """
+    ``sum value * CMF(wavelength)`` per line, ``(n_lines, 3)``, with the CMFs interpolated linearly between their
+    1-nm nodes (:func:`_cmf_linear`): each value split between its two nodes (two bincounts), then one product
+    with the nodes' CMFs, instead of three interpolations and three bincounts.
+    """
+    c, _ = _cmf_nodes()
+    x = np.clip(wavelength - colorimetry.HAT_LOW, 0.0, c.shape[0] - 1.0)
+    i = np.minimum(x.astype(np.int64), c.shape[0] - 2)
+    f = x - i
+    index = line * c.shape[0] + i
+    size = n_lines * c.shape[0]
+    bins = np.bincount(index, value * (1.0 - f), minlength=size) + np.bincount(index + 1, value * f, minlength=size)
+    return bins.reshape(n_lines, c.shape[0]) @ c
+
+
+#: Nodes per block of :func:`_line_reflectance`: its ~20 temporaries stay in cache (2.5x faster than whole arrays
+#: of ~1e5 nodes, measured).
+NODE_BLOCK = 16384
+
+
 def _line_reflectance(lines: _Lines, omega, line, kind) -> np.ndarray:
+    """At each node by ``kind`` (:func:`_line_reflectance_block`), by blocks of :data:`NODE_BLOCK` nodes."""
+    if omega.size <= NODE_BLOCK:
+        return _line_reflectance_block(lines, omega, line, kind)
+    out = np.empty(omega.shape)
+    for start in range(0, omega.size, NODE_BLOCK):
+        at = slice(start, start + NODE_BLOCK)
+        out[at] = _line_reflectance_block(lines, omega[at], line[at], kind[at])
+    return out
+
+
+def _line_reflectance_block(lines: _Lines, omega, line, kind) -> np.ndarray:
     """
     At each node by ``kind``: 0, Yeh's R; 1, its fringe average; 2, 1; 3, R - 1. Real arithmetic (Eqs. 2, 8-10;
-    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2``, as :func:`_reflectance_real`).
+    ``|r1|^2 : |t1|^2 = 4 r12^2 sin^2 phi : (1 - r12^2)^2``, as :func:`_reflectance_real`). In a pass band Eq. 2 is
+    written ``R = |r1|^2 sin^2 N u / (|r1|^2 sin^2 N u + |t1|^2 sin^2 u)``, finite at its transmission dips; in a gap
+    with Eq. 9's scaled sinh ratio (:func:`chebyshev_U`).
     """
     out = np.ones(omega.shape)
     rows = np.flatnonzero(kind != 2)
     omega, line, kind = omega[rows], line[rows], kind[rows]
-    a, _ = lines.a(omega, line)
+    # Eq. 8 from the layers' own phases (psi = omega p1, phi = omega p2; alpha - beta = Omega / 2): two sines and
+    # cosines per node, sin phi among them.
+    p2 = lines.p2[line]
+    cos_psi, sin_psi = _cos_sin(omega * (lines.n_plus[line] - p2))
+    cos_phi, sin_phi = _cos_sin(omega * p2)
+    a = cos_psi * cos_phi - (lines.alpha[line] - lines.beta[line]) * (sin_psi * sin_phi)
     r12_2 = lines.r12_2[line]
-    sin_phi = np.sin(omega * lines.p2[line])
-    r1_2 = 4.0 * r12_2 * sin_phi * sin_phi
+    r1_2 = (4.0 * r12_2) * (sin_phi * sin_phi)
     t1_2 = (1.0 - r12_2) ** 2
-    exact, mean = np.flatnonzero(kind != 1), np.flatnonzero(kind == 1)
-    N = float(lines.N)
+    sin2_u = np.maximum(1.0 - a * a, 0.0)
     value = np.empty(omega.shape)
+    N = float(lines.N)
+    exact = kind != 1
+    band = np.flatnonzero(exact & (np.abs(a) < 1.0))
+    gap = np.flatnonzero(exact & (np.abs(a) >= 1.0))
+    mean = np.flatnonzero(~exact)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        ae, r1e, t1e = a[exact], r1_2[exact], t1_2[exact]
-        a_band = np.clip(ae, -1.0, 1.0)
-        Q_band = (1.0 - a_band * a_band) / np.sin(N * np.arccos(a_band)) ** 2
-        abs_a = np.maximum(np.abs(ae), 1.0)
-        xg = np.maximum(np.arccosh(abs_a), 1e-12)
-        Q_gap = (np.exp(-(N - 1.0) * xg) * _one_minus_exp_minus_2x(xg) / _one_minus_exp_minus_2x(N * xg)) ** 2
-        Q = np.where(np.abs(ae) < 1.0, Q_band, Q_gap)
-        # R - 1 = -t1^2 Q / (r1^2 + t1^2 Q) without cancellation; R = 1 + that.
-        deficit = t1e * Q / (r1e + t1e * Q)
-        value[exact] = np.where(kind[exact] == 3, -deficit, 1.0 - deficit)
-        am, r1m, t1m = a[mean], r1_2[mean], t1_2[mean]
-        t_sin = t1m * np.maximum(1.0 - am * am, 0.0)
-        denominator = r1m + t_sin
+        # Pass band: the deficit 1 - R = |t1|^2 sin^2 u / (|r1|^2 sin^2 N u + |t1|^2 sin^2 u).
+        sin_Nu = _cos_sin(N * np.arccos(a[band]))[1]
+        t_sin = t1_2[band] * sin2_u[band]
+        deficit_band = t_sin / (r1_2[band] * sin_Nu * sin_Nu + t_sin)
+        # Gap: Q = (sinh Im[K] Lambda / sinh N Im[K] Lambda)^2, scaled as chebyshev_U.
+        xg = np.maximum(np.arccosh(np.abs(a[gap])), 1e-12)
+        Q = (np.exp(-(N - 1.0) * xg) * _one_minus_exp_minus_2x(xg) / _one_minus_exp_minus_2x(N * xg)) ** 2
+        deficit_gap = t1_2[gap] * Q / (r1_2[gap] + t1_2[gap] * Q)
+        for where, deficit in ((band, deficit_band), (gap, deficit_gap)):
+            value[where] = np.where(kind[where] == 3, -deficit, 1.0 - deficit)
+        t_sin = t1_2[mean] * sin2_u[mean]
+        denominator = r1_2[mean] + t_sin
         value[mean] = 1.0 - np.sqrt(np.where(denominator > 0.0, t_sin / denominator, 1.0))
     out[rows] = value
     return out
@@ -1677,8 +1771,10 @@ def _line_reflectance(lines: _Lines, omega, line, kind) -> np.ndarray:
 
 #: Below this many cells the pieces integrate Yeh's R throughout (the fringe average's far harmonics still count).
 PIECES_EXACT_N = 64
-#: From this many cells the table's colours come from the band pieces (measured faster than the windowed rule).
-PIECES_MIN_N = 600
+#: From this many cells the table's colours come from the band pieces. Below it the windowed rule costs less (its
+#: integrand is Yeh's R itself up to N = 4 EDGE_FRINGES, and where fringes are wide: WINDOW_EXACT_SUBSTEPS); from
+#: N ~ 64 the pieces do (default mirror, 65 angles: 19 against 30 ms at N = 100), whose cost stops growing.
+PIECES_MIN_N = 64
 
 
 def band_pieces_rgb(cos_theta: ArrayLike, mirror: BraggMirror, scale: int = 1) -> np.ndarray:
