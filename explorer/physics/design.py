@@ -61,7 +61,11 @@ FIRST_PASS_SAMPLES = 2048
 SCAN_SHAPES = 256
 SCAN_VALUES = 640
 #: The scan's spectra: samples at this relative step in s / lambda (~3 nm at 600 nm).
-SCAN_RELATIVE_STEP = 0.005
+SCAN_RELATIVE_STEP = 0.0025
+#: The scan's spectra average out fringes narrower than about this share of the wavelength.
+SCAN_SMOOTH = 0.004
+#: The scan's CIEDE2000 is evaluated at this many scales per shape, those nearest in CIELAB.
+SCAN_KEPT = 48
 #: Shapes per batch of the scan (memory: shapes x angles x values x 118 nodes).
 SCAN_BATCH = 8
 #: CPU seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
@@ -69,6 +73,9 @@ SCAN_BATCH = 8
 POLISH_SECONDS = 2.0
 #: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
 LOCAL_STARTS = 6
+#: Evaluations of each coarse refinement (0: none, the scans' shapes go to the polish).
+REFINE_NFEV = 40
+REFINE_SCREEN = True
 POLISHED = 2
 #: Two starts closer than this in the unit box (max norm) are the same basin.
 DISTINCT_STARTS = 0.08
@@ -85,6 +92,11 @@ SECOND_STARTS = 3
 POLISH_STEP = 1.0
 #: Above this median CIEDE2000 the coarse stage has not found the basin: more starts are refined.
 GOOD_ENOUGH = 0.05
+#: Local scans (after the first scan): the best distinct shapes improved, each by this many perturbed
+#: shapes per round, at these spreads in the unit box.
+LOCAL_SCAN_STARTS = 4
+LOCAL_SCAN_SHAPES = 12
+LOCAL_SCAN_SPREADS = (0.04, 0.015, 0.006)
 #: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
 BATCH = 32
 
@@ -166,8 +178,12 @@ def _interpolation_weights(step: float) -> tuple[np.ndarray, np.ndarray]:
     interpolant between them against the 1-nm CMFs: ``XYZ = R(nodes) @ weights``.
     """
     lo, hi = colorimetry.WAVELENGTH_MIN, colorimetry.WAVELENGTH_MAX
-    count = int(math.ceil((hi - lo) / step)) + 1
-    nodes = np.linspace(lo, hi, count)
+    return _interpolation_weights_at(np.linspace(lo, hi, int(math.ceil((hi - lo) / step)) + 1))
+
+
+def _interpolation_weights_at(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_interpolation_weights` at ascending ``nodes`` (nm) that span the CMFs' range."""
+    count = nodes.size
     fine = colorimetry.WAVELENGTHS
     position = np.interp(fine, nodes, np.arange(count))
     left = np.minimum(np.floor(position).astype(int), count - 2)
@@ -186,6 +202,21 @@ def coarse_nodes(step: float = COARSE_STEP) -> tuple[np.ndarray, np.ndarray]:
     if step not in _WEIGHTS:
         _WEIGHTS[step] = _interpolation_weights(step)
     return _WEIGHTS[step]
+
+
+_LOG_WEIGHTS: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def log_nodes(ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Wavelengths ``lambda_max r^-j`` (ascending) down to below ``lambda_min``, and the XYZ weights that
+    integrate the spectrum's linear interpolant between them against the 1-nm CMFs (the scale scan's).
+    """
+    if ratio not in _LOG_WEIGHTS:
+        lo, hi = colorimetry.WAVELENGTH_MIN, colorimetry.WAVELENGTH_MAX
+        count = int(np.ceil(np.log(hi / lo) / np.log(ratio))) + 1
+        _LOG_WEIGHTS[ratio] = _interpolation_weights_at(hi / ratio ** np.arange(count)[::-1])
+    return _LOG_WEIGHTS[ratio]
 
 
 def chebyshev_U_real_N(a: ArrayLike, N: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -250,6 +281,9 @@ def bragg_reflectance_batch(
         path = np.maximum(np.real(p1) + np.real(p2), 1e-9)
         fringe = wavelengths**2 / (2.0 * N * path)
         w_point = np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0)
+    # Where every sample is a point sample (or every one an average), the other is not computed.
+    point = step is None or bool(np.any(w_point > 0.0))
+    averaged = step is not None and bool(np.any(w_point < 1.0))
     total = 0.0
     for pol in bragg.POLARISATIONS:
         r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
@@ -260,11 +294,13 @@ def bragg_reflectance_batch(
         denominator = 1.0 - r12_2 * phase2
         r1 = r12 * (1.0 - phase2) / denominator
         t1 = (1.0 - r12_2) * e_phi / denominator
-        U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
-        r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
         r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
-        R = np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
-        if step is not None:
+        R = 0.0
+        if point:
+            U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
+            r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
+            R = np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
+        if averaged:
             average = bragg.fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), a)
             R = w_point * R + (1.0 - w_point) * average
         total = total + R
@@ -602,6 +638,58 @@ class _Problem:
             scores[start : start + SCAN_BATCH] = score
         return scores
 
+    def scale_scan(self, shapes: np.ndarray, relative_step: float = SCAN_RELATIVE_STEP,
+                   smooth_relative: float = SCAN_SMOOTH) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at every scale
+        ``s_m = s_0 r^m`` (``r = 1 + relative_step``) over the scale's range, and those scales as unit values
+        ``(G,)``. Without dispersion a structure's spectrum depends on ``x = s / lambda`` only (every phase
+        is ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``): one spectrum per shape on
+        the log grid ``x_k = x_0 r^k``, against CMF weights on the log-spaced wavelengths
+        ``lambda_j = lambda_max r^-j``, gives ``XYZ(s_m) = sum_j W_j R(x_{m+j})``, a correlation (FFT) that
+        yields every scale on the grid's own step. Values that put ``Lambda`` outside its box score infinity.
+        """
+        from scipy import fft
+
+        p = self.free[self.scale_index]
+        ratio = 1.0 + relative_step
+        s_low, s_high = max(p.low, 1.0), p.high  # a film of no thickness scanned from 1 nm
+        G = int(np.ceil(np.log(s_high / s_low) / np.log(ratio))) + 1
+        nodes, weights = log_nodes(ratio)  # ascending; node J - j is lambda_j
+        J = nodes.size - 1
+        lambda_max = nodes[-1]
+        x = (s_low / lambda_max) * ratio ** np.arange(G + J)
+        s = s_low * ratio ** np.arange(G)
+        size = fft.next_fast_len(G + 2 * J)
+        # Correlation with W_j (j = 0: lambda_max): convolution with W reversed in j, i.e. ascending nodes.
+        kernel = fft.rfft(weights, n=size, axis=0)  # (F, 3)
+        reference = 1000.0
+        scores = np.empty((shapes.shape[0], G))
+        for start in range(0, shapes.shape[0], SCAN_BATCH):
+            self._check()
+            rows = slice(start, start + SCAN_BATCH)
+            U = shapes[rows]
+            values = self.values(U, scale_value=reference)
+            R = self.model.spectra(values, self.cos_theta, reference / x, smooth_relative)  # (B, A, X)
+            self.evaluations += U.shape[0] * G
+            spectrum = fft.rfft(R, n=size, axis=-1)  # (B, A, F)
+            xyz = fft.irfft(spectrum[..., None] * kernel[None, None], n=size, axis=-2)[:, :, J : J + G]  # (B, A, G, 3)
+            rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
+            # CIEDE2000 at the scales whose CIELAB distance (cheap) is among the SCAN_KEPT smallest.
+            proxy = np.sum((rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab) ** 2, axis=(-1, -2))
+            if self.optical:
+                per_period = values["Lambda"] / reference
+                Lambda = s[None, :] * per_period[:, None]
+                box = self.box["Lambda"]
+                proxy = np.where((Lambda >= box.low * (1 - 1e-9)) & (Lambda <= box.high * (1 + 1e-9)), proxy, np.inf)
+            kept = np.argpartition(proxy, min(SCAN_KEPT, G) - 1, axis=1)[:, :SCAN_KEPT]
+            chosen = np.take_along_axis(rgb, kept[:, :, None, None], axis=1)
+            score = np.full(proxy.shape, np.inf)
+            finite = np.isfinite(np.take_along_axis(proxy, kept, axis=1))
+            np.put_along_axis(score, kept, np.where(finite, np.sum(self.residuals_of(chosen) ** 2, axis=-1), np.inf), axis=1)
+            scores[rows] = score
+        return scores, np.clip(p.to_unit(s), 0.0, 1.0)
+
     def screen(self, U) -> np.ndarray:
         """Sum of squared CIEDE2000 of unit-box rows on the screening model."""
         return np.sum(self.residuals_of(self.coarse_rgb(U, SCREEN_STEP, SCREEN_SMOOTH)) ** 2, axis=-1)
@@ -661,7 +749,7 @@ def _host_bounds(problem: _Problem, u: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _refine_coarse(problem: _Problem, u0: np.ndarray, max_nfev: int) -> tuple[np.ndarray, float]:
     """The screening model's refinement, then the coarse model's (a continuation: smooth landscape first)."""
-    u, _ = _refine_level(problem, u0, max_nfev, SCREEN_STEP, SCREEN_SMOOTH)
+    u = _refine_level(problem, u0, max_nfev, SCREEN_STEP, SCREEN_SMOOTH)[0] if REFINE_SCREEN else u0
     return _refine_level(problem, u, max_nfev, COARSE_STEP, None)
 
 
@@ -775,6 +863,50 @@ def _distinct(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DI
     return chosen
 
 
+def _local_scans(problem: _Problem, U: np.ndarray, scores: np.ndarray, rng: np.random.Generator) -> list[np.ndarray]:
+    """
+    The :data:`LOCAL_SCAN_STARTS` best distinct shapes of ``U``, each improved by rounds of
+    :data:`LOCAL_SCAN_SHAPES` normal perturbations (spreads :data:`LOCAL_SCAN_SPREADS`, the scale coordinate
+    then set by the scan), keeping the best; returned best first.
+    """
+    best = [(float(scores[i]), U[i]) for i in _distinct_indices(U, scores, LOCAL_SCAN_STARTS)]
+    for spread in LOCAL_SCAN_SPREADS:
+        trial = np.concatenate([np.clip(u + rng.normal(0.0, spread, (LOCAL_SCAN_SHAPES, u.size)), 0.0, 1.0) for _, u in best])
+        trial, trial_scores = _scan_best(problem, trial)
+        for k in range(len(best)):
+            block = slice(k * LOCAL_SCAN_SHAPES, (k + 1) * LOCAL_SCAN_SHAPES)
+            i = int(np.argmin(trial_scores[block]))
+            if trial_scores[block][i] < best[k][0]:
+                best[k] = (float(trial_scores[block][i]), trial[block][i])
+    return [u for _, u in sorted(best, key=lambda item: item[0])]
+
+
+def _distinct_indices(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DISTINCT_STARTS) -> list[int]:
+    """Indices of :func:`_distinct`'s rows."""
+    chosen: list[int] = []
+    for index in np.argsort(scores):
+        if all(np.max(np.abs(U[index] - U[c])) > spacing for c in chosen):
+            chosen.append(int(index))
+        if len(chosen) == count:
+            break
+    return chosen
+
+
+def _scan_best(problem: _Problem, shapes: np.ndarray, progress: Callable[[float], None] | None = None,
+               chunk: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Each shape at its best scale of :meth:`_Problem.scale_scan`, and that score."""
+    shapes = shapes.copy()
+    scores = np.empty(len(shapes))
+    for start in range(0, len(shapes), chunk):
+        block, grid = problem.scale_scan(shapes[start : start + chunk])
+        best = np.argmin(block, axis=1)
+        shapes[start : start + chunk, problem.scale_index] = grid[best]
+        scores[start : start + chunk] = block[np.arange(len(block)), best]
+        if progress is not None:
+            progress(min(1.0, (start + chunk) / len(shapes)))
+    return shapes, scores
+
+
 def _scale_grid(p: DesignParameter) -> np.ndarray:
     """:data:`SCAN_VALUES` unit-box values of a scale parameter, geometrically spaced (and its low end)."""
     if p.log:
@@ -856,14 +988,7 @@ def design(
         if scale is not None:
             # 1-2. Space-filling shapes (Sobol), each at every value of its scale (the scale scan).
             U = qmc.Sobol(P, scramble=True, seed=seed).random(SCAN_SHAPES)
-            grid = _scale_grid(problem.free[scale])
-            scores = np.empty((len(U), grid.size))
-            for start in range(0, len(U), chunk // 4):
-                scores[start : start + chunk // 4] = problem.scale_profile(U[start : start + chunk // 4], grid)
-                report(0.6 * min(1.0, (start + chunk // 4) / len(U)), "scale scan")
-            best = np.argmin(scores, axis=1)
-            U[:, scale] = grid[best]
-            scores = scores[np.arange(len(U)), best]
+            U, scores = _scan_best(problem, U, lambda f: report(0.6 * f, "scale scan"))
             stages["scan"] = time.perf_counter() - start_time
         else:
             # 1. Space-filling first pass (Sobol) on the screening model.
@@ -875,10 +1000,20 @@ def design(
             stages["first pass"] = time.perf_counter() - start_time
         # 3. Distinct starts, refined on the coarse model.
         chosen = _distinct(U, scores, starts)
+        if scale is not None and LOCAL_SCAN_STARTS:
+            # 2b. Local scans: the basins in shape are ~0.01 of the box wide (high orders, fringes, frustrated
+            # total reflection), too narrow for the screening model's gradient; shapes drawn ever closer
+            # around the best, each at its best scale, find them.
+            report(0.6, "local scan")
+            chosen = _local_scans(problem, U, scores, np.random.default_rng(seed)) + chosen
+            chosen = _distinct(np.array(chosen), np.arange(len(chosen)), starts, spacing=0.005)
         refined = []
         for k, u0 in enumerate(chosen):
             report(0.6 + 0.2 * k / len(chosen), "local refinement")
-            u, cost = _refine_coarse(problem, u0, max_nfev=40)
+            if not REFINE_NFEV:
+                refined.append((float(np.sum(problem.residuals_of(problem.coarse_rgb(u0[None]))[0] ** 2)), k, u0))
+                continue
+            u, cost = _refine_coarse(problem, u0, max_nfev=REFINE_NFEV)
             refined.append((cost, k, u))
             # A start that already matches every target to a small fraction of a unit needs no others.
             if k >= 1 and math.sqrt(cost / len(targets)) < GOOD_ENOUGH:
@@ -890,12 +1025,12 @@ def design(
             # refinement alone.
             report(0.75, "second scan")
             variants = _variants(problem, refined[0][2], np.random.default_rng(seed))
-            variant_scores = problem.scale_profile(variants, grid)
-            best = np.argmin(variant_scores, axis=1)
-            variants[:, scale] = grid[best]
-            variant_scores = variant_scores[np.arange(len(variants)), best]
+            variants, variant_scores = _scan_best(problem, variants)
             for k, u0 in enumerate(_distinct(variants, variant_scores, SECOND_STARTS, spacing=0.005)):
-                u, cost = _refine_coarse(problem, u0, max_nfev=40)
+                if not REFINE_NFEV:
+                    refined.append((float(np.sum(problem.residuals_of(problem.coarse_rgb(u0[None]))[0] ** 2)), len(refined), u0))
+                    continue
+                u, cost = _refine_coarse(problem, u0, max_nfev=REFINE_NFEV)
                 refined.append((cost, len(refined), u))
             refined.sort(key=lambda item: item[0])
         stages["coarse refinement"] = time.perf_counter() - start_time
