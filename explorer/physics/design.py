@@ -54,13 +54,12 @@ SCREEN_STEP = 4.0
 SCREEN_SMOOTH = 12.0
 #: Candidates of the first pass (a power of two: Sobol's balance).
 FIRST_PASS_SAMPLES = 2048
-#: The scan: the best distinct candidates of the first pass, each tried at this many values of the
-#: model's scale parameter (the period, the film's thickness), geometrically spaced over its range. A
-#: mirror's spectrum shifts by about lambda dLambda / Lambda when Lambda moves: its colour turns as fast
-#: in log Lambda everywhere, and high-order mirrors (Lambda ~ 1 um) have many narrow basins in Lambda.
+#: The scan: this many scrambled-Sobol shapes, each at every value of the scale parameter (the period, the
+#: film's thickness) on a geometric grid. A mirror's spectrum shifts by about lambda dLambda / Lambda when
+#: Lambda moves: its colour turns as fast in log Lambda everywhere, by several CIEDE2000 per percent at
+#: high orders (Lambda ~ 1 um), whose basins in Lambda are narrow.
 SCAN_SHAPES = 256
-SCAN_VALUES = 640
-#: The scan's spectra: samples at this relative step in s / lambda (~3 nm at 600 nm).
+#: The scan's spectra: samples at this relative step in s / lambda (1.5 nm at 600 nm), also its scales' step.
 SCAN_RELATIVE_STEP = 0.0025
 #: The scan's spectra average out fringes narrower than about this share of the wavelength.
 SCAN_SMOOTH = 0.004
@@ -92,11 +91,6 @@ SECOND_STARTS = 3
 POLISH_STEP = 1.0
 #: Above this median CIEDE2000 the coarse stage has not found the basin: more starts are refined.
 GOOD_ENOUGH = 0.05
-#: Local scans (after the first scan): the best distinct shapes improved, each by this many perturbed
-#: shapes per round, at these spreads in the unit box.
-LOCAL_SCAN_STARTS = 4
-LOCAL_SCAN_SHAPES = 12
-LOCAL_SCAN_SPREADS = (0.04, 0.015, 0.006)
 #: Candidates evaluated per batch of the coarse model (memory: rows x angles x wavelengths complex).
 BATCH = 32
 
@@ -160,7 +154,7 @@ class DesignModel:
     #: Parameters whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
     host_parameter: str | None = None
     host_threshold: float = 1.0
-    #: The length that scales the structure (scanned densely: :data:`SCAN_VALUES`).
+    #: The length that scales the structure (scanned on every value: :meth:`_Problem.scale_scan`).
     scale_parameter: str | None = None
     #: Search a mirror by its optical period and thickness share instead of ``Lambda`` and ``delta``.
     optical: bool = False
@@ -556,17 +550,17 @@ class _Problem:
         self.cancelled = cancelled
         self.evaluations = 0
 
-    def values(self, U: np.ndarray, scale_value: float | None = None) -> dict[str, np.ndarray]:
+    def values(self, U: np.ndarray, scale_value: float | np.ndarray | None = None) -> dict[str, np.ndarray]:
         """
         Unit-box rows ``(B, P)`` -> every design value as ``(B,)`` arrays. ``scale_value``: the scale
-        coordinate at this value instead, unclipped (the scale scan's reference structures).
+        coordinate at this value (one, or one per row) instead, unclipped (the scale scan's structures).
         """
         U = np.atleast_2d(U)
         out = {name: np.full(U.shape[0], value) for name, value in self.fixed.items()}
         for k, p in enumerate(self.free):
             out[p.name] = p.from_unit(U[:, k])
         if scale_value is not None:
-            out[self.scale_parameter] = np.full(U.shape[0], float(scale_value))
+            out[self.scale_parameter] = np.broadcast_to(np.asarray(scale_value, dtype=np.float64), (U.shape[0],)).copy()
         if self.optical:
             # Optical thicknesses n1 d1 = f P and n2 d2 = (1 - f) P at normal incidence (Eq. 8's phases):
             # Lambda = P (f / n1 + (1 - f) / n2), delta = (f / n1) / (f / n1 + (1 - f) / n2).
@@ -595,100 +589,58 @@ class _Problem:
         """The free coordinate that scales every length of the structure (None when it is fixed)."""
         return next((k for k, p in enumerate(self.free) if p.name == self.scale_parameter), None)
 
-    def scale_profile(self, shapes: np.ndarray, grid: np.ndarray) -> np.ndarray:
-        """
-        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at each scale
-        value of ``grid`` (unit values). Without dispersion a structure's spectrum depends on ``s / lambda``
-        only (every phase is ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``), so one
-        spectrum per shape over ``x = s / lambda``, log-spaced, gives the colours at every ``s``. Values
-        that put ``Lambda`` outside its box score infinity.
-        """
-        p = self.free[self.scale_index]
-        s = np.maximum(p.from_unit(grid), 1.0)  # a film of no thickness scanned as 1 nm
-        nodes, weights = coarse_nodes(SCREEN_STEP)
-        ratio = 1.0 + SCAN_RELATIVE_STEP
-        x_low, x_high = s.min() / nodes[-1] / ratio, s.max() / nodes[0] * ratio
-        x = x_low * ratio ** np.arange(int(np.ceil(np.log(x_high / x_low) / np.log(ratio))) + 1)
-        reference = 1000.0
-        # Position of every (s, lambda_j) in the x grid, and the linear map from a spectrum over x to the
-        # XYZ at every s: XYZ(s_m) = sum_j w_j R(s_m / lambda_j), R interpolated linearly in log x.
-        q = np.log(s[:, None] / nodes[None, :] / x_low) / np.log(ratio)
-        i = np.clip(np.floor(q).astype(int), 0, x.size - 2)
-        t = q - i
-        kernel = np.zeros((x.size, s.size, 3))
-        m = np.broadcast_to(np.arange(s.size)[:, None], i.shape)
-        np.add.at(kernel, (i, m), (1.0 - t)[..., None] * weights[None, :, :])
-        np.add.at(kernel, (i + 1, m), t[..., None] * weights[None, :, :])
-        kernel = kernel.reshape(x.size, -1)
-        scores = np.empty((shapes.shape[0], s.size))
-        for start in range(0, shapes.shape[0], SCAN_BATCH):
-            self._check()
-            U = shapes[start : start + SCAN_BATCH]
-            values = self.values(U, scale_value=reference)
-            R = self.model.spectra(values, self.cos_theta, reference / x, SCREEN_SMOOTH / 600.0)  # (B, A, X)
-            self.evaluations += U.shape[0] * s.size
-            xyz = (R @ kernel).reshape(R.shape[:2] + (s.size, 3))  # (B, A, G, 3)
-            rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
-            score = np.sum(self.residuals_of(rgb) ** 2, axis=-1)
-            if self.optical:
-                per_period = values["Lambda"] / reference
-                Lambda = s[None, :] * per_period[:, None]
-                box = self.box["Lambda"]
-                score = np.where((Lambda >= box.low) & (Lambda <= box.high), score, np.inf)
-            scores[start : start + SCAN_BATCH] = score
-        return scores
-
     def scale_scan(self, shapes: np.ndarray, relative_step: float = SCAN_RELATIVE_STEP,
                    smooth_relative: float = SCAN_SMOOTH) -> tuple[np.ndarray, np.ndarray]:
         """
-        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at every scale
-        ``s_m = s_0 r^m`` (``r = 1 + relative_step``) over the scale's range, and those scales as unit values
-        ``(G,)``. Without dispersion a structure's spectrum depends on ``x = s / lambda`` only (every phase
-        is ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``): one spectrum per shape on
-        the log grid ``x_k = x_0 r^k``, against CMF weights on the log-spaced wavelengths
-        ``lambda_j = lambda_max r^-j``, gives ``XYZ(s_m) = sum_j W_j R(x_{m+j})``, a correlation (FFT) that
-        yields every scale on the grid's own step. Values that put ``Lambda`` outside its box score infinity.
+        Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at the scales
+        ``s_bm = s_b r^m`` (``r = 1 + relative_step``) that keep each shape's ``Lambda`` in its box (else
+        the scale's whole range), and those scales as unit values ``(B, G)``.
+
+        Without dispersion a structure's spectrum depends on ``x = s / lambda`` only (every phase is
+        ``2 pi n d cos theta / lambda``, Eq. 8, and ``d`` scales with ``s``): one spectrum per shape on the
+        log grid ``x_k = (s_b / lambda_max) r^k``, against CMF weights on the log-spaced wavelengths
+        ``lambda_j = lambda_max r^-j``, gives ``XYZ(s_bm) = sum_j W_j R(x_{m+j})``, a correlation (FFT) that
+        yields every scale on the grid's own step. Scales that put ``Lambda`` outside its box score infinity.
         """
         from scipy import fft
 
         p = self.free[self.scale_index]
         ratio = 1.0 + relative_step
-        s_low, s_high = max(p.low, 1.0), p.high  # a film of no thickness scanned from 1 nm
-        G = int(np.ceil(np.log(s_high / s_low) / np.log(ratio))) + 1
-        nodes, weights = log_nodes(ratio)  # ascending; node J - j is lambda_j
+        low, high = (self.box["Lambda"].low, self.box["Lambda"].high) if self.optical else (max(p.low, 1.0), p.high)
+        G = int(np.ceil(np.log(high / low) / np.log(ratio))) + 1
+        nodes, weights = log_nodes(ratio)  # ascending: node J - j is lambda_j
         J = nodes.size - 1
-        lambda_max = nodes[-1]
-        x = (s_low / lambda_max) * ratio ** np.arange(G + J)
-        s = s_low * ratio ** np.arange(G)
+        # Row b's structure at scale s_b seen at lambda_max r^-k is its spectrum at x_k = (s_b / lambda_max) r^k.
+        wavelengths = nodes[-1] / ratio ** np.arange(G + J)
         size = fft.next_fast_len(G + 2 * J)
-        # Correlation with W_j (j = 0: lambda_max): convolution with W reversed in j, i.e. ascending nodes.
-        kernel = fft.rfft(weights, n=size, axis=0)  # (F, 3)
-        reference = 1000.0
+        kernel = fft.rfft(weights, n=size, axis=0)  # (F, 3): the correlation as a convolution with W reversed
         scores = np.empty((shapes.shape[0], G))
+        scales = np.empty((shapes.shape[0], G))
         for start in range(0, shapes.shape[0], SCAN_BATCH):
             self._check()
             rows = slice(start, start + SCAN_BATCH)
             U = shapes[rows]
-            values = self.values(U, scale_value=reference)
-            R = self.model.spectra(values, self.cos_theta, reference / x, smooth_relative)  # (B, A, X)
+            # The first scale: Lambda at its low end (optical period P = Lambda / per_period), or the range's.
+            s_first = low / (self.values(U, scale_value=1.0)["Lambda"] if self.optical else np.ones(len(U)))
+            values = self.values(U, scale_value=s_first)
+            R = self.model.spectra(values, self.cos_theta, wavelengths, smooth_relative)  # (B, A, X)
             self.evaluations += U.shape[0] * G
             spectrum = fft.rfft(R, n=size, axis=-1)  # (B, A, F)
             xyz = fft.irfft(spectrum[..., None] * kernel[None, None], n=size, axis=-2)[:, :, J : J + G]  # (B, A, G, 3)
             rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
+            s_rows = s_first[:, None] * ratio ** np.arange(G)[None, :]
             # CIEDE2000 at the scales whose CIELAB distance (cheap) is among the SCAN_KEPT smallest.
             proxy = np.sum((rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab) ** 2, axis=(-1, -2))
-            if self.optical:
-                per_period = values["Lambda"] / reference
-                Lambda = s[None, :] * per_period[:, None]
-                box = self.box["Lambda"]
-                proxy = np.where((Lambda >= box.low * (1 - 1e-9)) & (Lambda <= box.high * (1 + 1e-9)), proxy, np.inf)
+            top = s_rows * (values["Lambda"] / s_first)[:, None] if self.optical else s_rows  # Lambda, or the scale
+            proxy = np.where(top <= high * (1.0 + 1e-9), proxy, np.inf)
             kept = np.argpartition(proxy, min(SCAN_KEPT, G) - 1, axis=1)[:, :SCAN_KEPT]
             chosen = np.take_along_axis(rgb, kept[:, :, None, None], axis=1)
             score = np.full(proxy.shape, np.inf)
             finite = np.isfinite(np.take_along_axis(proxy, kept, axis=1))
             np.put_along_axis(score, kept, np.where(finite, np.sum(self.residuals_of(chosen) ** 2, axis=-1), np.inf), axis=1)
             scores[rows] = score
-        return scores, np.clip(p.to_unit(s), 0.0, 1.0)
+            scales[rows] = s_rows
+        return scores, np.clip(p.to_unit(scales), 0.0, 1.0)
 
     def screen(self, U) -> np.ndarray:
         """Sum of squared CIEDE2000 of unit-box rows on the screening model."""
@@ -863,35 +815,6 @@ def _distinct(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DI
     return chosen
 
 
-def _local_scans(problem: _Problem, U: np.ndarray, scores: np.ndarray, rng: np.random.Generator) -> list[np.ndarray]:
-    """
-    The :data:`LOCAL_SCAN_STARTS` best distinct shapes of ``U``, each improved by rounds of
-    :data:`LOCAL_SCAN_SHAPES` normal perturbations (spreads :data:`LOCAL_SCAN_SPREADS`, the scale coordinate
-    then set by the scan), keeping the best; returned best first.
-    """
-    best = [(float(scores[i]), U[i]) for i in _distinct_indices(U, scores, LOCAL_SCAN_STARTS)]
-    for spread in LOCAL_SCAN_SPREADS:
-        trial = np.concatenate([np.clip(u + rng.normal(0.0, spread, (LOCAL_SCAN_SHAPES, u.size)), 0.0, 1.0) for _, u in best])
-        trial, trial_scores = _scan_best(problem, trial)
-        for k in range(len(best)):
-            block = slice(k * LOCAL_SCAN_SHAPES, (k + 1) * LOCAL_SCAN_SHAPES)
-            i = int(np.argmin(trial_scores[block]))
-            if trial_scores[block][i] < best[k][0]:
-                best[k] = (float(trial_scores[block][i]), trial[block][i])
-    return [u for _, u in sorted(best, key=lambda item: item[0])]
-
-
-def _distinct_indices(U: np.ndarray, scores: np.ndarray, count: int, spacing: float = DISTINCT_STARTS) -> list[int]:
-    """Indices of :func:`_distinct`'s rows."""
-    chosen: list[int] = []
-    for index in np.argsort(scores):
-        if all(np.max(np.abs(U[index] - U[c])) > spacing for c in chosen):
-            chosen.append(int(index))
-        if len(chosen) == count:
-            break
-    return chosen
-
-
 def _scan_best(problem: _Problem, shapes: np.ndarray, progress: Callable[[float], None] | None = None,
                chunk: int = 64) -> tuple[np.ndarray, np.ndarray]:
     """Each shape at its best scale of :meth:`_Problem.scale_scan`, and that score."""
@@ -900,19 +823,11 @@ def _scan_best(problem: _Problem, shapes: np.ndarray, progress: Callable[[float]
     for start in range(0, len(shapes), chunk):
         block, grid = problem.scale_scan(shapes[start : start + chunk])
         best = np.argmin(block, axis=1)
-        shapes[start : start + chunk, problem.scale_index] = grid[best]
+        shapes[start : start + chunk, problem.scale_index] = grid[np.arange(len(block)), best]
         scores[start : start + chunk] = block[np.arange(len(block)), best]
         if progress is not None:
             progress(min(1.0, (start + chunk) / len(shapes)))
     return shapes, scores
-
-
-def _scale_grid(p: DesignParameter) -> np.ndarray:
-    """:data:`SCAN_VALUES` unit-box values of a scale parameter, geometrically spaced (and its low end)."""
-    if p.log:
-        return np.linspace(0.0, 1.0, SCAN_VALUES)
-    values = np.geomspace(max(p.low, 1.0), p.high, SCAN_VALUES - 1)
-    return np.clip(p.to_unit(np.concatenate([[p.low], values])), 0.0, 1.0)
 
 
 def design(
@@ -1000,13 +915,6 @@ def design(
             stages["first pass"] = time.perf_counter() - start_time
         # 3. Distinct starts, refined on the coarse model.
         chosen = _distinct(U, scores, starts)
-        if scale is not None and LOCAL_SCAN_STARTS:
-            # 2b. Local scans: the basins in shape are ~0.01 of the box wide (high orders, fringes, frustrated
-            # total reflection), too narrow for the screening model's gradient; shapes drawn ever closer
-            # around the best, each at its best scale, find them.
-            report(0.6, "local scan")
-            chosen = _local_scans(problem, U, scores, np.random.default_rng(seed)) + chosen
-            chosen = _distinct(np.array(chosen), np.arange(len(chosen)), starts, spacing=0.005)
         refined = []
         for k, u0 in enumerate(chosen):
             report(0.6 + 0.2 * k / len(chosen), "local refinement")
