@@ -58,7 +58,7 @@ FIRST_PASS_SAMPLES = 2048
 #: film's thickness) on a geometric grid. A mirror's spectrum shifts by about lambda dLambda / Lambda when
 #: Lambda moves: its colour turns as fast in log Lambda everywhere, by several CIEDE2000 per percent at
 #: high orders (Lambda ~ 1 um), whose basins in Lambda are narrow.
-SCAN_SHAPES = 256
+SCAN_SHAPES = 384
 #: The scan's spectra: samples at this relative step in s / lambda (1.5 nm at 600 nm), also its scales' step.
 SCAN_RELATIVE_STEP = 0.0025
 #: The scan's spectra average out fringes narrower than about this share of the wavelength.
@@ -76,7 +76,8 @@ LOCAL_STARTS = 6
 REFINE_NFEV = 40
 REFINE_SCREEN = True
 POLISHED = 2
-#: Two starts closer than this in the unit box (max norm) are the same basin.
+#: Two starts closer than this in the unit box (max norm) are the same basin; two polished ones, this.
+POLISH_DISTINCT = 0.01
 DISTINCT_STARTS = 0.08
 #: Finite-difference step in the unit box for the coarse Jacobians (the model is smooth there), and the
 #: converged model's (its adaptive refinement moves colours by up to ~2e-4: a larger step).
@@ -589,11 +590,12 @@ class _Problem:
         """The free coordinate that scales every length of the structure (None when it is fixed)."""
         return next((k for k, p in enumerate(self.free) if p.name == self.scale_parameter), None)
 
-    def scale_scan(self, shapes: np.ndarray, relative_step: float = SCAN_RELATIVE_STEP,
-                   smooth_relative: float = SCAN_SMOOTH) -> tuple[np.ndarray, np.ndarray]:
+    def scale_scan(self, shapes: np.ndarray, relative_step: float | None = None,
+                   smooth_relative: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """
         Screening scores ``(B, G)`` of ``shapes`` (unit rows; their scale coordinate ignored) at the scales
-        ``s_bm = s_b r^m`` (``r = 1 + relative_step``) that keep each shape's ``Lambda`` in its box (else
+        ``s_bm = s_b r^m`` (``r = 1 + relative_step``, default :data:`SCAN_RELATIVE_STEP`; fringes averaged
+        below ``smooth_relative`` lambda, default :data:`SCAN_SMOOTH`) that keep each shape's ``Lambda`` in its box (else
         the scale's whole range), and those scales as unit values ``(B, G)``.
 
         Without dispersion a structure's spectrum depends on ``x = s / lambda`` only (every phase is
@@ -605,7 +607,8 @@ class _Problem:
         from scipy import fft
 
         p = self.free[self.scale_index]
-        ratio = 1.0 + relative_step
+        ratio = 1.0 + (SCAN_RELATIVE_STEP if relative_step is None else relative_step)
+        smooth_relative = SCAN_SMOOTH if smooth_relative is None else smooth_relative
         low, high = (self.box["Lambda"].low, self.box["Lambda"].high) if self.optical else (max(p.low, 1.0), p.high)
         G = int(np.ceil(np.log(high / low) / np.log(ratio))) + 1
         nodes, weights = log_nodes(ratio)  # ascending: node J - j is lambda_j
@@ -902,7 +905,8 @@ def design(
         chunk = 256
         if scale is not None:
             # 1-2. Space-filling shapes (Sobol), each at every value of its scale (the scale scan).
-            U = qmc.Sobol(P, scramble=True, seed=seed).random(SCAN_SHAPES)
+            # The first SCAN_SHAPES points of the next power of two (its balance, without scipy's warning).
+            U = qmc.Sobol(P, scramble=True, seed=seed).random_base2(math.ceil(math.log2(SCAN_SHAPES)))[:SCAN_SHAPES]
             U, scores = _scan_best(problem, U, lambda f: report(0.6 * f, "scale scan"))
             stages["scan"] = time.perf_counter() - start_time
         else:
@@ -945,7 +949,9 @@ def design(
         # 4. Polish the best on the converged model, within a time budget.
         best = None
         deadline = time.process_time() + POLISH_SECONDS
-        for k, (_, _, u) in enumerate(refined[:POLISHED]):
+        # Distinct ones: the second scan's refinements often end in the first's basin.
+        polished = _distinct(np.array([u for _, _, u in refined]), np.arange(len(refined)), POLISHED, spacing=POLISH_DISTINCT)
+        for k, u in enumerate(polished):
             report(0.8 + 0.2 * k / POLISHED, "polish")
             values, cost = _polish(problem, u, max_nfev=20, deadline=deadline)
             if best is None or cost < best[1]:
