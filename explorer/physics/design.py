@@ -7,9 +7,11 @@ tabulated method shows, :func:`explorer.physics.bragg.reference_rgb`,
 :func:`explorer.physics.thinfilm.reference_rgb`). The search minimises the sum of the squared CIEDE2000
 differences over the targets, in three stages:
 
-1. a space-filling first pass: a scrambled Sobol sequence over the free parameters' box (``N`` on a log
-   scale), every candidate evaluated at once by a vectorised coarse model (:func:`bragg_rgb_batch`,
-   :func:`thin_film_rgb_batch`: point samples every :data:`COARSE_STEP` nm, ``N`` continuous);
+1. a space-filling first pass: a scrambled Sobol sequence of shapes over the free parameters' box (``N`` on
+   a log scale, continuous), each at every value of the length that scales it (:meth:`_Problem.scale_scan`:
+   one spectrum per shape over ``s / lambda``, a correlation with the CMFs gives every scale); without a
+   free scale, every candidate evaluated at once by a vectorised coarse model (:func:`bragg_rgb_batch`,
+   :func:`thin_film_rgb_batch`: point samples every :data:`COARSE_STEP` nm);
 2. local refinement (``scipy.optimize.least_squares``) of the best distinct candidates on the coarse model,
    with Jacobians by finite differences evaluated in one batch;
 3. a polish of the best few on the converged model with ``N`` rounded to an integer.
@@ -58,27 +60,29 @@ FIRST_PASS_SAMPLES = 2048
 #: film's thickness) on a geometric grid. A mirror's spectrum shifts by about lambda dLambda / Lambda when
 #: Lambda moves: its colour turns as fast in log Lambda everywhere, by several CIEDE2000 per percent at
 #: high orders (Lambda ~ 1 um), whose basins in Lambda are narrow.
-SCAN_SHAPES = 384
-#: The scan's spectra: samples at this relative step in s / lambda (1.5 nm at 600 nm), also its scales' step.
-SCAN_RELATIVE_STEP = 0.0025
+SCAN_SHAPES = 1024
+#: The scan's spectra: samples at this relative step in s / lambda (3 nm at 600 nm), also its scales' step.
+SCAN_RELATIVE_STEP = 0.005
 #: The scan's spectra average out fringes narrower than about this share of the wavelength.
 SCAN_SMOOTH = 0.004
 #: The scan's CIEDE2000 is evaluated at this many scales per shape, those nearest in CIELAB.
 SCAN_KEPT = 48
-#: Shapes per batch of the scan (memory: shapes x angles x values x 118 nodes).
+#: Shapes per batch of the scan (memory: shapes x angles x ~1800 samples x 3, complex).
 SCAN_BATCH = 8
 #: CPU seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
 #: CPU time, not wall time: a design's result must not depend on how busy the machine is.
 POLISH_SECONDS = 2.0
 #: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
 LOCAL_STARTS = 6
-#: Evaluations of each coarse refinement (0: none, the scans' shapes go to the polish).
+#: Evaluations of each coarse refinement (0: none, the scan's shapes go to the polish), and whether it starts on
+#: the screening model (smoother: its moves reach basins the 2-nm model alone misses).
 REFINE_NFEV = 40
 REFINE_SCREEN = True
 POLISHED = 2
-#: Two starts closer than this in the unit box (max norm) are the same basin; two polished ones, this.
-POLISH_DISTINCT = 0.01
+#: Two starts closer than this in the unit box (max norm) are the same basin.
 DISTINCT_STARTS = 0.08
+#: Two polished candidates closer than this are the same one.
+POLISH_DISTINCT = 0.01
 #: Finite-difference step in the unit box for the coarse Jacobians (the model is smooth there), and the
 #: converged model's (its adaptive refinement moves colours by up to ~2e-4: a larger step).
 COARSE_DIFF_STEP = 1e-4
