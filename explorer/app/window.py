@@ -250,6 +250,7 @@ class App:
             io.config_flags |= imgui.ConfigFlags_.docking_enable
             io.set_ini_filename(None)  # the layout is built here, the same every time
             _style(imgui, implot)
+            _fonts(imgui)
             backend = GlfwRenderer(window)
             self.scheduler = Scheduler(self.renderer)
             self.panels = [panel(self) for panel in PANELS]
@@ -426,6 +427,32 @@ class App:
         record(state, "menu_help")
         imgui.text(f"   {state.frame_label()}")
         imgui.end_main_menu_bar()
+
+
+#: The font whose glyphs fill in what ImGui's default (ProggyClean, ASCII only) lacks: ΔE2000, θ, λ, ≤, °, ...
+#: matplotlib's DejaVu Sans Mono, a dependency already: no font file of our own, nothing downloaded.
+FALLBACK_FONT = Path("mpl-data") / "fonts" / "ttf" / "DejaVuSansMono.ttf"
+
+
+def _fonts(imgui) -> None:
+    """
+    ImGui's default font with DejaVu Sans Mono merged under it: ASCII keeps the default's look and metrics,
+    and the labels' Greek letters and symbols (ΔE2000, θ, ≤) no longer show as '?'. ImGui 1.92 loads the
+    merged glyphs on demand (the backend renders textures), so no glyph ranges are listed.
+    """
+    import importlib.util
+
+    io = imgui.get_io()
+    io.fonts.add_font_default()
+    spec = importlib.util.find_spec("matplotlib")
+    roots = list(spec.submodule_search_locations or []) if spec is not None else []
+    for root in roots:
+        path = Path(root) / FALLBACK_FONT
+        if path.is_file():
+            config = imgui.ImFontConfig()
+            config.merge_mode = True
+            io.fonts.add_font_from_file_ttf(str(path), 0.0, config)  # 0: the default font's size
+            return
 
 
 def _style(imgui, implot) -> None:
