@@ -20,7 +20,7 @@ class ParametersPanel(Panel):
 
     def draw(self, imgui) -> None:
         state, app = self.state, self.app
-        imgui.text_wrapped(str(state.material_path))
+        imgui.text_wrapped(_shown_path(state.material_path))
         reload_clicked = imgui.button("Reload (F5)")
         record(state, "reload")
         if reload_clicked:
@@ -157,3 +157,14 @@ class ParametersPanel(Panel):
         if new != value:
             state.values = {**state.values, name: new}
             state.preset = None
+
+
+def _shown_path(path) -> str:
+    """The material's path as a user would type it: relative to the working directory when inside it."""
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except (ValueError, OSError):
+        return str(path)
