@@ -146,6 +146,15 @@ def test_band_pieces_under_a_vanishing_host_equal_no_host(N, monkeypatch):
     np.testing.assert_allclose(host, bragg.band_pieces_rgb(cos_theta, mirror), atol=1e-7)
 
 
+@pytest.mark.parametrize("mirror", [bragg.BraggMirror(1.0, 1.5, 500.0, 0.5, 1000, nh=1.33),
+                                    bragg.BraggMirror(1.5, 1.0, 80.0, 0.9, 3, nh=2.4)], ids=["N=1000", "N=3,n2<n1"])
+def test_table_rule_under_total_reflection_at_the_host(mirror):
+    """Beyond the host interface's critical angle (nh > n1) n1 is evanescent below the mirror too: R = 1 (white)."""
+    cos_theta = np.array([0.0, 0.2, 0.5])
+    assert (bragg.cell_geometry(cos_theta, mirror, "s").cos_theta_1.imag != 0).all()
+    np.testing.assert_allclose(bragg._converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror), atol=1e-12)
+
+
 def test_band_pieces_under_a_host_cost_is_bounded_in_N(monkeypatch):
     """Under a host too, reflectances per angle do not grow from N = 1000 to 10000."""
     count = 0

@@ -982,21 +982,27 @@ def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
     """
     The converged reference's colours (:func:`reference_rgb`) at a cost that does not grow with ``N``: by Gauss
     quadrature over band pieces (:func:`band_pieces_rgb`) where every wave propagates, from :data:`PIECES_MIN_N` cells
-    (:data:`PIECES_MIN_N_HOST` under a host ``nh != n1``, Appendix D); elsewhere (evanescent layers, total reflection at
-    the host interface, fewer cells) from the fringe average plus the fringes near band edges
-    (:func:`windowed_converged_spectra`), which costs less there (docs/performance.md).
+    (:data:`PIECES_MIN_N_HOST` under a host ``nh != n1``, Appendix D); R = 1 under total reflection at the host
+    interface; elsewhere (evanescent ``n2`` layers, fewer cells) from the fringe average plus the fringes near band
+    edges (:func:`windowed_converged_spectra`), which costs less there (docs/performance.md).
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     first = cell_geometry(cos_theta, mirror, "s")
     min_N = PIECES_MIN_N if first.host_is_n1 else PIECES_MIN_N_HOST
-    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & (mirror.N >= min_N)
+    # Total reflection at the host interface (nh > n1): the wave in n1, the medium below the mirror too, is evanescent,
+    # so nothing is transmitted and the lossless mirror reflects R = 1 at every wavelength (the reference to ~1e-15).
+    total = first.cos_theta_1.imag != 0
+    real = ~total & (first.cos_theta_2.imag == 0) & (mirror.N >= min_N)
+    rest = ~total & ~real
     rgb = np.empty((cos_theta.size, 3))
+    if total.any():
+        rgb[total] = colorimetry.spectrum_to_rgb(np.ones((1, colorimetry.WAVELENGTHS.size)))
     if real.any():
         rgb[real] = band_pieces_rgb(cos_theta[real], mirror)
-    if not real.all():
-        # A host nh != n1, or evanescent layers: the windowed rule (complex arithmetic).
-        spectra, _ = windowed_converged_spectra(cos_theta[~real], mirror, substeps_max=TABLE_MAX_SUBSTEPS)
-        rgb[~real] = colorimetry.spectrum_to_rgb(spectra)
+    if rest.any():
+        # Evanescent n2 layers, or fewer cells: the windowed rule (complex arithmetic where it must).
+        spectra, _ = windowed_converged_spectra(cos_theta[rest], mirror, substeps_max=TABLE_MAX_SUBSTEPS)
+        rgb[rest] = colorimetry.spectrum_to_rgb(spectra)
     return rgb
 
 
