@@ -1865,19 +1865,21 @@ def _host_line_reflectance(lines: _Lines, line, kind, a, sin2_u, cos_psi, sin_ps
     r_h1 = lines.r_h1[line]
     r1, t_cell = _host_slab(lines, line, cos_psi, sin_psi, cos_phi, sin_phi)
     N = float(lines.N)
-    band = np.abs(a) < 1.0
-    sin_u = np.sqrt(sin2_u)
-    A, B = 1.0 - a * t_cell, sin_u * t_cell
+    A, B = 1.0 - a * t_cell, np.sqrt(sin2_u) * t_cell
+    value = np.empty(a.shape)
+    exact = kind != 1
+    band = np.flatnonzero(exact & (np.abs(a) < 1.0))
+    gap = np.flatnonzero(exact & (np.abs(a) >= 1.0))
+    mean = np.flatnonzero(~exact)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        cos_Nu, sin_Nu = _cos_sin(N * np.arccos(np.clip(a, -1.0, 1.0)))
-        _, U_N2, _ = chebyshev_U(np.where(band, 0.0, a), N)  # gap rows only: U_{N-2} / U_{N-1}
-        num = np.where(band, r1 * sin_Nu, r1)
-        den = np.where(band, A * sin_Nu + B * cos_Nu, 1.0 - U_N2 * t_cell)
-        value = np.abs(num + r_h1 * den) ** 2 / np.abs(den + r_h1 * num) ** 2
-        S = A + r_h1 * r1
-        im = np.abs(np.imag(S * np.conj(B)))
-        mean = 1.0 - (1.0 - r_h1 * r_h1) * np.abs(B) ** 2 / np.maximum(im, 1e-300)
-    value = np.where(kind == 1, mean, value)
+        cos_Nu, sin_Nu = _cos_sin(N * np.arccos(a[band]))
+        _, U_N2, _ = chebyshev_U(a[gap], N)  # U_{N-2} / U_{N-1}, scaled in the gap
+        for where, num, den in ((band, r1[band] * sin_Nu, A[band] * sin_Nu + B[band] * cos_Nu),
+                                (gap, r1[gap], 1.0 - U_N2 * t_cell[gap])):
+            value[where] = np.abs(num + r_h1[where] * den) ** 2 / np.abs(den + r_h1[where] * num) ** 2
+        B_m, r_h1_m = B[mean], r_h1[mean]
+        im = np.abs(np.imag((A[mean] + r_h1_m * r1[mean]) * np.conj(B_m)))
+        value[mean] = 1.0 - (1.0 - r_h1_m * r_h1_m) * np.abs(B_m) ** 2 / np.maximum(im, 1e-300)
     return np.where(kind == 3, value - 1.0, value)
 
 
