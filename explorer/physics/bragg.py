@@ -1889,7 +1889,8 @@ PIECES_EXACT_N = 64
 #: integrand is Yeh's R itself up to N = 4 EDGE_FRINGES, and where fringes are wide: WINDOW_EXACT_SUBSTEPS); from
 #: N ~ 64 the pieces do (default mirror, 65 angles: 19 against 30 ms at N = 100), whose cost stops growing.
 PIECES_MIN_N = 64
-#: ... under a host nh != n1, where the windowed rule's complex arithmetic costs ~5x more.
+#: ... under a host nh != n1, where the windowed rule's complex arithmetic costs 2-3.5x more than the pieces already at
+#: N = 1-20 (n1 = 1.33, n2 = 1.8, nh = 1: 49 against 14 ms CPU at N = 1, 82 against 39 at N = 20; docs/performance.md).
 PIECES_MIN_N_HOST = 1
 
 
