@@ -118,7 +118,7 @@ def propagating_angles(mirror, cos_theta):
 
 
 @seed(2022)
-@settings(max_examples=24, deadline=None, database=None, phases=[Phase.explicit, Phase.generate],
+@settings(max_examples=40, deadline=None, database=None, phases=[Phase.explicit, Phase.generate],
           suppress_health_check=[HealthCheck.too_slow])
 @given(draw=st.integers(0, 2**32 - 1), N=st.sampled_from([64, 100, 300, 1000]), nh=st.sampled_from([1.0, 1.33, 1.6, 2.4]))
 def test_band_pieces_under_a_host_equal_converged_reference(draw, N, nh):

@@ -1347,7 +1347,12 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
 #   then R = 1, integrated against the CMFs in closed form.
 #
 # Every panel is also cut to at most PANEL_NM nm for the CMFs. The pieces tile the visible range exactly
-# (tests/test_fast_tables.py). References: Section 3.1 (Eqs. 2, 8-10), Appendix A; Yeh (1988), Chapter 6.
+# (tests/test_fast_tables.py).
+#
+# Under a host nh != n1 (Appendix D) the same pieces hold |r_hN|^2: its transmission peaks are the mirror's dips moved
+# by psi0 in N K Lambda and sharpened to k (_host_dip), so the fringe boundaries move there, and the fringe average is
+# the coherent one (fringe_average_under_host, in closed form). References: Section 3.1 (Eqs. 2, 8-10), Appendices A
+# and D; Yeh (1988), Chapter 6.
 
 #: Fringes from a band edge integrated exactly (Yeh's R); beyond them, the fringe average. 8, not 4: with
 #: fringes up to FRINGE_MEAN_NM wide the average's error at N = 64-100 halved (2e-4 -> 1e-4 of a 1e-5 reference).
