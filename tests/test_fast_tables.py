@@ -136,6 +136,18 @@ def test_band_pieces_under_a_host_equal_converged_reference(draw, N, nh):
         assert error.max() <= NODE_RTOL, (mirror, error.max(), cos_theta[error.argmax()])
 
 
+@pytest.mark.parametrize("mirror, cos_theta", [
+    (bragg.BraggMirror(1.5, 2.0, 300.0, 0.001, 1000, nh=1.0), [0.1, 0.3]),  # nearly closed gaps: peaks off the edges
+    (bragg.BraggMirror(1.5, 1.0, 500.0, 0.5, 64, nh=1.0), [0.02, 0.05]),  # grazing: host and mirror form a cavity
+], ids=["delta=0.001,N=1000", "grazing,N=64"])
+def test_band_pieces_under_a_host_where_its_peaks_move_far(mirror, cos_theta):
+    """The host's peaks far from the mirror's dips (psi0 ~ pi / 2 in N K Lambda): 1.5e-2 and 7e-4 before the boundaries
+    followed them (unwrapped, a fringe back where a peak would sit between an edge and the first boundary)."""
+    cos_theta = np.asarray(cos_theta)
+    error = relative_error(bragg.band_pieces_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror))
+    assert error.max() <= NODE_RTOL, (error.max(), cos_theta[error.argmax()])
+
+
 @pytest.mark.parametrize("N", [1, 20, 100, 1000])
 def test_band_pieces_under_a_vanishing_host_equal_no_host(N, monkeypatch):
     """nh -> n1: the host's path (complex r_hN, shifted fringe boundaries, its fringe average) tends to Yeh's."""

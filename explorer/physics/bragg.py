@@ -1601,9 +1601,13 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
                 # psi0 is defined mod pi: made continuous along each piece from its edge (where psi0 -> 0), so that every
                 # even boundary stays on a peak, also where a host that reflects strongly (grazing) and a weak mirror
                 # form a cavity whose sharp peaks sit near the mirror's half fringes (psi0 ~ pi / 2).
-                psi0 = np.unwrap(psi0.reshape(band.size, H), period=np.pi, axis=1).ravel()
+                psi0 = np.unwrap(psi0.reshape(band.size, H), period=np.pi, axis=1)
                 # u is K Lambda from the piece's edge: N K Lambda = N u where a > 0, N pi - N u where a < 0.
-                goal = target + np.sign(value) * psi0 / N
+                shift = np.sign(value).reshape(band.size, H) * psi0
+                # A peak left between the edge and the first boundary (psi0 not -> 0 at the edge: nearly closed gaps,
+                # delta ~ 0, where the edge's fringes are not sharp) would get plain nodes: the boundaries go a fringe back.
+                shift = (shift - np.pi * (shift[:, :1] > 0.25 * np.pi)).ravel()
+                goal = target + shift / N
                 shifted = np.clip(shifted + (goal - u) / np.maximum(du_dt, 1e-300), 0.0, 1.0)
             bounds = np.maximum.accumulate(np.where(target < 0.5 * np.pi - 1e-12, shifted, bounds)
                                            .reshape(band.size, H), axis=1).ravel()
