@@ -139,7 +139,9 @@ def test_band_pieces_under_a_host_equal_converged_reference(draw, N, nh):
 @pytest.mark.parametrize("mirror, cos_theta", [
     (bragg.BraggMirror(1.5, 2.0, 300.0, 0.001, 1000, nh=1.0), [0.1, 0.3]),  # nearly closed gaps: peaks off the edges
     (bragg.BraggMirror(1.5, 1.0, 500.0, 0.5, 64, nh=1.0), [0.02, 0.05]),  # grazing: host and mirror form a cavity
-], ids=["delta=0.001,N=1000", "grazing,N=64"])
+    # Weak contrast: the host's interference with the mirror, first order in r1, in 6-nm fringes: 4.4e-4 averaged.
+    (bragg.BraggMirror(1.0537408035934563, 1.1014253733312716, 171.63939826275566, 0.3635945633961879, 300, 1.0), [0.5167]),
+], ids=["delta=0.001,N=1000", "grazing,N=64", "weak,N=300"])
 def test_band_pieces_under_a_host_where_its_peaks_move_far(mirror, cos_theta):
     """The host's peaks far from the mirror's dips (psi0 ~ pi / 2 in N K Lambda): 1.5e-2 and 7e-4 before the boundaries
     followed them (unwrapped, a fringe back where a peak would sit between an edge and the first boundary)."""
@@ -152,6 +154,7 @@ def test_band_pieces_under_a_host_where_its_peaks_move_far(mirror, cos_theta):
 def test_band_pieces_under_a_vanishing_host_equal_no_host(N, monkeypatch):
     """nh -> n1: the host's path (complex r_hN, shifted fringe boundaries, its fringe average) tends to Yeh's."""
     monkeypatch.setattr(bragg, "HOST_FRINGE_NODES", bragg.FRINGE_NODES)  # the same nodes: only the formulas differ
+    monkeypatch.setattr(bragg, "HOST_FRINGE_MEAN_GROWTH", bragg.FRINGE_MEAN_GROWTH)
     mirror = bragg.BraggMirror(1.33, 1.8, 500.0, 0.4, N)
     cos_theta = np.linspace(0.05, 1.0, 5)
     host = bragg.band_pieces_rgb(cos_theta, bragg.BraggMirror(1.33, 1.8, 500.0, 0.4, N, nh=1.33 + 1e-9))
