@@ -981,20 +981,28 @@ TABLE_MAX_SUBSTEPS = 1024
 def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
     """
     The converged reference's colours (:func:`reference_rgb`) at a cost that does not grow with ``N``: by Gauss
-    quadrature over band pieces (:func:`band_pieces_rgb`) from :data:`PIECES_MIN_N` cells where every wave
-    propagates and ``nh == n1``; elsewhere from the fringe average plus the fringes near band edges
-    (:func:`windowed_converged_spectra`), which costs less there (docs/performance.md).
+    quadrature over band pieces (:func:`band_pieces_rgb`) where every wave propagates, from :data:`PIECES_MIN_N` cells
+    (:data:`PIECES_MIN_N_HOST` under a host ``nh != n1``, Appendix D); R = 1 under total reflection at the host
+    interface; elsewhere (evanescent ``n2`` layers, fewer cells) from the fringe average plus the fringes near band
+    edges (:func:`windowed_converged_spectra`), which costs less there (docs/performance.md).
     """
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     first = cell_geometry(cos_theta, mirror, "s")
-    real = (first.cos_theta_1.imag == 0) & (first.cos_theta_2.imag == 0) & first.host_is_n1 & (mirror.N >= PIECES_MIN_N)
+    min_N = PIECES_MIN_N if first.host_is_n1 else PIECES_MIN_N_HOST
+    # Total reflection at the host interface (nh > n1): the wave in n1, the medium below the mirror too, is evanescent,
+    # so nothing is transmitted and the lossless mirror reflects R = 1 at every wavelength (the reference to ~1e-15).
+    total = first.cos_theta_1.imag != 0
+    real = ~total & (first.cos_theta_2.imag == 0) & (mirror.N >= min_N)
+    rest = ~total & ~real
     rgb = np.empty((cos_theta.size, 3))
+    if total.any():
+        rgb[total] = colorimetry.spectrum_to_rgb(np.ones((1, colorimetry.WAVELENGTHS.size)))
     if real.any():
         rgb[real] = band_pieces_rgb(cos_theta[real], mirror)
-    if not real.all():
-        # A host nh != n1, or evanescent layers: the windowed rule (complex arithmetic).
-        spectra, _ = windowed_converged_spectra(cos_theta[~real], mirror, substeps_max=TABLE_MAX_SUBSTEPS)
-        rgb[~real] = colorimetry.spectrum_to_rgb(spectra)
+    if rest.any():
+        # Evanescent n2 layers, or fewer cells: the windowed rule (complex arithmetic where it must).
+        spectra, _ = windowed_converged_spectra(cos_theta[rest], mirror, substeps_max=TABLE_MAX_SUBSTEPS)
+        rgb[rest] = colorimetry.spectrum_to_rgb(spectra)
     return rgb
 
 
@@ -1339,7 +1347,12 @@ def windowed_converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror, **kwargs: 
 #   then R = 1, integrated against the CMFs in closed form.
 #
 # Every panel is also cut to at most PANEL_NM nm for the CMFs. The pieces tile the visible range exactly
-# (tests/test_fast_tables.py). References: Section 3.1 (Eqs. 2, 8-10), Appendix A; Yeh (1988), Chapter 6.
+# (tests/test_fast_tables.py).
+#
+# Under a host nh != n1 (Appendix D) the same pieces hold |r_hN|^2: its transmission peaks are the mirror's dips moved
+# by psi0 in N K Lambda and sharpened to k (_host_dip), so the fringe boundaries move there, and the fringe average is
+# the coherent one (fringe_average_under_host, in closed form). References: Section 3.1 (Eqs. 2, 8-10), Appendices A
+# and D; Yeh (1988), Chapter 6.
 
 #: Fringes from a band edge integrated exactly (Yeh's R); beyond them, the fringe average. 8, not 4: with
 #: fringes up to FRINGE_MEAN_NM wide the average's error at N = 64-100 halved (2e-4 -> 1e-4 of a 1e-5 reference).
@@ -1354,6 +1367,13 @@ FRINGE_MEAN_NM = 3.0
 #: ... times N / PIECES_EXACT_N, up to this factor: the average's error at a given fringe width falls with N (measured:
 #: 6-nm fringes 2.8e-4 at N = 64, 1.1e-4 at N = 100, against a 1e-5 reference).
 FRINGE_MEAN_GROWTH = 2.0
+#: ... under a host: a strongly reflecting host interface (grazing) and the mirror form a cavity whose fringes are
+#: not the mirror's shape (nh = 1 over n1 = 1.5, N = 20, cos 0.02: 2.9e-4 with 6 nodes, 1.3e-4 with 8).
+HOST_FRINGE_NODES = 8
+#: ... under a host: its interface and the mirror interfere to first order in the mirror's r1 (the mirror alone: second),
+#: so wide fringes' harmonics weigh more against R: no growth (weak contrast 1.05/1.10 under nh = 1, N = 300: 4.4e-4 with
+#: 6-nm fringes averaged, 1e-7 with 3 nm).
+HOST_FRINGE_MEAN_GROWTH = 1.0
 #: Dips with k = sqrt(1 + F) above this are integrated as 1 - (1 - R), the dip on squeezed nodes.
 DIP_SHARP = 2.0
 #: Panels of a gap's exact part.
@@ -1367,6 +1387,8 @@ ROOT_STEPS = 8
 #: Fringe boundaries: u on this many points of t per piece for first guesses, then Newton steps.
 ROOT_GRID = 17
 ROOT_POLISH = 2
+#: Under a host: Newton steps moving the fringe boundaries to the host's peaks (_host_dip).
+HOST_SHIFT_STEPS = 1
 
 
 @functools.lru_cache(maxsize=None)
@@ -1428,6 +1450,9 @@ class _Lines:
     p2: np.ndarray
     r12_2: np.ndarray
     N: int
+    #: Under a host nh != n1 (Appendix D): the signed r12 and the host interface's real r_h1 per line; None otherwise.
+    r12: np.ndarray | None = None
+    r_h1: np.ndarray | None = None
 
     def a(self, omega, line):
         """``cos K Lambda`` (Eq. 8) and its derivative in omega."""
@@ -1539,7 +1564,8 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         return lam * lam / (2.0 * N * np.maximum(du_domega, 1e-300))
 
     fringe_nm = np.maximum(np.maximum(fringe_nm_at(t0[band]), fringe_nm_at(t1[band])), fringe_nm_at(np.ones(band.size)))
-    mean_nm = FRINGE_MEAN_NM * min(max(N / PIECES_EXACT_N, 1.0), FRINGE_MEAN_GROWTH)
+    growth = FRINGE_MEAN_GROWTH if lines.r_h1 is None else HOST_FRINGE_MEAN_GROWTH
+    mean_nm = FRINGE_MEAN_NM * min(max(N / PIECES_EXACT_N, 1.0), growth)
     whole = exact_everywhere | (fringe_nm > mean_nm) | (BAND_EDGE_FRINGES * np.pi / N >= 0.5 * np.pi)
     u_cut = np.where(whole, 0.5 * np.pi, BAND_EDGE_FRINGES * np.pi / N)
     def fringe_panels(band, u_cut):
@@ -1566,6 +1592,30 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
         f = np.clip((targets - u_a) / np.maximum(u_b - u_a, 1e-300), 0.0, 1.0)
         guess = (grid[j - 1] + f * (grid[1] - grid[0])).ravel()
         bounds = _safeguarded_newton(g, grid[j - 1].ravel(), grid[j].ravel(), guess, False, steps=ROOT_POLISH)
+        if lines.r_h1 is not None:
+            # Under a host the transmission peaks sit at N K Lambda = j pi + psi0 (_host_dip), not at the mirror's
+            # dips: the boundaries move there (Newton steps on N u - psi0 = h pi / 2: psi0 varies slowly), so that the
+            # squeezed nodes are centred on the peaks and the cut to the fringe average lies where the fringes' boundary
+            # terms vanish (cut at the mirror's dip instead: 1.3e-3 at nh = 2.4, N = 100; 3e-5 once moved).
+            shifted = bounds
+            for _ in range(HOST_SHIFT_STEPS):
+                value, slope = a_at_t(shifted, bp)
+                u = np.arccos(np.clip(np.abs(value), 0.0, 1.0))
+                du_dt = np.abs(slope) / np.maximum(np.sin(u), 1e-300)
+                psi0, _ = _host_dip(lines, omega_at(shifted, bp), piece_line[bp])
+                # psi0 is defined mod pi: made continuous along each piece from its edge (where psi0 -> 0), so that every
+                # even boundary stays on a peak, also where a host that reflects strongly (grazing) and a weak mirror
+                # form a cavity whose sharp peaks sit near the mirror's half fringes (psi0 ~ pi / 2).
+                psi0 = np.unwrap(psi0.reshape(band.size, H), period=np.pi, axis=1)
+                # u is K Lambda from the piece's edge: N K Lambda = N u where a > 0, N pi - N u where a < 0.
+                shift = np.sign(value).reshape(band.size, H) * psi0
+                # A peak left between the edge and the first boundary (psi0 not -> 0 at the edge: nearly closed gaps,
+                # delta ~ 0, where the edge's fringes are not sharp) would get plain nodes: the boundaries go a fringe back.
+                shift = (shift - np.pi * (shift[:, :1] > 0.25 * np.pi)).ravel()
+                goal = target + shift / N
+                shifted = np.clip(shifted + (goal - u) / np.maximum(du_dt, 1e-300), 0.0, 1.0)
+            bounds = np.maximum.accumulate(np.where(target < 0.5 * np.pi - 1e-12, shifted, bounds)
+                                           .reshape(band.size, H), axis=1).ravel()
         bounds = np.where(target >= 0.5 * np.pi - 1e-12, 1.0, bounds).reshape(band.size, H)
         cut_t = bounds[:, -1]
         bounds = np.concatenate([np.zeros((band.size, 1)), bounds], axis=1)  # columns: h = 0..H
@@ -1584,19 +1634,21 @@ def _pieces_xyz(lines: _Lines, exact_everywhere: bool, scale: int = 1) -> np.nda
             r12_2 = lines.r12_2[line_dip]
             C2 = 4.0 * r12_2 * sin_phi * sin_phi / (1.0 - r12_2) ** 2  # |C|^2 (Eq. 2) = |r1|^2 / |t1|^2
             F = C2 / np.maximum(np.sin(np.tile(dips * 0.5 * np.pi / N, band.size)) ** 2, 1e-300)
-            k = np.sqrt(1.0 + F)
+            k_dip = np.sqrt(1.0 + F) if lines.r_h1 is None else _host_dip(lines, omega_dip, line_dip)[1]
+            k = k_dip
             left = bounds[:, dips - 1].ravel() - t_dip.ravel()
             right = bounds[:, np.minimum(dips + 1, H)].ravel() - t_dip.ravel()
             sharp = k > DIP_SHARP
             # The map takes psi linear in t over the half panel; the dip's width in t is set by dpsi/dt at the dip.
             value, slope = a_at_t(t_dip.ravel(), dip_piece)
             dpsi_dt = N * np.abs(slope) / np.maximum(np.sqrt(np.maximum(1.0 - value * value, 0.0)), 1e-300)
+            fringe_nodes = FRINGE_NODES if lines.r_h1 is None else HOST_FRINGE_NODES
             for side in (left, right):
-                k = np.sqrt(1.0 + F) * np.clip(dpsi_dt * np.abs(side) / (0.5 * np.pi), 0.25, 4.0)
+                k = k_dip * np.clip(dpsi_dt * np.abs(side) / (0.5 * np.pi), 0.25, 4.0)
                 # Soft dips: Yeh's R on plain nodes (1 and R - 1 would cancel to R's small values).
-                add(dip_piece[~sharp], t_dip.ravel()[~sharp], side[~sharp], np.ones(int((~sharp).sum())), 0, FRINGE_NODES)
-                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], np.ones(int(sharp.sum())), 2, FRINGE_NODES)
-                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], k[sharp], 3, FRINGE_NODES)
+                add(dip_piece[~sharp], t_dip.ravel()[~sharp], side[~sharp], np.ones(int((~sharp).sum())), 0, fringe_nodes)
+                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], np.ones(int(sharp.sum())), 2, fringe_nodes)
+                add(dip_piece[sharp], t_dip.ravel()[sharp], side[sharp], k[sharp], 3, fringe_nodes)
         return cut_t
 
     cut_band = np.ones(band.size)
@@ -1751,6 +1803,9 @@ def _line_reflectance_block(lines: _Lines, omega, line, kind) -> np.ndarray:
     band = np.flatnonzero(exact & (np.abs(a) < 1.0))
     gap = np.flatnonzero(exact & (np.abs(a) >= 1.0))
     mean = np.flatnonzero(~exact)
+    if lines.r_h1 is not None:
+        out[rows] = _host_line_reflectance(lines, line, kind, a, sin2_u, cos_psi, sin_psi, cos_phi, sin_phi)
+        return out
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         # Pass band: the deficit 1 - R = |t1|^2 sin^2 u / (|r1|^2 sin^2 N u + |t1|^2 sin^2 u).
         sin_Nu = _cos_sin(N * np.arccos(a[band]))[1]
@@ -1769,18 +1824,95 @@ def _line_reflectance_block(lines: _Lines, omega, line, kind) -> np.ndarray:
     return out
 
 
+def _host_slab(lines: _Lines, line, cos_psi, sin_psi, cos_phi, sin_phi) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 10's ``r1 = r12 (1 - e^{2i phi}) / (1 - r12^2 e^{2i phi})`` and ``t_cell = t1 e^{i psi}`` (Appendix D)."""
+    r12 = lines.r12[line]
+    r12_2 = r12 * r12
+    e_phi = cos_phi + 1j * sin_phi
+    e_2phi = e_phi * e_phi
+    inverse = 1.0 / (1.0 - r12_2 * e_2phi)
+    return r12 * (1.0 - e_2phi) * inverse, (1.0 - r12_2) * e_phi * inverse * (cos_psi + 1j * sin_psi)
+
+
+def _host_dip(lines: _Lines, omega, line) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Where the transmission peaks of a mirror under a host lie and how sharp they are, in a pass band: with
+    ``z = -S / B = p + i q`` (:func:`_host_line_reflectance`), ``1 - |r_hN|^2 = (1 - R_h1) / D(psi)``,
+    ``D = (cos psi - p sin psi)^2 + q^2 sin^2 psi``, ``psi = N K Lambda``: a quadratic form in ``(cos psi, sin psi)``,
+    smallest at ``psi0 = atan2(2p, p^2 + q^2 - 1) / 2`` (mod pi), with eigenvalues ``l1 l2 = q^2``,
+    ``l1 + l2 = 1 + p^2 + q^2``. So ``D = l1 (1 + (k^2 - 1) sin^2(psi - psi0))`` with ``k = l2 / q``: the mirror's
+    dip shape (``psi0 = 0``, ``k = sqrt(1 + F)`` without a host), shifted by ``psi0``.
+
+    Returns
+    -------
+    psi0, k : ndarray
+    """
+    p2 = lines.p2[line]
+    cos_psi, sin_psi = _cos_sin(omega * (lines.n_plus[line] - p2))
+    cos_phi, sin_phi = _cos_sin(omega * p2)
+    a = cos_psi * cos_phi - (lines.alpha[line] - lines.beta[line]) * (sin_psi * sin_phi)
+    r1, t_cell = _host_slab(lines, line, cos_psi, sin_psi, cos_phi, sin_phi)
+    B = np.sqrt(np.maximum(1.0 - a * a, 0.0)) * t_cell
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        z = -(1.0 - a * t_cell + lines.r_h1[line] * r1) / B
+        p, q = np.real(z), np.abs(np.imag(z))
+        s = 1.0 + p * p + q * q
+        k = 0.5 * (s + np.sqrt(np.maximum(s * s - 4.0 * q * q, 0.0))) / q
+        psi0 = 0.5 * np.arctan2(2.0 * p, p * p + q * q - 1.0)
+    # At a band edge (B = 0) the peaks are the edge's own: no shift, and sharp.
+    finite = np.isfinite(psi0) & np.isfinite(k)
+    return np.where(finite, psi0, 0.0), np.where(finite, k, 1e300)
+
+
+def _host_line_reflectance(lines: _Lines, line, kind, a, sin2_u, cos_psi, sin_psi, cos_phi, sin_phi) -> np.ndarray:
+    """
+    :func:`_line_reflectance_block`'s values under a host ``nh != n1`` (every wave propagating, so ``r12`` and ``r_h1``
+    real): ``|r_hN|^2`` (Appendix D), the same ``r_hN = (r_N + r_h1) / (1 + r_h1 r_N)`` as :func:`reference_rgb`'s.
+    With ``r_N = num / den``: in a pass band ``num = r1 sin N u``, ``den = A sin N u + B cos N u`` (``A = 1 - a t_cell``,
+    ``B = sin u t_cell``, ``t_cell = t1 e^{i psi}``: Appendix D's ``r1 U_{N-1} / (U_{N-1} - U_{N-2} t_cell)`` times
+    ``sin u``, finite at dips and edges); in a gap Eq. 9's scaled Chebyshev values (:func:`chebyshev_U`). The fringe
+    average (kind 1) is :func:`fringe_average_under_host`'s for a lossless cell: with ``r_hN = (P + Q x) / (S + T x)``,
+    ``x = cot N u``, ``1 - |r_hN|^2 = (1 - R_h1)(1 + x^2) / |x - z|^2``, ``z = -S / T``, whose Cauchy average over
+    a fringe is ``(1 - R_h1) / |Im z|``: ``Rbar = 1 - (1 - R_h1) |B|^2 / |Im(S B*)|``, ``S = A + r_h1 r1``.
+    A gap that reflects 1 still does under the (lossless) host interface: kind 2 stays 1, kind 3 is ``R - 1``.
+    """
+    r_h1 = lines.r_h1[line]
+    r1, t_cell = _host_slab(lines, line, cos_psi, sin_psi, cos_phi, sin_phi)
+    N = float(lines.N)
+    A, B = 1.0 - a * t_cell, np.sqrt(sin2_u) * t_cell
+    value = np.empty(a.shape)
+    exact = kind != 1
+    band = np.flatnonzero(exact & (np.abs(a) < 1.0))
+    gap = np.flatnonzero(exact & (np.abs(a) >= 1.0))
+    mean = np.flatnonzero(~exact)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        cos_Nu, sin_Nu = _cos_sin(N * np.arccos(a[band]))
+        _, U_N2, _ = chebyshev_U(a[gap], N)  # U_{N-2} / U_{N-1}, scaled in the gap
+        for where, num, den in ((band, r1[band] * sin_Nu, A[band] * sin_Nu + B[band] * cos_Nu),
+                                (gap, r1[gap], 1.0 - U_N2 * t_cell[gap])):
+            value[where] = np.abs(num + r_h1[where] * den) ** 2 / np.abs(den + r_h1[where] * num) ** 2
+        B_m, r_h1_m = B[mean], r_h1[mean]
+        im = np.abs(np.imag((A[mean] + r_h1_m * r1[mean]) * np.conj(B_m)))
+        value[mean] = 1.0 - (1.0 - r_h1_m * r_h1_m) * np.abs(B_m) ** 2 / np.maximum(im, 1e-300)
+    return np.where(kind == 3, value - 1.0, value)
+
+
 #: Below this many cells the pieces integrate Yeh's R throughout (the fringe average's far harmonics still count).
 PIECES_EXACT_N = 64
 #: From this many cells the table's colours come from the band pieces. Below it the windowed rule costs less (its
 #: integrand is Yeh's R itself up to N = 4 EDGE_FRINGES, and where fringes are wide: WINDOW_EXACT_SUBSTEPS); from
 #: N ~ 64 the pieces do (default mirror, 65 angles: 19 against 30 ms at N = 100), whose cost stops growing.
 PIECES_MIN_N = 64
+#: ... under a host nh != n1, where the windowed rule's complex arithmetic costs 2-3.5x more than the pieces already at
+#: N = 1-20 (n1 = 1.33, n2 = 1.8, nh = 1: 49 against 14 ms CPU at N = 1, 82 against 39 at N = 20; docs/performance.md).
+PIECES_MIN_N_HOST = 1
 
 
 def band_pieces_rgb(cos_theta: ArrayLike, mirror: BraggMirror, scale: int = 1) -> np.ndarray:
     """
     Linear sRGB of the converged spectral reference (:func:`reference_rgb` without a step) by Gauss quadrature
-    over band pieces (the section's comment), for angles where every wave propagates and ``nh == n1``.
+    over band pieces (the section's comment), for angles where every wave propagates (under a host ``nh != n1`` too:
+    Appendix D's ``|r_hN|^2`` at the nodes, :func:`_host_line_reflectance`).
 
     Parameters
     ----------
@@ -1800,13 +1932,16 @@ def band_pieces_rgb(cos_theta: ArrayLike, mirror: BraggMirror, scale: int = 1) -
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     geometries = [cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS]
     first = geometries[0]
-    if not (first.host_is_n1 and (first.cos_theta_1.imag == 0).all() and (first.cos_theta_2.imag == 0).all()):
-        raise ValueError("band_pieces_rgb: real angles only (nh == n1, no evanescent layer)")
+    if not ((first.cos_theta_1.imag == 0).all() and (first.cos_theta_2.imag == 0).all()):
+        raise ValueError("band_pieces_rgb: real angles only (no evanescent layer, no total reflection at the host)")
     p1 = np.concatenate([g.p1.real for g in geometries])
     p2 = np.concatenate([g.p2.real for g in geometries])
     Omega_ = np.concatenate([g.Omega.real for g in geometries])
-    lines = _Lines(p1 + p2, p1 - p2, 0.5 + 0.25 * Omega_, 0.5 - 0.25 * Omega_, p2,
-                   np.concatenate([g.r12.real ** 2 for g in geometries]), int(mirror.N))
+    r12 = np.concatenate([g.r12.real for g in geometries])
+    # Under a host (Appendix D) the nodes take |r_hN|^2; r_h1 is real where the wave in n1 propagates.
+    r_h1 = None if first.host_is_n1 else np.concatenate([np.broadcast_to(g.r_h1.real, g.p1.shape) for g in geometries])
+    lines = _Lines(p1 + p2, p1 - p2, 0.5 + 0.25 * Omega_, 0.5 - 0.25 * Omega_, p2, r12 * r12, int(mirror.N),
+                   r12=r12, r_h1=r_h1)
     exact_everywhere = mirror.N < PIECES_EXACT_N or BAND_EDGE_FRINGES * np.pi / mirror.N >= 0.5 * np.pi
     xyz = _pieces_xyz(lines, exact_everywhere, scale)
     xyz = 0.5 * (xyz[: cos_theta.size] + xyz[cos_theta.size :])
