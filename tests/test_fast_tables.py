@@ -78,8 +78,8 @@ def test_band_pieces_equal_converged_reference_on_random_mirrors():
     assert not failures, "\n".join(failures)
 
 
-def test_band_pieces_cost_is_bounded_in_N(monkeypatch):
-    """Reflectances evaluated per angle, counted: bounded from N = 1000 to N = 10000 (no fringe floor)."""
+def _reflectances_per_angle(monkeypatch, cos_theta, mirror_at) -> dict[int, float]:
+    """Reflectances :func:`bragg.band_pieces_rgb` evaluates per angle, counted, for ``mirror_at(N)`` at N = 1000, 3000, 10000."""
     count = 0
     original = bragg._line_reflectance
 
@@ -89,12 +89,17 @@ def test_band_pieces_cost_is_bounded_in_N(monkeypatch):
         return original(lines, omega, line, kind)
 
     monkeypatch.setattr(bragg, "_line_reflectance", counting)
-    cos_theta = np.linspace(0.0, 1.0, 17)
     samples = {}
     for N in (1000, 3000, 10000):
         count = 0
-        bragg.band_pieces_rgb(cos_theta, bragg.BraggMirror(N=N))
+        bragg.band_pieces_rgb(cos_theta, mirror_at(N))
         samples[N] = count / cos_theta.size
+    return samples
+
+
+def test_band_pieces_cost_is_bounded_in_N(monkeypatch):
+    """Reflectances evaluated per angle, counted: bounded from N = 1000 to N = 10000 (no fringe floor)."""
+    samples = _reflectances_per_angle(monkeypatch, np.linspace(0.0, 1.0, 17), lambda N: bragg.BraggMirror(N=N))
     assert max(samples.values()) <= 1.5 * min(samples.values()) and max(samples.values()) < 2000, samples
 
 
@@ -172,21 +177,7 @@ def test_table_rule_under_total_reflection_at_the_host(mirror):
 
 def test_band_pieces_under_a_host_cost_is_bounded_in_N(monkeypatch):
     """Under a host too, reflectances per angle do not grow from N = 1000 to 10000."""
-    count = 0
-    original = bragg._line_reflectance
-
-    def counting(lines, omega, line, kind):
-        nonlocal count
-        count += int(np.sum(kind != 2))
-        return original(lines, omega, line, kind)
-
-    monkeypatch.setattr(bragg, "_line_reflectance", counting)
-    cos_theta = np.linspace(0.05, 1.0, 9)
-    samples = {}
-    for N in (1000, 3000, 10000):
-        count = 0
-        bragg.band_pieces_rgb(cos_theta, bragg.BraggMirror(1.33, 1.8, N=N, nh=1.0))
-        samples[N] = count / cos_theta.size
+    samples = _reflectances_per_angle(monkeypatch, np.linspace(0.05, 1.0, 9), lambda N: bragg.BraggMirror(1.33, 1.8, N=N, nh=1.0))
     # HOST_FRINGE_NODES (8, not 6) per half fringe near band edges: ~2100-2400 a line pair here.
     assert max(samples.values()) <= 1.5 * min(samples.values()) and max(samples.values()) < 3000, samples
 
