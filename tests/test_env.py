@@ -87,6 +87,16 @@ def without_hook(path: Path, directory: Path):
     return load_material(copy)
 
 
+def progressive_mean(renderer, material, values, environment, size, spp, **options):
+    """The env view's mean and standard error (float64) after ``spp`` samples per pixel; ``options`` go to the render."""
+    render = ProgressiveEnvRender(renderer, material, values, environment, size, size, **options)
+    try:
+        render.step(spp)
+        return render.image().astype(np.float64), render.standard_error().astype(np.float64)
+    finally:
+        render.release()
+
+
 def z_scores(renderer, material, values, environment, size, spp, seed=0, pixels=None):
     """z per (pixel, channel) inside the disc (or at ``pixels``), the within-tolerance mask, the mean and the integral."""
     from explorer.materials.models import model_for

@@ -58,20 +58,13 @@ def test_cli_probe_options_are_for_the_env_view(tmp_path):
 
 @pytest.mark.gl
 def test_gl_rotation_and_background_equal_numpy(gl_renderer):
-    from test_env import HANDFUL, HANDFUL_MAX_Z, STACK_SIZE, smooth_environment
-
-    from explorer.gpu.env import ProgressiveEnvRender
+    from test_env import HANDFUL, HANDFUL_MAX_Z, STACK_SIZE, progressive_mean, smooth_environment
 
     material = load_material(GGX)
     values = material.resolve({"alpha": 0.3, "F0": 0.8})
     environment = smooth_environment().rotated(57.0)
     size = STACK_SIZE
-    render = ProgressiveEnvRender(gl_renderer, material, values, environment, size, size, background=True)
-    try:
-        render.step(1024)
-        mean, se = render.image().astype(np.float64), render.standard_error().astype(np.float64)
-    finally:
-        render.release()
+    mean, se = progressive_mean(gl_renderer, material, values, environment, size, 1024, background=True)
     exact = env_integral_numpy(model_for(material, values), environment, size, size, background=True).astype(np.float64)
     rows, columns = np.asarray(HANDFUL).T
     z = (mean[rows, columns] - exact[rows, columns]) / np.maximum(se[rows, columns], 1e-30)

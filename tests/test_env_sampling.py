@@ -64,14 +64,9 @@ def test_samples_follow_the_density(name):
 
 
 def run(renderer, material, values, environment, size, spp, weight):
-    from explorer.gpu.env import ProgressiveEnvRender
+    from test_env import progressive_mean
 
-    render = ProgressiveEnvRender(renderer, material, values, environment, size, size, environment_sampling=weight)
-    try:
-        render.step(spp)
-        return render.image().astype(np.float64), render.standard_error().astype(np.float64)
-    finally:
-        render.release()
+    return progressive_mean(renderer, material, values, environment, size, spp, environment_sampling=weight)
 
 
 @pytest.mark.gl

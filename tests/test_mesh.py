@@ -195,9 +195,8 @@ def test_gl_mesh_lit_view_equals_numpy(gl_renderer, make):
 
 @pytest.mark.gl
 def test_gl_mesh_env_view_converges_to_the_numpy_integral(gl_renderer):
-    from test_env import HANDFUL_MAX_Z, smooth_environment
+    from test_env import HANDFUL_MAX_Z, progressive_mean, smooth_environment
 
-    from explorer.gpu.env import ProgressiveEnvRender
     from explorer.views.env import env_integral_numpy
 
     material = load_material(GGX)
@@ -207,12 +206,7 @@ def test_gl_mesh_env_view_converges_to_the_numpy_integral(gl_renderer):
     safe = np.argwhere(surface.covered & (surface.margin > 0.05) & (surface.depth_gap > 0.05))
     pixels = safe[np.linspace(0, len(safe) - 1, 10).astype(int)]
     environment = smooth_environment()
-    render = ProgressiveEnvRender(gl_renderer, material, values, environment, size, size, mesh=mesh)
-    try:
-        render.step(2048)
-        mean, se = render.image().astype(np.float64), render.standard_error().astype(np.float64)
-    finally:
-        render.release()
+    mean, se = progressive_mean(gl_renderer, material, values, environment, size, 2048, mesh=mesh)
     exact = env_integral_numpy(model_for(material, values), environment, size, size, pixels, mesh=mesh)
     rows, columns = pixels.T
     z = (mean[rows, columns] - exact) / np.maximum(se[rows, columns], 1e-30)
