@@ -21,7 +21,7 @@ from explorer.gpu.programs import build_program_source, first_error, specialisat
 from explorer.gpu.tables import ModelCache
 from explorer.gpu.packed_tables import pack_table_intervals
 from explorer.gpu.resources import (
-    BUFFER_SAMPLERS, GL_SAMPLER_BUFFER, GL_UNSIGNED_INT_SAMPLER_BUFFER, BufferTexture, GLResources,
+    BUFFER_SAMPLERS, GL_UNSIGNED_INT_SAMPLER_BUFFER, BufferTexture, GLResources,
     buffer_textures_supported, set_buffer_sampler,
 )
 
@@ -35,7 +35,7 @@ SAMPLER_TYPES = frozenset([*range(0x8B5D, 0x8B65), *range(0x8DC0, 0x8DD9), *rang
 
 
 #: How a model's table is uploaded for a sampler of each GL type (others: "2d", a filtered 2D texture).
-TABLE_KINDS = {GL_SAMPLER_BUFFER: "buffer", GL_UNSIGNED_INT_SAMPLER_BUFFER: "packed"}
+TABLE_KINDS = {GL_UNSIGNED_INT_SAMPLER_BUFFER: "packed"}
 
 
 def _buffer_samplers(program) -> dict[str, int]:
@@ -59,7 +59,7 @@ class Renderer:
         self.buffer_tables = buffer_textures_supported(self.ctx)
         self._programs: dict[tuple, object] = {}
         self._library = self._library_textures()
-        self._model_textures: dict[tuple[str, str], object] = {}  # (name, kind: "2d", "buffer", "packed") -> texture
+        self._model_textures: dict[tuple[str, str], object] = {}  # (name, kind: "2d" or "packed") -> texture
         self._model_texture_keys: dict[tuple[str, str], tuple] = {}  # which model's table each model texture holds
         self._inputs: dict[str, object] = {}
         # id(program) -> (program, its vertex array, its samplers' GL types if one is a buffer sampler, else {})
@@ -81,8 +81,7 @@ class Renderer:
         """
         The texture of a model's table as the program reads it, rewritten in place when its shape is
         unchanged. ``kind`` ``"2d"``: a linearly filtered texture, ``(width, 3)`` a row (height 1),
-        ``(height, width, 3)`` a 2D table (row 0 = texel row 0); ``"buffer"``: a row's float texels in a
-        buffer texture (``samplerBuffer``); ``"packed"``: a row packed one interval a texel
+        ``(height, width, 3)`` a 2D table (row 0 = texel row 0); ``"packed"``: a row packed one interval a texel
         (:func:`explorer.gpu.packed_tables.pack_table_intervals`, ``usamplerBuffer``).
         """
         data = np.ascontiguousarray(table, dtype=np.float32)
@@ -96,7 +95,7 @@ class Renderer:
             # RGBA (alpha 1, as an RGB texture reads): 16-byte texels fetch faster than 12-byte ones
             # (llvmpipe: the tabulated method's sphere ~10% faster; bench --tables).
             data = np.concatenate([data, np.ones(data.shape[:2] + (1,), np.float32)], axis=-1)
-            options = {"buffer": True} if kind == "buffer" else {"linear": True}
+            options = {"linear": True}
         key = (name, kind)
         texture = self._model_textures[key] = self.resources.replace(self._model_textures.get(key), data, origin=name, **options)
         return texture

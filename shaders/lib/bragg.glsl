@@ -496,18 +496,9 @@ vec3 tabulated_rgb(sampler2D table, float cos_theta) {
 }
 
 #ifdef TABLE_BUFFERS
-// The same table in a buffer texture of float texels (the host defines TABLE_BUFFERS where it makes one):
-// the same two texels and float mix, ~13% cheaper on llvmpipe than a 2D texture (docs/performance.md).
-vec3 tabulated_rgb(samplerBuffer table, float cos_theta) {
-    int last = textureSize(table) - 1;
-    float x = clamp(cos_theta, 0.0, 1.0) * float(last);
-    int i = clamp(int(x), 0, max(last - 1, 0));
-    return mix(texelFetch(table, i).rgb, texelFetch(table, min(i + 1, last)).rgb, x - float(i));
-}
-
 // The table packed one interval a texel (what the host uploads for a usamplerBuffer): words 0-2 hold R, G, B
 // of entries i and i + 1 as signed 16-bit codes (low, high half), word 3 the interval's float scale. One
-// fetch a lookup (llvmpipe calls out of line for each), ~20% less CPU than the two above; entries within
+// fetch a lookup (llvmpipe calls out of line for each), ~20% less CPU than two float texels; entries within
 // 1.53e-5 of the interval's largest |channel|, mixed in float. Twin: explorer.gpu.packed_tables.packed_tabulated_rgb.
 vec3 packed_tabulated_rgb(usamplerBuffer table, float cos_theta) {
     int intervals = textureSize(table);
