@@ -46,26 +46,85 @@ def test_batch_film_equals_airy():
 RANGES = dict(n1=(1, 2.5), n2=(1, 2.5), Lambda=(50, 1500), delta=(0, 1), N=(1, 1000), nh=(0, 2.5))
 
 
-@pytest.mark.parametrize("fixed", [{}, {"delta": 0.3, "nh": 0.0}])  # optical period scanned; Lambda scanned
-def test_scale_scan_equals_direct_colours(fixed):
-    # The scan's FFT correlation over log s/lambda against each scale's colours summed directly.
-    from explorer.physics import colorimetry
+def test_colours_invariant_under_index_scaling():
+    # What the scan's index scaling relies on: n1, n2 and the host times k, Lambda over k: the same
+    # reflectance at every angle and wavelength (Yeh's, with Appendix D's host), TIR included.
+    rng = np.random.default_rng(8)
+    cos_theta = np.cos(np.radians([0.0, 30.0, 55.0, 80.0]))[:, None]
+    wavelengths = np.linspace(380.0, 780.0, 81)[None, :]
+    for _ in range(12):
+        n1, n2, nh = rng.uniform(1.0, 1.6, 3)
+        k = rng.uniform(1.0, 1.5)
+        mirror = bragg.BraggMirror(n1=n1, n2=n2, Lambda=rng.uniform(100, 900), delta=rng.uniform(0, 1), N=int(rng.integers(1, 60)), nh=nh)
+        scaled = bragg.BraggMirror(n1=k * n1, n2=k * n2, Lambda=mirror.Lambda / k, delta=mirror.delta, N=mirror.N, nh=k * nh)
+        np.testing.assert_allclose(bragg.bragg_reflectance(cos_theta, wavelengths, scaled),
+                                   bragg.bragg_reflectance(cos_theta, wavelengths, mirror), atol=1e-9)
 
+
+def _scan_problem(fixed):
     model = design.design_model("bragg_mirror")
     targets = [design.Target(a, c) for a, c in [(0.0, (0.1, 0.3, 0.05)), (35.0, (0.05, 0.1, 0.3)), (70.0, (0.2, 0.2, 0.2))]]
-    problem = design._Problem(model, design.parameter_box(model, RANGES), fixed, targets, None)
+    return design._Problem(model, design.parameter_box(model, RANGES), fixed, targets, None)
+
+
+@pytest.mark.parametrize("fixed, window", [({}, False), ({}, True), ({"delta": 0.3, "nh": 0.0}, False)])
+def test_scale_scan_equals_direct_colours(fixed, window):
+    # The scan's FFT correlation over log s/lambda against each scale's colours summed directly (all
+    # free: index scaling; window: the descent's scales around a period).
+    from explorer.physics import colorimetry
+
+    problem = _scan_problem(fixed)
     shapes = np.random.default_rng(5).uniform(0.05, 0.95, (3, len(problem.free)))
-    scores, units = problem.scale_scan(shapes)
+    if window:
+        around = problem.free[problem.scale_index].from_unit(shapes[:, problem.scale_index])
+        scores, scales = problem.scale_scan(shapes, around=around, span=design.DESCENT_SPAN)
+        assert np.all(scales >= around[:, None] / (1 + design.DESCENT_SPAN) * (1 - 1e-12))
+        assert np.all(scales <= around[:, None] * (1 + design.DESCENT_SPAN) * (1 + design.SCAN_RELATIVE_STEP))
+    else:
+        scores, scales = problem.scale_scan(shapes)
     nodes, weights = design.log_nodes(1.0 + design.SCAN_RELATIVE_STEP)
     for b in range(len(shapes)):
         finite = np.flatnonzero(np.isfinite(scores[b]))
         assert finite.size >= 10
         for m in finite[:: max(1, finite.size // 5)]:
-            u = shapes[b].copy()
-            u[problem.scale_index] = units[b, m]
-            R = design.bragg_spectra_batch(problem.values(u[None]), problem.cos_theta, nodes, design.SCAN_SMOOTH)
+            u = problem.at_scale(shapes[b], scales[b, m])
+            R = design.bragg_spectra_batch(problem.values(u), problem.cos_theta, nodes, design.SCAN_SMOOTH)
             direct = np.sum(problem.residuals_of(colorimetry.xyz_to_rgb(R @ weights)) ** 2)
             np.testing.assert_allclose(scores[b, m], direct, rtol=1e-6, atol=1e-9)
+
+
+def test_at_scale_puts_the_structure_in_its_box_with_the_same_colours():
+    # A scale some k allows: at_scale's structure lies in the box and has the colours of the unscaled one.
+    problem = _scan_problem({})
+    assert problem.index_scale
+    shapes = np.random.default_rng(6).uniform(0.0, 1.0, (40, len(problem.free)))
+    scores, scales = problem.scale_scan(shapes)
+    b = np.arange(len(shapes))
+    pick = np.array([np.flatnonzero(np.isfinite(row))[-1] for row in scores])  # the largest allowed period
+    rows = problem.at_scale(shapes, scales[b, pick])
+    values = problem.values(rows)
+    for p in problem.box.values():
+        assert np.all(values[p.name] >= p.low - 1e-9) and np.all(values[p.name] <= p.high + 1e-9), p.name
+    unscaled = problem.values(shapes, scale_value=scales[b, pick])
+    cos_theta = problem.cos_theta
+    np.testing.assert_allclose(design.bragg_rgb_batch(values, cos_theta), design.bragg_rgb_batch(unscaled, cos_theta), atol=1e-9)
+
+
+def test_scan_descent_walks_into_a_basin_the_first_pass_missed():
+    truth = dict(n1=1.45, n2=1.9, Lambda=700.0, delta=0.4, N=9.0, nh=1.6)
+    colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
+    model = design.design_model("bragg_mirror")
+    targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
+    problem = design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
+    P = truth["Lambda"] * (truth["delta"] * truth["n1"] + (1 - truth["delta"]) * truth["n2"])
+    named = dict(truth, optical_period=P, optical_fraction=truth["delta"] * truth["n1"] * truth["Lambda"] / P)
+    u = np.array([float(p.to_unit(named[p.name])) for p in problem.free])
+    starts = np.clip(u + np.random.default_rng(2).normal(0.0, 0.04, (4, u.size)), 0.0, 1.0)
+    starts, before = design._scan_best(problem, starts)
+    after_rows, after = design._scan_descent(problem, starts, before, np.random.default_rng(0))
+    # From an RMS CIEDE2000 per target above 5 to below 2.5: where the local refinement takes over.
+    assert np.all(after <= before)
+    assert np.sqrt(before.min() / len(targets)) > 5.0 and np.sqrt(after.min() / len(targets)) < 2.5, (before, after)
 
 
 
