@@ -216,3 +216,15 @@ def test_round_trip_median(round_trip_medians):
 
 def test_round_trip_share_within_1(round_trip_medians):
     assert np.mean(round_trip_medians <= 1.0) >= 0.9, round_trip_medians
+
+
+def test_a_cancelled_design_stops_within_its_threaded_scan():
+    # The scans run in threads: the app's cancel still ends the design promptly, with DesignCancelled.
+    import time
+
+    targets = [design.Target(a, (0.1, 0.2, 0.3)) for a in (0.0, 30.0, 60.0)]
+    start, stages = time.perf_counter(), []
+    with pytest.raises(design.DesignCancelled):
+        design.design("bragg_mirror", targets, RANGES, cancelled=lambda: time.perf_counter() - start > 0.3,
+                      progress=lambda fraction, stage: stages.append(stage))
+    assert time.perf_counter() - start < 2.0 and "done" not in stages and "descent" not in stages, stages
