@@ -22,13 +22,6 @@ OFFSETS = np.linspace(-0.1, 0.1, 81)
 LABELS = {"n1": "n1", "n2": "n2", "optical_fraction": "first layer's optical share f", "N": "N (log)", "nh": "nh"}
 
 
-def true_unit_row(problem: design._Problem, truth: dict) -> np.ndarray:
-    """The truth's unit coordinates in the search's parametrisation (optical period and share)."""
-    P = truth["Lambda"] * (truth["delta"] * truth["n1"] + (1.0 - truth["delta"]) * truth["n2"])
-    named = dict(truth, optical_period=P, optical_fraction=truth["delta"] * truth["n1"] * truth["Lambda"] / P)
-    return np.array([float(p.to_unit(named[p.name])) for p in problem.free])
-
-
 def main() -> None:
     import matplotlib
 
@@ -45,7 +38,7 @@ def main() -> None:
         colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
         targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
         problem = design._Problem(model, design.parameter_box(model, ranges), {}, targets, None)
-        u = true_unit_row(problem, truth)
+        u = problem.unit_row(truth)
         for k, p in enumerate(problem.free):
             if p.name not in LABELS:
                 continue

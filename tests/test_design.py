@@ -116,9 +116,8 @@ def test_scan_descent_walks_into_a_basin_the_first_pass_missed():
     model = design.design_model("bragg_mirror")
     targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
     problem = design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
-    P = truth["Lambda"] * (truth["delta"] * truth["n1"] + (1 - truth["delta"]) * truth["n2"])
-    named = dict(truth, optical_period=P, optical_fraction=truth["delta"] * truth["n1"] * truth["Lambda"] / P)
-    u = np.array([float(p.to_unit(named[p.name])) for p in problem.free])
+    u = problem.unit_row(truth)
+    np.testing.assert_allclose([problem.fine_values(u[None])[k] for k in truth], list(truth.values()), rtol=1e-12)
     starts = np.clip(u + np.random.default_rng(2).normal(0.0, 0.04, (4, u.size)), 0.0, 1.0)
     starts, before = design._scan_best(problem, starts)
     after_rows, after = design._scan_descent(problem, starts, before, np.random.default_rng(0))

@@ -601,6 +601,19 @@ class _Problem:
             out["delta"] = np.clip((f / out["n1"]) / per_period, 0.0, 1.0)
         return out
 
+    def unit_row(self, structure: Mapping[str, float]) -> np.ndarray:
+        """
+        The unit row of a structure (design values by name): the inverse of :meth:`values`, the optical
+        period ``P = Lambda (delta n1 + (1 - delta) n2)`` and share ``f = delta n1 Lambda / P`` where the
+        search walks those.
+        """
+        named = dict(structure)
+        if self.optical:
+            n1, n2, Lambda, delta = (float(named[k]) for k in ("n1", "n2", "Lambda", "delta"))
+            named["optical_period"] = Lambda * (delta * n1 + (1.0 - delta) * n2)
+            named["optical_fraction"] = delta * n1 * Lambda / named["optical_period"]
+        return np.array([float(p.to_unit(named[p.name])) for p in self.free])
+
     def index_scale_bounds(self, values: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """
         The factors ``k`` (per row, an interval) that keep ``k n1``, ``k n2`` and a host's ``k nh`` inside
