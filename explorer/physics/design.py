@@ -985,11 +985,10 @@ def _scan_descent(problem: _Problem, U: np.ndarray, scores: np.ndarray, rng: np.
         best = np.argmin(block, axis=1)
         move_scores = block[np.arange(len(block)), best].reshape(rows, DESCENT_SAMPLES)
         winners = np.argmin(move_scores, axis=1)
-        for k in range(rows):
-            if move_scores[k, winners[k]] < scores[k]:
-                j = k * DESCENT_SAMPLES + winners[k]
-                U[k] = problem.at_scale(moves[j], grid[j, best[j]])[0]
-                scores[k] = move_scores[k, winners[k]]
+        better = move_scores[np.arange(rows), winners] < scores
+        j = (np.arange(rows) * DESCENT_SAMPLES + winners)[better]
+        U[better] = problem.at_scale(moves[j], grid[j, best[j]])
+        scores[better] = block[j, best[j]]
         if progress is not None:
             progress((step + 1) / len(DESCENT_SIGMAS))
     return U, scores
