@@ -31,6 +31,27 @@ def test_batch_reflectance_equals_yeh_at_integer_N():
         np.testing.assert_allclose(batch[b], exact, atol=1e-9)
 
 
+def test_screening_spectra_batched_equal_one_sample_at_a_time():
+    # The batch evaluates point samples and fringe averages only where each sample's weight needs them;
+    # one wavelength at a time, every call needs just one of the two (or both everywhere). Rows span the
+    # blend between them (N 3-300, Lambda up to 1.5 um) on a scan's log grid.
+    rng = np.random.default_rng(11)
+    count = 12
+    values = dict(n1=rng.uniform(1, 2.5, count), n2=rng.uniform(1, 2.5, count), Lambda=rng.uniform(200, 1500, count),
+                  delta=rng.uniform(0, 1, count), N=np.exp(rng.uniform(np.log(3), np.log(300), count)),
+                  nh=rng.uniform(0, 2.5, count))
+    cos_theta = np.cos(np.radians([0.0, 30.0, 60.0, 85.0]))
+    wavelengths = 830.0 / 1.005 ** np.arange(0, 170, 3)
+    batched = design.bragg_spectra_batch(values, cos_theta, wavelengths, design.SCAN_SMOOTH)
+    single = np.concatenate([design.bragg_spectra_batch(values, cos_theta, wavelengths[j : j + 1], design.SCAN_SMOOTH)
+                             for j in range(wavelengths.size)], axis=-1)
+    np.testing.assert_allclose(batched, single, atol=1e-12)
+    smooth = design.SCAN_SMOOTH * wavelengths
+    path = values["Lambda"] * (values["delta"] * values["n1"] + (1 - values["delta"]) * values["n2"])
+    weight = (wavelengths**2 / (2 * values["N"][:, None] * path[:, None]) / smooth - 1) / 3  # at normal incidence
+    assert np.any((weight > 0) & (weight < 1)) and np.any(weight <= 0) and np.any(weight >= 1)
+
+
 def test_batch_film_equals_airy():
     values = dict(d=np.array([0.0, 300.0, 1200.0]), eta1=np.array([1.0, 1.2, 1.0]), eta2=np.array([1.5, 2.2, 1.33]),
                   eta3=np.array([1.0, 1.5, 0.2]), kappa3=np.array([0.0, 0.0, 3.0]))

@@ -290,15 +290,18 @@ def bragg_reflectance_batch(
     e_psi, e_phi = np.exp(1j * psi), np.exp(1j * phi)
     cos_psi, sin_psi = (e_psi + 1.0 / e_psi) / 2.0, (e_psi - 1.0 / e_psi) / 2j
     cos_phi, sin_phi = (e_phi + 1.0 / e_phi) / 2.0, (e_phi - 1.0 / e_phi) / 2j
-    if step is not None:
+    shape = np.broadcast_shapes(cos_1.shape, wavelengths.shape, n1.shape)
+    if step is None:
+        w_point = np.ones(shape)
+    else:
         # Fringes lambda^2 / (2 N path) apart (path: the cell's optical thickness along z); a point sample
         # per step resolves them from ~4 per fringe, and averages them out below 1 per fringe.
         path = np.maximum(np.real(p1) + np.real(p2), 1e-9)
         fringe = wavelengths**2 / (2.0 * N * path)
-        w_point = np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0)
-    # Where every sample is a point sample (or every one an average), the other is not computed.
-    point = step is None or bool(np.any(w_point > 0.0))
-    averaged = step is not None and bool(np.any(w_point < 1.0))
+        w_point = np.broadcast_to(np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0), shape)
+    # Each sample computes only the reflectances its weight needs: a scan's spectrum runs from point
+    # samples (thin, short cells) to averages (thick stacks), blending both over a factor ~4 in between.
+    point, averaged = w_point > 0.0, w_point < 1.0
     total = 0.0
     for pol in bragg.POLARISATIONS:
         r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
@@ -310,16 +313,30 @@ def bragg_reflectance_batch(
         r1 = r12 * (1.0 - phase2) / denominator
         t1 = (1.0 - r12_2) * e_phi / denominator
         r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
-        R = 0.0
-        if point:
-            U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
-            r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
-            R = np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
-        if averaged:
-            average = bragg.fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), a)
+        R = _where_needed(point, _point_reflectance, a, N, r1, t1, e_psi, r_h1)
+        if averaged.any():
+            average = _where_needed(averaged, lambda *v: bragg.fringe_average_under_host(*v[:3], _Geometry(*v[3:5]), v[5]),
+                                    r1, t1, omega, p1, r_h1, a)
             R = w_point * R + (1.0 - w_point) * average
         total = total + R
     return np.clip(total / 2.0, 0.0, 1.0)
+
+
+def _point_reflectance(a, N, r1, t1, e_psi, r_h1) -> np.ndarray:
+    """``|r_hN|^2`` of :func:`bragg_reflectance_batch` at its samples (Appendix D, ``N`` real)."""
+    U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
+    r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
+    return np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
+
+
+def _where_needed(mask: np.ndarray, function: Callable[..., np.ndarray], *arrays) -> np.ndarray:
+    """``function(*arrays)`` where ``mask`` (the arrays broadcast to its shape), 0 elsewhere."""
+    if mask.all():
+        return np.broadcast_to(function(*arrays), mask.shape)
+    out = np.zeros(mask.shape)
+    if mask.any():
+        out[mask] = function(*(np.broadcast_to(v, mask.shape)[mask] for v in arrays))
+    return out
 
 
 @dataclass
