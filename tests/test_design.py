@@ -238,6 +238,19 @@ def test_round_trip_share_within_1(round_trip_medians):
     assert np.mean(round_trip_medians <= 1.0) >= 0.9, round_trip_medians
 
 
+def test_design_bench_draws_its_mirrors_from_the_seed():
+    # Another seed is another set of mirrors (the docs' is seed 0): its truth is the seed's first draw.
+    run = run_cli("bench", "--design", "1", "--seed", "3", "--json")
+    assert run.returncode == 0, run.stderr
+    report = json.loads(run.stdout)
+    assert report["summary"]["seed"] == 3
+    from explorer.cli.design import load, ranges_of
+
+    ranges = ranges_of(load("bragg_mirror"))
+    assert report["mirrors"][0]["truth"] == design.random_structure("bragg_mirror", ranges, np.random.default_rng(3))
+    assert "--seed goes with --design" in one_line_error(run_cli("bench", "--seed", "3"))
+
+
 def test_a_cancelled_design_stops_within_its_threaded_scan():
     # The scans run in threads: the app's cancel still ends the design promptly, with DesignCancelled.
     import time

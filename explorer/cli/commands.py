@@ -617,6 +617,8 @@ def presets(material, as_json):
               help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
               help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
+@click.option("--seed", "design_seed", type=int, default=None, metavar="SEED",
+              help="With --design: the seed of the mirrors drawn and of their searches (default 0, the docs' set).")
 @click.option("--tables", "tables", is_flag=True,
               help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
 @click.option("--scaling", "scaling", is_flag=True,
@@ -627,7 +629,8 @@ def presets(material, as_json):
               help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
 @click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, tables, scaling, plot, markdown, mitsuba, spp):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, design_seed, tables, scaling, plot, markdown,
+          mitsuba, spp):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -637,6 +640,8 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
 
     if markdown and (as_json or app or position_free or design_count is not None or tables or scaling or mitsuba):
         raise click.UsageError("--markdown goes with Table 1, --thin-film or --layers, without --json")
+    if design_seed is not None and design_count is None:
+        raise click.UsageError("--seed goes with --design")
     if position_free:
         from explorer.cli.bench import run_position_free_bench
 
@@ -645,7 +650,7 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
     if design_count is not None:
         from explorer.cli.design import run_design_bench
 
-        run_design_bench(design_count, as_json=as_json)
+        run_design_bench(design_count, seed=design_seed or 0, as_json=as_json)
         return
     if scaling:
         from explorer.cli.bench import run_scaling_bench
