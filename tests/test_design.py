@@ -205,6 +205,7 @@ def test_thin_film_thickness_from_a_strip(tmp_path):
     (["--target", "0:#ff0000", "--fix", "alpha=0.1"], "not a design parameter"),
     (["--target", "0:#ff0000", "--free", "n1", "--fix", "n1=1"], "also fixed"),
     ([], "at least one"),
+    (["--target", "0:#ff0000", "--seed", "-1"], "'--seed': -1 is not in the range"),
 ])
 def test_bad_input_is_one_line(args, message):
     assert message in one_line_error(run_cli("design", "bragg_mirror", *args))
@@ -249,6 +250,7 @@ def test_design_bench_draws_its_mirrors_from_the_seed():
     ranges = ranges_of(load("bragg_mirror"))
     assert report["mirrors"][0]["truth"] == design.random_structure("bragg_mirror", ranges, np.random.default_rng(3))
     assert "--seed goes with --design" in one_line_error(run_cli("bench", "--seed", "3"))
+    assert "'--seed': -1 is not in the range" in one_line_error(run_cli("bench", "--design", "1", "--seed", "-1"))
 
 
 def test_a_cancelled_design_stops_within_its_threaded_scan():

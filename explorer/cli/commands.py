@@ -617,7 +617,7 @@ def presets(material, as_json):
               help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
               help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
-@click.option("--seed", "design_seed", type=int, default=None, metavar="SEED",
+@click.option("--seed", "design_seed", type=click.IntRange(min=0), default=None, metavar="SEED",
               help="With --design: the seed of the mirrors drawn and of their searches (default 0, the docs' set).")
 @click.option("--tables", "tables", is_flag=True,
               help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")

@@ -161,7 +161,7 @@ def render_command(material_name: str, values: dict) -> str:
 @click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable).")
 @click.option("--free", metavar="NAME,...", help="Search only these parameters; the others keep the material's defaults.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
-@click.option("--seed", type=int, default=0, show_default=True, help="The first pass's Sobol scrambling.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="The first pass's Sobol scrambling (>= 0).")
 def design_command(material, target_texts, target_strip, theta_range, fixes, free, as_json, seed):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
