@@ -206,6 +206,9 @@ def test_thin_film_thickness_from_a_strip(tmp_path):
     (["--target", "0:#ff0000", "--free", "n1", "--fix", "n1=1"], "also fixed"),
     ([], "at least one"),
     (["--target", "0:#ff0000", "--seed", "-1"], "'--seed': -1 is not in the range"),
+    (["--target", "0:#ff0000", "--fix", "N=2.5"], "N is a whole number"),
+    (["--target", "0:#ff0000", "--fix", "n1=1", "--fix", "n1=1.2"], "given twice"),
+    (["--target", "0:#ff0000", "--free", " , "], "name at least one parameter"),
 ])
 def test_bad_input_is_one_line(args, message):
     assert message in one_line_error(run_cli("design", "bragg_mirror", *args))

@@ -122,9 +122,13 @@ def parse_fixes(fixes, free, material):
             value = float("nan")
         if not np.isfinite(value):
             raise click.UsageError(f"--fix {text!r}: the value must be a finite number")
+        if name in fixed:
+            raise click.UsageError(f"--fix {name}: given twice")
         fixed[name] = value
     if free is not None:
         names = [n.strip() for n in free.split(",") if n.strip()]
+        if not names:
+            raise click.UsageError(f"--free {free!r}: name at least one parameter ({', '.join(model.parameters)})")
         for name in names:
             if name not in model.parameters:
                 raise click.UsageError(f"--free {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")

@@ -1068,6 +1068,8 @@ def design(
         low = float(ranges[name][0])
         if not (np.isfinite(value) and low <= value <= p.high):
             raise DesignError(f"cannot fix {name} = {value:g}: outside its range [{low:g}, {p.high:g}]")
+        if p.integer and value != round(value):
+            raise DesignError(f"cannot fix {name} = {value:g}: {name} is a whole number")
     problem = _Problem(model, box, fixed, targets, cancelled)
     report = progress or (lambda fraction, stage: None)
     stages: dict[str, float] = {}
