@@ -162,6 +162,19 @@ def test_design_finds_a_first_order_mirror_and_reports_converged_colours():
     assert result.reachable.all()
 
 
+def test_reachable_colours_are_whole_stacks():
+    # The Design window's chromaticity diagram: every structure behind it has a whole number of cells (a
+    # fractional N is the search's relaxation, with colours no stack has), and its points are their colours.
+    from explorer.physics import colorimetry
+
+    values = design.reachable_structures("bragg_mirror", RANGES, {"nh": 0.0}, samples=64)
+    assert np.all(values["N"] == np.round(values["N"])) and np.all(values["N"] >= 1) and len(np.unique(values["N"])) > 10
+    xy, Y = design.reachable_chromaticities("bragg_mirror", 30.0, RANGES, {"nh": 0.0}, samples=64)
+    xyz = colorimetry.rgb_to_xyz(design.bragg_rgb_batch(values, np.cos(np.radians([30.0])))[:, 0])
+    np.testing.assert_allclose(Y, xyz[:, 1], atol=1e-12)
+    np.testing.assert_allclose(xy, xyz[:, :2] / xyz.sum(axis=-1, keepdims=True), atol=1e-9)
+
+
 def test_json_schema_and_unreachable_target():
     # A saturated red at normal incidence turning green at 60 degrees, one air-layer mirror in air, only
     # its period free: not reachable, the closest structure reported all the same.

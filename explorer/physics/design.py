@@ -1160,24 +1160,43 @@ def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg: ArrayLi
     return model.converged(values, np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), final=True)
 
 
+def reachable_structures(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Mapping[str, float] | None = None,
+                         samples: int = 4096, seed: int = 0) -> dict[str, np.ndarray]:
+    """
+    ``samples`` structures spread over the box (scrambled Sobol over the free parameters, the search's unit
+    box), as arrays of design values; integer parameters (``N``) rounded, since a fractional count has
+    colours no whole stack has.
+    """
+    from scipy.stats import qmc
+
+    model = design_model(model_name)
+    problem = _Problem(model, parameter_box(model, ranges), dict(fixed or {}), [Target(0.0, (0.5, 0.5, 0.5))], None)
+    U = qmc.Sobol(max(len(problem.free), 1), scramble=True, seed=seed).random(samples)[:, : len(problem.free)]
+    values = problem.values(U)
+    for p in problem.free:
+        if p.integer:
+            values[p.name] = np.maximum(np.round(values[p.name]), p.low)
+    return values
+
+
 def reachable_chromaticities(model_name: str, theta_deg: float, ranges: Mapping[str, tuple[float, float]],
                              fixed: Mapping[str, float] | None = None, samples: int = 4096, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """
-    The chromaticities ``(x, y)`` and luminances ``Y`` of structures spread over the box (Sobol, coarse
-    model) at one angle: the colours a Bragg mirror (or film) can make there.
+    The chromaticities ``(x, y)`` and luminances ``Y`` of structures spread over the box
+    (:func:`reachable_structures`, coarse model) at one angle: the colours a Bragg mirror (or film) can
+    make there.
 
     Returns
     -------
     xy : ndarray (M, 2)
     Y : ndarray (M,)
     """
-    from scipy.stats import qmc
-
     model = design_model(model_name)
-    box = parameter_box(model, ranges)
-    problem = _Problem(model, box, dict(fixed or {}), [Target(float(theta_deg), (0.5, 0.5, 0.5))], None)
-    U = qmc.Sobol(max(len(problem.free), 1), scramble=True, seed=seed).random(samples)[:, : len(problem.free)]
-    rgb = problem.coarse_rgb(U)[:, 0]
+    values = reachable_structures(model_name, ranges, fixed, samples, seed)
+    cos_theta = np.cos(np.radians([float(theta_deg)]))
+    count = next(iter(values.values())).shape[0]
+    rgb = np.concatenate([model.batch({k: v[start : start + BATCH] for k, v in values.items()}, cos_theta, COARSE_STEP)[:, 0]
+                          for start in range(0, count, BATCH)])
     xyz = colorimetry.rgb_to_xyz(rgb)
     total = np.maximum(xyz.sum(axis=-1), 1e-12)
     return np.stack([xyz[:, 0] / total, xyz[:, 1] / total], axis=-1), xyz[:, 1]
