@@ -12,7 +12,6 @@ to the design; it does not see the structure.
 
 from __future__ import annotations
 
-
 from explorer.cli.design import load, ranges_of
 from explorer.physics import design
 

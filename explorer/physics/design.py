@@ -147,6 +147,10 @@ class DesignParameter:
             return np.exp(math.log(self.low) + u * (math.log(self.high) - math.log(self.low)))
         return self.low + u * (self.high - self.low)
 
+    def whole(self, value):
+        """``value`` at the nearest whole number in the box for an integer parameter, as it is otherwise."""
+        return np.maximum(np.round(value), self.low) if self.integer else value
+
     def to_unit(self, value):
         value = np.asarray(value, dtype=np.float64)
         if self.high == self.low:
@@ -315,8 +319,7 @@ def bragg_reflectance_batch(
         r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
         R = _where_needed(point, _point_reflectance, a, N, r1, t1, e_psi, r_h1)
         if averaged.any():
-            average = _where_needed(averaged, lambda *v: bragg.fringe_average_under_host(*v[:3], _Geometry(*v[3:5]), v[5]),
-                                    r1, t1, omega, p1, r_h1, a)
+            average = _where_needed(averaged, _averaged_reflectance, r1, t1, omega, p1, r_h1, a)
             R = w_point * R + (1.0 - w_point) * average
         total = total + R
     return np.clip(total / 2.0, 0.0, 1.0)
@@ -327,6 +330,11 @@ def _point_reflectance(a, N, r1, t1, e_psi, r_h1) -> np.ndarray:
     U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
     r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
     return np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
+
+
+def _averaged_reflectance(r1, t1, omega, p1, r_h1, a) -> np.ndarray:
+    """``|r_hN|^2`` of :func:`bragg_reflectance_batch` averaged over its fringes (Appendix D)."""
+    return bragg.fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), a)
 
 
 def _where_needed(mask: np.ndarray, function: Callable[..., np.ndarray], *arrays) -> np.ndarray:
@@ -597,15 +605,17 @@ class _Problem:
         self.evaluations = 0
         self._lock = threading.Lock()  # the scans run in threads (:func:`_threaded_scan`)
 
-    def values(self, U: np.ndarray, scale_value: float | np.ndarray | None = None) -> dict[str, np.ndarray]:
+    def values(self, U: np.ndarray, scale_value: float | np.ndarray | None = None, whole: bool = False) -> dict[str, np.ndarray]:
         """
         Unit-box rows ``(B, P)`` -> every design value as ``(B,)`` arrays. ``scale_value``: the scale
         coordinate at this value (one, or one per row) instead, unclipped (the scale scan's structures).
+        ``whole``: integer parameters (``N``) at their nearest whole values; the search otherwise walks them
+        continuously (a relaxation: a fractional count has colours no stack has).
         """
         U = np.atleast_2d(U)
         out = {name: np.full(U.shape[0], value) for name, value in self.fixed.items()}
         for k, p in enumerate(self.free):
-            out[p.name] = p.from_unit(U[:, k])
+            out[p.name] = p.whole(p.from_unit(U[:, k])) if whole else p.from_unit(U[:, k])
         if scale_value is not None:
             out[self.scale_parameter] = np.broadcast_to(np.asarray(scale_value, dtype=np.float64), (U.shape[0],)).copy()
         if self.optical:
@@ -686,13 +696,13 @@ class _Problem:
         if self.cancelled is not None and self.cancelled():
             raise DesignCancelled()
 
-    def coarse_rgb(self, U, step: float = COARSE_STEP, smooth: float | None = None) -> np.ndarray:
+    def coarse_rgb(self, U, step: float = COARSE_STEP, smooth: float | None = None, whole: bool = False) -> np.ndarray:
         U = np.atleast_2d(U)
         self.evaluations += U.shape[0]
         out = np.empty((U.shape[0], self.cos_theta.size, 3))
         for start in range(0, U.shape[0], BATCH):
             self._check()
-            out[start : start + BATCH] = self.model.batch(self.values(U[start : start + BATCH]), self.cos_theta, step, smooth)
+            out[start : start + BATCH] = self.model.batch(self.values(U[start : start + BATCH], whole=whole), self.cos_theta, step, smooth)
         return out
 
     @property
@@ -785,13 +795,9 @@ class _Problem:
         lab = rgb_to_lab(rgb)
         return delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
 
-    def fine_values(self, u: np.ndarray, fixed_extra: Mapping[str, float] = {}) -> dict[str, float]:
-        values = {k: float(v[0]) for k, v in self.values(u).items()}
-        values.update(fixed_extra)
-        for p in self.box.values():
-            if p.integer:
-                values[p.name] = float(max(round(values[p.name]), p.low))
-        return values
+    def fine_values(self, u: np.ndarray) -> dict[str, float]:
+        """The structure of one unit row, integer parameters whole (fixed ones are: :func:`design` checks)."""
+        return {k: float(v[0]) for k, v in self.values(u, whole=True).items()}
 
     def fine_rgb(self, values: Mapping[str, float], final: bool = False) -> np.ndarray:
         self._check()
@@ -1160,23 +1166,25 @@ def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg: ArrayLi
     return model.converged(values, np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), final=True)
 
 
+def _reachable(model_name: str, theta_deg: float, ranges: Mapping[str, tuple[float, float]],
+               fixed: Mapping[str, float] | None, samples: int, seed: int) -> tuple[_Problem, np.ndarray]:
+    """The problem at one angle and its ``samples`` scrambled-Sobol unit rows (:func:`reachable_structures`)."""
+    from scipy.stats import qmc
+
+    model = design_model(model_name)
+    problem = _Problem(model, parameter_box(model, ranges), dict(fixed or {}), [Target(float(theta_deg), (0.5, 0.5, 0.5))], None)
+    return problem, qmc.Sobol(max(len(problem.free), 1), scramble=True, seed=seed).random(samples)[:, : len(problem.free)]
+
+
 def reachable_structures(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Mapping[str, float] | None = None,
                          samples: int = 4096, seed: int = 0) -> dict[str, np.ndarray]:
     """
     ``samples`` structures spread over the box (scrambled Sobol over the free parameters, the search's unit
-    box), as arrays of design values; integer parameters (``N``) rounded, since a fractional count has
-    colours no whole stack has.
+    box), as arrays of design values; integer parameters (``N``) whole, since a fractional count has
+    colours no stack has.
     """
-    from scipy.stats import qmc
-
-    model = design_model(model_name)
-    problem = _Problem(model, parameter_box(model, ranges), dict(fixed or {}), [Target(0.0, (0.5, 0.5, 0.5))], None)
-    U = qmc.Sobol(max(len(problem.free), 1), scramble=True, seed=seed).random(samples)[:, : len(problem.free)]
-    values = problem.values(U)
-    for p in problem.free:
-        if p.integer:
-            values[p.name] = np.maximum(np.round(values[p.name]), p.low)
-    return values
+    problem, U = _reachable(model_name, 0.0, ranges, fixed, samples, seed)
+    return problem.values(U, whole=True)
 
 
 def reachable_chromaticities(model_name: str, theta_deg: float, ranges: Mapping[str, tuple[float, float]],
@@ -1191,12 +1199,8 @@ def reachable_chromaticities(model_name: str, theta_deg: float, ranges: Mapping[
     xy : ndarray (M, 2)
     Y : ndarray (M,)
     """
-    model = design_model(model_name)
-    values = reachable_structures(model_name, ranges, fixed, samples, seed)
-    cos_theta = np.cos(np.radians([float(theta_deg)]))
-    count = next(iter(values.values())).shape[0]
-    rgb = np.concatenate([model.batch({k: v[start : start + BATCH] for k, v in values.items()}, cos_theta, COARSE_STEP)[:, 0]
-                          for start in range(0, count, BATCH)])
+    problem, U = _reachable(model_name, theta_deg, ranges, fixed, samples, seed)
+    rgb = problem.coarse_rgb(U, whole=True)[:, 0]
     xyz = colorimetry.rgb_to_xyz(rgb)
     total = np.maximum(xyz.sum(axis=-1), 1e-12)
     return np.stack([xyz[:, 0] / total, xyz[:, 1] / total], axis=-1), xyz[:, 1]
@@ -1216,7 +1220,7 @@ def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]],
     values = {}
     for p in parameter_box(model, ranges):
         value = float(p.from_unit(rng.uniform())) if p.name in model.integer_parameters else float(rng.uniform(*ranges[p.name]))
-        values[p.name] = float(round(value)) if p.integer else value
+        values[p.name] = float(p.whole(value))
     return values
 
 
