@@ -148,6 +148,38 @@ def test_scan_descent_walks_into_a_basin_the_first_pass_missed():
 
 
 
+def _problem_of(truth):
+    colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
+    targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
+    model = design.design_model("bragg_mirror")
+    return design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None), targets
+
+
+def test_polish_reaches_a_thick_stack_from_a_hundredth_of_the_box():
+    # A weak-contrast high-order mirror (bands ~1 nm wide): the batch models' Jacobians stalled at ΔE 0.7-1.5.
+    truth = dict(n1=2.063, n2=2.184, Lambda=1208.8, delta=0.322, N=245.0, nh=0.563)
+    problem, targets = _problem_of(truth)
+    u = problem.unit_row(truth)
+    step = np.random.default_rng(0).normal(0.0, 0.01, u.size)
+    step[[k for k, p in enumerate(problem.free) if p.integer]] = 0.0
+    start = np.clip(u + step, 0.0, 1.0)
+    assert np.sqrt(problem.fine_cost(start) / len(targets)) > 5.0
+    values, cost = design._polish(problem, start, max_nfev=20, deadline=float("inf"))
+    assert np.sqrt(cost / len(targets)) < 0.05, values
+
+
+def test_a_guess_joins_the_first_pass():
+    # Two thick cells (N = 2, Lambda ~ 1 um): the search alone ends at Delta E ~10 (docs/design_round_trip.txt, 14).
+    truth = dict(n1=1.622, n2=2.102, Lambda=1081.0, delta=0.9321, N=2.0, nh=1.823)
+    _, targets = _problem_of(truth)
+    result = design.design("bragg_mirror", targets, RANGES, guesses=[truth])
+    assert result.median_delta_e2000 < 0.05, result
+    with pytest.raises(design.DesignError, match="lacks n2"):
+        design.design("bragg_mirror", targets, RANGES, guesses=[{"n1": 1.5}])
+    with pytest.raises(design.DesignError, match="not a finite number"):
+        design.design("bragg_mirror", targets, RANGES, guesses=[{**truth, "delta": float("nan")}])
+
+
 def test_design_finds_a_first_order_mirror_and_reports_converged_colours():
     truth = dict(n1=1.0, n2=1.55, Lambda=320.0, delta=0.6, N=12.0, nh=0.0)
     angles = [0.0, 20.0, 40.0, 60.0]
