@@ -80,7 +80,9 @@ SCAN_BATCH = 8
 SCAN_BATCH_SAMPLES = 1000
 #: CPU seconds the polish on the converged model may take (a mirror with N ~ 1000 costs ~0.1 s a colour).
 #: CPU time, not wall time: a design's result must not depend on how busy the machine is.
-POLISH_SECONDS = 2.0
+POLISH_SECONDS = 1.5
+#: The polish stops below this RMS CIEDE2000 per target (a hundredth of a just-noticeable difference).
+POLISHED_ENOUGH = 0.01
 #: Distinct starts refined on the coarse model, and of those, how many are polished on the converged one.
 LOCAL_STARTS = 6
 #: Evaluations of each coarse refinement.
@@ -899,7 +901,7 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
     lower, upper = _host_bounds(problem, u)
     damping = 1e-3
     for _ in range(max_nfev):
-        if time.process_time() > deadline or cost < 1e-8:
+        if time.process_time() > deadline or cost < POLISHED_ENOUGH**2 * len(problem.targets):
             break
         h = np.where(u[keep] + FINE_DIFF_STEP <= upper[keep], FINE_DIFF_STEP, -FINE_DIFF_STEP)
         U = np.repeat(u[None], keep.size, axis=0)
@@ -1156,7 +1158,7 @@ def design(
             values, cost = _polish(problem, u, max_nfev=20, deadline=deadline)
             if best is None or cost < best[1]:
                 best = (values, cost)
-            if time.process_time() > deadline:
+            if time.process_time() > deadline or best[1] < POLISHED_ENOUGH**2 * len(targets):
                 break
         values = best[0]
         stages["polish"] = time.perf_counter() - start_time
