@@ -23,6 +23,8 @@ def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  
     assert "clicked design:run" in log and not any("timed out" in line for line in log), log
     design = report["design"]
     assert design is not None and not design["running"] and "set" in design, design
+    # The material's structure before the design joined its first pass (the default).
+    assert len(design["guesses"]) == 1 and set(design["guesses"][0]) == set(design["set"]), design["guesses"]
     # The designed structure is the mirror's values now.
     for name, value in design["set"].items():
         assert report["values"][name] == value

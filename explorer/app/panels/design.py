@@ -60,6 +60,9 @@ class DesignPanel(Panel):
         self.strip_path = ""
         self.strip_range = [0.0, 90.0]
         self.fixed_n1_air = False
+        # The material's current structure joins the first pass: designing again after a change of the
+        # targets starts from the last result.
+        self.from_current = True
         self.index_bounds = [1.0, 2.5]
         self.chroma_theta = 0.0
         self._lock = threading.Lock()
@@ -107,16 +110,19 @@ class DesignPanel(Panel):
         ranges = {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
         fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and material.model != "thin_film" else {}
         targets = self.target_list()
+        parameters = inverse_design.design_model(material.model).parameters
+        current = {name: float(self.state.values[name]) for name in parameters if name in self.state.values}
+        guesses = [current] if self.from_current and len(current) == len(parameters) else []
         self._cancel = False
         self.error = ""
         self.progress = (0.0, "starting")
-        self.state.design = {"running": True, "targets": [[t.theta_deg, list(t.rgb)] for t in targets]}
+        self.state.design = {"running": True, "targets": [[t.theta_deg, list(t.rgb)] for t in targets], "guesses": guesses}
 
         def work():
             started = time.perf_counter()
             try:
                 result = inverse_design.design(material.model, targets, ranges, fixed, progress=self._progress,
-                                               cancelled=lambda: self._cancel)
+                                               cancelled=lambda: self._cancel, guesses=guesses)
                 theta = 90.0 * (np.arange(STRIP_COLUMNS) + 0.5) / STRIP_COLUMNS
                 strip = inverse_design.forward_rgb(material.model, result.values, theta)
             except inverse_design.DesignCancelled:
@@ -129,7 +135,7 @@ class DesignPanel(Panel):
                 return
             with self._lock:
                 self.result, self.result_strip = result, strip
-                self.state.design = {**result.as_json(material.model), "running": False,
+                self.state.design = {**result.as_json(material.model), "running": False, "guesses": guesses,
                                      "reachable": result.reachable.tolist(), "wall_seconds": time.perf_counter() - started}
                 self._pending_apply = True
 
@@ -207,6 +213,9 @@ class DesignPanel(Panel):
         imgui.same_line()
         _, self.fixed_n1_air = imgui.checkbox("air layers (n1 = 1)", self.fixed_n1_air)
         record(state, "design:air")
+        imgui.same_line()
+        _, self.from_current = imgui.checkbox("from the current structure", self.from_current)
+        record(state, "design:from_current")
         imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.5)
         typed, path = imgui.input_text("strip image", self.strip_path, imgui.InputTextFlags_.enter_returns_true)
         self.strip_path = path
