@@ -32,12 +32,17 @@ def misses(path: Path) -> list[int]:
     return found
 
 
-def main() -> None:
+def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]]:
+    """The mirror's ranges and model, the round trip's misses, and its true structures (seed 0) up to the last."""
     ranges = ranges_of(load("bragg_mirror"))
-    model = design.design_model("bragg_mirror")
     indices = misses(Path(__file__).with_name("design_round_trip.txt"))
     rng = np.random.default_rng(0)
     truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(max(indices) + 1)]
+    return ranges, design.design_model("bragg_mirror"), indices, truths
+
+
+def main() -> None:
+    ranges, model, indices, truths = round_trip_misses()
     header = " | ".join(f"step {100 * step:g} %, averaged below {100 * smooth:g} %" for step, smooth in SETTINGS)
     print(f"| mirror | N | Λ (nm) | {header} |")
     print("|---|---|---|" + "---|" * len(SETTINGS))

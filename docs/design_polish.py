@@ -9,12 +9,9 @@ limit). Prints the RMS CIEDE2000 per target before and after, four steps per mir
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from design_fidelity import misses
-from explorer.cli.design import load, ranges_of
+from design_fidelity import round_trip_misses
 from explorer.physics import design
 
 SIGMAS = (0.003, 0.01, 0.03)
@@ -22,11 +19,7 @@ TRIES = 4
 
 
 def main() -> None:
-    ranges = ranges_of(load("bragg_mirror"))
-    model = design.design_model("bragg_mirror")
-    indices = misses(Path(__file__).with_name("design_round_trip.txt"))
-    rng = np.random.default_rng(0)
-    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(max(indices) + 1)]
+    ranges, model, indices, truths = round_trip_misses()
     reached = {sigma: 0 for sigma in SIGMAS}
     for index in indices:
         truth = truths[index]
