@@ -174,6 +174,13 @@ def test_a_guess_joins_the_first_pass():
     _, targets = _problem_of(truth)
     result = design.design("bragg_mirror", targets, RANGES, guesses=[truth])
     assert result.median_delta_e2000 < 0.05, result
+    # The command line's --guess, the parameters it omits at the material's defaults (nh = 0 here: host n1).
+    thin = dict(truth, nh=0.0)
+    colours = design.forward_rgb("bragg_mirror", thin, design.ROUND_TRIP_ANGLES)
+    args = [f"--target={a:g}:{c[0]!r},{c[1]!r},{c[2]!r}" for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
+    run = run_cli("design", "bragg_mirror", *args, "--guess", "n1=1.622,n2=2.102,Lambda=1081,delta=0.9321,N=2", "--json")
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["median_delta_e2000"] < 0.05, run.stdout
     with pytest.raises(design.DesignError, match="lacks n2"):
         design.design("bragg_mirror", targets, RANGES, guesses=[{"n1": 1.5}])
     with pytest.raises(design.DesignError, match="not a finite number"):
@@ -254,6 +261,10 @@ def test_thin_film_thickness_from_a_strip(tmp_path):
     (["--target", "0:#ff0000", "--fix", "N=2.5"], "N is a whole number"),
     (["--target", "0:#ff0000", "--fix", "n1=1", "--fix", "n1=1.2"], "given twice"),
     (["--target", "0:#ff0000", "--free", " , "], "name at least one parameter"),
+    (["--target", "0:#ff0000", "--guess", "Lambda"], "expected NAME=VALUE"),
+    (["--target", "0:#ff0000", "--guess", "alpha=1"], "not a design parameter"),
+    (["--target", "0:#ff0000", "--guess", "N=nan"], "finite"),
+    (["--target", "0:#ff0000", "--guess", "N=2,N=3"], "given twice"),
 ])
 def test_bad_input_is_one_line(args, message):
     assert message in one_line_error(run_cli("design", "bragg_mirror", *args))

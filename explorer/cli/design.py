@@ -140,6 +140,32 @@ def parse_fixes(fixes, free, material):
     return fixed
 
 
+def parse_guess(text: str, material) -> dict[str, float]:
+    """``--guess NAME=VALUE,...``: a structure to start from, the parameters it omits at the material's defaults."""
+    from explorer.physics.design import design_model
+
+    model = design_model(material.model)
+    defaults = material.resolve({})
+    guess: dict[str, float] = {}
+    for item in (part.strip() for part in text.split(",")):
+        name, sep, value_text = item.partition("=")
+        name = name.strip()
+        if not sep:
+            raise click.UsageError(f"--guess {text!r}: expected NAME=VALUE,...")
+        if name not in model.parameters:
+            raise click.UsageError(f"--guess {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
+        try:
+            value = float(value_text)
+        except ValueError:
+            value = float("nan")
+        if not np.isfinite(value):
+            raise click.UsageError(f"--guess {item!r}: the value must be a finite number")
+        if name in guess:
+            raise click.UsageError(f"--guess {name}: given twice")
+        guess[name] = value
+    return {name: guess.get(name, float(defaults[name])) for name in model.parameters}
+
+
 def ranges_of(material) -> dict[str, tuple[float, float]]:
     """The declared ``(min, max)`` of each parameter of the material file."""
     return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
@@ -164,9 +190,11 @@ def render_command(material_name: str, values: dict) -> str:
 @click.option("--theta-range", metavar="A,B", help="--target-strip: theta (degrees) at its left and right edges.")
 @click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable).")
 @click.option("--free", metavar="NAME,...", help="Search only these parameters; the others keep the material's defaults.")
+@click.option("--guess", "guess_texts", multiple=True, metavar="NAME=VALUE,...",
+              help="A structure to start from (omitted parameters: the material's defaults); it joins the first pass. Repeatable.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="The first pass's Sobol scrambling (>= 0).")
-def design_command(material, target_texts, target_strip, theta_range, fixes, free, as_json, seed):
+def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, seed):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -189,7 +217,8 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         if not targets:
             raise click.UsageError("give at least one --target THETA:COLOUR or --target-strip IMAGE")
         fixed = parse_fixes(fixes, free, loaded)
-        result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed)
+        guesses = [parse_guess(text, loaded) for text in guess_texts]
+        result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed, guesses=guesses)
     except (LocatedError, DesignError) as error:
         _fail(str(error))
     name = display_path(loaded.path)

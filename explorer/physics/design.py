@@ -1057,9 +1057,9 @@ def design(
     cancelled : callable, optional
         Polled between batches; ``True`` raises :class:`DesignCancelled`.
     guesses : sequence of mapping, optional
-        Structures (every design parameter by name; fixed ones take their fixed values) that join the
-        first pass's shapes, each at its best scale like them: a structure known to be close, such as the
-        material's current one.
+        Structures (every design parameter by name; fixed ones take their fixed values; clipped to the
+        box) that join the first pass's shapes, each at its best scale like them: a structure known to be
+        close, such as the material's current one.
 
     Returns
     -------
