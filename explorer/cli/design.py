@@ -102,29 +102,35 @@ def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS
         raise click.UsageError(f"--target-strip {error}") from None
 
 
+def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE") -> dict[str, float]:
+    """``NAME=VALUE`` items of ``option`` as design values: known names, finite values, each name once."""
+    values: dict[str, float] = {}
+    for item in items:
+        name, sep, value_text = item.partition("=")
+        name = name.strip()
+        if not sep:
+            raise click.UsageError(f"{option} {item!r}: expected {expected}")
+        if name not in model.parameters:
+            raise click.UsageError(f"{option} {name}: not a design parameter of {material_model} ({', '.join(model.parameters)})")
+        try:
+            value = float(value_text)
+        except ValueError:
+            value = float("nan")
+        if not np.isfinite(value):
+            raise click.UsageError(f"{option} {item!r}: the value must be a finite number")
+        if name in values:
+            raise click.UsageError(f"{option} {name}: given twice")
+        values[name] = value
+    return values
+
+
 def parse_fixes(fixes, free, material):
     """``--fix NAME=VALUE`` and ``--free NAME,...`` as the fixed values (every design parameter not free)."""
     from explorer.physics.design import design_model
 
     model = design_model(material.model)
     values = material.resolve({})
-    fixed: dict[str, float] = {}
-    for text in fixes:
-        name, sep, value_text = text.partition("=")
-        name = name.strip()
-        if not sep:
-            raise click.UsageError(f"--fix {text!r}: expected NAME=VALUE")
-        if name not in model.parameters:
-            raise click.UsageError(f"--fix {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
-        try:
-            value = float(value_text)
-        except ValueError:
-            value = float("nan")
-        if not np.isfinite(value):
-            raise click.UsageError(f"--fix {text!r}: the value must be a finite number")
-        if name in fixed:
-            raise click.UsageError(f"--fix {name}: given twice")
-        fixed[name] = value
+    fixed = _named_values("--fix", fixes, model, material.model)
     if free is not None:
         names = [n.strip() for n in free.split(",") if n.strip()]
         if not names:
@@ -146,23 +152,7 @@ def parse_guess(text: str, material) -> dict[str, float]:
 
     model = design_model(material.model)
     defaults = material.resolve({})
-    guess: dict[str, float] = {}
-    for item in (part.strip() for part in text.split(",")):
-        name, sep, value_text = item.partition("=")
-        name = name.strip()
-        if not sep:
-            raise click.UsageError(f"--guess {text!r}: expected NAME=VALUE,...")
-        if name not in model.parameters:
-            raise click.UsageError(f"--guess {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
-        try:
-            value = float(value_text)
-        except ValueError:
-            value = float("nan")
-        if not np.isfinite(value):
-            raise click.UsageError(f"--guess {item!r}: the value must be a finite number")
-        if name in guess:
-            raise click.UsageError(f"--guess {name}: given twice")
-        guess[name] = value
+    guess = _named_values("--guess", [part.strip() for part in text.split(",")], model, material.model, "NAME=VALUE,...")
     return {name: guess.get(name, float(defaults[name])) for name in model.parameters}
 
 
