@@ -804,9 +804,19 @@ class _Problem:
         self.evaluations += 1
         return self.model.converged(values, self.cos_theta, final=final)
 
+    def fine_residuals(self, u: np.ndarray) -> tuple[dict[str, float], np.ndarray]:
+        """One unit row's structure (integer parameters whole) and its residuals on the converged model."""
+        values = self.fine_values(u[None])
+        return values, self.residuals_of(self.fine_rgb(values)[None])[0]
+
     def fine_cost(self, u: np.ndarray) -> float:
-        """Sum of squared CIEDE2000 of one unit row on the converged model (integer parameters whole)."""
-        return float(np.sum(self.residuals_of(self.fine_rgb(self.fine_values(u[None]))[None]) ** 2))
+        """Sum of squared CIEDE2000 of one unit row on the converged model (:meth:`fine_residuals`)."""
+        return float(np.sum(self.fine_residuals(u)[1] ** 2))
+
+    @property
+    def polished_cost(self) -> float:
+        """The cost below which the polish stops: :data:`POLISHED_ENOUGH` per target."""
+        return POLISHED_ENOUGH**2 * len(self.targets)
 
 
 def _least_squares(fun, jac, x0, lower, upper, max_nfev):
@@ -876,8 +886,8 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
     :data:`FINE_DIFF_STEP` (far above its adaptive refinement's ~1e-4 steps in colour), until no step
     lowers the converged cost, after ``max_nfev`` steps, or at ``deadline`` (``time.process_time()``).
     The batch models' Jacobians pointed elsewhere for thick stacks, whose narrow bands and fringes they
-    sample too coarsely: from 0.01 of the box around the truth, the 1-nm batch model's steps ended at
-    ΔE 0.4-3.4 where these reach 0 (docs/design.md).
+    sample too coarsely: from 0.003 of the box around the truths of 8 thick misses, the 1-nm batch model's
+    steps ended below 0.05 per target in 2 of 32 starts, these in 30 (docs/design.md, design_polish.py).
     """
     integer_free = [k for k, p in enumerate(problem.free) if p.integer]
     u0 = u0.copy()
@@ -889,8 +899,7 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
         choices = [np.concatenate([c[:k], [p.to_unit(o)], c[k + 1:]]) for c in choices for o in options]
 
     def fine(u):
-        values = problem.fine_values(u[None])
-        residuals = problem.residuals_of(problem.fine_rgb(values)[None])[0]
+        values, residuals = problem.fine_residuals(u)
         return values, residuals, float(np.sum(residuals**2))
 
     best = min((fine(np.clip(c, 0.0, 1.0)) + (np.clip(c, 0.0, 1.0),) for c in choices), key=lambda item: item[2])
@@ -901,7 +910,7 @@ def _polish(problem: _Problem, u0: np.ndarray, max_nfev: int, deadline: float) -
     lower, upper = _host_bounds(problem, u)
     damping = 1e-3
     for _ in range(max_nfev):
-        if time.process_time() > deadline or cost < POLISHED_ENOUGH**2 * len(problem.targets):
+        if time.process_time() > deadline or cost < problem.polished_cost:
             break
         h = np.where(u[keep] + FINE_DIFF_STEP <= upper[keep], FINE_DIFF_STEP, -FINE_DIFF_STEP)
         U = np.repeat(u[None], keep.size, axis=0)
@@ -1147,7 +1156,8 @@ def design(
         # 4. Polish the best on the converged model, within a time budget: the best as that model ranks
         # them, the coarse refinements' ends and the descent's shapes. The coarse model misjudges thick
         # stacks (their narrow bands fall between its samples): a shape the scan placed in the right basin
-        # was refined out of it (the truth among the scan's shapes: 84 % of round trips within 1, 90 % so).
+        # was refined out of it (the truth among the scan's shapes, docs/design_ceiling.py: 84 % of round
+        # trips within 1 without this ranking, 90 % with it).
         best = None
         deadline = time.process_time() + POLISH_SECONDS
         pool = np.array([u for _, _, u in refined] + (list(U[tops]) if scale is not None else []))
@@ -1158,7 +1168,7 @@ def design(
             values, cost = _polish(problem, u, max_nfev=20, deadline=deadline)
             if best is None or cost < best[1]:
                 best = (values, cost)
-            if time.process_time() > deadline or best[1] < POLISHED_ENOUGH**2 * len(targets):
+            if time.process_time() > deadline or best[1] < problem.polished_cost:
                 break
         values = best[0]
         stages["polish"] = time.perf_counter() - start_time
