@@ -226,12 +226,13 @@ def test_json_schema_and_unreachable_target():
     assert [set(t) for t in result["targets"]] == [{"theta_deg", "target_rgb", "achieved_rgb", "delta_e2000"}] * 2
     assert result["targets"][0]["target_rgb"] == [0.6, 0.03, 0.02]
     assert max(t["delta_e2000"] for t in result["targets"]) > design.REACHABLE_DELTA_E
-    assert "not reachable" in run.stderr
+    assert "not reachable" in run.stderr and "--guess" in run.stderr  # the caveat: the search is not exhaustive
     achieved = design.forward_rgb("bragg_mirror", result["set"], [0.0, 60.0])
     np.testing.assert_allclose(achieved, [t["achieved_rgb"] for t in result["targets"]], atol=1e-9)
     text = run_cli("design", "bragg_mirror", "--target", "0:0.6,0.03,0.02", "--target", "60:0.03,0.5,0.03",
                    "--free", "Lambda", "--fix", "n1=1", "--fix", "nh=0")
     assert "not reachable" in text.stdout and "render: bragg-explorer render" in text.stdout
+    assert "not exhaustive" in text.stdout and "--guess" in text.stdout
 
 
 def test_thin_film_thickness_from_a_strip(tmp_path):

@@ -251,6 +251,10 @@ class DesignPanel(Panel):
             imgui.text_wrapped(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in result.values.items()))
             imgui.text_wrapped("dE2000 per target: " + ", ".join(f"{d:.2f}" for d in result.delta_e2000)
                                + (f"; {unreachable} not reachable: the closest structure found" if unreachable else ""))
+            if unreachable:
+                # The search is not exhaustive (docs/design.md): say so, and what can help.
+                imgui.text_wrapped("The search can miss thick, high-order stacks: 'from the current structure' "
+                                   "starts it from the material's values.")
         self._chromaticity(imgui)
 
     def _strips(self, imgui, strip) -> None:
