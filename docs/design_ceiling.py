@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from design_fidelity import truth_targets
 from explorer.cli.design import load, ranges_of
 from explorer.physics import design
 
@@ -23,9 +24,7 @@ def main() -> None:
     medians = []
     for index in range(COUNT):
         truth = design.random_structure("bragg_mirror", ranges, rng)
-        colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
-        targets = [design.Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(design.ROUND_TRIP_ANGLES, colours)]
-        result = design.design("bragg_mirror", targets, ranges, seed=SEED + index, guesses=[truth])
+        result = design.design("bragg_mirror", truth_targets(truth), ranges, seed=SEED + index, guesses=[truth])
         medians.append(result.median_delta_e2000)
         print(f"{index:3d}  median ΔE2000 {result.median_delta_e2000:.3f}, {result.seconds:.2f} s", flush=True)
     medians = np.array(medians)

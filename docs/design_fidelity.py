@@ -41,6 +41,17 @@ def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]
     return ranges, design.design_model("bragg_mirror"), indices, truths
 
 
+def truth_targets(truth: dict) -> list[design.Target]:
+    """A true structure's converged colours at the round trip's angles, as targets."""
+    colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
+    return [design.Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(design.ROUND_TRIP_ANGLES, colours)]
+
+
+def truth_problem(model: design.DesignModel, ranges: dict, truth: dict) -> design._Problem:
+    """The design problem (every parameter free over ``ranges``) whose targets are ``truth``'s colours."""
+    return design._Problem(model, design.parameter_box(model, ranges), {}, truth_targets(truth), None)
+
+
 def main() -> None:
     ranges, model, indices, truths = round_trip_misses()
     header = " | ".join(f"step {100 * step:g} %, averaged below {100 * smooth:g} %" for step, smooth in SETTINGS)
@@ -48,9 +59,7 @@ def main() -> None:
     print("|---|---|---|" + "---|" * len(SETTINGS))
     for index in indices:
         truth = truths[index]
-        colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
-        targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
-        problem = design._Problem(model, design.parameter_box(model, ranges), {}, targets, None)
+        problem = truth_problem(model, ranges, truth)
         shape = problem.unit_row(truth)[None]
         scores = [problem.scale_scan(shape, relative_step=step, smooth_relative=smooth)[0].min() for step, smooth in SETTINGS]
         print(f"| {index} | {truth['N']:.0f} | {truth['Lambda']:.0f} | " + " | ".join(f"{s:.1f}" for s in scores) + " |")

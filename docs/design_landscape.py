@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from design_fidelity import truth_problem
 from explorer.cli.design import load, ranges_of
 from explorer.physics import design
 
@@ -35,9 +36,7 @@ def main() -> None:
     figure, axes = plt.subplots(1, len(MIRRORS), figsize=(5.2 * len(MIRRORS), 4.6), sharey=True)
     for axis, index in zip(axes, MIRRORS):
         truth = truths[index]
-        colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
-        targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
-        problem = design._Problem(model, design.parameter_box(model, ranges), {}, targets, None)
+        problem = truth_problem(model, ranges, truth)
         u = problem.unit_row(truth)
         for k, p in enumerate(problem.free):
             if p.name not in LABELS:
@@ -48,7 +47,7 @@ def main() -> None:
             axis.semilogy(OFFSETS, np.maximum(scores.min(axis=1), 1e-2), label=LABELS[p.name])
         for spread in (design.DESCENT_SIGMAS[0], design.DESCENT_SIGMAS[-1]):
             axis.axvspan(-spread, spread, color="0.5", alpha=0.08)
-        axis.axhline(len(targets), color="k", lw=0.8, ls=":")
+        axis.axhline(len(problem.targets), color="k", lw=0.8, ls=":")
         axis.set_title(f"round-trip mirror {index}: Λ = {truth['Lambda']:.0f} nm, N = {truth['N']:.0f}, "
                        f"nh = {truth['nh']:.2f}", fontsize=9)
         axis.set_xlabel("offset from the true shape (unit box)")

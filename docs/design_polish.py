@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from design_fidelity import round_trip_misses
+from design_fidelity import round_trip_misses, truth_problem
 from explorer.physics import design
 
 SIGMAS = (0.003, 0.01, 0.03)
@@ -23,9 +23,7 @@ def main() -> None:
     reached = {sigma: 0 for sigma in SIGMAS}
     for index in indices:
         truth = truths[index]
-        colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
-        targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
-        problem = design._Problem(model, design.parameter_box(model, ranges), {}, targets, None)
+        problem = truth_problem(model, ranges, truth)
         u = problem.unit_row(truth)
         whole = [k for k, p in enumerate(problem.free) if p.integer]
         line = []
@@ -35,7 +33,7 @@ def main() -> None:
                 step[whole] = 0.0
                 start = np.clip(u + step, 0.0, 1.0)
                 _, cost = design._polish(problem, start, max_nfev=20, deadline=float("inf"))
-                before, after = (np.sqrt(c / len(targets)) for c in (problem.fine_cost(start), cost))
+                before, after = (np.sqrt(c / len(problem.targets)) for c in (problem.fine_cost(start), cost))
                 reached[sigma] += after < 0.05
                 line.append(f"{before:.1f}->{after:.2f}")
         print(f"{index:3d}  " + "  ".join(line), flush=True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from design_fidelity import round_trip_misses
+from design_fidelity import round_trip_misses, truth_problem
 from explorer.physics import design
 
 DISTANCES = (0.0, 0.005, 0.01, 0.02, 0.05)
@@ -38,9 +38,7 @@ def main() -> None:
     print("mirror  " + "  ".join(f"d={d:<5g}" for d in DISTANCES) + "  random shapes")
     for index in indices:
         truth = truths[index]
-        colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
-        targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
-        problem = design._Problem(model, design.parameter_box(model, ranges), {}, targets, None)
+        problem = truth_problem(model, ranges, truth)
         u = problem.unit_row(truth)
         names = [p.name for p in problem.free]
         scale = problem.scale_index
