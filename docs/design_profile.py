@@ -8,12 +8,13 @@ value of the profiled coordinate:
 - the optical share f (``F_VALUES`` shares over [0, 1]), moving n1, n2, N and the host;
 - the host index (``HOST_VALUES`` values within ``HOST_WINDOW`` of the box around the truth's, or around n1
   where the truth has none: a host of n1's index is no host), moving n1, n2, N and f. The host sets the
-  angle inside each layer (Snell's invariant nh sin theta), so this profiles out the bands' angular shift.
+  angle inside each layer (Snell's invariant nh sin theta), so this profiles out the bands' angular shift;
+- the count N (``COUNT_VALUES`` whole counts, log-spaced over its box), moving n1, n2, f and the host.
 
 Prints the median score (sum over the 5 targets of ΔE2000², ~5 = 1 per target) per distance, and that of
 random shapes.
 
-    .venv/bin/python docs/design_profile.py       # ~3 minutes
+    .venv/bin/python docs/design_profile.py       # ~2 minutes
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ DIRECTIONS = 4
 F_VALUES = 256
 HOST_VALUES = 61
 HOST_WINDOW = 0.15
+COUNT_VALUES = 48
 
 
 def profiled(problem: design._Problem, u: np.ndarray, period: float, coordinate: int, values: np.ndarray) -> float:
@@ -39,7 +41,7 @@ def profiled(problem: design._Problem, u: np.ndarray, period: float, coordinate:
 
 
 def profile_table(profiled_name: str) -> None:
-    """The median scores per distance with ``profiled_name`` (``optical_fraction`` or ``nh``) profiled."""
+    """The median scores per distance with ``profiled_name`` (``optical_fraction``, ``nh`` or ``N``) profiled."""
     ranges, model, indices, truths = round_trip_misses()
     table = {d: [] for d in DISTANCES}
     randoms = []
@@ -57,6 +59,9 @@ def profile_table(profiled_name: str) -> None:
             host = problem.free[coordinate]
             centre = u[coordinate] if truth["nh"] >= model.host_threshold else host.to_unit(truth["n1"])
             values = np.clip(centre + np.linspace(-HOST_WINDOW, HOST_WINDOW, HOST_VALUES), 0.0, 1.0)
+        elif profiled_name == "N":
+            count = problem.free[coordinate]
+            values = count.to_unit(np.unique(np.round(np.geomspace(count.low, count.high, COUNT_VALUES))))
         else:
             values = (np.arange(F_VALUES) + 0.5) / F_VALUES
         rng = np.random.default_rng(index)
@@ -78,7 +83,7 @@ def profile_table(profiled_name: str) -> None:
 
 
 def main() -> None:
-    for name in ("optical_fraction", "nh"):
+    for name in ("optical_fraction", "nh", "N"):
         profile_table(name)
 
 
