@@ -201,16 +201,23 @@ def _interpolation_weights(step: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _interpolation_weights_at(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_interpolation_weights` at ascending ``nodes`` (nm) that span the CMFs' range."""
+    """
+    :func:`_interpolation_weights` at ascending ``nodes`` (nm) that span the CMFs' range: the interpolant
+    sampled every ``1 / K`` nm and integrated against the CMFs' hats as the converged colours are
+    (:func:`explorer.physics.colorimetry.hat_average`), ``K`` the power of two that puts a sample in every
+    node interval (``K = 1``, the 1-nm sum, for nodes 1 nm apart or more).
+    """
     count = nodes.size
-    fine = colorimetry.WAVELENGTHS
+    K = 2 ** max(0, math.ceil(math.log2(1.0 / float(np.min(np.diff(nodes))))))
+    fine = colorimetry.fine_wavelengths(K)
     position = np.interp(fine, nodes, np.arange(count))
     left = np.minimum(np.floor(position).astype(int), count - 2)
     frac = position - left
     interpolation = np.zeros((fine.size, count))
     interpolation[np.arange(fine.size), left] = 1.0 - frac
     interpolation[np.arange(fine.size), left + 1] += frac
-    return nodes, interpolation.T @ colorimetry.colour_matching_functions()
+    # Fortran order: at K = 1 the same product, bit for bit, as the 1-nm sum of the interpolant.
+    return nodes, np.asfortranarray(colorimetry.hat_average(interpolation.T, K)) @ colorimetry.colour_matching_functions()
 
 
 _WEIGHTS: dict[float, tuple[np.ndarray, np.ndarray]] = {}
