@@ -314,6 +314,7 @@ def round_trip_medians():
     results = design.round_trip("bragg_mirror", RANGES, 6, seed=1, draw_ranges=CI_DRAW)
     for result in results:  # what is reported is the converged colour of what is returned
         np.testing.assert_allclose(result.achieved_rgb, design.forward_rgb("bragg_mirror", result.values, design.ROUND_TRIP_ANGLES))
+        assert result.values["nh"] >= 1.0 or result.values["nh"] == RANGES["nh"][0], result.values
     return np.array([r.median_delta_e2000 for r in results])
 
 
@@ -323,6 +324,22 @@ def test_round_trip_median(round_trip_medians):
 
 def test_round_trip_share_within_1(round_trip_medians):
     assert np.mean(round_trip_medians <= 1.0) >= 0.9, round_trip_medians
+
+
+def test_a_host_below_its_threshold_is_reported_as_no_host():
+    # Any nh below 1 means "the host is n1": reported at the range's lower end (the file's "no host"), not
+    # as a number that reads like an index; a fixed one as it was given; a real host as found.
+    model = design.design_model("bragg_mirror")
+    targets = [design.Target(0.0, (0.1, 0.2, 0.3))]
+    found = dict(n1=1.4, n2=1.9, Lambda=300.0, delta=0.4, N=12.0, nh=0.37)
+    problem = design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
+    reported = design._reported_values(problem, found)
+    assert reported["nh"] == RANGES["nh"][0] and reported["N"] == 12 and isinstance(reported["N"], int)
+    np.testing.assert_array_equal(design.forward_rgb("bragg_mirror", reported, [0.0, 50.0]),
+                                  design.forward_rgb("bragg_mirror", found, [0.0, 50.0]))
+    assert design._reported_values(problem, {**found, "nh": 1.3})["nh"] == 1.3
+    fixed = design._Problem(model, design.parameter_box(model, RANGES), {"nh": 0.37}, targets, None)
+    assert design._reported_values(fixed, found)["nh"] == 0.37
 
 
 def test_design_bench_draws_its_mirrors_from_the_seed():

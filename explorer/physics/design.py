@@ -1183,7 +1183,7 @@ def design(
     report(1.0, "done")
     return DesignResult(
         model=model.name,
-        values={k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters},
+        values=_reported_values(problem, values),
         targets=list(targets),
         achieved_rgb=achieved,
         delta_e2000=problem.delta_e(achieved),
@@ -1192,6 +1192,20 @@ def design(
         evaluations=problem.evaluations,
         stages=stages,
     )
+
+
+def _reported_values(problem: _Problem, values: Mapping[str, float]) -> dict[str, float]:
+    """
+    The design values as reported: integers whole, and a free host found below its threshold (any value
+    there means "the host is n1", the same colours) at its range's lower end, the file's canonical "no
+    host", rather than an arbitrary number that reads like an index.
+    """
+    model = problem.model
+    out = {k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters}
+    host = model.host_parameter
+    if host is not None and host not in problem.fixed and out[host] < model.host_threshold:
+        out[host] = float(min(problem.box[host].low, out[host]))
+    return out
 
 
 def _guess_values(model: DesignModel, guess: Mapping[str, float], fixed: Mapping[str, float]) -> dict[str, float]:
