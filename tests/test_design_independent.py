@@ -89,6 +89,8 @@ CASES = {
     # Air layers and no separate host (nh = 0: the host is n1).
     "air-layer mirror": ("bragg_mirror", ["--target", "0:0.02,0.3,0.05", "--target", "45:0.02,0.1,0.35",
                                           "--fix", "n1=1", "--fix", "N=6", "--fix", "nh=0"], mirror_layers),
+    # A rough Bragg layer: its smooth mirror's (specular) colour.
+    "rough layer's mirror": ("bragg_layer", ["--target", "0:#c03a5a", "--target", "50:#5a8a3a", "--fix", "N=4"], mirror_layers),
     "film on a metal": ("thin_film", ["--target", "0:#b07a3a", "--target", "40:#8a5aa0", "--target", "70:#5a7ac0",
                                       "--free", "d,eta2,eta3,kappa3"], film_layers),
 }
