@@ -273,6 +273,40 @@ def test_thin_film_thickness_from_a_strip(tmp_path):
     assert len(result["targets"]) == 5 and result["median_delta_e2000"] <= 0.5, result
 
 
+def test_strip_images_of_every_depth_read_as_linear_rgb(tmp_path):
+    # A strip as people save it: 8- or 16-bit, grey, RGB or RGBA PNGs decoded from sRGB by their depth
+    # (a 16-bit PNG is not clipped to 8 bits: it was read white), render's .exr and .npy as they are.
+    import cv2
+    from PIL import Image
+
+    from explorer.views.images import read_linear_image, write_image
+
+    rng = np.random.default_rng(5)
+    encoded = rng.uniform(0.0, 1.0, (3, 7, 3))
+    linear = np.asarray(colour_decode(encoded))
+    rgb16 = np.round(encoded * 65535).astype(np.uint16)
+    cv2.imwrite(str(tmp_path / "rgb16.png"), rgb16[..., ::-1])
+    cv2.imwrite(str(tmp_path / "grey16.png"), rgb16[..., 1])
+    rgba8 = np.concatenate([np.round(encoded * 255).astype(np.uint8), np.full((3, 7, 1), 9, np.uint8)], axis=-1)
+    Image.fromarray(rgba8, mode="RGBA").save(tmp_path / "rgba8.png")
+    # One 16-bit step is ~1e-5 of linear at most; one 8-bit step ~1e-2 near white.
+    np.testing.assert_allclose(read_linear_image(tmp_path / "rgb16.png"), linear, atol=2e-5)
+    np.testing.assert_allclose(read_linear_image(tmp_path / "grey16.png"), np.repeat(linear[..., 1:2], 3, axis=-1), atol=2e-5)
+    np.testing.assert_allclose(read_linear_image(tmp_path / "rgba8.png"), linear, atol=1e-2)
+    vivid = linear * 1.3 - 0.1  # outside [0, 1], as render's linear outputs are
+    write_image(vivid, tmp_path / "strip.exr")
+    np.testing.assert_allclose(read_linear_image(tmp_path / "strip.exr"), vivid.astype(np.float32), atol=0)
+    cv2.imwrite(str(tmp_path / "float.tiff"), vivid.astype(np.float32))
+    with pytest.raises(ValueError, match="float32 pixels in an sRGB image"):
+        read_linear_image(tmp_path / "float.tiff")
+
+
+def colour_decode(encoded):
+    import colour
+
+    return colour.cctf_decoding(encoded, function="sRGB")
+
+
 @pytest.mark.parametrize("args, message", [
     (["--target", "0:#12345"], "not #RRGGBB"),
     (["--target", "0:1,2"], "three numbers"),

@@ -4,8 +4,8 @@ wanted at a few angles (:mod:`explorer.physics.design`), registered by :mod:`exp
 
 A target is ``--target THETA:COLOUR``: THETA in degrees in the outer medium, COLOUR ``#RRGGBB`` (sRGB) or
 ``r,g,b`` (linear RGB, the convention of ``render``'s ``.npy``, kept as it is even outside [0, 1]). A strip
-(``--target-strip IMAGE --theta-range A,B``: a ``.png`` in sRGB or a ``.npy`` of linear RGB, column ``i`` of
-``W`` at ``A + (B - A)(i + 0.5) / W`` degrees, as the gradient view draws it) gives
+(``--target-strip IMAGE --theta-range A,B``: a ``.png`` in sRGB or a ``.npy``/``.exr`` of linear RGB,
+column ``i`` of ``W`` at ``A + (B - A)(i + 0.5) / W`` degrees, as the gradient view draws it) gives
 :data:`STRIP_TARGETS` targets, each the mean of its column's rows.
 """
 
@@ -180,7 +180,7 @@ def render_command(material_name: str, values: dict) -> str:
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--target", "target_texts", multiple=True, metavar="THETA:COLOUR",
               help="A colour wanted at THETA degrees: #RRGGBB (sRGB) or r,g,b (linear, as render's .npy). Repeatable.")
-@click.option("--target-strip", metavar="IMAGE", help="Targets from a strip (.png sRGB or .npy linear), theta across.")
+@click.option("--target-strip", metavar="IMAGE", help="Targets from a strip (.png, 8 or 16 bits, sRGB; .npy or .exr linear), theta across.")
 @click.option("--theta-range", metavar="A,B", help="--target-strip: theta (degrees) at its left and right edges.")
 @click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable).")
 @click.option("--free", metavar="NAME,...", help="Search only these parameters; the others keep the material's defaults.")

@@ -75,25 +75,27 @@ def _write_exr(image: np.ndarray, temporary: str, out: Path) -> None:
         raise OSError(0, "OpenCV could not write OpenEXR")
 
 
+#: Image files read as linear RGB as they are (``render``'s float outputs); any other is decoded from sRGB.
+LINEAR_INPUT_SUFFIXES = (".npy", ".exr", ".hdr")
+
+
 def read_linear_image(path) -> np.ndarray:
     """
-    An image as linear RGB ``(H, W, 3)`` float64: a ``.npy`` as it is (linear, ``render``'s convention), any
-    other image file decoded from sRGB. ``ValueError`` (one line) when it cannot be read.
+    An image as linear RGB ``(H, W, 3)`` float64: ``.npy``, ``.exr`` and ``.hdr`` as they are (linear,
+    ``render``'s convention), any other image file (PNG, JPEG, TIFF, ...; 8 or 16 bits per channel, grey,
+    RGB or RGBA) decoded from sRGB. ``ValueError`` (one line) when it cannot be read.
     """
-    import colour
-
     file = Path(path)
     if not file.is_file():
         raise ValueError(f"{path}: no such file")
+    suffix = file.suffix.lower()
     try:
-        if file.suffix.lower() == ".npy":
+        if suffix == ".npy":
             image = np.load(file, allow_pickle=False).astype(np.float64)
+        elif suffix in LINEAR_INPUT_SUFFIXES:
+            image = _channels_rgb(_opencv_read(file)).astype(np.float64)
         else:
-            from PIL import Image
-
-            with Image.open(file) as picture:
-                encoded = np.asarray(picture.convert("RGB"), dtype=np.float64) / 255.0
-            image = np.asarray(colour.cctf_decoding(encoded, function="sRGB"))
+            image = _decoded_srgb(file)
     except (OSError, ValueError) as error:
         raise ValueError(f"{path}: cannot read ({' '.join(str(error).split())[:120]})") from None
     if image.ndim != 3 or image.shape[2] < 3 or image.shape[0] < 1 or image.shape[1] < 1:
@@ -101,3 +103,48 @@ def read_linear_image(path) -> np.ndarray:
     if not np.all(np.isfinite(image[..., :3])):
         raise ValueError(f"{path}: non-finite values")
     return image[..., :3]
+
+
+def _opencv_read(file: Path) -> np.ndarray:
+    """The file's pixels as OpenCV decodes them, unchanged (depth, channels in BGR(A) order), or OSError."""
+    from explorer.views.env import _cv2
+
+    cv2 = _cv2()
+    try:
+        pixels = cv2.imdecode(np.fromfile(file, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+    except cv2.error as error:
+        raise OSError(f"OpenCV: {' '.join(str(error).split())[:120]}") from None
+    if pixels is None:
+        raise OSError("not an image OpenCV can decode")
+    return pixels
+
+
+def _channels_rgb(pixels: np.ndarray) -> np.ndarray:
+    """OpenCV's grey, BGR or BGRA pixels as ``(H, W, 3)`` RGB (alpha dropped)."""
+    if pixels.ndim == 2:
+        return np.repeat(pixels[..., None], 3, axis=-1)
+    if pixels.ndim == 3 and pixels.shape[2] == 1:
+        return np.repeat(pixels, 3, axis=-1)
+    if pixels.ndim == 3 and pixels.shape[2] >= 3:
+        return pixels[..., 2::-1]
+    return pixels
+
+
+def _decoded_srgb(file: Path) -> np.ndarray:
+    """
+    An sRGB image file as linear RGB: integers scaled by their depth's maximum (a 16-bit PNG is not
+    clipped to 8 bits), then the sRGB decoding; what OpenCV cannot decode, Pillow reads as 8-bit RGB.
+    """
+    import colour
+
+    try:
+        pixels = _channels_rgb(_opencv_read(file))
+    except OSError:
+        from PIL import Image
+
+        with Image.open(file) as picture:
+            pixels = np.asarray(picture.convert("RGB"))
+    if not np.issubdtype(pixels.dtype, np.integer):
+        raise ValueError(f"{pixels.dtype} pixels in an sRGB image (linear floats go in .exr or .npy)")
+    encoded = pixels.astype(np.float64) / np.iinfo(pixels.dtype).max
+    return np.asarray(colour.cctf_decoding(encoded, function="sRGB"))
