@@ -37,3 +37,23 @@ def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  
     assert len(frames) >= 10, len(frames)
     assert max(frames) < 0.5 * design["wall_seconds"] * 1e3, (max(frames), design["wall_seconds"])
     assert window.is_file()
+
+
+def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_display, tmp_path):  # noqa: F811
+    # A render-style .npy strip of a vivid mirror (a negative red: outside sRGB): its colours are the
+    # targets as they are, not the pickers' sRGB clipping of them.
+    from explorer.physics.design import targets_from_strip
+
+    truth = {"n1": 1.38, "n2": 1.6, "Lambda": 175.0, "delta": 0.5, "N": 15, "nh": 1.0}
+    theta = 90.0 * (np.arange(32) + 0.5) / 32
+    strip = np.repeat(forward_rgb("bragg_mirror", truth, theta)[None], 3, axis=0)
+    np.save(tmp_path / "strip.npy", strip)
+    expected = targets_from_strip(strip, 0.0, 90.0)
+    assert min(min(t.rgb) for t in expected) < -0.05
+    actions = [{"wait": 2}, {"focus": "Design"}, {"wait": 2}, {"type": "design:strip_path", "text": str(tmp_path / "strip.npy")},
+               {"wait": 2}, {"click": "design:run"}, {"wait_for": "design", "timeout": 4000}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    design = report["design"]
+    assert design is not None and "set" in design, (design, report["script_log"])
+    assert [t["theta_deg"] for t in design["targets"]] == [t.theta_deg for t in expected]
+    np.testing.assert_allclose([t["target_rgb"] for t in design["targets"]], [t.rgb for t in expected], atol=1e-12)

@@ -49,6 +49,12 @@ def strip_of(targets, columns: int = STRIP_COLUMNS) -> np.ndarray:
     return np.array([targets[k].rgb for k in nearest])
 
 
+def _target(theta: float, rgb) -> list:
+    """A target row: ``[theta, sRGB picker values (clipped, 8-bit), linear RGB as given]``."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    return [float(theta), [float(c) for c in colorimetry.encode_srgb8(rgb) / 255.0], tuple(float(c) for c in rgb)]
+
+
 class DesignPanel(Panel):
     title = "Design"
     dock = "right_top"
@@ -56,7 +62,7 @@ class DesignPanel(Panel):
     def __init__(self, app):
         super().__init__(app)
         colours = inverse_design.forward_rgb("bragg_mirror", DEFAULT_STRUCTURE, DEFAULT_ANGLES)
-        self.targets = [[theta, [float(c) for c in colorimetry.encode_srgb8(rgb) / 255.0]] for theta, rgb in zip(DEFAULT_ANGLES, colours)]
+        self.targets = [_target(theta, rgb) for theta, rgb in zip(DEFAULT_ANGLES, colours)]
         self.strip_path = ""
         self.strip_range = [0.0, 90.0]
         self.fixed_n1_air = False
@@ -79,11 +85,15 @@ class DesignPanel(Panel):
     # -- the targets --------------------------------------------------------------------------------
 
     def target_list(self) -> list:
-        """The targets as :class:`explorer.physics.design.Target` (the pickers hold sRGB-encoded values)."""
+        """
+        The targets as :class:`explorer.physics.design.Target`: a colour read from a strip (or the default
+        gradient) as its linear RGB, which may lie outside sRGB; one picked, as its picker's sRGB.
+        """
         import colour
 
-        return [inverse_design.Target(float(theta), tuple(float(c) for c in colour.cctf_decoding(np.clip(srgb, 0.0, 1.0), function="sRGB")))
-                for theta, srgb in self.targets]
+        return [inverse_design.Target(float(theta), tuple(float(c) for c in (
+                    linear if linear is not None else colour.cctf_decoding(np.clip(srgb, 0.0, 1.0), function="sRGB"))))
+                for theta, srgb, linear in self.targets]
 
     def _load_strip(self) -> None:
         from explorer.views.images import read_linear_image
@@ -95,7 +105,7 @@ class DesignPanel(Panel):
             self.error = str(error)
             return
         self.error = ""
-        self.targets = [[t.theta_deg, [float(c) for c in colorimetry.encode_srgb8(np.array(t.rgb)) / 255.0]] for t in targets]
+        self.targets = [_target(t.theta_deg, t.rgb) for t in targets]
 
     # -- the worker ---------------------------------------------------------------------------------
 
@@ -197,8 +207,8 @@ class DesignPanel(Panel):
             record(state, f"design:theta_{k}")
             imgui.same_line()
             changed, colour = imgui.color_edit3("##colour", list(target[1]))
-            if changed:
-                target[1] = [float(c) for c in colour]
+            if changed:  # a picked colour replaces the strip's (the picker shows it clipped to sRGB)
+                target[1], target[2] = [float(c) for c in colour], None
             record(state, f"design:colour_{k}")
             imgui.same_line()
             if len(self.targets) > 1 and imgui.small_button("x"):
@@ -208,7 +218,7 @@ class DesignPanel(Panel):
             del self.targets[remove]
         if imgui.button("add an angle"):
             last = self.targets[-1]
-            self.targets.append([min(last[0] + 15.0, 89.0), list(last[1])])
+            self.targets.append([min(last[0] + 15.0, 89.0), list(last[1]), last[2]])
         record(state, "design:add")
         imgui.same_line()
         _, self.fixed_n1_air = imgui.checkbox("air layers (n1 = 1)", self.fixed_n1_air)
