@@ -32,13 +32,19 @@ def misses(path: Path) -> list[int]:
     return found
 
 
+def round_trip_truths(count: int) -> tuple[dict, design.DesignModel, list[dict]]:
+    """The mirror's ranges and model, and the round trip's first ``count`` true structures (seed 0)."""
+    ranges = ranges_of(load("bragg_mirror"))
+    rng = np.random.default_rng(0)
+    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(count)]
+    return ranges, design.design_model("bragg_mirror"), truths
+
+
 def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]]:
     """The mirror's ranges and model, the round trip's misses, and its true structures (seed 0) up to the last."""
-    ranges = ranges_of(load("bragg_mirror"))
     indices = misses(Path(__file__).with_name("design_round_trip.txt"))
-    rng = np.random.default_rng(0)
-    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(max(indices) + 1)]
-    return ranges, design.design_model("bragg_mirror"), indices, truths
+    ranges, model, truths = round_trip_truths(max(indices) + 1)
+    return ranges, model, indices, truths
 
 
 def truth_targets(truth: dict) -> list[design.Target]:

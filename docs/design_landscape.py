@@ -13,8 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from design_fidelity import truth_problem
-from explorer.cli.design import load, ranges_of
+from design_fidelity import round_trip_truths, truth_problem
 from explorer.physics import design
 
 #: Round-trip mirrors (seed 0): a thin stack, a vivid first-order stack under a host, a high-order mirror.
@@ -29,10 +28,7 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    ranges = ranges_of(load("bragg_mirror"))
-    model = design.design_model("bragg_mirror")
-    rng = np.random.default_rng(0)
-    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(max(MIRRORS) + 1)]
+    ranges, model, truths = round_trip_truths(max(MIRRORS) + 1)
     figure, axes = plt.subplots(1, len(MIRRORS), figsize=(5.2 * len(MIRRORS), 4.6), sharey=True)
     for axis, index in zip(axes, MIRRORS):
         truth = truths[index]

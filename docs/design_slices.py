@@ -14,9 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from design_fidelity import truth_problem
-from explorer.cli.design import load, ranges_of
-from explorer.physics import design
+from design_fidelity import round_trip_truths, truth_problem
 
 #: Round-trip mirrors (seed 0) the search misses: a high-order stack under a dense host (13), a thin
 #: stack (31), a thick high-order stack under a dense host (2).
@@ -43,10 +41,7 @@ def main() -> None:
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
 
-    ranges = ranges_of(load("bragg_mirror"))
-    model = design.design_model("bragg_mirror")
-    rng = np.random.default_rng(0)
-    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(max(MIRRORS) + 1)]
+    ranges, model, truths = round_trip_truths(max(MIRRORS) + 1)
     figure, axes = plt.subplots(len(MIRRORS), len(AGAINST), figsize=(3.3 * len(AGAINST), 3.0 * len(MIRRORS)),
                                 sharex=True, sharey=True, layout="constrained")
     norm = LogNorm(1.0, 3000.0)
