@@ -51,9 +51,12 @@ def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_disp
     expected = targets_from_strip(strip, 0.0, 90.0)
     assert min(min(t.rgb) for t in expected) < -0.05
     actions = [{"wait": 2}, {"focus": "Design"}, {"wait": 2}, {"type": "design:strip_path", "text": str(tmp_path / "strip.npy")},
-               {"wait": 2}, {"click": "design:run"}, {"wait_for": "design", "timeout": 4000}, {"quit": True}]
+               {"wait": 2}, {"click": "design:run"}, {"wait_for": "design", "timeout": 4000},
+               {"click": "design:run"}, {"wait_for": "design", "timeout": 4000}, {"quit": True}]
     _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
     design = report["design"]
     assert design is not None and "set" in design, (design, report["script_log"])
+    # Pressed again, it searched from fresh samples (the next seed), from the first result (applied).
+    assert design["seed"] == 1 and len(design["guesses"]) == 1, design
     assert [t["theta_deg"] for t in design["targets"]] == [t.theta_deg for t in expected]
     np.testing.assert_allclose([t["target_rgb"] for t in design["targets"]], [t.rgb for t in expected], atol=1e-12)

@@ -23,6 +23,7 @@ from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
+from explorer.cli.design import MAX_TRIES
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
@@ -619,6 +620,8 @@ def presets(material, as_json):
               help="Instead: COUNT random mirrors designed back from their colours at 5 angles (time, ΔE2000; 50 for the docs).")
 @click.option("--seed", "design_seed", type=click.IntRange(min=0), default=None, metavar="SEED",
               help="With --design: the seed of the mirrors drawn and of their searches (default 0, the docs' set).")
+@click.option("--tries", "design_tries", type=click.IntRange(min=1, max=MAX_TRIES), default=None, metavar="K",
+              help="With --design: each design searches up to K times (design --tries; default 1).")
 @click.option("--tables", "tables", is_flag=True,
               help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
 @click.option("--scaling", "scaling", is_flag=True,
@@ -629,8 +632,8 @@ def presets(material, as_json):
               help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
 @click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, design_seed, tables, scaling, plot, markdown,
-          mitsuba, spp):
+def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
+          plot, markdown, mitsuba, spp):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -642,6 +645,8 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
         raise click.UsageError("--markdown goes with Table 1, --thin-film or --layers, without --json")
     if design_seed is not None and design_count is None:
         raise click.UsageError("--seed goes with --design")
+    if design_tries is not None and design_count is None:
+        raise click.UsageError("--tries goes with --design")
     if position_free:
         from explorer.cli.bench import run_position_free_bench
 
@@ -650,7 +655,7 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
     if design_count is not None:
         from explorer.cli.design import run_design_bench
 
-        run_design_bench(design_count, seed=design_seed or 0, as_json=as_json)
+        run_design_bench(design_count, seed=design_seed or 0, as_json=as_json, tries=design_tries or 1)
         return
     if scaling:
         from explorer.cli.bench import run_scaling_bench

@@ -18,6 +18,9 @@ differences over the targets, in three stages:
    with Jacobians by finite differences evaluated in one batch;
 3. a polish of the best few on the converged model with ``N`` rounded to an integer.
 
+With ``tries`` above 1, a design that leaves a target above :data:`REACHED_DELTA_E` searches again from a
+fresh first pass with the best structure so far among its guesses (an iterated search with restarts).
+
 Residuals are the CIELAB differences scaled per target by ``dE2000 / dE76``, so that their squared norm per
 target is exactly CIEDE2000 squared while staying differentiable.
 
@@ -37,7 +40,7 @@ import math
 import os
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping, Sequence
 
 import colour
@@ -50,6 +53,11 @@ from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 #: A target whose CIEDE2000 stays above this is reported as not reachable (about twice a just
 #: noticeable difference).
 REACHABLE_DELTA_E = 2.0
+#: Tries (``design(..., tries=K)``) stop once every target is within this CIEDE2000 (about a just
+#: noticeable difference).
+REACHED_DELTA_E = 1.0
+#: Successive tries' seeds this far apart: each a fresh scrambled Sobol first pass.
+TRY_SEED_STRIDE = 1000
 #: The coarse model's wavelength step (nm): the spectrum at these nodes, interpolated linearly, against the
 #: 1-nm CMFs.
 COARSE_STEP = 2.0
@@ -537,6 +545,8 @@ class DesignResult:
     seconds: float
     cpu_seconds: float = 0.0
     evaluations: int = 0
+    #: Searches run (:func:`design`'s ``tries``: fewer when every target was reached early).
+    tries: int = 1
     stages: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -1050,6 +1060,7 @@ def design(
     progress: Callable[[float, str], None] | None = None,
     cancelled: Callable[[], bool] | None = None,
     guesses: Sequence[Mapping[str, float]] = (),
+    tries: int = 1,
 ) -> DesignResult:
     """
     The structure whose converged colours come closest (least squares of CIEDE2000) to ``targets``.
@@ -1076,6 +1087,11 @@ def design(
         Structures (every design parameter by name; fixed ones take their fixed values; clipped to the
         box) that join the first pass's shapes, each at its best scale like them: a structure known to be
         close, such as the material's current one.
+    tries : int
+        Searches at most: after one that leaves a target above :data:`REACHED_DELTA_E`, another from a
+        fresh first pass (seed + :data:`TRY_SEED_STRIDE` k) with the best structure so far among its
+        guesses, so that each try also walks on from the last (an iterated search with restarts); the best
+        result is returned, its times and evaluations summed over the tries.
 
     Returns
     -------
@@ -1083,6 +1099,32 @@ def design(
         Achieved colours from :func:`explorer.physics.bragg.reference_rgb` (or the film's), whatever the
         search used.
     """
+    if not (isinstance(tries, int) and tries >= 1):
+        raise DesignError(f"tries = {tries!r}: give a whole number of searches, at least 1")
+    start_time, start_cpu = time.perf_counter(), time.process_time()
+    best: DesignResult | None = None
+    evaluations = 0
+    for k in range(tries):
+        def report(fraction, stage, k=k):
+            if progress is not None:
+                progress((k + fraction) / tries, stage if tries == 1 else f"try {k + 1} of {tries}: {stage}")
+
+        carried = [] if best is None else [best.values]
+        result = _design_once(model_name, targets, ranges, fixed, seed + TRY_SEED_STRIDE * k, samples, starts, report,
+                              cancelled, [*guesses, *carried])
+        evaluations += result.evaluations
+        if best is None or np.sum(result.delta_e2000 ** 2) < np.sum(best.delta_e2000 ** 2):
+            best = result
+        if np.all(best.delta_e2000 <= REACHED_DELTA_E):
+            break
+    if progress is not None:
+        progress(1.0, "done")
+    return replace(best, seconds=time.perf_counter() - start_time, cpu_seconds=time.process_time() - start_cpu,
+                   evaluations=evaluations, tries=k + 1)
+
+
+def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, progress, cancelled, guesses) -> DesignResult:
+    """One search of :func:`design` (its parameters), from the first pass on."""
     start_time, start_cpu = time.perf_counter(), time.process_time()
     model = design_model(model_name)
     fixed = dict(fixed or {})
@@ -1286,11 +1328,11 @@ def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]],
 
 def round_trip(model_name: str, ranges: Mapping[str, tuple[float, float]], count: int, seed: int = 0,
                angles: Sequence[float] = ROUND_TRIP_ANGLES, report: Callable[[int, dict, DesignResult], None] | None = None,
-               draw_ranges: Mapping[str, tuple[float, float]] | None = None) -> list[DesignResult]:
+               draw_ranges: Mapping[str, tuple[float, float]] | None = None, tries: int = 1) -> list[DesignResult]:
     """
     Designs for ``count`` reachable targets: random structures (:func:`random_structure`, seeded, from
     ``draw_ranges``, default ``ranges``), their converged colours at ``angles`` as targets, each designed
-    back from its colours alone over ``ranges``.
+    back from its colours alone over ``ranges`` (in at most ``tries`` searches, :func:`design`).
     """
     rng = np.random.default_rng(seed)
     results = []
@@ -1298,7 +1340,7 @@ def round_trip(model_name: str, ranges: Mapping[str, tuple[float, float]], count
         truth = random_structure(model_name, {**ranges, **(draw_ranges or {})}, rng)
         colours = forward_rgb(model_name, truth, angles)
         targets = [Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(angles, colours)]
-        result = design(model_name, targets, ranges, seed=seed + k)
+        result = design(model_name, targets, ranges, seed=seed + k, tries=tries)
         results.append(result)
         if report is not None:
             report(k, truth, result)

@@ -69,6 +69,9 @@ class DesignPanel(Panel):
         # The material's current structure joins the first pass: designing again after a change of the
         # targets starts from the last result.
         self.from_current = True
+        # Each press of "design" searches from a fresh first pass (its seed), so pressing again (from the
+        # current structure) searches on from the last result.
+        self.runs = 0
         self.index_bounds = [1.0, 2.5]
         self.chroma_theta = 0.0
         self._lock = threading.Lock()
@@ -126,12 +129,14 @@ class DesignPanel(Panel):
         self._cancel = False
         self.error = ""
         self.progress = (0.0, "starting")
-        self.state.design = {"running": True, "targets": [[t.theta_deg, list(t.rgb)] for t in targets], "guesses": guesses}
+        seed, self.runs = self.runs, self.runs + 1
+        self.state.design = {"running": True, "targets": [[t.theta_deg, list(t.rgb)] for t in targets], "guesses": guesses,
+                             "seed": seed}
 
         def work():
             started = time.perf_counter()
             try:
-                result = inverse_design.design(material.model, targets, ranges, fixed, progress=self._progress,
+                result = inverse_design.design(material.model, targets, ranges, fixed, seed=seed, progress=self._progress,
                                                cancelled=lambda: self._cancel, guesses=guesses)
                 theta = 90.0 * (np.arange(STRIP_COLUMNS) + 0.5) / STRIP_COLUMNS
                 strip = inverse_design.forward_rgb(material.model, result.values, theta)
@@ -145,7 +150,7 @@ class DesignPanel(Panel):
                 return
             with self._lock:
                 self.result, self.result_strip = result, strip
-                self.state.design = {**result.as_json(material.model), "running": False, "guesses": guesses,
+                self.state.design = {**result.as_json(material.model), "running": False, "guesses": guesses, "seed": seed,
                                      "reachable": result.reachable.tolist(), "wall_seconds": time.perf_counter() - started}
                 self._pending_apply = True
 
@@ -263,8 +268,8 @@ class DesignPanel(Panel):
                                + (f"; {unreachable} not reachable: the closest structure found" if unreachable else ""))
             if unreachable:
                 # The search is not exhaustive (docs/design.md): say so, and what can help.
-                imgui.text_wrapped("The search can miss thick, high-order stacks: 'from the current structure' "
-                                   "starts it from the material's values.")
+                imgui.text_wrapped("The search can miss thick, high-order stacks: press design again to search on "
+                                   "from fresh samples and, with 'from the current structure', from this result.")
         self._chromaticity(imgui)
 
     def _strips(self, imgui, strip) -> None:
