@@ -244,8 +244,9 @@ def test_json_schema_and_unreachable_target():
     # A saturated red at normal incidence turning green at 60 degrees, one air-layer mirror in air, only
     # its period free: not reachable, the closest structure reported all the same.
     run = run_cli("design", "bragg_mirror", "--target", "0:0.6,0.03,0.02", "--target", "60:0.03,0.5,0.03",
-                  "--free", "Lambda", "--fix", "n1=1", "--fix", "nh=0", "--json")
+                  "--free", "Lambda", "--fix", "n1=1", "--fix", "nh=0", "--tries", "2", "--json")
     assert run.returncode == 0, run.stderr
+    assert "design: try 2 of 2" in run.stderr  # each try said on stderr; stdout stays one JSON document
     result = json.loads(run.stdout)
     assert set(result) == {"material", "set", "targets", "median_delta_e2000", "seconds"}
     assert set(result["set"]) == {"n1", "n2", "Lambda", "delta", "N", "nh"}

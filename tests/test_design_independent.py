@@ -99,7 +99,7 @@ CASES = {
 @pytest.mark.parametrize("case", list(CASES))
 def test_achieved_colours_equal_tmm_and_colour_science(case):
     material, args, layers = CASES[case]
-    run = run_cli("design", material, *args, "--json")
+    run = run_cli("design", material, *args, "--tries", "1", "--json")  # one search: its colours are what is checked
     assert run.returncode == 0, run.stderr
     report = json.loads(run.stdout)
     indices, thicknesses = layers(report["set"])

@@ -23,7 +23,7 @@ from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
-from explorer.cli.design import MAX_TRIES
+from explorer.cli.design import DEFAULT_TRIES, MAX_TRIES
 from explorer.cli.materials import PROG, resolve_values
 from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
@@ -621,7 +621,7 @@ def presets(material, as_json):
 @click.option("--seed", "design_seed", type=click.IntRange(min=0), default=None, metavar="SEED",
               help="With --design: the seed of the mirrors drawn and of their searches (default 0, the docs' set).")
 @click.option("--tries", "design_tries", type=click.IntRange(min=1, max=MAX_TRIES), default=None, metavar="K",
-              help="With --design: each design searches up to K times (design --tries; default 1).")
+              help=f"With --design: each design searches up to K times (design --tries; default {DEFAULT_TRIES}; 1: one search).")
 @click.option("--tables", "tables", is_flag=True,
               help="Instead: host table rebuilds (converged table at N = 20, 100, 1000; a layer's tables) and the tabulated method's cost over Schlick's.")
 @click.option("--scaling", "scaling", is_flag=True,
@@ -655,7 +655,7 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
     if design_count is not None:
         from explorer.cli.design import run_design_bench
 
-        run_design_bench(design_count, seed=design_seed or 0, as_json=as_json, tries=design_tries or 1)
+        run_design_bench(design_count, seed=design_seed or 0, as_json=as_json, tries=design_tries or DEFAULT_TRIES)
         return
     if scaling:
         from explorer.cli.bench import run_scaling_bench
