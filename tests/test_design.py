@@ -304,9 +304,11 @@ def test_strip_images_of_every_depth_read_as_linear_rgb(tmp_path):
 
     from explorer.views.images import read_linear_image, write_image
 
+    import colour
+
     rng = np.random.default_rng(5)
     encoded = rng.uniform(0.0, 1.0, (3, 7, 3))
-    linear = np.asarray(colour_decode(encoded))
+    linear = np.asarray(colour.cctf_decoding(encoded, function="sRGB"))
     rgb16 = np.round(encoded * 65535).astype(np.uint16)
     cv2.imwrite(str(tmp_path / "rgb16.png"), rgb16[..., ::-1])
     cv2.imwrite(str(tmp_path / "grey16.png"), rgb16[..., 1])
@@ -322,12 +324,6 @@ def test_strip_images_of_every_depth_read_as_linear_rgb(tmp_path):
     cv2.imwrite(str(tmp_path / "float.tiff"), vivid.astype(np.float32))
     with pytest.raises(ValueError, match="float32 pixels in an sRGB image"):
         read_linear_image(tmp_path / "float.tiff")
-
-
-def colour_decode(encoded):
-    import colour
-
-    return colour.cctf_decoding(encoded, function="sRGB")
 
 
 @pytest.mark.parametrize("args, message", [

@@ -106,6 +106,18 @@ def _cv2():
     return cv2
 
 
+def opencv_rgb(pixels: np.ndarray) -> np.ndarray:
+    """OpenCV's grey, BGR or BGRA pixels (as ``IMREAD_UNCHANGED`` gives them) as ``(H, W, 3)`` RGB, alpha dropped."""
+    pixels = np.asarray(pixels)
+    if pixels.ndim == 2:
+        return np.repeat(pixels[..., None], 3, axis=-1)
+    if pixels.ndim == 3 and pixels.shape[2] == 1:
+        return np.repeat(pixels, 3, axis=-1)
+    if pixels.ndim == 3 and pixels.shape[2] >= 3:
+        return pixels[..., 2::-1]
+    return pixels
+
+
 # --------------------------------------------------------------------------------------------------
 # Directions
 
@@ -226,16 +238,10 @@ class EnvironmentMap:
         if image is None:
             what = "HDR" if path.suffix.lower() != ".exr" else "OpenEXR"
             raise EnvironmentFileError(name, None, f"environment file is not an {what} image OpenCV can read" + (f" ({reason})" if reason else ""))
-        image = np.asarray(image)
-        if image.ndim == 2:
-            image = np.repeat(image[:, :, None], 3, axis=2)
-        elif image.shape[2] == 4:
-            image = image[:, :, :3]
-        elif image.shape[2] == 1:
-            image = np.repeat(image, 3, axis=2)
+        image = opencv_rgb(image)
         if image.dtype.kind != "f":
             raise EnvironmentFileError(name, None, f"environment file holds {image.dtype} values, not floating-point radiance")
-        return cls(image[:, :, ::-1], name)  # OpenCV's BGR to RGB
+        return cls(image, name)
 
     @classmethod
     def default(cls) -> "EnvironmentMap":

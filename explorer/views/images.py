@@ -93,7 +93,7 @@ def read_linear_image(path) -> np.ndarray:
         if suffix == ".npy":
             image = np.load(file, allow_pickle=False).astype(np.float64)
         elif suffix in LINEAR_INPUT_SUFFIXES:
-            image = _channels_rgb(_opencv_read(file)).astype(np.float64)
+            image = _opencv_read(file).astype(np.float64)
         else:
             image = _decoded_srgb(file)
     except (OSError, ValueError) as error:
@@ -106,8 +106,8 @@ def read_linear_image(path) -> np.ndarray:
 
 
 def _opencv_read(file: Path) -> np.ndarray:
-    """The file's pixels as OpenCV decodes them, unchanged (depth, channels in BGR(A) order), or OSError."""
-    from explorer.views.env import _cv2
+    """The file's pixels as OpenCV decodes them (their depth kept), as RGB (:func:`opencv_rgb`), or OSError."""
+    from explorer.views.env import _cv2, opencv_rgb
 
     cv2 = _cv2()
     try:
@@ -116,18 +116,7 @@ def _opencv_read(file: Path) -> np.ndarray:
         raise OSError(f"OpenCV: {' '.join(str(error).split())[:120]}") from None
     if pixels is None:
         raise OSError("not an image OpenCV can decode")
-    return pixels
-
-
-def _channels_rgb(pixels: np.ndarray) -> np.ndarray:
-    """OpenCV's grey, BGR or BGRA pixels as ``(H, W, 3)`` RGB (alpha dropped)."""
-    if pixels.ndim == 2:
-        return np.repeat(pixels[..., None], 3, axis=-1)
-    if pixels.ndim == 3 and pixels.shape[2] == 1:
-        return np.repeat(pixels, 3, axis=-1)
-    if pixels.ndim == 3 and pixels.shape[2] >= 3:
-        return pixels[..., 2::-1]
-    return pixels
+    return opencv_rgb(pixels)
 
 
 def _decoded_srgb(file: Path) -> np.ndarray:
@@ -138,7 +127,7 @@ def _decoded_srgb(file: Path) -> np.ndarray:
     import colour
 
     try:
-        pixels = _channels_rgb(_opencv_read(file))
+        pixels = _opencv_read(file)
     except OSError:
         from PIL import Image
 
