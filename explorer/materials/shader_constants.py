@@ -100,5 +100,5 @@ GENERATED: dict[str, Callable[[], str]] = {
         "PREFILTER_SIGMA_STEP": thinfilm.PREFILTER_SIGMA_STEP,
         "PREFILTER_LEVELS": thinfilm.PREFILTER_LEVELS,
         "D_INC_BLEND": thinfilm.D_INC_BLEND,
-    }, "explorer/physics/thinfilm.py"),
+    }, "explorer/physics/thinfilm/"),
 }
