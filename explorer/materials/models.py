@@ -441,11 +441,11 @@ class GGXSchlickModel:
 MODELS = TWINS
 
 
-def model_for(material, values: Mapping[str, object], normalised: bool = False):
+def model_for(material, values: Mapping[str, object]):
     """
-    The numpy twin of ``material`` with parameter ``values`` (None when it names no known model), its
-    ``int`` parameters rounded as the GL host rounds them (:meth:`explorer.materials.brd.Material.physical_values`;
-    ``normalised``: they already are, once per bind).
+    The numpy twin of ``material`` with parameter ``values`` (None when it names no known model), read as
+    :class:`explorer.materials.brd.Values` (:meth:`explorer.materials.brd.Material.typed_values`: ``int``
+    parameters rounded as the GL host rounds them; a resolved set as it is).
     """
     measured = getattr(material, "measured", None)
     if measured is not None:  # a measured material's data makes its twin (explorer.materials.merl)
@@ -453,4 +453,4 @@ def model_for(material, values: Mapping[str, object], normalised: bool = False):
     factory = registry().get(material.model or "")
     if factory is None:
         return None
-    return factory(values if normalised else material.physical_values(values))
+    return factory(material.typed_values(values))

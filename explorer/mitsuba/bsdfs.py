@@ -225,7 +225,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return {p.name for p in self.material.parameters}
 
         def _rebuild(self):
-            self.model = model_for(self.material, self.material.physical_values(self.values))
+            self.model = model_for(self.material, self.values)
             if not spectral and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
                 # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
                 # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
