@@ -25,11 +25,11 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
 
 def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
     """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
-    from explorer.mitsuba import BSDF_NAMES
+    from explorer.materials.twins import capabilities_of, supporting
     from explorer.mitsuba.scene import render_env_mitsuba
 
-    if material.model not in BSDF_NAMES:
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
+    if not capabilities_of(material).supports("mitsuba"):
+        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
     return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
