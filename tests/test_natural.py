@@ -202,3 +202,40 @@ def test_info_dispersions(capsys):
     for name in ("chitin", "keratin", "melanin", "guanine", "water", "air", "SiO2", "TiO2"):
         assert f"\n{name}: " in out
     assert "Leertouwer" in out and "Stavenga" in out
+
+
+# --------------------------------------------------------------------------------------------------
+# Fitting a measured spectrum
+
+
+def test_fit_recovers_random_absorbing_dispersive_mirrors(tmp_path, capsys):
+    """Seeded random mirrors (chitin and an absorbing layer) from their own spectra: median RMS <= 0.01."""
+    rng = np.random.default_rng(35)
+    wavelengths = np.arange(380.0, 801.0, 10.0)
+    rms = []
+    for k in range(3):
+        truth = NaturalMirror(n1=dispersion.LIBRARY["chitin"], n2=float(rng.uniform(1.6, 1.9)), k2=float(rng.uniform(0.0, 0.1)),
+                              Lambda=float(rng.uniform(150.0, 400.0)), delta=float(rng.uniform(0.2, 0.8)), N=int(rng.integers(3, 16)), nh=1.0)
+        R = mirror_spectrum(truth, wavelengths, [0.0])["R"][0]
+        measured = tmp_path / f"m{k}.csv"
+        measured.write_text("wavelength_nm,R (%)\n" + "".join(f"{w:g},{100 * r:.6f}\n" for w, r in zip(wavelengths, R)))
+        main(["design", "bragg_mirror", "--target-spectrum", str(measured), "--fix", "n1=chitin", "--fix", "nh=1", "--json"])
+        document = json.loads(capsys.readouterr().out)
+        assert document["reading"] == "R in percent (header)"
+        rms.append(document["rms"])
+        # The reported fit is the spectrum of the reported values (tmm at one wavelength).
+        v = document["values"]
+        fitted = NaturalMirror(n1=dispersion.LIBRARY["chitin"], n2=v["n2"], k1=v["k1"], k2=v["k2"], Lambda=v["Lambda"],
+                               delta=v["delta"], N=v["N"], nh=1.0)
+        Rs, Rp, _, _ = tmm_mirror(fitted, wavelengths[7], 0.0)
+        assert abs(document["fitted"][7] - 0.5 * (Rs + Rp)) < 1e-9
+    assert np.median(rms) <= 0.01, rms
+
+
+def test_fit_file_errors(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("wavelength_nm,R\n400,0.1\n410,oops\n")
+    with pytest.raises(SystemExit):
+        main(["design", "bragg_mirror", "--target-spectrum", str(bad)])
+    err = capsys.readouterr().err.strip()
+    assert "bad.csv:3:" in err and "\n" not in err
