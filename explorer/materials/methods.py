@@ -34,7 +34,8 @@ class _Method(enum.IntEnum):
 
     @classmethod
     def glsl_prefix(cls) -> str:
-        raise NotImplementedError
+        """The prefix of its members' ``#define`` names (``BRAGG_`` …): by default the class name's, upper case."""
+        return cls.__name__.upper().removesuffix("METHOD") + "_"
 
 
 class BraggMethod(_Method):
