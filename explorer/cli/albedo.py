@@ -74,8 +74,11 @@ def _fail(message: str) -> None:
               help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (layered Bragg stacks).")
 @click.option("--samples", type=int, metavar="N", help=f"position-free: paths per angle (default {DEFAULT_SAMPLES}).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="position-free: the random generator's seed (>= 0).")
+@click.option("--microsurface", type=click.Choice(["single", "walk"]), default="single", show_default=True,
+              help="position-free: a rough layer's microfacets scatter once (Eq. 17, the model's assumption) "
+                   "or every time (the random walk of Heitz et al. 2016).")
 @click.option("--json", "as_json", is_flag=True, help='Print {"theta_deg": [...], "rgb": [[r, g, b], ...]} (plus "stderr" for position-free).')
-def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, as_json):
+def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, microsurface, as_json):
     """Directional albedo of MATERIAL: BRDF x cos integrated over the outgoing hemisphere, plus its Dirac
     reflection (a coating's Fresnel; a smooth mirror's specular reflectance), per incidence angle.
 
@@ -89,6 +92,8 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         angles = parse_theta(theta)
         if samples is not None and engine != "position-free":
             raise click.BadParameter("paths per angle are for --engine position-free", param_hint="--samples")
+        if microsurface != "single" and engine != "position-free":
+            raise click.BadParameter("the microsurface walk is for --engine position-free", param_hint="--microsurface")
         if samples is not None and samples < 1:
             raise click.BadParameter(f"{samples} is not a positive number of paths", param_hint="--samples")
         loaded = load(material)
@@ -110,7 +115,7 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
             else:
                 _check_position_free(loaded, model)
                 result = albedo_views.albedo_position_free(
-                    model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"))
+                    model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"), microsurface)
                 rgb, stderr = result.value, result.stderr
     except (LocatedError, GLUnavailable) as error:
         _fail(str(error))

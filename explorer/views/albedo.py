@@ -180,12 +180,14 @@ def position_free_stack(model):
 
 
 def albedo_position_free(model, theta_deg, samples: int = 20000, seed: int = 0,
-                         progress: Callable[[int, int], None] | None = None):
+                         progress: Callable[[int, int], None] | None = None, microsurface: str = "single"):
     """
     The position-free directional albedo (:meth:`explorer.physics.position_free.PositionFree.albedo`) of a
     twin that supports it (a layered Bragg stack's): a :class:`explorer.physics.position_free.PositionFreeResult`.
+    ``microsurface``: ``single`` (Eq. 17's single scattering per layer) or ``walk`` (every bounce among a
+    layer's facets).
     """
     from explorer.physics.position_free import PositionFree
 
     stack = position_free_stack(model)
-    return PositionFree(stack, getattr(model, "tables", None)).albedo(check_theta(theta_deg), samples, seed, progress)
+    return PositionFree(stack, getattr(model, "tables", None), microsurface).albedo(check_theta(theta_deg), samples, seed, progress)
