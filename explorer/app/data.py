@@ -18,9 +18,8 @@ from explorer.materials.methods import BraggMethod, methods_for
 
 #: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
 BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
-#: The gradient rows of Figure 4: the reference, the paper's approximations, ours, the tabulated colours.
-BRAGG_STRIP_METHODS = (BraggMethod.REFERENCE, BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED,
-                       BraggMethod.TABULATED)
+#: The gradient rows of Figure 4, one per method in the methods' order (as the combo and ``info`` list them).
+BRAGG_STRIP_METHODS = tuple(sorted(BraggMethod))
 
 
 def method_names(material) -> dict[int, str]:
