@@ -537,13 +537,21 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 
 
 @cli.command()
-@click.argument("material", type=click.Path(dir_okay=False))
+@click.argument("material", type=click.Path(dir_okay=False), required=False)
 @click.option("--json", "as_json", is_flag=True, help="Print the parameters as JSON.")
+@click.option("--dispersions", is_flag=True, help="List the media an index may name (n2=chitin), with formula and citation.")
 @_errors
-def info(material, as_json):
-    """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film)."""
+def info(material, as_json, dispersions):
+    """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film), or --dispersions."""
     from explorer.materials.methods import method_labels, opening_values
 
+    if dispersions:
+        from explorer.cli.spectrum import dispersions_listing
+
+        click.echo(dispersions_listing(as_json))
+        return
+    if material is None:
+        raise click.UsageError("info needs MATERIAL (or --dispersions)")
     loaded = _load(material)
     labels = method_labels(loaded)
     opening = opening_values(loaded).get("method")
@@ -755,8 +763,14 @@ from explorer.cli.design import design_command  # noqa: E402  (inverse design of
 cli.add_command(design_command)
 
 from explorer.cli.export import export_command  # noqa: E402  (materials out: Mitsuba, BRDF Explorer, tables)
+from explorer.cli.check import check_command  # noqa: E402  (GLSL against the numpy twin, for material authors)
 
 cli.add_command(export_command)
+cli.add_command(check_command)
+
+from explorer.cli.spectrum import spectrum_command  # noqa: E402  (exact spectra of natural mirrors)
+
+cli.add_command(spectrum_command)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -208,11 +208,19 @@ def render_command(material_name: str, values: dict) -> str:
 @click.option("--guess", "guess_texts", multiple=True, metavar="NAME=VALUE,...",
               help="A structure to start from (omitted parameters: the material's defaults); it joins the first pass. Repeatable.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
+@click.option("--target-spectrum", metavar="FILE.csv",
+              help="Fit a measured reflectance instead (wavelength_nm,R as a fraction or in %): least squares in R(lambda); "
+                   "--fix may name media (n2=chitin).")
+@click.option("--theta", "spectrum_theta", type=click.FloatRange(0.0, 89.9), default=0.0, show_default=True,
+              help="--target-spectrum: the measurement's incidence angle in degrees.")
+@click.option("--plot", "spectrum_plot", type=click.Path(dir_okay=False), metavar="FILE.png",
+              help="--target-spectrum: plot the measured against the fitted spectrum.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="The first pass's Sobol scrambling (>= 0).")
 @click.option("--tries", type=click.IntRange(min=1, max=MAX_TRIES), default=DEFAULT_TRIES, show_default=True, metavar="K",
               help="Search up to K times until every target is within ΔE2000 1, each from fresh samples and the best "
                    "structure so far (~4 s each; 1: one search).")
-def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, seed, tries):
+def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
+                   spectrum_theta, spectrum_plot, seed, tries):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -224,6 +232,13 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
     from explorer.resources import display_path
 
+    if target_spectrum is not None:
+        from explorer.cli.spectrum_fit import fit_command
+
+        if target_texts or target_strip or free or guess_texts:
+            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip, --free or --guess")
+        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed)
+        return
     try:
         loaded = load(material)
         design_model(loaded.model)
