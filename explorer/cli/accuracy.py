@@ -71,7 +71,7 @@ def preset_mirrors(preset_files=None) -> list[PresetMirror]:
             if kind in ("bragg_mirror", "bragg_layer"):
                 add(model_for(preset_file.material, preset.resolve()).mirror, name, kind)
             elif kind == "bragg_stack":
-                stack = BraggStackModel.stack_of(preset_file.material.physical_values(preset.resolve()))
+                stack = BraggStackModel.stack_of(preset_file.material.typed_values(preset.resolve()))
                 for k, layer in enumerate(stack.layers, start=1):
                     add(layer.mirror(stack.n1), f"{name}/layer {k}", kind)
     return list(found.values())

@@ -762,8 +762,10 @@ from explorer.cli.design import design_command  # noqa: E402  (inverse design of
 cli.add_command(design_command)
 
 from explorer.cli.export import export_command  # noqa: E402  (materials out: Mitsuba, BRDF Explorer, tables)
+from explorer.cli.check import check_command  # noqa: E402  (GLSL against the numpy twin, for material authors)
 
 cli.add_command(export_command)
+cli.add_command(check_command)
 
 from explorer.cli.spectrum import spectrum_command  # noqa: E402  (exact spectra of natural mirrors)
 

@@ -185,12 +185,12 @@ class Renderer:
     ) -> tuple[dict[str, object], dict[str, object]]:
         """
         ``(uniforms, textures)`` of ``material`` at ``values`` for ``program``, as :meth:`draw` takes them:
-        the parameters (``int`` ones as :meth:`explorer.materials.brd.Material.physical_values` has them, exact
+        the parameters (``int`` ones as :meth:`explorer.materials.brd.Material.typed_values` has them, exact
         integers), the colour matrix, the library and model tables; ``inputs`` (a view's textures, e.g.
         the textured view's D_inc) and ``uniforms`` (a view's flags) added. A smooth mirror's lit view
         (``MIRROR_ONLY``) gets ``environment`` (default: the env view's) and its glint (:mod:`explorer.views.mirror`).
         """
-        values = material.physical_values(values)
+        values = material.typed_values(values)
         bound: dict[str, object] = {}
         for parameter in material.parameters:
             if parameter.name not in program:
@@ -222,7 +222,7 @@ class Renderer:
             turn = environment.turn if environment is not None else self._default_environment.turn
             bound.update(mirror_environment_turn=turn, glint_sin2=GLINT_SIN2, glint_peak=GLINT_PEAK)
         start = time.perf_counter()
-        key, entry = self.models.entry(material, values, normalised=True)  # values normalised once, above
+        key, entry = self.models.entry(material, values)
         if entry is not None:
             for name, table in entry.ensure_tables().items():
                 if name in program:

@@ -29,8 +29,6 @@ from explorer.physics import bragg, colorimetry
 ACCURACY_LIMIT = 2.0
 #: The gradient view's columns the badge compares: θ = 90° (i + 0.5) / W.
 BADGE_WIDTH = 90
-#: Models whose ``method`` picks one of the RGB methods of a smooth Bragg mirror (their ``reflectance``).
-BRAGG_METHOD_MODELS = ("bragg_mirror", "bragg_layer")
 #: The methods' names (``shaders/bragg_mirror.brd``), and the order in which accurate ones are suggested:
 #: the exact table first (one texture fetch per pixel), then the closed forms, the spectral sum last.
 METHOD_NAMES = {int(m): m.label for m in BraggMethod}
@@ -142,7 +140,11 @@ def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | No
     the current method (method 0 at its ``wavelength_step``: the paper's 1-nm sum is not converged for N
     of a few tens and more) and, when it is off, every closed-form method and the tabulated one.
     """
-    if getattr(material, "model", None) not in BRAGG_METHOD_MODELS or "method" not in values:
+    from explorer.materials.twins import capabilities_of
+
+    capabilities = capabilities_of(material)
+    # A material whose ``method`` picks one of the RGB methods of a smooth Bragg mirror (its ``reflectance``).
+    if not (capabilities.bragg_spectrum and capabilities.methods is BraggMethod) or "method" not in values:
         return None
     from explorer.materials.models import model_for
 

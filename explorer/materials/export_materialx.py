@@ -32,8 +32,10 @@ class MaterialXExportError(LocatedError):
 
 def materialx_document(material, values) -> str:
     """The ``.mtlx`` text for a thin-film material at ``values``."""
-    if material.model != "thin_film":
-        raise MaterialXExportError(material.path, None, "--to materialx exports a thin film (# model: thin_film) only")
+    from explorer.materials.twins import capabilities_of, supporting
+
+    if not capabilities_of(material).supports("materialx"):
+        raise MaterialXExportError(material.path, None, f"--to materialx exports a thin film ({', '.join(supporting('materialx'))}) only")
     eta1, eta2, eta3, kappa3 = (float(values[k]) for k in ("eta1", "eta2", "eta3", "kappa3"))
     if abs(eta1 - 1.0) > 1e-9:
         raise MaterialXExportError(material.path, None, f"standard_surface's film lies in air: eta1 must be 1, got {eta1:g}")

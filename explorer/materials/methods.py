@@ -13,7 +13,6 @@ compare ``method`` with. No other place spells a method's number.
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
 
 
 def _member(cls, value: int, label: str, options: dict):
@@ -73,22 +72,24 @@ class ThinFilmMethod(_Method):
                 ThinFilmMethod.GAUSSIAN: 3}.get(self, 0)
 
 
-#: The method enumeration of each numpy model (by ``# model:`` name).
-METHODS_BY_MODEL: Mapping[str, type[_Method]] = {
-    "bragg_mirror": BraggMethod,
-    "bragg_layer": BraggMethod,
-    "thin_film": ThinFilmMethod,
-}
+#: The base of every method enumeration: a plugin's own methods subclass it (members ``(value, label, options)``).
+Method = _Method
 
 
-def methods_for(model: str | None) -> type[_Method] | None:
-    """The enumeration of a material's ``method`` parameter, or None (no named methods)."""
-    return METHODS_BY_MODEL.get(model or "")
+def methods_for(model) -> type[_Method] | None:
+    """The enumeration of a material's (or a ``# model:`` name's) ``method`` parameter, or None: its twin's declaration."""
+    from explorer.materials.twins import capabilities_of
+
+    return capabilities_of(model).methods
 
 
 def glsl_defines() -> dict[str, int]:
-    """``{"BRAGG_REFERENCE": 0, …}`` for every method: ``#define``d in every program at assembly."""
-    return {f"{enumeration.glsl_prefix()}{m.name}": int(m) for enumeration in (BraggMethod, ThinFilmMethod) for m in enumeration}
+    """``{"BRAGG_REFERENCE": 0, …}`` for every registered twin's methods: ``#define``d in every program at assembly."""
+    from explorer.materials.twins import registry
+
+    enumerations = dict.fromkeys(m for cls in registry().values()
+                                 if (m := getattr(getattr(cls, "capabilities", None), "methods", None)) is not None)
+    return {f"{enumeration.glsl_prefix()}{m.name}": int(m) for enumeration in enumerations for m in enumeration}
 
 
 def method_labels(material) -> dict[int, str]:

@@ -113,7 +113,7 @@ def main() -> None:
     print("  white: the same under a white sky")
     for overrides in MIRRORS:
         values = material.resolve({"method": int(BraggMethod.TABULATED), **overrides})
-        gap = spectral_gap(model_for(material, material.physical_values(values)), EnvironmentMap.default())
+        gap = spectral_gap(model_for(material, values), EnvironmentMap.default())
         label = ", ".join(f"{k} = {v:g}" for k, v in overrides.items()) or "defaults"
         print(f"  {label:<14} roundtrip {gap['roundtrip']:.2f} (max {gap['roundtrip_max']:.2f})  product {gap['product']:.2f}"
               f"  consistent {gap['product_consistent']:.2f}  white {gap['white']:.2f}")
