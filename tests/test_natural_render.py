@@ -86,3 +86,11 @@ def test_energy_with_disorder(sigma, k2, theta):
     mirror = NaturalMirror(n1=1.0, n2=dispersion.LIBRARY["chitin"], k2=k2, N=4, Lambda=250.0, sigma=sigma)
     out = mirror_spectrum(mirror, np.array([420.0, 640.0]), [theta])
     assert np.all(out["A"] >= -1e-12) and np.all(out["R"] + out["T"] <= 1.0 + 1e-12)
+
+
+def test_the_badge_names_the_exact_table(mirror_material):
+    from explorer.materials.accuracy import accuracy_badge
+
+    badge = accuracy_badge(mirror_material, mirror_material.resolve({"n2": "chitin", "method": "1", "N": "4"}))
+    assert badge.natural and badge.accurate and "exact table" in badge.text() and badge.note() is None
+    assert not accuracy_badge(mirror_material, mirror_material.resolve({"method": "1", "N": "4"})).natural
