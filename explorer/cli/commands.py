@@ -450,9 +450,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
     light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
-    from explorer.materials.methods import method_labels, opening_values
+    from explorer.materials.methods import method_labels
 
-    values = resolve_values(loaded, preset, params_file, assignments, opening=opening_values(loaded))  # as the app opens it
+    values = resolve_values(loaded, preset, params_file, assignments)  # as the app opens it
     width, height = parse_size(size, view)
     plot = parse_plot(view, theta_d=theta_d, theta_h=theta_h, phi_v=phi_v, log=log_scale, channel=channel, ndotl=ndotl)
     if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
@@ -572,7 +572,8 @@ def info(material, as_json, dispersions):
             shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
         default = labels.get(shown["default"], shown["default"]) if p.name == "method" else shown["default"]
         bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
-        opens = f" (the app and render open it on {labels.get(opening, opening)})" if p.name == "method" and opening is not None else ""
+        opens = (f" (every command and the app open it on {labels.get(opening, opening)})"
+                 if p.name == "method" and opening is not None and opening != shown["default"] else "")
         click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")

@@ -71,7 +71,11 @@ def split_natural(loaded, assignments, preset_values: dict | None = None) -> tup
     for text in assignments:
         name, value = parse_assignment(text)
         if name in INDEX_PARAMETERS and dispersion.is_dispersion_text(value):
-            natural[name] = dispersion.dispersion_named(value, origin=f"--set {name}")
+            medium = dispersion.dispersion_named(value, origin=f"--set {name}")
+            if f"medium_{name}" in declared and medium.name in dispersion.LIBRARY:
+                passed.append(text)  # the material selects it (medium_NAME)
+            else:
+                natural[name] = medium
         elif name in NATURAL_PARAMETERS and name not in declared:
             low, high = NATURAL_PARAMETERS[name]
             try:
@@ -88,12 +92,14 @@ def split_natural(loaded, assignments, preset_values: dict | None = None) -> tup
 
 def natural_mirror(values: dict, natural: dict) -> NaturalMirror:
     """The mirror of a material's values (a ``bragg_mirror`` or ``bragg_layer``'s), with the natural ones over them."""
-    nh = natural.get("nh", float(values.get("nh", 0.0)))
+    from explorer.materials.media import index_value
+
+    nh = natural.get("nh", index_value(values, "nh") if "nh" in values else 0.0)
     if not isinstance(nh, dispersion.Dispersion) and nh < 1.0:
         nh = None  # below 1 the host is n1 (bragg_mirror.brd)
     try:
         return NaturalMirror(
-            n1=natural.get("n1", float(values["n1"])), n2=natural.get("n2", float(values["n2"])),
+            n1=natural.get("n1", index_value(values, "n1")), n2=natural.get("n2", index_value(values, "n2")),
             Lambda=float(values["Lambda"]), delta=float(values["delta"]), N=int(round(float(values["N"]))), nh=nh,
             k1=natural.get("k1", float(values.get("k1", 0.0))), k2=natural.get("k2", float(values.get("k2", 0.0))),
             sigma=natural.get("sigma", float(values.get("sigma", 0.0))),

@@ -448,6 +448,17 @@ class Material:
         """
         values: dict[str, Value] = {p.name: p.default for p in self.parameters}
         for name, value in overrides.items():
+            if isinstance(value, str) and f"medium_{name}" in values and not _NUMBER_RE.match(value.strip()):
+                # An index naming a medium (n2=chitin): the material's medium_NAME selects it (explorer.materials.media).
+                from explorer.materials.media import medium_values
+
+                try:
+                    values.update(medium_values(self, name, value))
+                except LocatedError as exc:
+                    raise MaterialError(self.path, self.parameter(name).line, f"parameter {name!r}: {exc.message}") from None
+                continue
+            if f"medium_{name}" in values and f"medium_{name}" not in overrides:
+                values[f"medium_{name}"] = 0.0  # a number replaces a medium
             p = self.parameter(name)
             try:
                 values[name] = p.coerce(value)

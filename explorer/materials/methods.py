@@ -114,19 +114,16 @@ def method_labels(material) -> dict[int, str]:
 
 def opening_values(material) -> dict[str, int]:
     """
-    The overrides a material opens with, in the app and in ``render`` alike: the default material
-    (``bragg_mirror.brd``) on its fastest exact method, the tabulated one (its file's default is the
-    reference, 1-nm sum); ``{}`` for every other material.
+    The overrides a material opens with, in the app, ``render``, ``export`` and ``albedo`` alike: every
+    Bragg material (a ``# model:`` whose methods are :class:`BraggMethod`, built-in or a copy, whatever its
+    name) on the tabulated method, exact and fast; the built-in files declare it as their default, and an
+    older copy that declares the 1-nm reference opens on it too. The reference stays a choice
+    (``--set method=0``). ``{}`` for every other material.
     """
-    from pathlib import Path
-
-    from explorer.resources import DEFAULT_MATERIAL
-
-    path = getattr(material, "path", None)
-    if path is None or not any(p.name == "method" for p in material.parameters):
+    parameter = next((p for p in getattr(material, "parameters", ()) if p.name == "method"), None)
+    if parameter is None or methods_for(getattr(material, "model", None)) is not BraggMethod:
         return {}
-    try:
-        same = Path(path).resolve() == DEFAULT_MATERIAL.resolve()
-    except OSError:
-        same = False
-    return {"method": int(BraggMethod.TABULATED)} if same else {}
+    tabulated = int(BraggMethod.TABULATED)
+    if parameter.min is not None and not (parameter.min <= tabulated <= parameter.max):
+        return {}
+    return {"method": tabulated}
