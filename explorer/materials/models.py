@@ -71,7 +71,7 @@ class BraggMirrorModel:
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -221,7 +221,7 @@ class BraggLayerModel(BraggMirrorModel):
 
     name = "bragg_layer"
     capabilities = Capabilities(methods=BraggMethod, dirac=False, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
     # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
@@ -306,7 +306,7 @@ class BraggStackModel:
 
     name = "bragg_stack"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table"), design=False)
+                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -413,7 +413,7 @@ class SchlickFresnelModel:
 
     name = "schlick_fresnel"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.F0 = float(values["F0"])
@@ -439,7 +439,7 @@ class GGXSchlickModel:
 
     name = "ggx_schlick"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.alpha = float(values["alpha"])
