@@ -174,6 +174,20 @@ def test_the_broken_plugin_error_reaches_the_cli_as_one_line(tmp_path):
 
 
 @pytest.mark.gl
+@pytest.mark.parametrize("name", ["ggx_schlick", "bragg_layer"])
+def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, name):
+    """``check``'s comparisons are the harness's: a built-in twin is within the named tolerance in each view."""
+    from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
+
+    material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
+    assert check_views(material) == tuple(CHECK_SIZES)
+    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}))
+    assert [r.view for r in results] == list(CHECK_SIZES)
+    for result in results:
+        assert result.passed and 0.0 < result.max_difference, result.message()
+
+
+@pytest.mark.gl
 def test_check_fails_a_plugin_whose_twin_disagrees_with_its_shader(tmp_path):
     path = _example(tmp_path)
     source = path.with_suffix(".py")

@@ -53,15 +53,22 @@ def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray
     return layered.integrated_transmissivity(F, 1.0 - R)
 
 
+def host_index(nh):
+    """
+    The host a mirror's ``nh`` value stands for: a number below 1 means the host is ``n1`` (None), as the shaders
+    have it; any other value (an index, a dispersive medium) is the host. The one place of this rule.
+    """
+    return None if isinstance(nh, (int, float)) and float(nh) < 1.0 else nh
+
+
 def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
     """
-    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: below 1 the host
-    is ``n1``, as the shaders have it): the one reading of these values, for the twins, the app and design.
+    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: :func:`host_index`):
+    the one reading of these values, for the twins, the app and design.
     """
-    nh = float(values.get("nh", 0.0))
     return bragg.BraggMirror(
         n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
-        N=round_integer(values["N"]), nh=nh if nh >= 1.0 else None,
+        N=round_integer(values["N"]), nh=host_index(float(values.get("nh", 0.0))),
     )
 
 
@@ -176,7 +183,7 @@ def natural_mirror_of(values: Mapping[str, object]) -> "natural.NaturalMirror | 
     media = any(not isinstance(v, float) for v in (n1, n2, nh_value))
     if not (k1 > 0.0 or k2 > 0.0 or sigma > 0.0 or media):
         return None
-    nh = nh_value if not isinstance(nh_value, float) else (nh_value if nh_value >= 1.0 else None)
+    nh = host_index(nh_value)
     return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(values["Lambda"]), delta=float(values["delta"]),
                                  N=round_integer(values["N"]), nh=nh, k1=k1, k2=k2, sigma=sigma)
 
