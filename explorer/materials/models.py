@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.physics import bragg, colorimetry, layered, microfacet, natural
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
@@ -78,6 +78,8 @@ class BraggMirrorModel:
         self.mirror = mirror_of(values)
         self.method = BraggMethod(round_integer(values.get("method", 0)))
         self.s = round_integer(values.get("s", 3))
+        #: Absorbing, dispersive or disordered layers (explorer.physics.natural): every method shows their exact table.
+        self.natural = natural_mirror_of(values)
         # The reference's wavelength step (nm): 1 is the paper's 1-nm sum (bragg_layer.brd has no such parameter).
         self.wavelength_step = float(values.get("wavelength_step", 1.0))
         self._table: np.ndarray | None = None
@@ -86,11 +88,13 @@ class BraggMirrorModel:
     def table(self) -> np.ndarray:
         """The tabulated method's RGB over cos(theta) (built once per parameter set)."""
         if self._table is None:
-            self._table = bragg.tabulated_rgb_table(self.mirror)
+            self._table = bragg.tabulated_rgb_table(self.mirror) if self.natural is None else natural.natural_rgb_table(self.natural)
         return self._table
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """Linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
+        if self.natural is not None:  # the shader's natural_structure(): the exact table whatever the method
+            return bragg.tabulated_rgb(self.table, np.asarray(cos_theta, dtype=np.float64))
         return BRAGG_REFLECTANCE[self.method](self, np.asarray(cos_theta, dtype=np.float64))
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
@@ -143,8 +147,10 @@ class BraggMirrorModel:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
         return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
 
-    #: The parameters the tabulated method's table depends on (:func:`mirror_of`).
-    MIRROR_PARAMETERS = ("n1", "n2", "Lambda", "delta", "N", "nh")
+    #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
+    #: where the file declares them), and the integer ones among them.
+    MIRROR_PARAMETERS = ("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma", "medium_n1", "medium_n2", "medium_nh")
+    INTEGER_MIRROR_PARAMETERS = ("N", "medium_n1", "medium_n2", "medium_nh")
     #: The shader's improved approximation (method 4, its ``reflectance`` branch): what an exported table
     #: falls back to away from its values.
     IMPROVED_GLSL = "approximate_rgb(cos_theta, bragg_mirror(), s, false, true)"
@@ -155,8 +161,8 @@ class BraggMirrorModel:
         table for the exported mirror, whatever the exported method, and the values it holds for: where a
         mirror parameter moves away from them, the file's method 3 reads method 4 (the improved approximation).
         """
-        baked = {name: float(self.values[name]) for name in self.MIRROR_PARAMETERS}
-        integers = tuple(name for name in self.MIRROR_PARAMETERS if name == "N")
+        baked = {name: float(self.values[name]) for name in self.MIRROR_PARAMETERS if name in self.values}
+        integers = tuple(name for name in self.INTEGER_MIRROR_PARAMETERS if name in baked)
         return {"tables": {"bragg_table": self.table},
                 "baked": {"bragg_table": {"values": baked, "integers": integers, "fallback": self.IMPROVED_GLSL,
                                           "fallback_label": f"{int(BraggMethod.IMPROVED)} {BraggMethod.IMPROVED.label}",
@@ -165,14 +171,35 @@ class BraggMirrorModel:
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
-        return {"bragg_table": self.table if self.method.needs_table else np.zeros((1, 3), np.float32)}
+        needed = self.method.needs_table or self.natural is not None
+        return {"bragg_table": self.table if needed else np.zeros((1, 3), np.float32)}
 
     def draft_textures(self) -> dict[str, np.ndarray] | None:
         """
         Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's draft table,
         :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
         """
+        if self.natural is not None:
+            return None  # the exact table only (no draft of complex, dispersive spectra)
         return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method.needs_table else None
+
+
+def natural_mirror_of(values: Mapping[str, object]) -> "natural.NaturalMirror | None":
+    """
+    The natural mirror of a ``bragg_mirror``'s (or ``bragg_layer``'s) values when they have absorbing, dispersive
+    or disordered layers (``k1``, ``k2``, ``sigma``, ``medium_*``), else None (the paper's mirror).
+    """
+    from explorer.materials.media import index_value
+
+    k1, k2, sigma = (float(values.get(name, 0.0)) for name in ("k1", "k2", "sigma"))
+    n1, n2 = index_value(values, "n1"), index_value(values, "n2")
+    nh_value = index_value(values, "nh") if "nh" in values else 0.0
+    media = any(not isinstance(v, float) for v in (n1, n2, nh_value))
+    if not (k1 > 0.0 or k2 > 0.0 or sigma > 0.0 or media):
+        return None
+    nh = nh_value if not isinstance(nh_value, float) else (nh_value if nh_value >= 1.0 else None)
+    return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+                                 N=round_integer(values["N"]), nh=nh, k1=k1, k2=k2, sigma=sigma)
 
 
 #: The Bragg mirror's reflectance per method (the shader's branches on BRAGG_* in bragg_mirror.brd).
