@@ -154,6 +154,27 @@ class BraggMirrorModel:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
         return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
 
+    #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
+    #: where the file declares them), and the integer ones among them.
+    MIRROR_PARAMETERS = ("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma", "medium_n1", "medium_n2", "medium_nh")
+    INTEGER_MIRROR_PARAMETERS = ("N", "medium_n1", "medium_n2", "medium_nh")
+    #: The shader's improved approximation (method 4, its ``reflectance`` branch): what an exported table
+    #: falls back to away from its values.
+    IMPROVED_GLSL = "approximate_rgb(cos_theta, bragg_mirror(), s, false, true)"
+
+    def brdf_export(self) -> dict:
+        """
+        How ``export --to brdf`` bakes the mirror (:mod:`explorer.materials.export_brdf`): the tabulated method's
+        table for the exported mirror, whatever the exported method, and the values it holds for: where a
+        mirror parameter moves away from them, the file's method 3 reads method 4 (the improved approximation).
+        """
+        baked = {name: float(self.values[name]) for name in self.MIRROR_PARAMETERS if name in self.values}
+        integers = tuple(name for name in self.INTEGER_MIRROR_PARAMETERS if name in baked)
+        return {"tables": {"bragg_table": self.table},
+                "baked": {"bragg_table": {"values": baked, "integers": integers, "fallback": self.IMPROVED_GLSL,
+                                          "fallback_label": f"{int(BraggMethod.IMPROVED)} {BraggMethod.IMPROVED.label}",
+                                          "label": f"{int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label}"}}}
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.

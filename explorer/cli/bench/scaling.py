@@ -118,17 +118,13 @@ def plot_scaling(document: dict, path: Path) -> None:
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=8)
     figure.tight_layout()
-    # Atomically: a temporary file beside the plot, renamed over it.
-    import os
-    import tempfile
+    # Atomically: a temporary file beside the plot, renamed over it (mode 0644 under the usual umask).
+    from explorer.files import atomic_output
 
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
     try:
-        with os.fdopen(handle, "wb") as stream:
-            figure.savefig(stream, dpi=110, format="png")
-        os.replace(temporary, path)
+        with atomic_output(path) as temporary:
+            figure.savefig(temporary, dpi=110, format="png")
     finally:
-        Path(temporary).unlink(missing_ok=True)
         plt.close(figure)
 
 
