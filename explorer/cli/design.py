@@ -186,15 +186,16 @@ def ranges_of(material) -> dict[str, tuple[float, float]]:
     return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
 
 
-def render_command(material_name: str, values: dict) -> str:
-    """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
-    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
-    from explorer.materials.methods import BraggMethod, ThinFilmMethod
+def render_command(material_name: str, values: dict, material=None) -> str:
+    """The ``render`` command line that shows the designed structure's θ strip (the material's preferred method:
+    Bragg's converged table, the film's Fourier m = 3, within ~0.002 of the reference)."""
+    from explorer.materials.twins import capabilities_of
 
-    # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of the reference).
-    best = ThinFilmMethod.FOURIER_3 if "thin_film" in material_name else BraggMethod.TABULATED
-    method = f"--set method={int(best)}"
-    return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
+    methods = capabilities_of(material).methods if material is not None else None
+    best = methods.preferred_member() if methods is not None else None
+    method = f" --set method={int(best)}" if best is not None else ""
+    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")
@@ -277,7 +278,7 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
                    "the structure above is the closest found")
         click.echo(SEARCH_CAVEAT)
-    click.echo(f"render: {render_command(name, result.values)}")
+    click.echo(f"render: {render_command(name, result.values, loaded)}")
 
 
 def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None,
@@ -289,7 +290,9 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
     """
     from explorer.physics.design import round_trip
 
-    material = load("bragg_mirror")
+    from explorer.materials.models import BraggMirrorModel
+
+    material = load(BraggMirrorModel.name)
     ranges = ranges_of(material)
     draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
     rows = []
@@ -304,7 +307,7 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
                        f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s "
                        f"({row['cpu_seconds']:.2f} s CPU{f', {result.tries} searches' if result.tries > 1 else ''})")
 
-    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
+    round_trip(BraggMirrorModel.name, ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
     medians = np.array([r["median_delta_e2000"] for r in rows])
     seconds = np.array([r["seconds"] for r in rows])
     cpu = np.array([r["cpu_seconds"] for r in rows])

@@ -37,7 +37,7 @@ def render_env_with_mitsuba(material, values, width, height, environment, spp, v
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--to", "target", type=click.Choice(TARGETS), required=True,
               help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
-                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film); "
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (a thin film); "
                    "gltf: a .glb sphere with KHR_materials_iridescence (a thin film, or the nearest one).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")

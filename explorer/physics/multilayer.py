@@ -50,7 +50,7 @@ def forward_kz(n: ArrayLike, n_sin: ArrayLike) -> np.ndarray:
     return np.where(flip, -kz, kz)
 
 
-def interface(polarisation: str, n_i, kz_i, n_t, kz_t) -> tuple[np.ndarray, np.ndarray]:
+def interface(polarisation: str, n_i: ArrayLike, kz_i: ArrayLike, n_t: ArrayLike, kz_t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Amplitude ``(r, t)`` of an interface from ``n_i`` to ``n_t`` (``kz = n cos theta``; ``tmm``'s signs)."""
     if polarisation == "s":
         denominator = kz_i + kz_t
@@ -141,7 +141,7 @@ def disordered_thicknesses(thicknesses: ArrayLike, sigma: float, realisations: i
     return thicknesses * (1.0 + sigma * disorder_noise(thicknesses.size, realisations, seed))
 
 
-def mean_optics(polarisation: str, n0, indices: list, thicknesses: np.ndarray, n_base, wavelength_nm: np.ndarray,
+def mean_optics(polarisation: str, n0: ArrayLike, indices: list, thicknesses: np.ndarray, n_base: ArrayLike, wavelength_nm: np.ndarray,
                 sin_theta0: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """The mean ``R`` and ``T`` over the rows of ``thicknesses`` (realisations), in blocks of :data:`REALISATION_BLOCK`."""
     R = np.zeros(np.shape(wavelength_nm))

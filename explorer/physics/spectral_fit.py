@@ -15,6 +15,7 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from explorer.physics import multilayer
 from explorer.physics.dispersion import Dispersion, complex_index
@@ -80,13 +81,13 @@ def _model(free: list[str], fixed: dict, vector: np.ndarray, wavelength_nm: np.n
     return host, n1, n2, delta * Lambda, (1.0 - delta) * Lambda
 
 
-def mirror_of(free: list[str], fixed: dict, vector, N: int) -> NaturalMirror:
+def mirror_of(free: list[str], fixed: dict, vector: ArrayLike, N: int) -> NaturalMirror:
     values = {**{k: v for k, v in fixed.items() if k in ("n1", "n2", "nh", "k1", "k2", "Lambda", "delta", "sigma")},
               **{name: float(x) for name, x in zip(free, vector)}}
     return NaturalMirror(N=int(N), **values)
 
 
-def fit_spectrum(wavelength_nm, measured, theta_deg: float, fixed: dict, seed: int = 0) -> SpectrumFit:
+def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float, fixed: dict, seed: int = 0) -> SpectrumFit:
     """
     The mirror whose unpolarised reflectance at ``theta_deg`` best matches ``measured`` at ``wavelength_nm``.
 
