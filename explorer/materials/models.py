@@ -359,6 +359,7 @@ class BraggStackModel:
             ))
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
+            tau_h=float(values.get("tau_h", 0.0)),
         )
 
     @property
