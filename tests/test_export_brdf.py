@@ -155,7 +155,7 @@ def test_exported_slice_equals_the_original(core410, name, overrides):
     from explorer.materials.models import model_for
     from explorer.views.render import render_numpy
 
-    original = render_numpy(model_for(material, material.physical_values(values)), "slice", *SIZE).astype(np.float64)
+    original = render_numpy(model_for(material, values), "slice", *SIZE).astype(np.float64)
     peak = np.abs(original).max()
     assert peak > 1e-3
     exported = slice_of_export(core410, text)

@@ -186,15 +186,16 @@ def ranges_of(material) -> dict[str, tuple[float, float]]:
     return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
 
 
-def render_command(material_name: str, values: dict) -> str:
-    """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
-    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
-    from explorer.materials.methods import BraggMethod, ThinFilmMethod
+def render_command(material_name: str, values: dict, material=None) -> str:
+    """The ``render`` command line that shows the designed structure's θ strip (the material's preferred method:
+    Bragg's converged table, the film's Fourier m = 3, within ~0.002 of the reference)."""
+    from explorer.materials.twins import capabilities_of
 
-    # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of the reference).
-    best = ThinFilmMethod.FOURIER_3 if "thin_film" in material_name else BraggMethod.TABULATED
-    method = f"--set method={int(best)}"
-    return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
+    methods = capabilities_of(material).methods if material is not None else None
+    best = methods.preferred_member() if methods is not None else None
+    method = f" --set method={int(best)}" if best is not None else ""
+    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")
@@ -208,11 +209,19 @@ def render_command(material_name: str, values: dict) -> str:
 @click.option("--guess", "guess_texts", multiple=True, metavar="NAME=VALUE,...",
               help="A structure to start from (omitted parameters: the material's defaults); it joins the first pass. Repeatable.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
+@click.option("--target-spectrum", metavar="FILE.csv",
+              help="Fit a measured reflectance instead (wavelength_nm,R as a fraction or in %): least squares in R(lambda); "
+                   "--fix may name media (n2=chitin).")
+@click.option("--theta", "spectrum_theta", type=click.FloatRange(0.0, 89.9), default=0.0, show_default=True,
+              help="--target-spectrum: the measurement's incidence angle in degrees.")
+@click.option("--plot", "spectrum_plot", type=click.Path(dir_okay=False), metavar="FILE.png",
+              help="--target-spectrum: plot the measured against the fitted spectrum.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="The first pass's Sobol scrambling (>= 0).")
 @click.option("--tries", type=click.IntRange(min=1, max=MAX_TRIES), default=DEFAULT_TRIES, show_default=True, metavar="K",
               help="Search up to K times until every target is within ΔE2000 1, each from fresh samples and the best "
                    "structure so far (~4 s each; 1: one search).")
-def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, seed, tries):
+def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
+                   spectrum_theta, spectrum_plot, seed, tries):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -224,6 +233,13 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
     from explorer.resources import display_path
 
+    if target_spectrum is not None:
+        from explorer.cli.spectrum_fit import fit_command
+
+        if target_texts or target_strip or free or guess_texts:
+            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip, --free or --guess")
+        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed)
+        return
     try:
         loaded = load(material)
         design_model(loaded.model)
@@ -262,7 +278,7 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
                    "the structure above is the closest found")
         click.echo(SEARCH_CAVEAT)
-    click.echo(f"render: {render_command(name, result.values)}")
+    click.echo(f"render: {render_command(name, result.values, loaded)}")
 
 
 def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None,
@@ -274,7 +290,9 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
     """
     from explorer.physics.design import round_trip
 
-    material = load("bragg_mirror")
+    from explorer.materials.models import BraggMirrorModel
+
+    material = load(BraggMirrorModel.name)
     ranges = ranges_of(material)
     draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
     rows = []
@@ -289,7 +307,7 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
                        f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s "
                        f"({row['cpu_seconds']:.2f} s CPU{f', {result.tries} searches' if result.tries > 1 else ''})")
 
-    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
+    round_trip(BraggMirrorModel.name, ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
     medians = np.array([r["median_delta_e2000"] for r in rows])
     seconds = np.array([r["seconds"] for r in rows])
     cpu = np.array([r["cpu_seconds"] for r in rows])

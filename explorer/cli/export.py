@@ -25,11 +25,11 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
 
 def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
     """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
-    from explorer.mitsuba import BSDF_NAMES
+    from explorer.materials.twins import capabilities_of, supporting
     from explorer.mitsuba.scene import render_env_mitsuba
 
-    if material.model not in BSDF_NAMES:
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
+    if not capabilities_of(material).supports("mitsuba"):
+        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
     return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
@@ -37,7 +37,7 @@ def render_env_with_mitsuba(material, values, width, height, environment, spp, v
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--to", "target", type=click.Choice(TARGETS), required=True,
               help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
-                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film); "
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (a thin film); "
                    "gltf: a .glb sphere with KHR_materials_iridescence (a thin film, or the nearest one).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")

@@ -33,8 +33,6 @@ from explorer.files import write_text_atomic
 from explorer.errors import LocatedError
 from explorer.resources import SHADER_DIR
 
-#: The materials with an export (a numpy twin and no view-specific hooks in BRDF).
-EXPORTABLE = ("bragg_mirror", "bragg_layer", "thin_film")
 _INCLUDE = re.compile(r'\s*#\s*include\s*"([^"]+)"')
 _DIRECTIVE = re.compile(r"\s*#\s*(\w+)\s*(.*?)\s*(//.*)?$")
 
@@ -265,8 +263,8 @@ def _parameter_lines(material, values: Mapping[str, object]) -> list[str]:
     return lines
 
 
-def material_tables(material, values: Mapping[str, object]) -> dict[str, np.ndarray]:
-    """The library's tables and the material's own (for its values), as (height, width, 3) arrays."""
+def material_tables(material, values: Mapping[str, object], model=None) -> dict[str, np.ndarray]:
+    """The library's tables and the material's own (its twin's ``textures()`` for its values), as (height, width, 3) arrays."""
     from explorer.materials.models import model_for
     from explorer.tables import luts
 
@@ -275,32 +273,30 @@ def material_tables(material, values: Mapping[str, object]) -> dict[str, np.ndar
         "cmf_cumulative": luts.load("cmf_cumulative").reshape(1, -1, 3),
         "sensitivity_fourier": luts.load("sensitivity_fourier").reshape(2, -1, 3),
     }
-    model = model_for(material, material.physical_values(values))
+    model = model_for(material, values) if model is None else model
     for name, table in model.textures().items():
         table = np.asarray(table, dtype=np.float64)
         tables[name] = table.reshape(1, -1, 3) if table.ndim == 2 else table
-    if material.model == "bragg_layer":
-        tables["transmission_table"] = np.asarray(model.transmission_table, np.float64).reshape(1, -1, 3)
     return tables
 
 
 def brdf_text(material, values: Mapping[str, object]) -> str:
     """The self-contained ``.brdf`` text of ``material`` at ``values``."""
-    if material.model not in EXPORTABLE:
-        raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(EXPORTABLE)})")
+    from explorer.materials.models import model_for
+    from explorer.materials.twins import capabilities_of, supporting
+
+    if not capabilities_of(material).supports("brdf"):
+        raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(supporting('brdf'))})")
     ints = [p.name for p in material.parameters if p.type == "int"]
     shader = round_int_parameters(material.shader, ints)
-    defined = {}
-    tables = material_tables(material, values)
-    if material.model == "thin_film":
-        # The film's export is specialised to its method: the 4096 x 2 sensitivity_fourier table, inlined,
-        # takes Mesa's compiler many minutes, so only methods 1-3 (which read it) carry it.
-        from explorer.materials.brd import round_integer
-
-        method = round_integer(values["method"])
-        defined["SPECIALISED_method"] = str(method)
-        # Methods 1-3 read the envelope through _coarse_envelope (below), not the inlined table.
-        tables.pop("sensitivity_fourier")
+    model = model_for(material, values)
+    tables = material_tables(material, values, model)
+    # A twin may specialise its export (its brdf_export hook): #defines, tables it leaves out, a coarse envelope.
+    hook = getattr(model, "brdf_export", None)
+    special = hook() if callable(hook) else {}
+    defined = dict(special.get("defines", {}))
+    for name in special.get("drop_tables", ()):
+        tables.pop(name, None)
     # The methods' names, which the host #defines in every program: substituted by their values, as PI is
     # (a `const int BRAGG_REFERENCE` would break the explorer's own loading of the file, whose host
     # #defines the same names).
@@ -308,11 +304,8 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
 
     defined.update({name: str(value) for name, value in glsl_defines().items()})
     flat = flatten(shader, str(material.path), defined)
-    if material.model == "thin_film":
-        from explorer.materials.thinfilm_model import TABULATED_FOURIER
-
-        if method in TABULATED_FOURIER:
-            flat = _coarse_envelope(flat)
+    if special.get("coarse_envelope", False):
+        flat = _coarse_envelope(flat)
     flat = _forward_declare(inline_tables(flat, tables), list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):

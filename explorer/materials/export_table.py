@@ -72,7 +72,7 @@ def material_table(material, values) -> np.ndarray:
 
     names = roughness_names(material)
     cos = np.linspace(0.0, 1.0, COLUMNS)
-    base = model_for(material, material.physical_values(values))
+    base = model_for(material, values)
     if base is None or not callable(getattr(base, "reflectance", None)):
         raise TableExportError(material.path, None, "this material has no numpy twin to bake (no known '# model:' line)")
     smooth = np.asarray(base.reflectance(cos), dtype=np.float64)
@@ -80,6 +80,6 @@ def material_table(material, values) -> np.ndarray:
         return smooth[None].astype(np.float32)
     rows = [smooth]
     for alpha in np.linspace(0.0, 1.0, ROWS)[1:]:
-        model = model_for(material, material.physical_values({**values, **{n: float(alpha) for n in names}}))
+        model = model_for(material, {**values, **{n: float(alpha) for n in names}})
         rows.append(_albedo(model, cos, float(alpha)))
     return np.asarray(rows, dtype=np.float32)

@@ -61,7 +61,7 @@ GENERATED: dict[str, Callable[[], str]] = {
         "N_RESOLVE": bragg.N_RESOLVE,
         "GROW_EXPONENT": bragg.GROW_EXPONENT,
         "MAX_RESOLVED_PIECES": bragg.MAX_RESOLVED_PIECES,
-    }, "explorer/physics/bragg.py"),
+    }, "explorer/physics/bragg/"),
     "generated/colorimetry.glsl": lambda: _block({
         "CMF_COUNT": colorimetry.WAVELENGTHS.size,
         "CMF_FIRST_WAVELENGTH": float(colorimetry.WAVELENGTH_MIN),
@@ -100,5 +100,5 @@ GENERATED: dict[str, Callable[[], str]] = {
         "PREFILTER_SIGMA_STEP": thinfilm.PREFILTER_SIGMA_STEP,
         "PREFILTER_LEVELS": thinfilm.PREFILTER_LEVELS,
         "D_INC_BLEND": thinfilm.D_INC_BLEND,
-    }, "explorer/physics/thinfilm.py"),
+    }, "explorer/physics/thinfilm/"),
 }

@@ -135,6 +135,6 @@ def export_scene(material, values: Mapping[str, object], directory: str | os.Pat
 
 
 def _plugin_names() -> tuple[str, ...]:
-    from explorer.mitsuba import BSDF_NAMES
+    from explorer.mitsuba.bsdfs import plugin_names
 
-    return BSDF_NAMES
+    return plugin_names()

@@ -173,18 +173,18 @@ MIRRORS = ({}, {"Lambda": 400.0}, {"Lambda": 600.0})
 
 def main() -> None:
     from explorer.materials.brd import load_material
-    from explorer.materials.models import model_for
+    from explorer.materials.models import BraggMirrorModel, model_for
     from explorer.resources import material_path
     from explorer.views.env import EnvironmentMap
 
-    material = load_material(material_path("bragg_mirror"))
-    print("bragg_mirror (method 3), default sky, 64x64 pixel centres: median ΔE2000 of")
+    material = load_material(material_path(BraggMirrorModel.name))
+    print(f"{BraggMirrorModel.name} (method 3), default sky, 64x64 pixel centres: median ΔE2000 of")
     print("  roundtrip: the sky's RGB upsampled as Mitsuba does, read in the explorer's convention, vs its RGB")
     print("  product: spectral RGB(R L) vs GL's RGB(R) RGB(L); consistent: the sky's spectra corrected to its RGB")
     print("  white: the same under a white sky")
     for overrides in MIRRORS:
         values = material.resolve({"method": int(BraggMethod.TABULATED), **overrides})
-        gap = spectral_gap(model_for(material, material.physical_values(values)), EnvironmentMap.default())
+        gap = spectral_gap(model_for(material, values), EnvironmentMap.default())
         label = ", ".join(f"{k} = {v:g}" for k, v in overrides.items()) or "defaults"
         print(f"  {label:<14} roundtrip {gap['roundtrip']:.2f} (max {gap['roundtrip_max']:.2f})  product {gap['product']:.2f}"
               f"  consistent {gap['product_consistent']:.2f}  white {gap['white']:.2f}")

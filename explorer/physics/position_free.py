@@ -53,9 +53,13 @@ from typing import Callable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from explorer.physics import colorimetry, layered, microfacet
+from explorer.physics import colorimetry, layered, microfacet, microsurface
 from explorer.physics.fresnel import fresnel_reflectance
 
+#: How a rough layer's microsurface scatters: ``single``, Eq. 17's one reflection and Eq. 28's ballistic
+#: transmission (what single scattering loses, Eq. 30's ``A``, is absorbed); ``walk``, every bounce among
+#: its facets (the random walk of Heitz et al. 2016, :mod:`explorer.physics.microsurface`; albedo only).
+MICROSURFACES = ("single", "walk")
 #: Paths traced together (a few hundred bytes each).
 BATCH_PATHS = 1 << 17
 #: Russian roulette starts after this many events, for paths whose weight fell below the threshold.
@@ -131,7 +135,10 @@ class PositionFree:
     Fourneau et al. (2024), Section 4.2; Guo et al. (2018).
     """
 
-    def __init__(self, stack: layered.LayeredBragg, tables=None):
+    def __init__(self, stack: layered.LayeredBragg, tables=None, microsurface: str = "single"):
+        if microsurface not in MICROSURFACES:
+            raise ValueError(f"microsurface must be one of {', '.join(MICROSURFACES)}, got {microsurface!r}")
+        self.walk = microsurface == "walk"
         self.stack = stack
         tables = layered.stack_tables(stack) if tables is None else tuple(tables)
         if len(tables) != len(stack.layers):
@@ -196,6 +203,18 @@ class PositionFree:
         u = ((np.arange(count)[None, :] + rng.random((groups, count))) / count).reshape(-1, 1)
         u = (u + np.arange(K)[None, :] / K) % 1.0
         return np.minimum(np.searchsorted(self.cdf, u, side="right"), self.pdf.size - 1)
+
+    def _walk_layer(self, l, at, d, beta, pi, gap, alive, wavelength, rng) -> None:
+        """
+        Multiple scattering on layer ``l``'s microsurface for the paths ``at`` (in place): the random walk
+        of :func:`explorer.physics.microsurface.walk` takes each to the layer's top (reflected) or bottom
+        (transmitted, ballistically after every crossing), its facets reflecting with the layer's ``R_lambda``.
+        """
+        table = self.reflectance[l]
+        d[at], beta[at], pi[at], up, kept, _ = microsurface.walk(
+            d[at], beta[at], pi[at], self.alphas[l], lambda cos_d, rows: self._lookup(table, cos_d, wavelength[rows]), rng)
+        alive[at[~kept]] = False
+        gap[at] = np.where(up, l, l + 1)
 
     # ----------------------------------------------------------------------------------------------
     # The walk
@@ -272,6 +291,9 @@ class PositionFree:
                 if at.size == 0:
                     continue
                 alpha = self.alphas[l]
+                if self.walk:
+                    self._walk_layer(l, at, d, beta, pi, gap, alive, wl[pid[at]], rng)
+                    continue
                 from_above = going_down[at]
                 cos_in = np.abs(d[at, 2])
                 j = wl[pid[at]]
@@ -484,6 +506,8 @@ class PositionFree:
             As in :meth:`albedo`.
         """
         start = time.perf_counter()
+        if self.walk:
+            raise ValueError("the microsurface walk estimates the directional albedo only (no next-event BRDF)")
         if int(samples) < 1:
             raise ValueError(f"samples must be at least 1, got {samples}")
         i_air, o_air = np.broadcast_arrays(np.atleast_2d(np.asarray(i_air, dtype=np.float64)),
@@ -523,9 +547,10 @@ def _worker_replicate(i_air, o_air, per, key):
 def directional_albedo(
     stack: layered.LayeredBragg, theta_deg: ArrayLike, samples: int = 20000, seed: int = 0,
     tables: Sequence[layered.LayerTables] | None = None, progress: Callable[[int, int], None] | None = None,
+    microsurface: str = "single",
 ) -> PositionFreeResult:
-    """The position-free directional albedo of ``stack`` (:meth:`PositionFree.albedo`)."""
-    return PositionFree(stack, tables).albedo(theta_deg, samples, seed, progress)
+    """The position-free directional albedo of ``stack`` (:meth:`PositionFree.albedo`; ``microsurface``: :data:`MICROSURFACES`)."""
+    return PositionFree(stack, tables, microsurface).albedo(theta_deg, samples, seed, progress)
 
 
 def brdf(
