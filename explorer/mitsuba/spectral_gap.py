@@ -141,7 +141,7 @@ def material_gap(material, values, environment, size: int = 16) -> dict[str, flo
     from explorer.views.env import EnvironmentMap
     from explorer.views.geometry import brdf_view_geometry
 
-    model = model_for(material, material.physical_values(values))
+    model = model_for(material, values)
     coarse = EnvironmentMap(cv2.resize(np.asarray(environment.pixels), GAP_ENVIRONMENT, interpolation=cv2.INTER_AREA),
                             environment.name, environment.rotation)
     directions, solid_angle, radiance = coarse.quadrature(1)
@@ -159,7 +159,7 @@ def material_gap(material, values, environment, size: int = 16) -> dict[str, flo
             weight = (cos[up] * solid_angle[up])[:, None]
             f_rgb = model.brdf(l, np.broadcast_to(v, l.shape), n, x, y)
             gl.append(np.sum(np.nan_to_num(f_rgb) * rgb_light[up] * weight, axis=0))
-            f = spectral_brdf(material.model, model, l @ frame.T, np.broadcast_to(frame @ v, l.shape),
+            f = spectral_brdf(model, l @ frame.T, np.broadcast_to(frame @ v, l.shape),
                               np.broadcast_to(grid, (l.shape[0], grid.size)), reflectance_spectra)
             spectrum = np.sum(f * spectral_light[up] * weight, axis=0)
             spectral.append(colorimetry.spectrum_to_rgb(np.interp(colorimetry.WAVELENGTHS, grid, spectrum)))
@@ -193,7 +193,8 @@ def main() -> None:
 def main_materials(size: int = 12) -> None:
     """Every material with a Mitsuba plugin at its defaults (the Bragg layer with the tabulated method)."""
     from explorer.materials.brd import load_material
-    from explorer.mitsuba.bsdfs import BSDF_NAMES
+    from explorer.materials.twins import capabilities_of
+    from explorer.mitsuba.bsdfs import plugin_names
     from explorer.resources import material_path
     from explorer.views.env import EnvironmentMap
 
@@ -201,14 +202,14 @@ def main_materials(size: int = 12) -> None:
           f"{GAP_ENVIRONMENT[0]}x{GAP_ENVIRONMENT[1]} texels: median ΔE2000 of the spectral product vs GL's product of RGBs")
     from explorer.materials.models import model_for
 
-    for name in BSDF_NAMES:
+    for name in plugin_names():
         material = load_material(material_path(name))
         values = material.resolve({})
         model = model_for(material, values)
         if isinstance(getattr(model, "mirror", None), bragg.BraggMirror):  # the Bragg twins: the tabulated method
             values = material.resolve({"method": int(BraggMethod.TABULATED)})
             model = model_for(material, values)
-        if getattr(model, "mirror_only", False):  # a Dirac: the exact per-pixel decomposition above
+        if capabilities_of(material).dirac:  # a Dirac: the exact per-pixel decomposition above
             gap = spectral_gap(model, EnvironmentMap.default(), size)
             gap = {"sky": gap["product"], "white": gap["white"]}
         else:
