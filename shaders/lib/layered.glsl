@@ -109,7 +109,7 @@ void compensation_row(float theta, out int k, out float f) {
 }
 
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table) {
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table, float tau_h) {
     if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
     float path = 1.0;
     vec3 ih = i, oh = o;
@@ -121,6 +121,10 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
     vec3 used = layer_mask(layer_count);
     vec3 h = normalize(ih + oh);
     float ci = max(ih.z, 0.0), co = max(oh.z, 0.0);
+    // The host's gaps (tau_h), as in single_reflection_brdf.
+    float gap = gap_transmittance(tau_h, ci) * gap_transmittance(tau_h, co);
+    path *= gap;
+    vec3 g = mix(vec3(1.0), vec3(gap), used);
     vec3 lobe, G1_i, G1_o, lambda_i, lambda_o, root_i, root_o;  // per layer, wavelength-independent
     for (int l = 0; l < MAX_LAYERS; ++l) {
         float a = alphas[l];
@@ -151,11 +155,11 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
         vec3 Ge_i = 1.0 / (1.0 + lambda_i * rho_i), Ge_o = 1.0 / (1.0 + lambda_o * rho_o);
         vec3 layer = lobe * masking_over_cos(ci, root_i, rho_i) * masking_over_cos(co, root_o, rho_o) * R + scale * m_i * m_o;
         vec3 t = mix(vec3(1.0), ((1.0 - rho_i) * Ge_i * Ge_i + (1.0 - up) * m_i) * ((1.0 - rho_o) * Ge_o * Ge_o + (1.0 - up) * m_o), used);
-        float p2 = path * t.x, p3 = p2 * t.y;
+        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
         float layers_term = used.x * layer.x * path + used.y * layer.y * p2 + used.z * layer.z * p3;
         vec3 cmf = colour_matching_functions(j);
         xyz_layers += cmf * layers_term;
-        xyz_base += cmf * (p3 * t.z);
+        xyz_base += cmf * (p3 * t.z * gap);
     }
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
