@@ -577,6 +577,9 @@ def info(material, as_json, dispersions):
         click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
+    from explorer.materials.twins import capabilities_of
+
+    click.echo(f"  supports: {capabilities_of(loaded).summary()}")
 
 
 @cli.command()

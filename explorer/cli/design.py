@@ -113,7 +113,7 @@ def parse_target(text: str):
 def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS):
     """Targets read from a strip image over ``theta_range`` (``A,B`` degrees)."""
     from explorer.physics.design import DesignError, targets_from_strip
-    from explorer.views.images import read_linear_image
+    from explorer.views.images import clipped_codes, read_linear_image
 
     if theta_range is None:
         raise click.UsageError("--target-strip needs --theta-range A,B (degrees at its left and right edges)")
@@ -122,9 +122,20 @@ def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS
     except ValueError:
         raise click.UsageError(f"--theta-range {theta_range!r}: expected A,B in degrees") from None
     try:
-        return targets_from_strip(read_linear_image(path), a, b, count)
+        image = read_linear_image(path)
+        targets = targets_from_strip(image, a, b, count, clipped_codes(path))
     except (ValueError, DesignError) as error:
         raise click.UsageError(f"--target-strip {error}") from None
+    bounded = [t for t in targets if t.bounded]
+    if bounded:
+        words = {-1: "at most", 1: "at least"}
+        described = "; ".join(f"{t.theta_deg:.3g} deg " + ", ".join(f"{'rgb'[c]} {words[b]} {t.rgb[c]:.3g}"
+                                                                    for c, b in enumerate(t.bounds) if b)
+                              for t in bounded)
+        click.echo(f"{PROG}: note: {path}: channels at the image's limit (0 or 255) are clipped colours, taken as "
+                   f"bounds, not values: {described}. For exact targets, render the strip to .npy or .exr "
+                   "(linear, unclipped).", err=True)
+    return targets
 
 
 def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE") -> dict[str, float]:

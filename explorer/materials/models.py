@@ -53,15 +53,22 @@ def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray
     return layered.integrated_transmissivity(F, 1.0 - R)
 
 
+def host_index(nh):
+    """
+    The host a mirror's ``nh`` value stands for: a number below 1 means the host is ``n1`` (None), as the shaders
+    have it; any other value (an index, a dispersive medium) is the host. The one place of this rule.
+    """
+    return None if isinstance(nh, (int, float)) and float(nh) < 1.0 else nh
+
+
 def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
     """
-    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: below 1 the host
-    is ``n1``, as the shaders have it): the one reading of these values, for the twins, the app and design.
+    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: :func:`host_index`):
+    the one reading of these values, for the twins, the app and design.
     """
-    nh = float(values.get("nh", 0.0))
     return bragg.BraggMirror(
         n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
-        N=round_integer(values["N"]), nh=nh if nh >= 1.0 else None,
+        N=round_integer(values["N"]), nh=host_index(float(values.get("nh", 0.0))),
     )
 
 
@@ -71,7 +78,7 @@ class BraggMirrorModel:
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -147,6 +154,27 @@ class BraggMirrorModel:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
         return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
 
+    #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
+    #: where the file declares them), and the integer ones among them.
+    MIRROR_PARAMETERS = ("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma", "medium_n1", "medium_n2", "medium_nh")
+    INTEGER_MIRROR_PARAMETERS = ("N", "medium_n1", "medium_n2", "medium_nh")
+    #: The shader's improved approximation (method 4, its ``reflectance`` branch): what an exported table
+    #: falls back to away from its values.
+    IMPROVED_GLSL = "approximate_rgb(cos_theta, bragg_mirror(), s, false, true)"
+
+    def brdf_export(self) -> dict:
+        """
+        How ``export --to brdf`` bakes the mirror (:mod:`explorer.materials.export_brdf`): the tabulated method's
+        table for the exported mirror, whatever the exported method, and the values it holds for: where a
+        mirror parameter moves away from them, the file's method 3 reads method 4 (the improved approximation).
+        """
+        baked = {name: float(self.values[name]) for name in self.MIRROR_PARAMETERS if name in self.values}
+        integers = tuple(name for name in self.INTEGER_MIRROR_PARAMETERS if name in baked)
+        return {"tables": {"bragg_table": self.table},
+                "baked": {"bragg_table": {"values": baked, "integers": integers, "fallback": self.IMPROVED_GLSL,
+                                          "fallback_label": f"{int(BraggMethod.IMPROVED)} {BraggMethod.IMPROVED.label}",
+                                          "label": f"{int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label}"}}}
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
@@ -176,7 +204,7 @@ def natural_mirror_of(values: Mapping[str, object]) -> "natural.NaturalMirror | 
     media = any(not isinstance(v, float) for v in (n1, n2, nh_value))
     if not (k1 > 0.0 or k2 > 0.0 or sigma > 0.0 or media):
         return None
-    nh = nh_value if not isinstance(nh_value, float) else (nh_value if nh_value >= 1.0 else None)
+    nh = host_index(nh_value)
     return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(values["Lambda"]), delta=float(values["delta"]),
                                  N=round_integer(values["N"]), nh=nh, k1=k1, k2=k2, sigma=sigma)
 
@@ -221,7 +249,7 @@ class BraggLayerModel(BraggMirrorModel):
 
     name = "bragg_layer"
     capabilities = Capabilities(methods=BraggMethod, dirac=False, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
     # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
@@ -325,7 +353,7 @@ class BraggStackModel:
     #: and in the textures the shader reads alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
     facet_reflectance_override: float | None = None
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table"), design=False)
+                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -352,6 +380,7 @@ class BraggStackModel:
             ))
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
+            tau_h=float(values.get("tau_h", 0.0)),
         )
 
     @property
@@ -457,7 +486,7 @@ class SchlickFresnelModel:
 
     name = "schlick_fresnel"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.F0 = float(values["F0"])
@@ -483,7 +512,7 @@ class GGXSchlickModel:
 
     name = "ggx_schlick"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.alpha = float(values["alpha"])

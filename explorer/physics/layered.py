@@ -119,12 +119,17 @@ class LayeredBragg:
     coating : bool
         ``False`` drops the coating's interface (no Fresnel reflection, no refraction, no ``1/n1^2``):
         the stack seen from inside its host. With ``n1 = 1`` both give the same BRDF.
+    tau_h : float
+        The host's optical depth, at normal incidence, of each gap a path crosses: below the coating,
+        between consecutive layers, above the base. Crossing one at ``theta_t`` in the host attenuates by
+        ``exp(-tau_h / cos theta_t)`` (Beer-Lambert; Section 6's absorption between the layers). >= 0.
     """
 
     layers: tuple = ()
     n1: float = 1.0
     rho_d: tuple = (0.0, 0.0, 0.0)
     coating: bool = True
+    tau_h: float = 0.0
 
     def __post_init__(self):
         layers = tuple(self.layers) if not isinstance(self.layers, RoughBraggLayer) else (self.layers,)
@@ -144,6 +149,20 @@ class LayeredBragg:
         object.__setattr__(self, "layers", layers)
         object.__setattr__(self, "rho_d", tuple(float(x) for x in rho_d))
         object.__setattr__(self, "n1", float(self.n1))
+        if not (float(self.tau_h) >= 0.0 and np.isfinite(self.tau_h)):
+            raise ValueError(f"tau_h must be >= 0, got {self.tau_h}")
+        object.__setattr__(self, "tau_h", float(self.tau_h))
+
+
+#: Cosines of the host angles are kept above this in the gaps' attenuation (exp(-tau / cos) is 0 there anyway).
+GAP_COS_MIN = 1e-6
+
+
+def gap_transmittance(tau_h: float, cos_theta_host: ArrayLike) -> np.ndarray:
+    """``exp(-tau_h / cos theta)``: one crossing of a host gap at ``theta`` in the host (1 when ``tau_h = 0``)."""
+    if tau_h == 0.0:
+        return np.ones(np.shape(cos_theta_host))
+    return np.exp(-tau_h / np.maximum(np.asarray(cos_theta_host, dtype=np.float64), GAP_COS_MIN))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -459,8 +478,11 @@ def single_reflection_spectra(
     theta_d = np.arctan2(np.linalg.norm(i_host - o_host, axis=-1), np.linalg.norm(i_host + o_host, axis=-1))
     cos_i_host = np.maximum(i_host[..., 2], 0.0)
     cos_o_host = np.maximum(o_host[..., 2], 0.0)
+    # The host's absorption: each gap above a layer (and above the base) crossed down along i' and up along o'.
+    gap = (gap_transmittance(stack.tau_h, cos_i_host) * gap_transmittance(stack.tau_h, cos_o_host))[..., None]
     layers = 0.0
     for l, (layer, table) in enumerate(zip(stack.layers, tables)):
+        path = path * gap
         if compensation is not None:
             layer_term, t_i, t_o = _compensated_layer(layer, table, compensation[l], h, theta_d, theta_i, theta_o, cos_i_host, cos_o_host)
             layers = layers + layer_term * path
@@ -481,6 +503,7 @@ def single_reflection_spectra(
             R = lookup(table.reflectance, theta_d)
         layers = layers + lobe[..., None] * R * path
         path = path * lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o)
+    path = path * gap
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
 
 
@@ -573,8 +596,10 @@ def stack_specular_rgb(stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequen
     tables = stack_tables(stack) if tables is None else tuple(tables)
     theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
     through = ((1.0 - F) ** 2)[..., None]
+    gap = (gap_transmittance(stack.tau_h, np.cos(theta)) ** 2)[..., None]  # a gap down and up at theta'
     spectrum = 0.0
     for table in tables:
+        through = through * gap
         R = lookup(table.reflectance, theta)
         spectrum = spectrum + through * R
         through = through * (1.0 - R) ** 2

@@ -40,8 +40,13 @@ vec3 layer_mask(int layer_count) { return vec3(1.0, layer_count >= 2 ? 1.0 : 0.0
 // The single-reflection BRDF (Eq. 34) in linear sRGB, from the host's tables. i, o: unit directions in
 // air in the local frame (n = +z). Each wavelength's paths through the layers are multiplied before the
 // CMF integration; the base's RGB albedo multiplies the RGB of its spectral term (it has no spectrum).
+// The host's absorption: one crossing of a gap of optical depth tau_h at cos theta in the host (Beer-Lambert).
+float gap_transmittance(float tau_h, float cos_theta_host) {
+    return tau_h == 0.0 ? 1.0 : exp(-tau_h / max(cos_theta_host, 1e-6));
+}
+
 vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                           sampler2D reflectance_table, sampler2D transmissivity_table) {
+                           sampler2D reflectance_table, sampler2D transmissivity_table, float tau_h) {
     if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
     float path = 1.0;
     vec3 ih = i, oh = o;
@@ -59,6 +64,9 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
         lobe[l] = used[l] * 0.25 * ggx_D(h.z, alphas[l]) * smith_G1_over_cos(max(ih.z, 0.0), alphas[l])
                 * smith_G1_over_cos(max(oh.z, 0.0), alphas[l]);
     }
+    // Each gap above a layer, and above the base, crossed down along i' and up along o' (tau_h).
+    float gap = gap_transmittance(tau_h, max(ih.z, 0.0)) * gap_transmittance(tau_h, max(oh.z, 0.0));
+    path *= gap;
     int k_i, k_o, k_d;
     float f_i, f_o, f_d;
     table_row(polar_angle(ih), k_i, f_i);
@@ -68,11 +76,13 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k_d, f_d);
         vec3 t = mix(vec3(1.0), table_fetch(transmissivity_table, j, k_i, f_i) * table_fetch(transmissivity_table, j, k_o, f_o), used);
-        float p2 = path * t.x, p3 = p2 * t.y;  // the paths down to layers 2 and 3
+        // The paths down to layers 2 and 3 and to the base (a layer beyond layer_count passes 1 and no gap).
+        vec3 g = mix(vec3(1.0), vec3(gap), used);
+        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
         float layers_term = lobe.x * R.x * path + lobe.y * R.y * p2 + lobe.z * R.z * p3;
         vec3 cmf = colour_matching_functions(j);
         xyz_layers += cmf * layers_term;
-        xyz_base += cmf * (p3 * t.z);
+        xyz_base += cmf * (p3 * t.z * gap);
     }
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
@@ -99,7 +109,7 @@ void compensation_row(float theta, out int k, out float f) {
 }
 
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table) {
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table, float tau_h) {
     if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
     float path = 1.0;
     vec3 ih = i, oh = o;
@@ -111,6 +121,10 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
     vec3 used = layer_mask(layer_count);
     vec3 h = normalize(ih + oh);
     float ci = max(ih.z, 0.0), co = max(oh.z, 0.0);
+    // The host's gaps (tau_h), as in single_reflection_brdf.
+    float gap = gap_transmittance(tau_h, ci) * gap_transmittance(tau_h, co);
+    path *= gap;
+    vec3 g = mix(vec3(1.0), vec3(gap), used);
     vec3 lobe, G1_i, G1_o, lambda_i, lambda_o, root_i, root_o;  // per layer, wavelength-independent
     for (int l = 0; l < MAX_LAYERS; ++l) {
         float a = alphas[l];
@@ -141,11 +155,11 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
         vec3 Ge_i = 1.0 / (1.0 + lambda_i * rho_i), Ge_o = 1.0 / (1.0 + lambda_o * rho_o);
         vec3 layer = lobe * masking_over_cos(ci, root_i, rho_i) * masking_over_cos(co, root_o, rho_o) * R + scale * m_i * m_o;
         vec3 t = mix(vec3(1.0), ((1.0 - rho_i) * Ge_i * Ge_i + (1.0 - up) * m_i) * ((1.0 - rho_o) * Ge_o * Ge_o + (1.0 - up) * m_o), used);
-        float p2 = path * t.x, p3 = p2 * t.y;
+        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
         float layers_term = used.x * layer.x * path + used.y * layer.y * p2 + used.z * layer.z * p3;
         vec3 cmf = colour_matching_functions(j);
         xyz_layers += cmf * layers_term;
-        xyz_base += cmf * (p3 * t.z);
+        xyz_base += cmf * (p3 * t.z * gap);
     }
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
@@ -154,7 +168,7 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
 // F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2, theta' the refracted angle (without a
 // coating: theta' = theta, F = 0). Smooth layers transmit 1 - R (the rough layer's integrated
 // transmissivity would exceed it beside band edges: see explorer.physics.layered.stack_specular_rgb).
-vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table) {
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h) {
     float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
     float F = 0.0, through = 1.0;
     if (coating) {
@@ -167,10 +181,13 @@ vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count
     float f;
     table_row(atan(s, c), k, f);
     vec3 used = layer_mask(layer_count);
+    float g = gap_transmittance(tau_h, c);
+    g *= g;  // a gap down and up at theta'
+    through *= g;
     vec3 xyz = vec3(0.0);
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k, f) * used;
-        vec3 t = (1.0 - R) * (1.0 - R);
+        vec3 t = (1.0 - R) * (1.0 - R) * g;
         xyz += colour_matching_functions(j) * (through * (R.x + t.x * (R.y + t.y * R.z)));
     }
     return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)
