@@ -574,7 +574,10 @@ def info(material, as_json, dispersions):
         bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
         opens = (f" (every command and the app open it on {labels.get(opening, opening)})"
                  if p.name == "method" and opening is not None and opening != shown["default"] else "")
-        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
+        unit = f" {p.unit}" if p.unit and p.unit != "1" else ""
+        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{unit}{opens}")
+        if p.doc:
+            click.echo(f"  {'':5} {'':{width}} {p.doc}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
 
