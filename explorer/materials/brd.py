@@ -436,8 +436,11 @@ class Material:
         for p in self.parameters:
             if p.name == name:
                 return p
+        from explorer.errors import did_you_mean
+
         valid = ", ".join(p.name for p in self.parameters) or "(none)"
-        raise UnknownParameterError(self.path, None, f"unknown parameter {name!r}; valid names: {valid}")
+        hint = did_you_mean(name, [p.name for p in self.parameters])
+        raise UnknownParameterError(self.path, None, f"unknown parameter {name!r}{hint}; valid names: {valid}")
 
     def resolve(
         self, overrides: Mapping[str, str | float | bool | Sequence[float]] = MappingProxyType({})
