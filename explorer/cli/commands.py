@@ -591,6 +591,9 @@ def info(material, as_json, dispersions):
             click.echo(f"  {'':5} {'':{width}} {p.doc}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
+    from explorer.materials.twins import capabilities_of
+
+    click.echo(f"  supports: {capabilities_of(loaded).summary()}")
 
 
 @cli.command()

@@ -15,6 +15,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 # --------------------------------------------------------------------------------------------------
 # bench --scaling: how the table and the shading cost grow (issue 22)
@@ -63,8 +64,8 @@ def scaling_study(repeats: int = 3, renderer=None) -> dict:
                     times.setdefault(("angles", N, n), []).append(measured)
         _progress(f"bench --scaling: table against its size, round {round_}/{repeats}")
     renderer = Renderer() if renderer is None else renderer
-    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
-    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    mirror_material = load_material(SHADER_DIR / f"{BraggMirrorModel.name}.brd")
+    schlick_material = load_material(SHADER_DIR / f"{SchlickFresnelModel.name}.brd")
     cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": int(BraggMethod.TABULATED)})),
              ("schlick", schlick_material, schlick_material.resolve({}))]
     for _, material, values in cases:
