@@ -19,6 +19,13 @@ from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessText
 ENV_SAMPLES = 256
 
 
+def no_texture_text(name: str) -> str:
+    """What the Texture tab says for a material whose surface no image can vary (in words, not the file's syntax)."""
+    return (f"{name} looks the same all over its surface: nothing in it follows an image. This tab shows a material "
+            "whose look varies across the surface with a grey image: a thin film whose thickness follows it, or a smooth "
+            "Bragg mirror whose period and layer ratio follow it (File > Open... a thin film or a Bragg mirror).")
+
+
 class TexturePanel(Panel):
     title = "Texture"
     dock = "right_top"
@@ -63,7 +70,9 @@ class TexturePanel(Panel):
         state = self.state
         kind = state.material.texture
         if kind not in TEXTURE_KINDS:
-            imgui.text_wrapped(f"this material declares no '# texture: {'|'.join(TEXTURE_KINDS)}' (thin_film and bragg_mirror do)")
+            text = no_texture_text(state.material_path.name)
+            imgui.text_wrapped(text)
+            state.texture_view = {"message": text}
             return
         _, self.path = imgui.input_text("texture (grey image)", self.path)
         if kind == "bragg":
