@@ -360,6 +360,7 @@ def test_main_execs_venv_pytest_from_repo_root(monkeypatch, tmp_path):
     monkeypatch.delenv(bs.ENV_NO_SETUP, raising=False)
     monkeypatch.setattr(bs, "ensure_system_packages", lambda mode: None)
     monkeypatch.setattr(bs, "ensure_optional_packages", lambda extras: None)
+    monkeypatch.setattr(bs, "ensure_node_packages", lambda mode: None)
     monkeypatch.setattr(bs, "ensure_python_packages", lambda extras, inside: False)
     monkeypatch.setattr(bs, "in_venv", lambda venv_dir: False)
     monkeypatch.chdir(tmp_path)
@@ -422,3 +423,26 @@ def test_bootstrap_and_main_import_only_stdlib():
     imports = [line.strip() for line in main_src.splitlines() if line.lstrip().startswith(("import", "from"))
                and not line.startswith("    from explorer.cli")]
     assert imports == ["import sys", "from explorer.dev.bootstrap import main"]
+
+
+def test_node_packages_only_for_tests_and_skipped_when_installed(tmp_path, monkeypatch):
+    """The test set-up npm-installs the pinned validator once into the cache folder; run mode never does."""
+    monkeypatch.setenv(bs.ENV_NODE_PREFIX, str(tmp_path))
+    calls = []
+
+    def runner(cmd, env=None):
+        calls.append(cmd)
+        for spec in cmd[cmd.index("--loglevel=error") + 1:]:
+            name, _, version = spec.rpartition("@")
+            (tmp_path / "node_modules" / name).mkdir(parents=True)
+            (tmp_path / "node_modules" / name / "package.json").write_text(json.dumps({"version": version}))
+        return 0, ""
+
+    which = lambda name: "/usr/bin/npm"  # noqa: E731
+    bs.ensure_node_packages(bs.MODE_RUN, which, runner)
+    assert calls == []
+    bs.ensure_node_packages(bs.MODE_TEST, which, runner)
+    assert len(calls) == 1 and calls[0][:4] == ["/usr/bin/npm", "install", "--prefix", str(tmp_path)]
+    assert calls[0][-1] == "gltf-validator@" + bs.NODE_PACKAGES["gltf-validator"]
+    bs.ensure_node_packages(bs.MODE_TEST, which, runner)
+    assert len(calls) == 1  # the second time: nothing to do

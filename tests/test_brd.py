@@ -457,7 +457,7 @@ def test_int_values_round_halves_up(value, expected) -> None:
     resolved = m.resolve({"method": value})["method"]
     assert resolved == float(expected) and isinstance(resolved, float)
     assert round_integer(float(value)) == expected
-    assert m.physical_values({"method": float(value), "other": 0.5}) == {"method": float(expected), "other": 0.5}
+    assert m.typed_values({"method": float(value), "other": 0.5}) == {"method": float(expected), "other": 0.5}
 
 
 def test_round_integer_is_not_bankers_rounding() -> None:

@@ -1,5 +1,5 @@
 """
-Issue 22: the converged table built from fewer computed colours (explorer/physics/bragg.py): midpoints from
+Issue 22: the converged table built from fewer computed colours (explorer/physics/bragg/tables.py): midpoints from
 a cubic where its error estimate allows (``_cubic_midpoints``), against independent values.
 """
 
@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from explorer.physics import bragg, colorimetry
+from explorer.physics.bragg import band_pieces  # where the quadrature reads its helpers (patched below)
 
 
 def test_cubic_midpoints_are_trusted_only_where_accurate():
@@ -57,10 +58,10 @@ def test_band_pieces_tile_the_visible_range(monkeypatch):
     """With R = 1 and flat CMFs the pieces' nodes integrate to the visible range's width: band edges, Airy
     points, fringe boundaries and the gaps' closed form neither overlap nor leave holes."""
     low, high = colorimetry.HAT_LOW, colorimetry.HAT_HIGH
-    monkeypatch.setattr(bragg, "_line_reflectance", lambda lines, omega, line, kind: np.where(kind == 3, 0.0, 1.0))
+    monkeypatch.setattr(band_pieces, "_line_reflectance", lambda lines, omega, line, kind: np.where(kind == 3, 0.0, 1.0))
     # Flat CMFs over [low, high] (ones at every 1-nm node) and their cumulative integral, for the nodes and the closed form.
     nodes = np.arange(int(round(high - low)) + 1, dtype=float)
-    monkeypatch.setattr(bragg, "_cmf_nodes", lambda: (np.ones((nodes.size, 3)), np.repeat(nodes[:, None], 3, axis=1)))
+    monkeypatch.setattr(band_pieces, "_cmf_nodes", lambda: (np.ones((nodes.size, 3)), np.repeat(nodes[:, None], 3, axis=1)))
     monkeypatch.setattr(colorimetry, "xyz_to_rgb", lambda xyz: xyz)
     # Hosts too: their fringe boundaries move to the host's transmission peaks (bragg._host_dip).
     for mirror, cos_theta in random_real_mirrors(5, 16, [1, 3, 20, 64, 100, 300, 1000], hosts=(None, 1.0, 1.33, 2.4)):
@@ -88,7 +89,7 @@ def _reflectances_per_angle(monkeypatch, cos_theta, mirror_at) -> dict[int, floa
         count += int(np.sum(kind != 2))
         return original(lines, omega, line, kind)
 
-    monkeypatch.setattr(bragg, "_line_reflectance", counting)
+    monkeypatch.setattr(band_pieces, "_line_reflectance", counting)
     samples = {}
     for N in (1000, 3000, 10000):
         count = 0
@@ -158,8 +159,8 @@ def test_band_pieces_under_a_host_where_its_peaks_move_far(mirror, cos_theta):
 @pytest.mark.parametrize("N", [1, 20, 100, 1000])
 def test_band_pieces_under_a_vanishing_host_equal_no_host(N, monkeypatch):
     """nh -> n1: the host's path (complex r_hN, shifted fringe boundaries, its fringe average) tends to Yeh's."""
-    monkeypatch.setattr(bragg, "HOST_FRINGE_NODES", bragg.FRINGE_NODES)  # the same nodes: only the formulas differ
-    monkeypatch.setattr(bragg, "HOST_FRINGE_MEAN_GROWTH", bragg.FRINGE_MEAN_GROWTH)
+    monkeypatch.setattr(band_pieces, "HOST_FRINGE_NODES", bragg.FRINGE_NODES)  # the same nodes: only the formulas differ
+    monkeypatch.setattr(band_pieces, "HOST_FRINGE_MEAN_GROWTH", bragg.FRINGE_MEAN_GROWTH)
     mirror = bragg.BraggMirror(1.33, 1.8, 500.0, 0.4, N)
     cos_theta = np.linspace(0.05, 1.0, 5)
     host = bragg.band_pieces_rgb(cos_theta, bragg.BraggMirror(1.33, 1.8, 500.0, 0.4, N, nh=1.33 + 1e-9))

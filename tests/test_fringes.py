@@ -1,5 +1,5 @@
 """
-The fast converged table (explorer/physics/bragg.py's windowed_converged_spectra): the fringe average plus the fringes near band edges
+The fast converged table (explorer/physics/bragg/windowed.py's windowed_converged_spectra): the fringe average plus the fringes near band edges
 integrates to the converged reference's colours at any N, under a host and with n2 < n1, and its cost does
 not grow with N (counted in samples, not timed: timings are ``bench --tables``).
 """

@@ -117,7 +117,25 @@ def test_resolve_rounds_what_the_cli_and_presets_pass():
     mirror = load_material(BRAGG_MATERIAL)
     values = mirror.resolve({"method": "2.5", "N": 10.5, "s": "2.4999"})
     assert (values["method"], values["N"], values["s"]) == (3.0, 11.0, 2.0)
-    assert mirror.physical_values(values) == values
+    assert mirror.typed_values(values) is values
+
+
+def test_resolved_values_are_typed_and_frozen():
+    """resolve() returns the one typed set every consumer reads: ints exact, nothing changes it after."""
+    import pickle
+
+    from explorer.materials.brd import Values
+
+    mirror = load_material(BRAGG_MATERIAL)
+    values = mirror.resolve({"N": "10.5"})
+    assert isinstance(values, Values) and values.integer("N") == 11 and values["N"] == 11.0
+    with pytest.raises(TypeError, match="frozen"):
+        values["N"] = 3.0
+    with pytest.raises(TypeError, match="frozen"):
+        values.update(N=3.0)
+    assert pickle.loads(pickle.dumps(values)) == values and {**values, "N": 4.0}["N"] == 4.0
+    typed = mirror.typed_values({**values, "N": 2.5})  # a caller's mapping: ints rounded, not range-checked
+    assert isinstance(typed, Values) and typed["N"] == 3.0
 
 
 @pytest.mark.gl
@@ -142,7 +160,7 @@ def test_cli_set_and_engines_agree_on_a_half(gl_renderer, tmp_path):
 
 #: Every integer parameter of the shipped materials: declared ``int``.
 SHIPPED_INTEGERS = {
-    "bragg_mirror.brd": {"N", "method", "s"},
+    "bragg_mirror.brd": {"N", "method", "s", "medium_n1", "medium_n2", "medium_nh"},
     "bragg_layer.brd": {"N", "method", "s"},
     "bragg_stack.brd": {"layers", "N_1", "N_2", "N_3"},
     "thin_film.brd": {"method"},

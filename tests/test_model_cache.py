@@ -20,9 +20,9 @@ def counted_models(monkeypatch):
     calls = []
     original = tables.model_for
 
-    def counting(material, values, normalised=False):
+    def counting(material, values):
         calls.append(threading.current_thread().name)
-        return original(material, values, normalised=normalised)
+        return original(material, values)
 
     monkeypatch.setattr(tables, "model_for", counting)
     return calls

@@ -13,14 +13,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from explorer.physics import bragg, colorimetry
-from explorer.materials.brd import round_integer
 from explorer.materials.methods import BraggMethod, methods_for
+from explorer.materials.models import mirror_of
+from explorer.materials.twins import capabilities_of
 
-#: Models whose parameters describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): they get a spectrum.
-BRAGG_MODELS = ("bragg_mirror", "bragg_layer")
-#: The gradient rows of Figure 4, one per method in the order of their numbers (as the method combo lists
-#: them): the reference, the paper's approximations, the tabulated colours, ours.
-BRAGG_STRIP_METHODS = tuple(sorted(BraggMethod, key=int))
+#: The gradient rows of Figure 4, one per method in the methods' order (as the combo and ``info`` list them).
+BRAGG_STRIP_METHODS = tuple(sorted(BraggMethod))
 
 
 def method_names(material) -> dict[int, str]:
@@ -34,13 +32,10 @@ def method_names(material) -> dict[int, str]:
     return {m: known.get(m, f"method {m}") for m in range(int(parameter.min), int(parameter.max) + 1)}
 
 
-def mirror_of(values) -> bragg.BraggMirror:
-    """The Bragg mirror of a material's values (``nh`` below 1: the host is ``n1``, as the shaders do)."""
-    nh = float(values.get("nh", 0.0))
-    return bragg.BraggMirror(
-        n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
-        N=round_integer(values["N"]), nh=nh if nh >= 1.0 else None,
-    )
+def has_bragg_spectrum(material) -> bool:
+    """Whether the material's values describe one Bragg mirror (n1, n2, Lambda, delta, N, nh): its twin declares
+    ``bragg_spectrum`` (:mod:`explorer.materials.twins`); it gets a spectrum and the methods' strips."""
+    return capabilities_of(material).bragg_spectrum
 
 
 @dataclass

@@ -353,9 +353,9 @@ class App:
             self._layout_done = True
             # The first screen: the Spectrum window in front of its dock (Inverse and Design dock there too),
             # the Polar one for a material without a Bragg mirror's spectrum.
-            from explorer.app.data import BRAGG_MODELS
+            from explorer.app.data import has_bragg_spectrum
 
-            state.focus_request = state.focus_request or ("Spectrum" if state.material.model in BRAGG_MODELS else "Polar")
+            state.focus_request = state.focus_request or ("Spectrum" if has_bragg_spectrum(state.material) else "Polar")
         state.sync_selected()
         state.visible = set()
         self._menu(imgui)

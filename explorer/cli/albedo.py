@@ -71,11 +71,14 @@ def _fail(message: str) -> None:
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--theta", default=DEFAULT_THETA, show_default=True, metavar="DEG,DEG,...", help="Incidence angles in degrees (in the outer medium).")
 @click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="numpy", show_default=True,
-              help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (bragg_stack).")
+              help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (layered Bragg stacks).")
 @click.option("--samples", type=int, metavar="N", help=f"position-free: paths per angle (default {DEFAULT_SAMPLES}).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="position-free: the random generator's seed (>= 0).")
+@click.option("--microsurface", type=click.Choice(["single", "walk"]), default="single", show_default=True,
+              help="position-free: a rough layer's microfacets scatter once (Eq. 17, the model's assumption) "
+                   "or every time (the random walk of Heitz et al. 2016).")
 @click.option("--json", "as_json", is_flag=True, help='Print {"theta_deg": [...], "rgb": [[r, g, b], ...]} (plus "stderr" for position-free).')
-def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, as_json):
+def albedo_command(material, preset, params_file, assignments, theta, engine, samples, seed, microsurface, as_json):
     """Directional albedo of MATERIAL: BRDF x cos integrated over the outgoing hemisphere, plus its Dirac
     reflection (a coating's Fresnel; a smooth mirror's specular reflectance), per incidence angle.
 
@@ -89,6 +92,8 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         angles = parse_theta(theta)
         if samples is not None and engine != "position-free":
             raise click.BadParameter("paths per angle are for --engine position-free", param_hint="--samples")
+        if microsurface != "single" and engine != "position-free":
+            raise click.BadParameter("the microsurface walk is for --engine position-free", param_hint="--microsurface")
         if samples is not None and samples < 1:
             raise click.BadParameter(f"{samples} is not a positive number of paths", param_hint="--samples")
         loaded = load(material)
@@ -108,11 +113,9 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
             if engine == "numpy":
                 rgb = albedo_views.albedo_numpy(model, angles)
             else:
-                if getattr(model, "name", None) not in albedo_views.POSITION_FREE_MODELS:
-                    raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
-                                        f"({', '.join(albedo_views.POSITION_FREE_MODELS)}) only")
+                _check_position_free(loaded, model)
                 result = albedo_views.albedo_position_free(
-                    model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"))
+                    model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"), microsurface)
                 rgb, stderr = result.value, result.stderr
     except (LocatedError, GLUnavailable) as error:
         _fail(str(error))
@@ -130,23 +133,29 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         click.echo(line)
 
 
+def _check_position_free(loaded, model) -> None:
+    """A one-line error unless the material's twin declares the position-free engine."""
+    from explorer.materials.brd import MaterialError
+    from explorer.materials.twins import capabilities_of, supporting
+
+    if not capabilities_of(model).supports("position-free"):
+        raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
+                            f"({', '.join(supporting('position-free'))}) only")
+
+
 def render_position_free(loaded, values, view: str, width: int, height: int, light, spp: int | None) -> np.ndarray:
     """
-    ``render --engine position-free``: the lit or slice view of a ``bragg_stack`` material with its BRDF
+    ``render --engine position-free``: the lit or slice view of a layered Bragg stack with its BRDF
     estimated by the position-free reference (next-event estimation, ``spp`` paths per pixel), under the
     views' rule; progress on stderr. Small sizes: each pixel costs ``spp`` random walks.
     """
-    from explorer.materials.brd import MaterialError
     from explorer.physics.position_free import PositionFree
-    from explorer.views import albedo as albedo_views
     from explorer.views.geometry import brdf_view_geometry
 
     if view not in POSITION_FREE_VIEWS:
         raise click.BadParameter(f"the position-free engine renders the {' and '.join(POSITION_FREE_VIEWS)} views", param_hint="--view")
     model = _twin(loaded, values)
-    if getattr(model, "name", None) not in albedo_views.POSITION_FREE_MODELS:
-        raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
-                            f"({', '.join(albedo_views.POSITION_FREE_MODELS)}) only")
+    _check_position_free(loaded, model)
     L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
 
     def local(d):

@@ -113,7 +113,7 @@ def parse_target(text: str):
 def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS):
     """Targets read from a strip image over ``theta_range`` (``A,B`` degrees)."""
     from explorer.physics.design import DesignError, targets_from_strip
-    from explorer.views.images import read_linear_image
+    from explorer.views.images import clipped_codes, read_linear_image
 
     if theta_range is None:
         raise click.UsageError("--target-strip needs --theta-range A,B (degrees at its left and right edges)")
@@ -122,9 +122,20 @@ def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS
     except ValueError:
         raise click.UsageError(f"--theta-range {theta_range!r}: expected A,B in degrees") from None
     try:
-        return targets_from_strip(read_linear_image(path), a, b, count)
+        image = read_linear_image(path)
+        targets = targets_from_strip(image, a, b, count, clipped_codes(path))
     except (ValueError, DesignError) as error:
         raise click.UsageError(f"--target-strip {error}") from None
+    bounded = [t for t in targets if t.bounded]
+    if bounded:
+        words = {-1: "at most", 1: "at least"}
+        described = "; ".join(f"{t.theta_deg:.3g} deg " + ", ".join(f"{'rgb'[c]} {words[b]} {t.rgb[c]:.3g}"
+                                                                    for c, b in enumerate(t.bounds) if b)
+                              for t in bounded)
+        click.echo(f"{PROG}: note: {path}: channels at the image's limit (0 or 255) are clipped colours, taken as "
+                   f"bounds, not values: {described}. For exact targets, render the strip to .npy or .exr "
+                   "(linear, unclipped).", err=True)
+    return targets
 
 
 def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE") -> dict[str, float]:
@@ -186,15 +197,16 @@ def ranges_of(material) -> dict[str, tuple[float, float]]:
     return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
 
 
-def render_command(material_name: str, values: dict) -> str:
-    """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
-    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
-    from explorer.materials.methods import BraggMethod, ThinFilmMethod
+def render_command(material_name: str, values: dict, material=None) -> str:
+    """The ``render`` command line that shows the designed structure's θ strip (the material's preferred method:
+    Bragg's converged table, the film's Fourier m = 3, within ~0.002 of the reference)."""
+    from explorer.materials.twins import capabilities_of
 
-    # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of the reference).
-    best = ThinFilmMethod.FOURIER_3 if "thin_film" in material_name else BraggMethod.TABULATED
-    method = f"--set method={int(best)}"
-    return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
+    methods = capabilities_of(material).methods if material is not None else None
+    best = methods.preferred_member() if methods is not None else None
+    method = f" --set method={int(best)}" if best is not None else ""
+    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")
@@ -208,13 +220,21 @@ def render_command(material_name: str, values: dict) -> str:
 @click.option("--guess", "guess_texts", multiple=True, metavar="NAME=VALUE,...",
               help="A structure to start from (omitted parameters: the material's defaults); it joins the first pass. Repeatable.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (colours linear RGB).")
+@click.option("--target-spectrum", metavar="FILE.csv",
+              help="Fit a measured reflectance instead (wavelength_nm,R as a fraction or in %): least squares in R(lambda); "
+                   "--fix may name media (n2=chitin).")
+@click.option("--theta", "spectrum_theta", type=click.FloatRange(0.0, 89.9), default=0.0, show_default=True,
+              help="--target-spectrum: the measurement's incidence angle in degrees.")
+@click.option("--plot", "spectrum_plot", type=click.Path(dir_okay=False), metavar="FILE.png",
+              help="--target-spectrum: plot the measured against the fitted spectrum.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="The first pass's Sobol scrambling (>= 0).")
 @click.option("--tries", type=click.IntRange(min=1, max=MAX_TRIES), default=DEFAULT_TRIES, show_default=True, metavar="K",
               help="Search up to K times until every target is within ΔE2000 1, each from fresh samples and the best "
                    "structure so far (~4 s each; 1: one search).")
 @click.option("--save", metavar="FILE", help="Also write the structure as a parameter set (FILE.json, or BRDF Explorer's .bparam) "
               "that render, export and open take with --params.")
-def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, seed, tries, save):
+def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
+                   spectrum_theta, spectrum_plot, seed, tries, save):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -226,6 +246,13 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
     from explorer.resources import display_path
 
+    if target_spectrum is not None:
+        from explorer.cli.spectrum_fit import fit_command
+
+        if target_texts or target_strip or free or guess_texts:
+            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip, --free or --guess")
+        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed)
+        return
     try:
         loaded = load(material)
         design_model(loaded.model)
@@ -266,7 +293,7 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
                    "the structure above is the closest found")
         click.echo(SEARCH_CAVEAT)
-    click.echo(f"render: {render_command(name, result.values)}")
+    click.echo(f"render: {render_command(name, result.values, loaded)}")
 
 
 def _save_structure(material, values: dict, path: str) -> None:
@@ -290,7 +317,9 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
     """
     from explorer.physics.design import round_trip
 
-    material = load("bragg_mirror")
+    from explorer.materials.models import BraggMirrorModel
+
+    material = load(BraggMirrorModel.name)
     ranges = ranges_of(material)
     draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
     rows = []
@@ -305,7 +334,7 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
                        f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s "
                        f"({row['cpu_seconds']:.2f} s CPU{f', {result.tries} searches' if result.tries > 1 else ''})")
 
-    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
+    round_trip(BraggMirrorModel.name, ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
     medians = np.array([r["median_delta_e2000"] for r in rows])
     seconds = np.array([r["seconds"] for r in rows])
     cpu = np.array([r["cpu_seconds"] for r in rows])

@@ -12,7 +12,7 @@ import click
 from explorer.materials.brd import MaterialError
 
 from explorer.cli.materials import PROG, load, resolve_values, warn  # noqa: F401
-TARGETS = ("mitsuba", "brdf", "table", "materialx")
+TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
 
 
 def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
@@ -25,11 +25,11 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
 
 def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
     """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
-    from explorer.mitsuba import BSDF_NAMES
+    from explorer.materials.twins import capabilities_of, supporting
     from explorer.mitsuba.scene import render_env_mitsuba
 
-    if material.model not in BSDF_NAMES:
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
+    if not capabilities_of(material).supports("mitsuba"):
+        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
     return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
@@ -37,24 +37,52 @@ def render_env_with_mitsuba(material, values, width, height, environment, spp, v
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--to", "target", type=click.Choice(TARGETS), required=True,
               help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
-                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film).")
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (a thin film); "
+                   "gltf: a .glb sphere with KHR_materials_iridescence (a thin film, or the nearest one).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--env", "env_file", metavar="FILE", help="mitsuba: the environment (.hdr or .exr; default the env view's).")
-@click.option("--mesh", metavar="FILE", help="mitsuba: an .obj or .ply in place of the unit sphere.")
+@click.option("--mesh", metavar="FILE", help="mitsuba: an .obj or .ply in place of the unit sphere; gltf: an .obj or teapot, cube, torus.")
+@click.option("--texture-table", is_flag=True, help="gltf: embed the exact reflectance table too (extras; docs/export.md).")
 @click.option("--spp", type=click.IntRange(min=1), default=256, show_default=True, help="mitsuba: samples per pixel.")
 @click.argument("out", type=click.Path())
-def export_command(material, target, preset, params_file, assignments, env_file, mesh, spp, out):
+def export_command(material, target, preset, params_file, assignments, env_file, mesh, texture_table, spp, out):
     """Write MATERIAL (a file or a built-in's name) for use elsewhere, to OUT (a directory for --to mitsuba)."""
     from explorer.errors import LocatedError
     from explorer.views.images import OutputError
 
     try:
+        if texture_table and target != "gltf":
+            raise click.BadParameter("--texture-table is for --to gltf", param_hint="--texture-table")
+        if target == "gltf":
+            _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, load(material))
+            return
         _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load(material))
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
+
+
+def _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, loaded):
+    """``--to gltf``: the .glb, and the film's ΔE2000 per angle on stdout."""
+    from explorer.materials.export_gltf import export_gltf
+    from explorer.views.mesh import mesh_named
+
+    for warning in loaded.warnings:
+        warn(warning)
+    if env_file is not None:
+        raise click.BadParameter("--env is for --to mitsuba", param_hint="--env")
+    values = resolve_values(loaded, preset, params_file, assignments)
+    shape = None
+    if mesh is not None:
+        m = mesh_named(mesh)
+        shape = (m.positions, m.normals, m.triangles)
+    path, film = export_gltf(loaded, values, Path(out), shape, texture_table)
+    from explorer.materials.export_gltf import describe
+
+    click.echo(describe(film))
+    click.echo(f"wrote {path} (glTF 2.0, KHR_materials_iridescence; the ΔE per angle in the material's extras)")
 
 
 def _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded):
@@ -84,7 +112,9 @@ def _export(material, target, preset, params_file, assignments, env_file, mesh, 
         path = Path(out)
         if path.suffix.lower() != ".exr":
             raise TableExportError(path, None, "the table is an OpenEXR file: name it .exr")
-        table = material_table(loaded, values)
+        from explorer.cli.albedo import progress_printer
+
+        table = material_table(loaded, values, progress_printer("table", "rows"))
         write_image(table, path)  # atomically
         click.echo(f"wrote {path} ({table.shape[1]}x{table.shape[0]} RGB, docs/export.md)")
     else:

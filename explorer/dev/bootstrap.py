@@ -71,6 +71,21 @@ MITSUBA_PACKAGES = ("libllvm19",)
 #: The pip extras that bring Mitsuba (the test extra includes it: CI runs the Mitsuba tests).
 MITSUBA_EXTRAS = ("mitsuba", "test")
 
+# npm packages the tests use (``test`` mode only), pinned: the Khronos glTF Validator checks the glTF export
+# (tests/test_gltf.py). Installed with node's npm into a cache folder outside the checkout, shared by every
+# checkout of this machine; skipped while the installed version matches. Without node or npm: one note.
+NODE_PACKAGES = {"gltf-validator": "2.0.0-dev.3.10"}
+ENV_NODE_PREFIX = "BRAGG_EXPLORER_NODE_PREFIX"
+
+
+def node_prefix() -> Path:
+    """The npm prefix of :data:`NODE_PACKAGES` (its ``node_modules``): $BRAGG_EXPLORER_NODE_PREFIX, else the user's cache."""
+    if os.environ.get(ENV_NODE_PREFIX):
+        return Path(os.environ[ENV_NODE_PREFIX])
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(cache) / "bragg-explorer" / "node"
+
+
 RUN_CLI_SNIPPET = "from explorer.dev.bootstrap import run_cli; run_cli()"
 PIP_TAIL_LINES = 25
 
@@ -447,6 +462,44 @@ def ensure_optional_packages(extras: Sequence[str]) -> None:
         log(f"note: {' '.join(missing)} not installed: Mitsuba falls back to its (slow) scalar variants")
 
 
+def missing_node_packages(prefix: Path, packages: dict[str, str] = NODE_PACKAGES) -> list[str]:
+    """``name@version`` of each package whose pinned version is not installed under ``prefix``."""
+    missing = []
+    for name, version in packages.items():
+        try:
+            installed = json.loads((prefix / "node_modules" / name / "package.json").read_text()).get("version")
+        except (OSError, ValueError, AttributeError):
+            installed = None
+        if installed != version:
+            missing.append(f"{name}@{version}")
+    return missing
+
+
+def npm_install_command(npm: str, prefix: Path, specs: Sequence[str]) -> list[str]:
+    return [npm, "install", "--prefix", str(prefix), "--no-audit", "--no-fund", "--no-save", "--loglevel=error", *specs]
+
+
+def ensure_node_packages(mode: str, which: Callable[[str], str | None] | None = None,
+                         runner: Callable[..., tuple[int, str]] | None = None) -> None:
+    """``test`` mode: npm-install :data:`NODE_PACKAGES` into :func:`node_prefix` when missing; a note where it cannot."""
+    if mode != MODE_TEST:
+        return
+    prefix = node_prefix()
+    missing = missing_node_packages(prefix)
+    if not missing:
+        return
+    npm = (which or shutil.which)("npm")
+    if not npm:
+        log(f"note: npm not found: {' '.join(missing)} not installed (the glTF export's validation tests need it)")
+        return
+    log(f"installing {' '.join(missing)} with npm into {prefix} (first run only)…")
+    prefix.mkdir(parents=True, exist_ok=True)
+    code, out = (runner or _run_quiet)(npm_install_command(npm, prefix, missing))
+    if code != 0:
+        print(_tail(out), file=sys.stderr)
+        log(f"note: npm install failed (exit {code}): the glTF export's validation tests will fail")
+
+
 # --------------------------------------------------------------------------
 # Virtual environment and Python packages
 
@@ -672,6 +725,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         ensure_system_packages(mode)
         ensure_optional_packages(extras)
+        ensure_node_packages(mode)
         inside = in_venv(VENV_DIR)
         installed = ensure_python_packages(extras, inside)
     except SetupError as exc:

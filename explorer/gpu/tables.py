@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from explorer.materials.brd import Material
-from explorer.materials.models import MODELS, model_for
+from explorer.materials.models import model_for
+from explorer.materials.twins import twin_class
 
 #: Numpy models (and their tables) kept by :class:`ModelCache`.
 MODEL_CACHE_SIZE = 8
@@ -55,24 +56,22 @@ class ModelCache:
             return None
         return key
 
-    def entry(self, material: Material, values: Mapping[str, object], normalised: bool = False) -> tuple[tuple | None, CacheEntry | None]:
+    def entry(self, material: Material, values: Mapping[str, object]) -> tuple[tuple | None, CacheEntry | None]:
         """
         ``(key, entry)`` of ``material`` at ``values`` (entry None: it has no model), from the cache or
         built here; key None: uncached. The entry's tables are None until someone asks for them.
-        ``normalised``: ``values`` are already :meth:`Material.physical_values` (the renderer's bind).
         """
-        if not normalised:
-            values = material.physical_values(values)
+        values = material.typed_values(values)
         key = self.key(material, values)
         if key is None:
-            model = model_for(material, values, normalised=True)
+            model = model_for(material, values)
             return None, (CacheEntry(model) if model is not None else None)
         with self._lock:
             entry = self._models.get(key)
             if entry is not None:
                 self._models.move_to_end(key)
                 return key, entry
-        model = model_for(material, values, normalised=True)
+        model = model_for(material, values)
         if model is None:
             return key, None
         return key, self._store(key, CacheEntry(model))
@@ -87,9 +86,9 @@ class ModelCache:
 
     def ready(self, material: Material, values: Mapping[str, object]) -> bool:
         """Whether ``material`` at ``values`` needs no numpy work (its tables are cached, or it has none)."""
-        if (material.model or "") not in MODELS:
+        if twin_class(material) is None:
             return True
-        key = self.key(material, material.physical_values(values))
+        key = self.key(material, material.typed_values(values))
         with self._lock:
             entry = self._models.get(key) if key is not None else None
         return entry is not None and entry.tables is not None and not entry.draft
@@ -98,7 +97,7 @@ class ModelCache:
         """Whether ``material`` at ``values`` can be drawn without numpy work, its draft tables accepted."""
         if self.ready(material, values):
             return True
-        key = self.key(material, material.physical_values(values))
+        key = self.key(material, material.typed_values(values))
         with self._lock:
             entry = self._models.get(key) if key is not None else None
         return entry is not None and entry.tables is not None
@@ -107,7 +106,7 @@ class ModelCache:
         """Build ``material``'s model at ``values`` and its tables into the cache; safe on a worker thread."""
         if self.ready(material, values):
             return
-        values = material.physical_values(values)
+        values = material.typed_values(values)
         key = self.key(material, values)
         model = model_for(material, values)
         if model is None or key is None:
@@ -121,7 +120,7 @@ class ModelCache:
         """
         if self.ready(material, values):
             return True
-        values = material.physical_values(values)
+        values = material.typed_values(values)
         key = self.key(material, values)
         if key is None:
             return False

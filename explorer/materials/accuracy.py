@@ -29,8 +29,6 @@ from explorer.physics import bragg, colorimetry
 ACCURACY_LIMIT = 2.0
 #: The gradient view's columns the badge compares: θ = 90° (i + 0.5) / W.
 BADGE_WIDTH = 90
-#: Models whose ``method`` picks one of the RGB methods of a smooth Bragg mirror (their ``reflectance``).
-BRAGG_METHOD_MODELS = ("bragg_mirror", "bragg_layer")
 #: The methods' names (``shaders/bragg_mirror.brd``), and the order in which accurate ones are suggested:
 #: the exact table first (one texture fetch per pixel), then the closed forms, the spectral sum last.
 METHOD_NAMES = {int(m): m.label for m in BraggMethod}
@@ -84,6 +82,9 @@ class AccuracyBadge:
 
     method: int
     methods: dict[int, MethodAccuracy]
+    #: Absorbing, dispersive or disordered layers: the approximations' landmarks assume none, so every method
+    #: shows the exact table (``shaders/bragg_mirror.brd``'s natural_structure()).
+    natural: bool = False
 
     @property
     def current(self) -> MethodAccuracy:
@@ -103,6 +104,8 @@ class AccuracyBadge:
 
     def text(self) -> str:
         """One line for the app: the current method's ΔE2000 and, when it is off, the accurate methods."""
+        if self.natural:
+            return f"natural layers (k, media, sigma): every method shows the exact table ({METHOD_NAMES[3]}, method 3)"
         c = self.current
         head = f"ΔE2000 vs converged: median {c.dE_median:.1f}, max {c.dE_max:.1f}"
         if c.accurate:
@@ -142,13 +145,20 @@ def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | No
     the current method (method 0 at its ``wavelength_step``: the paper's 1-nm sum is not converged for N
     of a few tens and more) and, when it is off, every closed-form method and the tabulated one.
     """
-    if getattr(material, "model", None) not in BRAGG_METHOD_MODELS or "method" not in values:
+    from explorer.materials.twins import capabilities_of
+
+    capabilities = capabilities_of(material)
+    # A material whose ``method`` picks one of the RGB methods of a smooth Bragg mirror (its ``reflectance``).
+    if not (capabilities.bragg_spectrum and capabilities.methods is BraggMethod) or "method" not in values:
         return None
     from explorer.materials.models import model_for
 
     model = model_for(material, values)
     if model.method not in METHOD_NAMES:
         return None
+    if getattr(model, "natural", None) is not None:  # the exact table whatever the method
+        exact = MethodAccuracy(model.method, 0.0, 0.0)
+        return AccuracyBadge(model.method, {model.method: exact}, natural=True)
     options = dict(s=model.s, wavelength_step=model.wavelength_step)
     accuracies = mirror_accuracy(model.mirror, (model.method,), **options)
     if not accuracies[model.method].accurate:  # only then are the others needed (render's note, the app's hint)

@@ -69,6 +69,7 @@ __all__ = [
     "load_material",
     "parse_assignment",
     "round_integer",
+    "Values",
     "GLSL_KEYWORDS",
 ]
 
@@ -347,6 +348,32 @@ class Parameter:
         return {"name": self.name, "type": self.type, "min": self.min, "max": self.max, "default": default}
 
 
+class Values(dict):
+    """A material's parameter values, typed and frozen: what :meth:`Material.resolve` returns and every consumer reads.
+
+    Each declared parameter holds its type's value: a float, a bool, an ``(r, g, b)`` tuple of floats, and
+    for an ``int`` a float holding the exact integer `round_integer` gives (as its GL uniform holds it), so
+    that the GL host, the numpy twins, the exports and the app evaluate the same numbers. Built once
+    (:meth:`Material.resolve`: ranges checked; :meth:`Material.typed_values` for values from elsewhere);
+    a consumer never rounds again. A ``dict`` that refuses changes (``{**values, name: v}`` makes a new
+    mapping; resolve it again).
+    """
+
+    __slots__ = ()
+
+    def _frozen(self, *args, **kwargs):
+        raise TypeError("a material's values are frozen: resolve a new set (Material.resolve({**values, name: value}))")
+
+    __setitem__ = __delitem__ = update = pop = popitem = clear = setdefault = __ior__ = _frozen  # type: ignore[assignment]
+
+    def __reduce__(self):
+        return (type(self), (dict(self),))
+
+    def integer(self, name: str) -> int:
+        """An ``int`` parameter's value as a Python ``int``."""
+        return int(self[name])
+
+
 @dataclass
 class Material:
     """A parsed material file.
@@ -399,7 +426,7 @@ class Material:
 
     def resolve(
         self, overrides: Mapping[str, str | float | bool | Sequence[float]] = MappingProxyType({})
-    ) -> dict[str, Value]:
+    ) -> Values:
         """Return every parameter's value: defaults, overridden by `overrides`.
 
         Parameters
@@ -410,8 +437,8 @@ class Material:
 
         Returns
         -------
-        dict
-            Name to float, bool or (r, g, b) tuple, in file order.
+        Values
+            Name to float, bool or (r, g, b) tuple, in file order (frozen; ints exact integers).
 
         Raises
         ------
@@ -421,36 +448,40 @@ class Material:
         """
         values: dict[str, Value] = {p.name: p.default for p in self.parameters}
         for name, value in overrides.items():
+            if isinstance(value, str) and f"medium_{name}" in values and not _NUMBER_RE.match(value.strip()):
+                # An index naming a medium (n2=chitin): the material's medium_NAME selects it (explorer.materials.media).
+                from explorer.materials.media import medium_values
+
+                try:
+                    values.update(medium_values(self, name, value))
+                except LocatedError as exc:
+                    raise MaterialError(self.path, self.parameter(name).line, f"parameter {name!r}: {exc.message}") from None
+                continue
+            if f"medium_{name}" in values and f"medium_{name}" not in overrides:
+                values[f"medium_{name}"] = 0.0  # a number replaces a medium
             p = self.parameter(name)
             try:
                 values[name] = p.coerce(value)
             except ValueError as exc:
                 # Name the line that declares the parameter: that is where its range is.
                 raise MaterialError(self.path, p.line, f"parameter {name!r}: {exc}") from None
-        return values
+        return Values(values)
 
-    def physical_values(self, values: Mapping[str, object]) -> dict[str, object]:
-        """The values the physics sees: every ``int`` parameter's value rounded by `round_integer`.
+    def typed_values(self, values: Mapping[str, object]) -> Values:
+        """The :class:`Values` of ``values`` from elsewhere (a caller's mapping): every ``int`` parameter's value
+        rounded by `round_integer`, nothing else checked; a :class:`Values` is returned as it is.
 
-        Applied by the GL host before uploading uniforms and choosing ``# specialise:`` constants, and
-        by `explorer.materials.models.model_for` before building a numpy twin, so that both evaluate the same
-        integers whatever the caller passed (``resolve`` already rounds what it coerces).
-
-        Parameters
-        ----------
-        values : mapping of str to value
-            Resolved values; names the material does not declare are kept as they are.
-
-        Returns
-        -------
-        dict
-            A copy, ints as floats holding exact integers.
+        The GL host and :func:`explorer.materials.models.model_for` read their values through this, so that both
+        evaluate the same integers whatever the caller passed (``resolve`` has rounded what it coerced).
+        Names the material does not declare are kept as they are.
         """
+        if isinstance(values, Values):
+            return values
         result = dict(values)
         for p in self.parameters:
             if p.type == "int" and p.name in result:
                 result[p.name] = float(round_integer(result[p.name]))
-        return result
+        return Values(result)
 
     def uniform_declarations(self) -> str:
         """GLSL uniform declarations for the parameters, one per line.
@@ -778,7 +809,8 @@ def load_material(path: str | os.PathLike[str]) -> Material:
     Notes
     -----
     A MERL ``.binary`` table (by suffix, or by its header and size) loads as a measured material without
-    parameters (:mod:`explorer.materials.merl`).
+    parameters (:mod:`explorer.materials.merl`). A Python file of the same stem beside a material file is its
+    plugin twin, loaded here (:mod:`explorer.materials.plugins`; its errors are a ``PluginError`` with file and line).
     """
     name = os.fspath(path)
     try:
@@ -797,13 +829,15 @@ def load_material(path: str | os.PathLike[str]) -> Material:
     except merl.MerlFileError as error:  # a MaterialError for every caller of the loader
         raise MaterialError(error.path, error.line, error.message) from None
     try:
-        return parse_material(data.decode("utf-8-sig"), name)
+        material = parse_material(data.decode("utf-8-sig"), name)
     except UnicodeDecodeError:
-        pass
-    # Old files may carry Latin-1 comments; BRDF Explorer reads bytes and
-    # does not care, so neither do we (but say so).
-    material = parse_material(data.decode("latin-1"), name)
-    material.warnings.insert(0, f"{name}:1: file is not UTF-8; read as Latin-1")
+        # Old files may carry Latin-1 comments; BRDF Explorer reads bytes and
+        # does not care, so neither do we (but say so).
+        material = parse_material(data.decode("latin-1"), name)
+        material.warnings.insert(0, f"{name}:1: file is not UTF-8; read as Latin-1")
+    from explorer.materials import plugins
+
+    plugins.attach(material)  # a Python file of the same stem beside it: its twin (explorer.materials.plugins)
     return material
 
 

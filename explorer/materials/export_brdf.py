@@ -33,8 +33,6 @@ from explorer.files import write_text_atomic
 from explorer.errors import LocatedError
 from explorer.resources import SHADER_DIR
 
-#: The materials with an export (a numpy twin and no view-specific hooks in BRDF).
-EXPORTABLE = ("bragg_mirror", "bragg_layer", "thin_film")
 _INCLUDE = re.compile(r'\s*#\s*include\s*"([^"]+)"')
 _DIRECTIVE = re.compile(r"\s*#\s*(\w+)\s*(.*?)\s*(//.*)?$")
 
@@ -265,8 +263,8 @@ def _parameter_lines(material, values: Mapping[str, object]) -> list[str]:
     return lines
 
 
-def material_tables(material, values: Mapping[str, object]) -> dict[str, np.ndarray]:
-    """The library's tables and the material's own (for its values), as (height, width, 3) arrays."""
+def material_tables(material, values: Mapping[str, object], model=None) -> dict[str, np.ndarray]:
+    """The library's tables and the material's own (its twin's ``textures()`` for its values), as (height, width, 3) arrays."""
     from explorer.materials.models import model_for
     from explorer.tables import luts
 
@@ -275,32 +273,34 @@ def material_tables(material, values: Mapping[str, object]) -> dict[str, np.ndar
         "cmf_cumulative": luts.load("cmf_cumulative").reshape(1, -1, 3),
         "sensitivity_fourier": luts.load("sensitivity_fourier").reshape(2, -1, 3),
     }
-    model = model_for(material, material.physical_values(values))
+    model = model_for(material, values) if model is None else model
     for name, table in model.textures().items():
         table = np.asarray(table, dtype=np.float64)
         tables[name] = table.reshape(1, -1, 3) if table.ndim == 2 else table
-    if material.model == "bragg_layer":
-        tables["transmission_table"] = np.asarray(model.transmission_table, np.float64).reshape(1, -1, 3)
     return tables
 
 
 def brdf_text(material, values: Mapping[str, object]) -> str:
     """The self-contained ``.brdf`` text of ``material`` at ``values``."""
-    if material.model not in EXPORTABLE:
-        raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(EXPORTABLE)})")
+    from explorer.materials.models import model_for
+    from explorer.materials.twins import capabilities_of, supporting
+
+    if not capabilities_of(material).supports("brdf"):
+        raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(supporting('brdf'))})")
     ints = [p.name for p in material.parameters if p.type == "int"]
     shader = round_int_parameters(material.shader, ints)
-    defined = {}
-    tables = material_tables(material, values)
-    if material.model == "thin_film":
-        # The film's export is specialised to its method: the 4096 x 2 sensitivity_fourier table, inlined,
-        # takes Mesa's compiler many minutes, so only methods 1-3 (which read it) carry it.
-        from explorer.materials.brd import round_integer
-
-        method = round_integer(values["method"])
-        defined["SPECIALISED_method"] = str(method)
-        # Methods 1-3 read the envelope through _coarse_envelope (below), not the inlined table.
-        tables.pop("sensitivity_fourier")
+    model = model_for(material, values)
+    tables = material_tables(material, values, model)
+    # A twin may specialise its export (its brdf_export hook): #defines, tables it leaves out, a coarse envelope.
+    hook = getattr(model, "brdf_export", None)
+    special = hook() if callable(hook) else {}
+    defined = dict(special.get("defines", {}))
+    for name in special.get("drop_tables", ()):
+        tables.pop(name, None)
+    for name, table in special.get("tables", {}).items():  # baked whatever the exported method
+        table = np.asarray(table, dtype=np.float64)
+        tables[name] = table.reshape(1, -1, 3) if table.ndim == 2 else table
+    baked = special.get("baked", {})
     # The methods' names, which the host #defines in every program: substituted by their values, as PI is
     # (a `const int BRAGG_REFERENCE` would break the explorer's own loading of the file, whose host
     # #defines the same names).
@@ -308,21 +308,49 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
 
     defined.update({name: str(value) for name, value in glsl_defines().items()})
     flat = flatten(shader, str(material.path), defined)
-    if material.model == "thin_film":
-        from explorer.materials.thinfilm_model import TABULATED_FOURIER
-
-        if method in TABULATED_FOURIER:
-            flat = _coarse_envelope(flat)
-    flat = _forward_declare(inline_tables(flat, tables), list(tables))
+    if special.get("coarse_envelope", False):
+        flat = _coarse_envelope(flat)
+    flat = inline_tables(flat, tables)
+    for name, bake in baked.items():
+        flat = _fall_back(flat, name, bake)
+    flat = _forward_declare(flat, list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):
         raise BrdfExportError(material.path, None, "a preprocessor line is left in the exported shader")
-    header = ("analytic\n\n"
+    notes = [f"{material.model} exported by bragg-explorer (export --to brdf): self-contained, no preprocessor;",
+             "the tables are computed for the exported values."]
+    notes += [baked_note(name, bake) for name, bake in baked.items()]
+    header = ("analytic\n\n" + "".join(f"# {line}\n" for line in notes) + "\n"
               "::begin parameters\n" + "\n".join(_parameter_lines(material, values)) + "\n::end parameters\n\n")
-    return (header + "::begin shader\n"
-            f"// {material.model} exported by bragg-explorer (export --to brdf): self-contained, no preprocessor;\n"
-            "// the tables are baked for the exported values.\n"
-            f"{flat}\n::end shader\n")
+    return (header + "::begin shader\n" + "".join(f"// {line}\n" for line in notes) + f"{flat}\n::end shader\n")
+
+
+def _baked_values(bake: Mapping) -> str:
+    return ", ".join(f"{name} = {value:.9g}" for name, value in bake["values"].items())
+
+
+def baked_note(name: str, bake: Mapping) -> str:
+    """The header's line on a baked table: what it holds for, and what the file reads elsewhere."""
+    return (f"{name}: method {bake['label']}'s table, baked for {_baked_values(bake)}; where one of these moves, "
+            f"method {bake['label']} falls back to method {bake['fallback_label']} (never a stale or black table).")
+
+
+def _fall_back(flat: str, name: str, bake: Mapping) -> str:
+    """
+    Guard ``tabulated_rgb_NAME`` (:func:`inline_tables`) by the values its table was baked for: elsewhere it
+    returns ``bake["fallback"]`` (GLSL of ``cos_theta``). Floats compare within 1e-6 relative (float32
+    uniforms), integers within 0.5.
+    """
+    head = f"vec3 tabulated_rgb_{name}(float cos_theta) {{\n"
+    if head not in flat:
+        raise BrdfExportError("<export>", None, f"the baked table {name} has no lookup to guard")
+    tests = []
+    for parameter, value in bake["values"].items():
+        tolerance = 0.5 if parameter in bake.get("integers", ()) else 1e-6 * max(1.0, abs(value))
+        tests.append(f"abs({parameter} - {value:.9g}) <= {tolerance:.9g}")
+    guard = (f"// {name}: baked for {_baked_values(bake)}; elsewhere method {bake['fallback_label']}.\n"
+             f"bool {name}_baked() {{\n    return " + "\n        && ".join(tests) + ";\n}\n")
+    return flat.replace(head, guard + head + f"    if (!{name}_baked()) return {bake['fallback']};\n", 1)
 
 
 def bparam_text(brdf_file: str, parameters, values: Mapping[str, object]) -> str:

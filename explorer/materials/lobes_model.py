@@ -11,7 +11,7 @@ import numpy as np
 
 from explorer.physics import lobes
 from explorer.tables import luts
-from explorer.materials.twins import twin
+from explorer.materials.twins import Capabilities, twin
 from explorer.materials.brd import round_integer
 from explorer.errors import LocatedError
 
@@ -59,6 +59,8 @@ class LayeredLobesModel:
     """Twin of ``shaders/layered_lobes.brd``: ``reflectance(cos_theta)`` (sum of the lobes' energies) and Eq. 3."""
 
     name = "layered_lobes"
+    capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
+                                exports=("mitsuba", "table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -72,6 +74,18 @@ class LayeredLobesModel:
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         return lobes.brdf(self.stack, L, V, N)
+
+    def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
+        """For Mitsuba's spectral variants: an RGB model (Belcour 2018's lobes), upsampled."""
+        rgb = self.brdf(i, o, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+        return rgb_upsample(rgb, wavelengths)
+
+    def sampling_lobes(self, cos_o):
+        """Every layer's roughness, equal weights, a little cosine for the broad tails (the shader's ``sampling_lobes``)."""
+        ones = np.ones_like(cos_o)
+        count = round_integer(self.values.get("layers", 1))
+        alphas = [max(float(self.values[f"alpha_{k}"]), 1e-4) for k in range(1, count + 1)]
+        return alphas, [ones] * len(alphas), 0.05 * len(alphas) * ones
 
     def textures(self) -> dict[str, np.ndarray]:
         return {"lobes_fgd": fgd_texture(), "lobes_ggx_moments": moments_texture()}

@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, thinfilm
+from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, multiscatter, thinfilm
 
 
 def declaration(name: str, value) -> str:
@@ -61,7 +61,7 @@ GENERATED: dict[str, Callable[[], str]] = {
         "N_RESOLVE": bragg.N_RESOLVE,
         "GROW_EXPONENT": bragg.GROW_EXPONENT,
         "MAX_RESOLVED_PIECES": bragg.MAX_RESOLVED_PIECES,
-    }, "explorer/physics/bragg.py"),
+    }, "explorer/physics/bragg/"),
     "generated/colorimetry.glsl": lambda: _block({
         "CMF_COUNT": colorimetry.WAVELENGTHS.size,
         "CMF_FIRST_WAVELENGTH": float(colorimetry.WAVELENGTH_MIN),
@@ -76,7 +76,9 @@ GENERATED: dict[str, Callable[[], str]] = {
         "THETA_ROWS": microfacet.THETA_COUNT,
         "THETA_STEP": float(microfacet.THETA_STEP),
         "LAYER_COS_THETA_MIN": microfacet.COS_THETA_MIN,
-    }, "explorer/physics/layered.py and microfacet.py"),
+        "COMPENSATION_ROWS": multiscatter.COMPENSATION_ROWS,
+        "COMPENSATION_STEP_DEG": float(multiscatter.COMPENSATION_STEP_DEG),
+    }, "explorer/physics/layered.py, microfacet.py and multiscatter.py"),
     "generated/lobes.glsl": lambda: _block({
         "LOBES_MAX": lobes.MAX_INTERFACES,
         "FGD_COS_COUNT": lobes_fgd.FGD_COS_COUNT,
@@ -100,5 +102,5 @@ GENERATED: dict[str, Callable[[], str]] = {
         "PREFILTER_SIGMA_STEP": thinfilm.PREFILTER_SIGMA_STEP,
         "PREFILTER_LEVELS": thinfilm.PREFILTER_LEVELS,
         "D_INC_BLEND": thinfilm.D_INC_BLEND,
-    }, "explorer/physics/thinfilm.py"),
+    }, "explorer/physics/thinfilm/"),
 }

@@ -19,7 +19,7 @@ from typing import Mapping
 import numpy as np
 
 from explorer.physics import microfacet, thinfilm
-from explorer.materials.twins import twin
+from explorer.materials.twins import Capabilities, twin
 from explorer.materials.brd import round_integer
 from explorer.materials.methods import ThinFilmMethod
 
@@ -48,6 +48,8 @@ class ThinFilmModel:
     """Twin of ``shaders/thin_film.brd``: ``reflectance(cos_theta)`` and ``brdf(L, V, N, X, Y)``, every method."""
 
     name = "thin_film"
+    capabilities = Capabilities(methods=ThinFilmMethod, dirac=False, bragg_spectrum=False, numpy=True,
+                                albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx", "gltf"), design=True)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -111,6 +113,27 @@ class ThinFilmModel:
         if above.any():
             result[above] = lobe[above, None] * reflectance(cos_theta_d[above], above)
         return result
+
+    def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
+        """The BRDF per wavelength for Mitsuba: the GGX lobe times the film's Airy reflectance at ``theta_d``."""
+        lobe, cos_d, _ = microfacet.microfacet_lobe(i, o, np.array([0.0, 0.0, 1.0]), self.alpha)
+        F = thinfilm.airy_reflectance(self.eta_1, self.eta_2, self.eta_3, self.kappa_3,
+                                      np.clip(cos_d, microfacet.COS_THETA_MIN, 1.0)[:, None], self.thickness_d, wavelengths)
+        return lobe[:, None] * F
+
+    def sampling_lobes(self, cos_o):
+        """``(alphas, weights, cosine_weight)`` at view cosines ``(n,)``: one GGX lobe (the shader's ``sampling_lobes``)."""
+        ones = np.ones_like(cos_o)
+        return [max(self.alpha, 1e-4)], [ones], 0.0 * ones
+
+    def brdf_export(self) -> dict:
+        """
+        How ``export --to brdf`` specialises the film (:mod:`explorer.materials.export_brdf`): to its method, since
+        the 4096 x 2 ``sensitivity_fourier`` table, inlined, takes Mesa's compiler many minutes; methods 1-3 read
+        its envelope through a coarse copy instead (``coarse_envelope``), the others not at all.
+        """
+        return {"defines": {"SPECIALISED_method": str(int(self.method))}, "drop_tables": ("sensitivity_fourier",),
+                "coarse_envelope": self.method in TABULATED_FOURIER}
 
     def textures(self) -> dict[str, np.ndarray]:
         """None of its own: the ``sensitivity_fourier`` table is a library texture (:mod:`explorer.gpu.renderer`)."""

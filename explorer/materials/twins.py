@@ -1,18 +1,86 @@
 """
-The numpy twins of the materials: what a twin provides, and the registry they add themselves to.
+The numpy twins of the materials: what a twin provides, what it declares, and the registry they add
+themselves to.
 
 A twin (``# model: NAME`` in a material file) computes in float64 what the material's shader computes
-in float32; the GL-vs-numpy harness (tests/twins.py) compares them view by view. Each twin class
-declares itself with :func:`twin`; :data:`TWINS` is the one list, from which
-:func:`explorer.materials.models.model_for` and the table cache (:mod:`explorer.gpu.tables`) read.
+in float32; the GL-vs-numpy harness (:mod:`explorer.views.twin_check`, ``bragg-explorer check``) compares
+them view by view. Each twin class declares itself with :func:`twin`, and declares with its
+:class:`Capabilities` everything the rest of the code would otherwise look up by the material's name:
+its methods, whether it is a Dirac reflector or has a Bragg spectrum, its engines and its exports.
+:data:`TWINS` is the one registry: the app, the CLI, the exports, Mitsuba, design, albedo and the
+accuracy badge query it (:func:`capabilities_of`, :func:`names_with`), in the spirit of Mitsuba 3's
+plugins. The built-in twins register when :func:`registry` first runs; a plugin's on loading its file
+(:mod:`explorer.materials.plugins`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+
+#: The albedo engines (``albedo --engine``): the numpy twin's quadrature, the GLSL scatter view, the
+#: position-free Monte Carlo reference of layered Bragg structures.
+ALBEDO_ENGINES = ("numpy", "gl", "position-free")
+#: The export targets a twin may declare (``export --to``).
+EXPORT_TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Capabilities:
+    """
+    What a material can do, declared by its twin class (every field, no default: a built-in states each).
+
+    ``methods``: the enumeration of its ``int method`` parameter (an :class:`explorer.materials.methods.Method`
+    subclass) or None; ``dirac``: its ``BRDF`` is a smooth mirror's reflectance at the half vector (a Dirac's
+    weight: its albedo is ``reflectance``, Mitsuba samples it as a delta); ``bragg_spectrum``: its values
+    describe one Bragg mirror (``n1, n2, Lambda, delta, N, nh``: the spectrum window, the method strips, the
+    accuracy badge); ``numpy``: ``render --engine numpy`` draws its twin; ``albedo``: the engines of
+    :data:`ALBEDO_ENGINES` it supports; ``exports``: the targets of :data:`EXPORT_TARGETS` it supports
+    (``mitsuba`` needs the twin's ``spectral_brdf`` and ``sampling_lobes``, or ``dirac`` and
+    ``spectral_reflectance``); ``design``: ``design`` fits its parameters (its ``design_model``).
+    """
+
+    methods: type | None
+    dirac: bool
+    bragg_spectrum: bool
+    numpy: bool
+    albedo: tuple[str, ...]
+    exports: tuple[str, ...]
+    design: bool
+
+    def __post_init__(self):
+        unknown = [e for e in self.albedo if e not in ALBEDO_ENGINES] + [e for e in self.exports if e not in EXPORT_TARGETS]
+        if unknown:
+            raise ValueError(f"unknown engine or export {unknown[0]!r} (albedo engines: {', '.join(ALBEDO_ENGINES)}; "
+                             f"exports: {', '.join(EXPORT_TARGETS)})")
+
+    def summary(self) -> str:
+        """One line for ``info``: the engines, the exports, design, and what kind of reflector it is."""
+        if not self.numpy:
+            return f"GL only (no numpy twin); albedo {', '.join(self.albedo)}"
+        kinds = [k for k, on in (("a Dirac reflector", self.dirac), ("a Bragg spectrum", self.bragg_spectrum)) if on]
+        parts = ["render gl, numpy", f"albedo {', '.join(self.albedo)}", f"export {', '.join(self.exports) or 'none'}",
+                 f"design {'yes' if self.design else 'no'}"]
+        return "; ".join(parts + kinds)
+
+    def supports(self, what: str) -> bool:
+        """Whether ``what`` (an albedo engine, an export target, ``numpy`` or ``design``) is declared."""
+        if what in ("numpy", "design"):
+            return bool(getattr(self, what))
+        return what in self.albedo or what in self.exports
+
+
+#: The names of the fields a twin declares (the registry test checks every shipped twin sets each).
+CAPABILITY_FIELDS = tuple(f.name for f in fields(Capabilities))
+#: What a material without a twin can do: the GLSL engines only (any file of the format renders in GL).
+NO_TWIN = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=False, albedo=("gl",), exports=(),
+                       design=False)
+#: What a twin that declares nothing can do (a test's twin, a measured table): its numpy engine and albedo.
+UNDECLARED = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
+                          exports=(), design=False)
 
 
 @runtime_checkable
@@ -21,6 +89,8 @@ class Twin(Protocol):
 
     #: The ``# model:`` name of the material files it twins.
     name: str
+    #: What the material can do (:class:`Capabilities`).
+    capabilities: Capabilities
 
     def __init__(self, values: Mapping[str, object]) -> None: ...
 
@@ -34,8 +104,10 @@ class Twin(Protocol):
         """The tables the shader samples, by uniform name (host-built)."""
 
 
-#: ``{name: twin class}``: every registered twin (filled as their modules are imported).
+#: ``{name: twin class}``: every registered twin (the built-ins by :func:`registry`, plugins as they load).
 TWINS: dict[str, type] = {}
+#: The modules whose twins ship with the package (imported by :func:`registry`, each registers its own).
+BUILTIN_MODULES = ("explorer.materials.models", "explorer.materials.thinfilm_model", "explorer.materials.lobes_model")
 
 
 def twin(cls: type) -> type:
@@ -48,5 +120,55 @@ def twin(cls: type) -> type:
     missing = [m for m in ("reflectance", "brdf", "textures") if not callable(getattr(cls, m, None))]
     if missing:
         raise TypeError(f"{cls.__name__}: a twin needs {', '.join(missing)}")
+    capabilities = getattr(cls, "capabilities", None)
+    if capabilities is not None and not isinstance(capabilities, Capabilities):
+        raise TypeError(f"{cls.__name__}: 'capabilities' must be a Capabilities(...)")
+    if capabilities is not None and "mitsuba" in capabilities.exports:
+        hooks = ("spectral_reflectance",) if capabilities.dirac else ("spectral_brdf", "sampling_lobes")
+        lacking = [h for h in hooks if not callable(getattr(cls, h, None))]
+        if lacking:
+            raise TypeError(f"{cls.__name__}: a Mitsuba export needs {', '.join(lacking)}")
     TWINS[name] = cls
     return cls
+
+
+def registry() -> dict[str, type]:
+    """:data:`TWINS`, the built-in twins registered (their modules imported) on first use."""
+    import importlib
+
+    for module in BUILTIN_MODULES:
+        importlib.import_module(module)
+    return TWINS
+
+
+def twin_class(material_or_model) -> type | None:
+    """The twin class of a material (or of a ``# model:`` name); None when it names none."""
+    name = material_or_model if isinstance(material_or_model, str) or material_or_model is None \
+        else getattr(material_or_model, "model", None)
+    return registry().get(name or "")
+
+
+def capabilities_of(material_or_model) -> Capabilities:
+    """
+    What a material (or a ``# model:`` name, or a twin instance) can do: its twin's declaration,
+    :data:`UNDECLARED` for a twin that declares none (a measured table's), :data:`NO_TWIN` without a twin.
+    """
+    if material_or_model is not None and not isinstance(material_or_model, str) and hasattr(material_or_model, "brdf"):
+        return getattr(material_or_model, "capabilities", None) or UNDECLARED  # a twin instance
+    measured = getattr(material_or_model, "measured", None)
+    if measured is not None:
+        return getattr(measured, "capabilities", None) or UNDECLARED
+    cls = twin_class(material_or_model)
+    if cls is None:
+        return NO_TWIN
+    return getattr(cls, "capabilities", None) or UNDECLARED
+
+
+def names_with(predicate: Callable[[Capabilities], bool]) -> tuple[str, ...]:
+    """The registered twins' names whose capabilities satisfy ``predicate``, sorted."""
+    return tuple(sorted(name for name, cls in registry().items() if predicate(getattr(cls, "capabilities", None) or UNDECLARED)))
+
+
+def supporting(what: str) -> tuple[str, ...]:
+    """The registered twins that support ``what`` (:meth:`Capabilities.supports`), sorted: for messages."""
+    return names_with(lambda c: c.supports(what))

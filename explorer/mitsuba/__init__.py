@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from explorer.mitsuba.variants import VARIANTS, MitsubaError, choose_variant
 
-__all__ = ["register", "load_file", "render_file", "choose_variant", "VARIANTS", "MitsubaError", "BSDF_NAMES"]
+__all__ = ["register", "load_file", "render_file", "choose_variant", "VARIANTS", "MitsubaError", "plugin_names"]
 
-from explorer.mitsuba.bsdfs import BSDF_NAMES  # noqa: E402  (numpy only: mitsuba is imported by register)
+from explorer.mitsuba.bsdfs import plugin_names  # noqa: E402  (numpy only: mitsuba is imported by register)
 from explorer.mitsuba.registry import register  # noqa: E402
 def load_file(path, variant: str | None = None, **parameters):
     """
@@ -44,7 +44,6 @@ def render_file(path, variant: str | None = None, spp: int | None = None, seed: 
     scene = load_file(path, variant)
     import mitsuba as mi
 
-    mi.set_log_level(mi.LogLevel.Error)
     image = render_in_passes(mi, scene, spp, seed)
     if is_spectral(mi.variant()):
         image = xyz_to_explorer_rgb(image)

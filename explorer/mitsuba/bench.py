@@ -18,7 +18,8 @@ import warnings
 from explorer.materials.methods import BraggMethod
 import numpy as np
 
-from explorer.mitsuba.bsdfs import BSDF_NAMES
+from explorer.materials.twins import capabilities_of
+from explorer.mitsuba.bsdfs import plugin_names
 from explorer.mitsuba.variants import llvm_works
 
 
@@ -54,9 +55,9 @@ def run_mitsuba_bench(as_json: bool = False, size: int = 64, spp: int = 64, vari
     renderer = Renderer()
     rows = []
     warmed = set()
-    for name in materials or BSDF_NAMES:
+    for name in materials or plugin_names():
         material = load_material(material_path(name))
-        values = material.resolve({"method": int(BraggMethod.TABULATED)} if name.startswith("bragg_mirror") or name == "bragg_layer" else {})
+        values = material.resolve({"method": int(BraggMethod.TABULATED)} if capabilities_of(material).bragg_spectrum else {})
         render_env(material, values, 8, 8, spp=1, renderer=renderer)  # compiles the program: not timed
         start = time.perf_counter()
         gl = render_env(material, values, size, size, spp=spp, renderer=renderer)

@@ -1,5 +1,6 @@
 """
-The explorer's materials as Mitsuba 3 BSDFs (Python plugins), one class per built-in material.
+The explorer's materials as Mitsuba 3 BSDFs (Python plugins), one class per registered twin that declares
+a Mitsuba export (its spectral BRDF and sampling lobes are the twin's hooks).
 
 Each plugin reads the ``.brd`` parameters by their names (``<float name="Lambda" value="600"/>``,
 ``<rgb name="rho_d" .../>``) and exposes them through ``traverse``; a change through ``mi.traverse``
@@ -15,7 +16,7 @@ call back into numpy, so no parameter change recompiles one).
   normalised D65, so a white emitter lights it as E does; ``"d65"`` (default) is the bare physics
   (docs/mitsuba.md).
 
-Sampling (``sample``/``pdf``): the smooth ``bragg_mirror`` is a Dirac (``DeltaReflection``); the rough
+Sampling (``sample``/``pdf``): a smooth mirror (a twin that declares ``dirac``) is a Dirac (``DeltaReflection``); the rough
 ones draw one-sample MIS over GGX visible-normal lobes (Heitz 2018) and a cosine lobe, with the
 mixture's density as ``pdf`` (the env view's sampler, ``shaders/views/env.glsl``), so ``eval``,
 ``sample`` and ``pdf`` agree for any lobe weights.
@@ -36,90 +37,44 @@ import numpy as np
 from explorer.materials.methods import BraggMethod
 from explorer.materials.brd import load_material, round_integer
 from explorer.materials.models import model_for
-from explorer.physics import bragg, colorimetry, layered, microfacet, thinfilm
+from explorer.materials.twins import names_with, supporting, twin_class
+from explorer.physics import bragg, colorimetry, microfacet
 from explorer.resources import material_path
 
-#: The plugin names, each a built-in material of the same name.
-BSDF_NAMES = ("bragg_mirror", "bragg_layer", "bragg_stack", "thin_film", "layered_lobes")
-#: The rough ones (Mitsuba's chi2 test runs on these).
-ROUGH_BSDFS = ("bragg_layer", "bragg_stack", "thin_film", "layered_lobes")
 #: The plugins' ``method`` where the scene sets none (see ExplorerBSDF.__init__).
 DEFAULT_METHOD = 3
-#: Samples per numpy call in spectral Eq. 34 (bounds the (samples, 471) temporaries).
+#: Samples per numpy call of the RGB evaluation (bounds the (samples, 471) temporaries of a stack's twin).
 CHUNK = 1 << 14
 
 
+def plugin_names() -> tuple[str, ...]:
+    """The plugin names: every registered twin that declares a Mitsuba export (the material of the same name)."""
+    return supporting("mitsuba")
+
+
+def rough_plugin_names() -> tuple[str, ...]:
+    """The rough ones, not Dirac reflectors (Mitsuba's chi2 test runs on these)."""
+    return names_with(lambda c: "mitsuba" in c.exports and not c.dirac)
+
+
 # --------------------------------------------------------------------------------------------------
-# Spectral physics per material (numpy; directions local, n = +z; wavelengths (n, W) in nm)
+# Spectral physics per material: the twin's hooks (directions local, n = +z; wavelengths (n, W) in nm)
 
 
-def _interp_wavelength(table: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
-    """Rows of spectra on the 1-nm grid (``(n, 471)``) at per-row wavelengths ``(n, W)``, linearly."""
-    x = np.clip(wavelengths - colorimetry.WAVELENGTH_MIN, 0.0, colorimetry.WAVELENGTHS.size - 1.0)
-    j0 = np.minimum(np.floor(x).astype(np.int64), colorimetry.WAVELENGTHS.size - 2)
-    f = x - j0
-    rows = np.arange(table.shape[0])[:, None]
-    return table[rows, j0] * (1.0 - f) + table[rows, j0 + 1] * f
-
-
-@functools.lru_cache(maxsize=16)
-def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray:
-    """The rough layer's spectral integrated transmissivity ``f_t cos theta`` (Eq. 28), ``(361, 471)``."""
-    F = layered.transmission_filter_for(alpha)
-    R = layered.reflectance_table(mirror, np.cos(F.theta))
-    return layered.integrated_transmissivity(F, 1.0 - R)
-
-
-def _theta(v: np.ndarray) -> np.ndarray:
-    return np.arctan2(np.hypot(v[..., 0], v[..., 1]), np.maximum(v[..., 2], 0.0))
-
-
-def spectral_brdf(name: str, model, i: np.ndarray, o: np.ndarray, wavelengths: np.ndarray, rgb_upsample) -> np.ndarray:
+def spectral_brdf(model, i: np.ndarray, o: np.ndarray, wavelengths: np.ndarray, rgb_upsample) -> np.ndarray:
     """
-    The spectral BRDF (1/sr) of material ``name`` (its numpy ``model``) at local directions ``i`` (light),
-    ``o`` (view), ``(n, 3)``, and wavelengths ``(n, W)``; ``rgb_upsample(rgb (n, 3), wavelengths)`` turns
-    RGB albedos (and the RGB-only layered lobes) into spectra (Mitsuba's sRGB model).
+    The spectral BRDF (1/sr) of a numpy twin ``model`` at local directions ``i`` (light), ``o`` (view),
+    ``(n, 3)``, and wavelengths ``(n, W)``: its ``spectral_brdf`` hook where both lie above the surface, 0
+    elsewhere and where not finite. ``rgb_upsample(rgb (n, 3), wavelengths)`` turns RGB albedos (and RGB-only
+    models) into spectra (Mitsuba's sRGB model).
     """
     above = (i[:, 2] > 0.0) & (o[:, 2] > 0.0)
     out = np.zeros(wavelengths.shape)
     if not above.any():
         return out
-    i, o, wl = i[above], o[above], wavelengths[above]
-    if name == "bragg_layer":
-        # Eq. 17, D G1 G1 R_lambda(theta_d) / (4 cos cos), plus the base seen through the layer twice.
-        lobe, cos_d, _ = microfacet.microfacet_lobe(i, o, np.array([0.0, 0.0, 1.0]), model.alpha)
-        R = bragg.bragg_reflectance(np.maximum(cos_d, microfacet.COS_THETA_MIN)[:, None], wl, model.mirror)
-        value = lobe[:, None] * R
-        rho = np.asarray(model.values.get("rho_d", (0.0, 0.0, 0.0)), dtype=np.float64)
-        if rho.any():
-            T = _layer_transmissivity(model.mirror, float(model.alpha))
-            Ti = _interp_wavelength(layered.lookup(T, _theta(i)), wl)
-            To = _interp_wavelength(layered.lookup(T, _theta(o)), wl)
-            value = value + rgb_upsample(np.broadcast_to(rho, (i.shape[0], 3)), wl) / np.pi * Ti * To
-    elif name == "thin_film":
-        lobe, cos_d, _ = microfacet.microfacet_lobe(i, o, np.array([0.0, 0.0, 1.0]), model.alpha)
-        F = thinfilm.airy_reflectance(model.eta_1, model.eta_2, model.eta_3, model.kappa_3,
-                                      np.clip(cos_d, microfacet.COS_THETA_MIN, 1.0)[:, None], model.thickness_d, wl)
-        value = lobe[:, None] * F
-    elif name == "bragg_stack":
-        value = np.empty(wl.shape)
-        rho = np.asarray(model.values.get("rho_d", (0.0, 0.0, 0.0)), dtype=np.float64)
-        for start in range(0, i.shape[0], CHUNK):
-            part = slice(start, start + CHUNK)
-            spectra = layered.single_reflection_spectra(model.stack, i[part], o[part], model.tables)  # Eq. 34
-            layers = _interp_wavelength(spectra.layers, wl[part])
-            base = _interp_wavelength(spectra.base, wl[part])
-            value[part] = layers + rgb_upsample(np.broadcast_to(rho, (base.shape[0], 3)), wl[part]) * base
-    else:  # layered_lobes: an RGB model (Belcour 2018's lobes), upsampled
-        rgb = model.brdf(i, o, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
-        value = rgb_upsample(rgb, wl)
+    value = model.spectral_brdf(i[above], o[above], wavelengths[above], rgb_upsample)
     out[above] = np.where(np.isfinite(value), value, 0.0)
     return out
-
-
-def spectral_mirror(model, cos_theta: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
-    """The smooth Bragg mirror's reflectance ``R_lambda(theta)`` (Eqs. 2, 9, 10), ``(n, W)``."""
-    return bragg.bragg_reflectance(np.clip(cos_theta, microfacet.COS_THETA_MIN, 1.0)[:, None], wavelengths, model.mirror)
 
 
 #: Nodes in cos(theta) of the thin film's reference colours in the RGB variants (linear interpolation).
@@ -131,35 +86,6 @@ def reference_table(model) -> np.ndarray:
     if isinstance(getattr(model, "mirror", None), bragg.BraggMirror):
         return bragg.tabulated_rgb_table(model.mirror)
     return model.reflectance(np.linspace(0.0, 1.0, REFERENCE_NODES))
-
-
-# --------------------------------------------------------------------------------------------------
-# Sampling lobes per material: GGX roughnesses, their weights and a cosine lobe's (the env view's hooks)
-
-
-def sampling_lobes(name: str, model, cos_o: np.ndarray) -> tuple[list[float], list[np.ndarray], np.ndarray]:
-    """
-    ``(alphas, weights, cosine_weight)`` for views at ``cos_o`` (``(n,)``): the GLSL ``sampling_lobes``
-    hooks of the materials (Eq. 31 for one layer, Eq. 35's layer choice for the stack). Unnormalised.
-    """
-    ones = np.ones_like(cos_o)
-    if name == "bragg_layer":
-        T = model.transmission_table
-        t = bragg.tabulated_rgb(T, np.clip(cos_o, 0.0, 1.0)).mean(axis=-1)
-        p_trans = np.clip(2.0 * t / (1.0 + microfacet.smith_G1(np.clip(cos_o, 1e-9, 1.0), model.alpha)), 0.0, 1.0)
-        rho = float(np.mean(model.values.get("rho_d", (0.0, 0.0, 0.0))))
-        return [max(model.alpha, 1e-4)], [1.0 - p_trans + 1e-3], p_trans * rho
-    if name == "thin_film":
-        return [max(model.alpha, 1e-4)], [ones], 0.0 * ones
-    if name == "bragg_stack":
-        p_refl, p_base = layered.layer_choice_probabilities(model.stack, np.clip(cos_o, 0.0, 1.0), model.tables)
-        alphas = [max(layer.alpha, 1e-4) for layer in model.stack.layers]
-        rho = float(np.max(model.values.get("rho_d", (0.0, 0.0, 0.0))))
-        return alphas, [p_refl[..., k] + 1e-3 for k in range(len(alphas))], p_base * rho
-    # layered_lobes: every layer's roughness, equal weights, a little cosine for the broad tails
-    count = round_integer(model.values.get("layers", 1))
-    alphas = [max(float(model.values[f"alpha_{k}"]), 1e-4) for k in range(1, count + 1)]
-    return alphas, [ones] * len(alphas), 0.05 * len(alphas) * ones
 
 
 def mixture_pdf(alphas, weights, cosine_weight, l: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -205,7 +131,7 @@ def _float_property(props, name: str, default):
 
 
 def define_bsdfs(mi, dr) -> dict[str, type]:
-    """The five plugin classes for the active variant ``mi.variant()``."""
+    """The plugin classes (:func:`plugin_names`) for the active variant ``mi.variant()``."""
     spectral = "spectral" in mi.variant()
     jit = dr.is_jit_v(mi.Float)
 
@@ -272,7 +198,8 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            self.material = load_material(material_path(self.material_name))
+            self.material = load_material(getattr(twin_class(self.material_name), "material_file", None)
+                                          or material_path(self.material_name))
             overrides = {}
             for p in self.material.parameters:
                 value = _float_property(props, p.name, p.default)
@@ -298,7 +225,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return {p.name for p in self.material.parameters}
 
         def _rebuild(self):
-            self.model = model_for(self.material, self.material.physical_values(self.values))
+            self.model = model_for(self.material, self.values)
             if not spectral and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
                 # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
                 # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
@@ -342,7 +269,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             if spectral:
                 wl = wavelengths_of(si)
                 wl = np.broadcast_to(wl, (l.shape[0], wl.shape[1])) if wl.shape[0] != l.shape[0] else wl
-                f = spectral_brdf(self.material_name, self.model, l, v, wl, rgb_upsample)
+                f = spectral_brdf(self.model, l, v, wl, rgb_upsample)
                 if self.illuminant == "e":
                     f = f * d65_weight(wl)
             else:
@@ -359,7 +286,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return f * cos_l[:, None]
 
         def _lobes(self, v):
-            return sampling_lobes(self.material_name, self.model, v[:, 2])
+            return self.model.sampling_lobes(v[:, 2])
 
         def eval(self, ctx, si, wo, active=True):
             if self.dirac:
@@ -390,7 +317,7 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
                 cos = v[:, 2]
                 if spectral:
                     wl = wavelengths_of(si)
-                    weight = spectral_mirror(self.model, cos, np.broadcast_to(wl, (n, wl.shape[1])))
+                    weight = self.model.spectral_reflectance(cos, np.broadcast_to(wl, (n, wl.shape[1])))
                     if self.illuminant == "e":
                         weight = weight * d65_weight(np.broadcast_to(wl, weight.shape))
                 else:
@@ -414,6 +341,6 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return bs, dr.select(active, spectrum_from_numpy(weight), 0.0)
 
     classes = {}
-    for name in BSDF_NAMES:
-        classes[name] = type(name, (ExplorerBSDF,), {"material_name": name, "dirac": name == "bragg_mirror"})
+    for name in plugin_names():
+        classes[name] = type(name, (ExplorerBSDF,), {"material_name": name, "dirac": twin_class(name).capabilities.dirac})
     return classes

@@ -53,9 +53,13 @@ from typing import Callable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from explorer.physics import colorimetry, layered, microfacet
+from explorer.physics import colorimetry, layered, microfacet, microsurface
 from explorer.physics.fresnel import fresnel_reflectance
 
+#: How a rough layer's microsurface scatters: ``single``, Eq. 17's one reflection and Eq. 28's ballistic
+#: transmission (what single scattering loses, Eq. 30's ``A``, is absorbed); ``walk``, every bounce among
+#: its facets (the random walk of Heitz et al. 2016, :mod:`explorer.physics.microsurface`; albedo only).
+MICROSURFACES = ("single", "walk")
 #: Paths traced together (a few hundred bytes each).
 BATCH_PATHS = 1 << 17
 #: Russian roulette starts after this many events, for paths whose weight fell below the threshold.
@@ -131,7 +135,10 @@ class PositionFree:
     Fourneau et al. (2024), Section 4.2; Guo et al. (2018).
     """
 
-    def __init__(self, stack: layered.LayeredBragg, tables=None):
+    def __init__(self, stack: layered.LayeredBragg, tables=None, microsurface: str = "single"):
+        if microsurface not in MICROSURFACES:
+            raise ValueError(f"microsurface must be one of {', '.join(MICROSURFACES)}, got {microsurface!r}")
+        self.walk = microsurface == "walk"
         self.stack = stack
         tables = layered.stack_tables(stack) if tables is None else tuple(tables)
         if len(tables) != len(stack.layers):
@@ -149,6 +156,7 @@ class PositionFree:
         self.rho = np.asarray(stack.rho_d, dtype=np.float64)
         self.n1 = stack.n1 if stack.coating else 1.0
         self.refracts = stack.coating and stack.n1 != 1.0
+        self.tau_h = float(stack.tau_h)
 
     # ----------------------------------------------------------------------------------------------
     # Tables and interfaces
@@ -196,6 +204,18 @@ class PositionFree:
         u = ((np.arange(count)[None, :] + rng.random((groups, count))) / count).reshape(-1, 1)
         u = (u + np.arange(K)[None, :] / K) % 1.0
         return np.minimum(np.searchsorted(self.cdf, u, side="right"), self.pdf.size - 1)
+
+    def _walk_layer(self, l, at, d, beta, pi, gap, alive, wavelength, rng) -> None:
+        """
+        Multiple scattering on layer ``l``'s microsurface for the paths ``at`` (in place): the random walk
+        of :func:`explorer.physics.microsurface.walk` takes each to the layer's top (reflected) or bottom
+        (transmitted, ballistically after every crossing), its facets reflecting with the layer's ``R_lambda``.
+        """
+        table = self.reflectance[l]
+        d[at], beta[at], pi[at], up, kept, _ = microsurface.walk(
+            d[at], beta[at], pi[at], self.alphas[l], lambda cos_d, rows: self._lookup(table, cos_d, wavelength[rows]), rng)
+        alive[at[~kept]] = False
+        gap[at] = np.where(up, l, l + 1)
 
     # ----------------------------------------------------------------------------------------------
     # The walk
@@ -248,14 +268,18 @@ class PositionFree:
             o_host = self._into_host(o_air)
             exit_weight = (1.0 - self._coating_F_air(np.clip(o_air[:, 2], 0.0, 1.0))) / (self.n1 * self.n1)
             exit_weight = np.where((o_air[:, 2] > 0.0) & (i_air[:, 2] > 0.0), exit_weight, 0.0)
-            E = [np.repeat(exit_weight[:, None], K, axis=1)]
+            # The host's gaps (tau_h): the one above a vertex and every one above it, crossed along o'.
+            gap_o = layered.gap_transmittance(self.tau_h, o_host[:, 2])[:, None]
+            E = [np.repeat(exit_weight[:, None], K, axis=1) * gap_o]
             for table in self.transmissivity:
-                E.append(E[-1] * self._lookup(table, o_host[:, 2], wl))
+                E.append(E[-1] * self._lookup(table, o_host[:, 2], wl) * gap_o)
         for event in range(MAX_EVENTS):
             if pid.size == 0:
                 break
             going_down = d[:, 2] < 0.0
             interface = np.where(going_down, gap + 1, gap)
+            if self.tau_h > 0.0:  # every path crosses its gap to the next interface: Beer-Lambert in the host
+                beta *= layered.gap_transmittance(self.tau_h, np.abs(d[:, 2]))[:, None]
             alive = np.ones(pid.size, dtype=bool)
             born = []  # the reflected branches of this event's splits
             # -- the coating, from inside: deterministic split (escape 1 - F, reflect F)
@@ -272,6 +296,9 @@ class PositionFree:
                 if at.size == 0:
                     continue
                 alpha = self.alphas[l]
+                if self.walk:
+                    self._walk_layer(l, at, d, beta, pi, gap, alive, wl[pid[at]], rng)
+                    continue
                 from_above = going_down[at]
                 cos_in = np.abs(d[at, 2])
                 j = wl[pid[at]]
@@ -484,6 +511,8 @@ class PositionFree:
             As in :meth:`albedo`.
         """
         start = time.perf_counter()
+        if self.walk:
+            raise ValueError("the microsurface walk estimates the directional albedo only (no next-event BRDF)")
         if int(samples) < 1:
             raise ValueError(f"samples must be at least 1, got {samples}")
         i_air, o_air = np.broadcast_arrays(np.atleast_2d(np.asarray(i_air, dtype=np.float64)),
@@ -523,9 +552,10 @@ def _worker_replicate(i_air, o_air, per, key):
 def directional_albedo(
     stack: layered.LayeredBragg, theta_deg: ArrayLike, samples: int = 20000, seed: int = 0,
     tables: Sequence[layered.LayerTables] | None = None, progress: Callable[[int, int], None] | None = None,
+    microsurface: str = "single",
 ) -> PositionFreeResult:
-    """The position-free directional albedo of ``stack`` (:meth:`PositionFree.albedo`)."""
-    return PositionFree(stack, tables).albedo(theta_deg, samples, seed, progress)
+    """The position-free directional albedo of ``stack`` (:meth:`PositionFree.albedo`; ``microsurface``: :data:`MICROSURFACES`)."""
+    return PositionFree(stack, tables, microsurface).albedo(theta_deg, samples, seed, progress)
 
 
 def brdf(

@@ -16,10 +16,10 @@ Three engines:
 - ``position-free``: the Monte Carlo reference of Section 4.2 for layered Bragg structures
   (:mod:`explorer.physics.position_free`), with its standard error.
 
-A smooth mirror (``bragg_mirror``: its ``BRDF`` is its reflectance at the half vector, a Dirac's weight)
-has for albedo its specular reflectance ``reflectance(cos theta)``. (``schlick_fresnel`` is a
-Fresnel-weighted Lambertian, ``F / pi``: integrated like any BRDF.) The coating
-of ``bragg_stack`` adds its Dirac reflection (``mirror_reflection``: Eq. 34's ``f_r,0``).
+A smooth mirror (a twin that declares ``dirac``: its ``BRDF`` is its reflectance at the half vector, a Dirac's
+weight) has for albedo its specular reflectance ``reflectance(cos theta)``. (A Fresnel-weighted Lambertian,
+``F / pi``, is integrated like any BRDF.) A twin's ``mirror_reflection`` (the coating of a layered Bragg
+stack: Eq. 34's ``f_r,0``) adds its Dirac reflection.
 
 References
 ----------
@@ -33,11 +33,8 @@ from typing import Callable
 
 import numpy as np
 
-#: Models whose ``BRDF`` is a smooth mirror's reflectance at the half vector (a Dirac's weight, not a
-#: density): their albedo is ``reflectance(cos theta)``.
-SPECULAR_MODELS = ("bragg_mirror",)
-#: The models the position-free engine simulates.
-POSITION_FREE_MODELS = ("bragg_stack",)
+from explorer.materials.twins import capabilities_of, supporting
+
 #: Cell edges in theta_h (radians), graded toward the normal: lobes down to alpha ~ 1e-3 span cells.
 THETA_H_EDGES = np.array([0.0, 1e-3, 3e-3, 0.01, 0.02, 0.035, 0.06, 0.1, 0.15, 0.22, 0.32, 0.45, 0.6, 0.8, 1.05, 1.3, 0.5 * np.pi])
 #: Gauss-Legendre nodes per theta_h cell, and azimuths (midpoint rule) of the numpy quadrature.
@@ -99,14 +96,14 @@ def albedo_numpy(model, theta_deg) -> np.ndarray:
     """
     The directional albedo of a numpy twin (:mod:`explorer.materials.models`) at ``theta_deg``: (n, 3).
 
-    A model in :data:`SPECULAR_MODELS` gives ``reflectance(cos theta)``; others ``brdf`` under the views'
+    A Dirac reflector (its twin declares ``dirac``) gives ``reflectance(cos theta)``; others ``brdf`` under the views'
     rule (:func:`explorer.views.geometry.view_brdf`) on :func:`half_vector_quadrature`, plus their
     ``mirror_reflection`` where they have one.
     """
     from explorer.views.geometry import view_brdf
 
     theta = np.radians(check_theta(theta_deg))
-    if getattr(model, "name", None) in SPECULAR_MODELS:
+    if capabilities_of(model).dirac:
         return np.asarray(model.reflectance(np.cos(theta)), dtype=np.float64).reshape(-1, 3)
     if not callable(getattr(model, "brdf", None)):
         raise ValueError(f"{type(model).__name__} has no brdf(): no albedo")
@@ -121,6 +118,16 @@ def albedo_numpy(model, theta_deg) -> np.ndarray:
             f = view_brdf(model.brdf, *frame)
             result[k] += np.sum(f * (V[:, 2] * w[start:start + BLOCK])[:, None], axis=0)
     return result
+
+
+def sum_albedo_terms(terms: np.ndarray, columns: int) -> np.ndarray:
+    """
+    The albedo of ``columns`` incidence angles from the albedo view's terms (``shaders/views/albedo.glsl``:
+    rows from the top, ``columns`` blocks of one row per ``theta_h`` node, a column per azimuth), summed
+    in float64: ``(columns, 3)``.
+    """
+    terms = np.asarray(terms, dtype=np.float64)
+    return terms.reshape(columns, -1, terms.shape[-1])[..., :3].sum(axis=1)
 
 
 def scatter_solid_angles(width: int, height: int) -> np.ndarray:
@@ -139,13 +146,13 @@ def scatter_solid_angles(width: int, height: int) -> np.ndarray:
 def albedo_gl(material, values, theta_deg, renderer, size: int = GL_SIZE, model=None) -> np.ndarray:
     """
     The directional albedo by the GPU: ``BRDF cos theta_o`` in the scatter view (light at ``(theta, 0)``)
-    summed with :func:`scatter_solid_angles`; a material in :data:`SPECULAR_MODELS` gives its reflectance
+    summed with :func:`scatter_solid_angles`; a Dirac reflector (its twin declares ``dirac``) gives its reflectance
     at the mirror pixel's angle instead (the gradient view, interpolated). ``model`` (its numpy twin, when
     it has one) adds its ``mirror_reflection``. ``renderer``: an :class:`explorer.gpu.Renderer` (views
     come below gpu: the caller makes it). (n, 3).
     """
     theta = check_theta(theta_deg)
-    if material.model in SPECULAR_MODELS:
+    if capabilities_of(material).dirac:
         # The gradient's column k shows reflectance at theta = 90 (k + 0.5) / W degrees.
         width = 8192
         row = renderer.render(material, values, "gradient", width, 1)[0].astype(np.float64)
@@ -176,19 +183,21 @@ def gl_size_for(model) -> int:
 
 def position_free_stack(model):
     """The :class:`explorer.physics.layered.LayeredBragg` of a numpy twin the position-free engine simulates."""
-    if getattr(model, "name", None) not in POSITION_FREE_MODELS:
-        raise ValueError(f"the position-free engine simulates layered Bragg structures ({', '.join(POSITION_FREE_MODELS)}), "
+    if not capabilities_of(model).supports("position-free"):
+        raise ValueError(f"the position-free engine simulates layered Bragg structures ({', '.join(supporting('position-free'))}), "
                          f"not {getattr(model, 'name', type(model).__name__)}")
     return model.stack
 
 
 def albedo_position_free(model, theta_deg, samples: int = 20000, seed: int = 0,
-                         progress: Callable[[int, int], None] | None = None):
+                         progress: Callable[[int, int], None] | None = None, microsurface: str = "single"):
     """
     The position-free directional albedo (:meth:`explorer.physics.position_free.PositionFree.albedo`) of a
-    ``bragg_stack`` twin: a :class:`explorer.physics.position_free.PositionFreeResult`.
+    twin that supports it (a layered Bragg stack's): a :class:`explorer.physics.position_free.PositionFreeResult`.
+    ``microsurface``: ``single`` (Eq. 17's single scattering per layer) or ``walk`` (every bounce among a
+    layer's facets).
     """
     from explorer.physics.position_free import PositionFree
 
     stack = position_free_stack(model)
-    return PositionFree(stack, getattr(model, "tables", None)).albedo(check_theta(theta_deg), samples, seed, progress)
+    return PositionFree(stack, getattr(model, "tables", None), microsurface).albedo(check_theta(theta_deg), samples, seed, progress)

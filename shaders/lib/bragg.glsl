@@ -1,4 +1,4 @@
-// Bragg mirrors: twin of explorer/physics/bragg.py, function for function and under the same names.
+// Bragg mirrors: twin of the subpackage explorer/physics/bragg/, function for function and under the same names.
 // Fourneau, Pacanowski, Barla (2024), Interactive Exploration of Vivid Material Iridescence using
 // Bragg Mirrors: Sections 3.1-3.2, Appendices A, B, D. Equation numbers are the paper's.
 //
@@ -122,7 +122,7 @@ void chebyshev_U(float a, float N, out float U_N1, out float U_N2, out float sca
 // 1 - cos K Lambda = 2 (1 - Theta) sin^2 h- + 2 Theta sin^2 h+ and 1 + cos K Lambda = the same with cos^2:
 // no cancellation against 1, so sin K Lambda keeps its relative precision where sin(N K Lambda) / sin K Lambda
 // would amplify an absolute error of cos K Lambda. Four trig calls in all; sin phi = sin(h+ - h-) comes free.
-// float64 (explorer/physics/bragg.py) needs none of this.
+// float64 (explorer/physics/bragg/reflectance.py) needs none of this.
 void chebyshev_U_half_angles(vec4 half_angles, float Omega_, float N, out float U_N1, out float U_N2, out float scale) {
     float sm = half_angles.x, cm = half_angles.y, sp = half_angles.z, cp = half_angles.w;
     float Theta = 0.5 + 0.25 * Omega_;
@@ -196,7 +196,7 @@ float bragg_reflectance(float cos_theta, float wavelength, BraggMirror mirror) {
 }
 
 // The spectral reference: R_lambda, both polarisations, sampled every 1/K nm with K = round(1 / step_nm),
-// against the CMFs interpolated linearly (explorer/physics/bragg.py, reference_rgb with a step; the samples'
+// against the CMFs interpolated linearly (explorer/physics/bragg/reference.py, reference_rgb with a step; the samples'
 // trapezoids against the hat functions of explorer/physics/colorimetry.py). step_nm = 1: the paper's sum over every
 // nm from 360 to 830, which misses or hits the narrow resonances beside band edges for N of a few tens
 // and more; a finer step converges towards the integral (numpy's reference_rgb without a step).
@@ -261,7 +261,7 @@ float paper_weight(float omega, CellGeometry g) {
 
 // |r_hN|^2 averaged over the fringes, coherently (Appendix D): r_hN = alpha + beta / (x - z) with x = cot(N K Lambda)
 // spanning the real line with the Cauchy density 1 / (pi (1 + x^2)); <1 / (x - z)> = 1 / (-i sign(Im z) - z),
-// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/physics/bragg.py has the derivation).
+// <1 / |x - z|^2> = (1 + |q|) / (|q| ((1 + |q|)^2 + p^2)) for z = p + i q (explorer/physics/bragg/approximation.py has the derivation).
 float fringe_average_under_host(vec2 r1, vec2 t1, float omega, CellGeometry g, float a) {
     vec2 t_cell = cmul(t1, cexpi(omega * g.p1));
     float sin_t = sqrt(max(1.0 - a * a, 0.0));
@@ -347,7 +347,7 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
 // The improved variant (ours) resolves a pass band's fringes where, in its visible part, a fringe feature
 // is wider than FRINGE_RESOLVE_NM / s nm (times (N / N_RESOLVE)^GROW_EXPONENT beyond N_RESOLVE cells) and
 // SAMPLES_PER_FRINGE N <= RESOLVE_BUDGET, with SAMPLES_PER_FRINGE sub-boxes per feature weighted by the
-// exact reflectance (explorer/physics/bragg.py has the reasoning).
+// exact reflectance (explorer/physics/bragg/approximation.py has the reasoning).
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
 float fringe_count(float omega_low, float omega_high, CellGeometry g) {

@@ -1,4 +1,4 @@
-// Thin films: twin of explorer/physics/thinfilm.py, function for function and under the same names.
+// Thin films: twin of the subpackage explorer/physics/thinfilm/, function for function and under the same names.
 // Belcour, Barla (2017), A Practical Extension to Microfacet Theory for the Modeling of Varying
 // Iridescence: Sections 3-5 and the Appendix. Equation numbers are the paper's.
 //
@@ -12,7 +12,7 @@
 //   cos(m phi_2), sin(m phi_2) are powers of a phasor and sin(Phi / 2) is the imaginary part of a
 //   product of half-angle phasors, never 1 - cos Phi;
 // - R = 1 - T12 T23 / |1 - R_l e^{i Phi}|^2 (the Appendix's closed form without its cancellation at
-//   grazing angles, see explorer/physics/thinfilm.py), with |1 - R_l e^{i Phi}|^2 = (1 - R_l)^2 + 4 R_l sin^2(Phi/2)
+//   grazing angles, see explorer/physics/thinfilm/airy.py), with |1 - R_l e^{i Phi}|^2 = (1 - R_l)^2 + 4 R_l sin^2(Phi/2)
 //   and 1 - R_l = (T21 + T23 - T21 T23) / (1 + R_l); T12 = T21 = |t12 t21| and T23 from |t23|^2 (no 1 - R);
 // - complex square roots without cancellation (csqrt); phases reduced to one turn (fract) before sin/cos.
 #include "lib/fresnel.glsl"

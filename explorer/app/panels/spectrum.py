@@ -30,8 +30,8 @@ class SpectrumPanel(Panel):
 
     def draw(self, imgui) -> None:
         state = self.state
-        others = [e for e in state.visible_entries() if e.material is not state.material and e.material.model in data.BRAGG_MODELS]
-        if state.material.model not in data.BRAGG_MODELS and not others:
+        others = [e for e in state.visible_entries() if e.material is not state.material and data.has_bragg_spectrum(e.material)]
+        if not data.has_bragg_spectrum(state.material) and not others:
             imgui.text("the spectrum needs a Bragg mirror material (n1, n2, Lambda, delta, N)")
             return
         _, state.spectrum_theta = imgui.slider_float("theta", state.spectrum_theta, 0.0, 89.0, "%.1f deg")
@@ -42,7 +42,7 @@ class SpectrumPanel(Panel):
             _, state.spectrum_show[key] = imgui.checkbox(key, state.spectrum_show[key])
             record(state, f"spectrum_show:{key}")
         selected = state.materials[state.selected] if state.materials else None
-        shown = selected is None or (selected.visible and state.material.model in data.BRAGG_MODELS)
+        shown = selected is None or (selected.visible and data.has_bragg_spectrum(state.material))
         if shown:
             self._update()
         overlays = [(entry, self._other(entry)) for entry in others]

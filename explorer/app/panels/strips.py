@@ -25,7 +25,7 @@ class StripsPanel(Panel):
         if not has_reflectance(state.material):
             imgui.text("this material has no reflectance(cos_theta)")
             return
-        if state.material.model in data.BRAGG_MODELS:
+        if data.has_bragg_spectrum(state.material):
             methods = [m for m in data.BRAGG_STRIP_METHODS if m in names]
         else:
             methods = list(names) or [None]

@@ -6,24 +6,32 @@ Figure 7), from a grey image (the shipped noise by default), lit by the app's li
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.errors import LocatedError
 from explorer.resources import DEFAULT_TEXTURE
-from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
+from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture, textured_builtins
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
 
 #: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
 ENV_SAMPLES = 256
 
 
+@functools.cache
+def _textured_builtins() -> str:
+    """:func:`textured_builtins`, read once (it loads every built-in material)."""
+    return textured_builtins()
+
+
 def no_texture_text(name: str) -> str:
     """What the Texture tab says for a material whose surface no image can vary (in words, not the file's syntax)."""
     return (f"{name} looks the same all over its surface: nothing in it follows an image. This tab shows a material "
             "whose look varies across the surface with a grey image: a thin film whose thickness follows it, or a smooth "
-            "Bragg mirror whose period and layer ratio follow it (File > Open... a thin film or a Bragg mirror).")
+            f"Bragg mirror whose period and layer ratio follow it: File > Open... one ({_textured_builtins()} do).")
 
 
 class TexturePanel(Panel):

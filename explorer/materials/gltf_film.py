@@ -1,0 +1,249 @@
+"""
+glTF's one thin film (``KHR_materials_iridescence``) and the nearest such film to any material.
+
+:func:`iridescent_fresnel` is the extension's ``iridescent_fresnel(outside_ior, iridescence_ior, base_f0,
+thickness)`` at the view angle, as the Khronos specification writes it (section "Iridescence Fresnel"):
+Schlick at both interfaces, phase shifts of 0 or pi, the Airy series summed to m = 2 in Fourier space with
+Gaussian fits of the XYZ sensitivities, then XYZ -> Rec. 709. :func:`specular_reflectance` is the smooth
+material's reflection under the specification's metallic-roughness model with the extension
+(``iridescent_conductor_layer`` / ``iridescent_dielectric_layer`` over a black base colour): what a glTF
+engine shows in the mirror direction.
+
+A single film (``thin_film``) whose exterior is air and whose base is a dielectric of index >= 1 or a conductor maps
+directly (:func:`direct_film`). Any other material gets the nearest film (:func:`fit_film`): the
+thickness, film index, factor and metallic base colour minimising the ΔE2000 between
+:func:`specular_reflectance` and the material's own ``reflectance(cos theta)`` over :data:`THETA_DEG`.
+Both report the ΔE2000 per angle (docs/export.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from explorer.physics import colorimetry
+
+#: The angles (degrees from the normal) at which a film is fitted and its ΔE2000 reported.
+THETA_DEG = np.arange(0.0, 90.0, 5.0)
+
+# The specification's Gaussian fits of the XYZ sensitivities in Fourier space (evalSensitivity) and its
+# XYZ -> Rec. 709 matrix (row-major here: rgb = M @ xyz).
+_VAL = np.array([5.4856e-13, 4.4201e-13, 5.2481e-13])
+_POS = np.array([1.6810e06, 1.7953e06, 2.2084e06])
+_VAR = np.array([4.3278e09, 9.3046e09, 6.6121e09])
+_XYZ_TO_REC709 = np.array([
+    [3.2404542, -1.5371385, -0.4985314],
+    [-0.9692660, 1.8760108, 0.0415560],
+    [0.0556434, -0.2040259, 1.0572252],
+])
+
+#: The thickness (nm) and film index ranges the fit searches (the extension allows any thickness >= 0
+#: and an index >= 1).
+THICKNESS_RANGE = (0.0, 1500.0)
+IOR_RANGE = (1.0, 3.0)
+
+
+def _schlick(f0, cos):
+    return f0 + (1.0 - f0) * (1.0 - cos) ** 5
+
+
+def _ior_to_f0(transmitted, incident):
+    return ((transmitted - incident) / (transmitted + incident)) ** 2
+
+
+def _sensitivity(opd: np.ndarray, shift: np.ndarray) -> np.ndarray:
+    """The specification's ``evalSensitivity``: ``opd`` (...,), ``shift`` (..., 3) -> Rec. 709 (..., 3)."""
+    phase = (2.0 * np.pi * 1.0e-9 * opd)[..., None]
+    xyz = _VAL * np.sqrt(2.0 * np.pi * _VAR) * np.cos(_POS * phase + shift) * np.exp(-phase**2 * _VAR)
+    xyz[..., 0] += (9.7470e-14 * np.sqrt(2.0 * np.pi * 4.5282e09) * np.cos(2.2399e06 * phase[..., 0] + shift[..., 0])
+                    * np.exp(-4.5282e09 * phase[..., 0] ** 2))
+    return (xyz / 1.0685e-7) @ _XYZ_TO_REC709.T
+
+
+def iridescent_fresnel(outside_ior, film_ior, base_f0, thickness, cos_theta) -> np.ndarray:
+    """
+    The extension's film Fresnel (linear Rec. 709, ``(..., 3)``) at ``cos_theta`` (broadcast with the
+    scalars ``outside_ior``, ``film_ior``, ``thickness`` in nm and the RGB ``base_f0`` ``(..., 3)``).
+    """
+    cos1 = np.asarray(cos_theta, dtype=np.float64)
+    outside, film = np.asarray(outside_ior, np.float64), np.asarray(film_ior, np.float64)
+    thickness = np.asarray(thickness, np.float64)
+    base_f0 = np.asarray(base_f0, np.float64)
+    shape = np.broadcast_shapes(cos1.shape, outside.shape, film.shape, thickness.shape, base_f0.shape[:-1])
+    cos1, outside, film, thickness = (np.broadcast_to(a, shape) for a in (cos1, outside, film, thickness))
+    base_f0 = np.broadcast_to(base_f0, shape + (3,))
+    sin2_sq = (outside / film) ** 2 * (1.0 - cos1**2)
+    cos2_sq = 1.0 - sin2_sq
+    tir = cos2_sq < 0.0
+    cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
+    # First interface.
+    r12 = _schlick(_ior_to_f0(film, outside), cos1)[..., None]
+    t121 = 1.0 - r12
+    # Second interface: the base's index from its F0 (guarded against 1).
+    sqrt_f0 = np.sqrt(base_f0 + 0.0001)
+    base_ior = (1.0 + sqrt_f0) / (1.0 - sqrt_f0)
+    r23 = _schlick(_ior_to_f0(base_ior, film[..., None]), cos2[..., None])
+    opd = 2.0 * film * thickness * cos2
+    phi12 = np.where(film < outside, np.pi, 0.0)[..., None]
+    phi21 = np.pi - phi12
+    phi23 = np.where(base_ior < film[..., None], np.pi, 0.0)
+    phi = phi21 + phi23
+    r123 = np.clip(r12 * r23, 1e-5, 0.9999)
+    sqrt_r123 = np.sqrt(r123)
+    rs = t121**2 * r23 / (1.0 - r123)
+    intensity = r12 + rs
+    cm = rs - t121
+    for m in (1, 2):
+        cm = cm * sqrt_r123
+        intensity = intensity + cm * 2.0 * _sensitivity(m * opd, m * phi)
+    return np.where(tir[..., None], 1.0, np.maximum(intensity, 0.0))
+
+
+@dataclass
+class Film:
+    """The glTF parameters of one film over a black-based dielectric (``metallic`` 0) or a metal (1)."""
+
+    thickness: float  # nm: iridescenceThicknessMaximum (no thickness texture)
+    ior: float  # iridescenceIor
+    factor: float  # iridescenceFactor
+    metallic: float  # metallicFactor: 0 or 1
+    base_color: tuple[float, float, float] = (0.0, 0.0, 0.0)  # baseColorFactor's RGB (the metal's F0)
+    base_ior: float = 1.5  # KHR_materials_ior (the dielectric's)
+    mapping: str = "direct"  # "direct" (a thin film), "refined" (from the direct one) or "fit" (the nearest film)
+    delta_e: np.ndarray = field(default_factory=lambda: np.zeros(0))  # ΔE2000 at THETA_DEG
+    direct: "Film | None" = None  # a refined film's direct mapping
+
+
+def specular_reflectance(film: Film, cos_theta) -> np.ndarray:
+    """The glTF material's smooth reflection at ``cos_theta`` (``(..., 3)``), black base colour for a dielectric."""
+    cos = np.asarray(cos_theta, dtype=np.float64)
+    if film.metallic >= 0.5:
+        f0 = np.asarray(film.base_color, np.float64)
+        plain = _schlick(f0, cos[..., None])  # conductor_fresnel
+    else:
+        f0 = np.full(3, _ior_to_f0(film.base_ior, 1.0))
+        plain = _schlick(f0, cos[..., None])  # fresnel_mix over a black base: the specular share
+    iridescent = iridescent_fresnel(1.0, film.ior, f0, film.thickness, cos)
+    return (1.0 - film.factor) * plain + film.factor * iridescent
+
+
+def delta_e(film: Film, target_rgb: np.ndarray) -> np.ndarray:
+    """ΔE2000 at :data:`THETA_DEG` between the film's reflection and ``target_rgb`` (``(len(THETA_DEG), 3)``)."""
+    return colorimetry.delta_E_2000(specular_reflectance(film, np.cos(np.radians(THETA_DEG))), target_rgb)
+
+
+def target_rgb(model) -> np.ndarray:
+    """A material twin's smooth reflectance at :data:`THETA_DEG` (what its sphere and gradient views show)."""
+    return np.asarray(model.reflectance(np.cos(np.radians(THETA_DEG))), dtype=np.float64)
+
+
+def direct_film(model) -> Film | None:
+    """
+    A single film's twin (one with ``film = (eta1, eta2, eta3, kappa3)`` and ``thickness_d``) as the
+    extension's parameters; None for any other material, or where the extension cannot hold the film.
+    """
+    film = getattr(model, "film", None)
+    if film is None or not hasattr(model, "thickness_d"):
+        return None
+    eta1, eta2, eta3, kappa3 = (float(x) for x in film)
+    d = float(model.thickness_d)
+    if abs(eta1 - 1.0) > 1e-9 or eta2 < 1.0:
+        return None  # the extension's film lies in air, and its index is at least 1
+    if kappa3 > 0.0:  # a conductor: a metal whose base colour is its normal-incidence reflectance (grey)
+        f0 = abs((complex(eta3, kappa3) - 1.0) / (complex(eta3, kappa3) + 1.0)) ** 2
+        return Film(d, eta2, 1.0, 1.0, (f0, f0, f0))
+    if eta3 < 1.0:
+        return None  # KHR_materials_ior holds indices >= 1 only
+    return Film(d, eta2, 1.0, 0.0, base_ior=eta3)
+
+
+def _films_rgb(params: np.ndarray, metallic: bool, cos: np.ndarray) -> np.ndarray:
+    """:func:`specular_reflectance` of many films at once: ``params`` ``(K, 6)`` (thickness, ior, factor, then
+    the base colour for a metal, or the base's index for a dielectric) -> ``(K, len(cos), 3)``."""
+    thickness, ior, factor = params[:, 0:1], params[:, 1:2], params[:, 2:3, None]
+    if metallic:
+        f0 = params[:, None, 3:6]
+    else:
+        f0 = np.repeat(_ior_to_f0(params[:, None, 3:4], 1.0), 3, axis=-1)
+    plain = _schlick(f0, cos[None, :, None])
+    iridescent = iridescent_fresnel(1.0, ior, f0, thickness, cos[None, :])
+    return (1.0 - factor) * plain + factor * iridescent
+
+
+def _lab(rgb: np.ndarray) -> np.ndarray:
+    import colour
+
+    return colour.XYZ_to_Lab(colorimetry.rgb_to_xyz(rgb), colour.XYZ_to_xy(colorimetry.white_xyz()))
+
+
+def _films_delta_e(params: np.ndarray, metallic: bool, target_lab: np.ndarray, cos: np.ndarray) -> np.ndarray:
+    """ΔE2000 ``(K, len(cos))`` of films ``params`` (:func:`_films_rgb`) against ``target_lab``."""
+    import colour
+
+    return np.asarray(colour.delta_E(_lab(_films_rgb(params, metallic, cos)), target_lab[None], method="CIE 2000"))
+
+
+def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: bool, target_lab, cos):
+    """Bounded least squares on the ΔE2000 per angle from ``start`` (scipy), the Jacobian's differences in one batch."""
+    from scipy.optimize import least_squares
+
+    steps = np.array([0.05, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4])[: len(start)]
+
+    def jacobian(p):
+        sign = np.where(p + steps <= upper, 1.0, -1.0)
+        batch = np.vstack([p, p + np.diag(steps * sign)])
+        e = _films_delta_e(batch, metallic, target_lab, cos)
+        return ((e[1:] - e[0]) / (steps * sign)[:, None]).T
+
+    result = least_squares(lambda p: _films_delta_e(p[None], metallic, target_lab, cos)[0], np.clip(start, lower, upper),
+                           jac=jacobian, bounds=(lower, upper), max_nfev=100)
+    return result.x, result.cost
+
+
+def _film_of(params: np.ndarray, metallic: bool, mapping: str, target: np.ndarray) -> Film:
+    if metallic:
+        film = Film(float(params[0]), float(params[1]), float(params[2]), 1.0, tuple(float(c) for c in params[3:6]), mapping=mapping)
+    else:
+        film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping)
+    film.delta_e = delta_e(film, target)
+    return film
+
+
+def fit_film(target: np.ndarray, starts: int = 3) -> Film:
+    """
+    The nearest metallic film to ``target`` (linear RGB at :data:`THETA_DEG`): a grid over thickness and
+    index (factor 1, base colours from the target's normal-incidence colour and two greys) picks the
+    ``starts``, then bounded least squares on the ΔE2000 per angle refines each (scipy); the best is kept.
+    """
+    cos = np.cos(np.radians(THETA_DEG))
+    target = np.asarray(target, np.float64)
+    target_lab = _lab(target)
+    bases = [np.clip(target[0], 0.0, 1.0), np.full(3, 0.04), np.full(3, 0.5)]
+    d, n = np.meshgrid(np.linspace(*THICKNESS_RANGE, 151), np.linspace(1.0, 2.6, 17), indexing="ij")
+    grid = np.concatenate([np.column_stack([d.ravel(), n.ravel(), np.ones(d.size), np.broadcast_to(b, (d.size, 3))]) for b in bases])
+    cost = np.sum(_films_delta_e(grid, True, target_lab, cos) ** 2, axis=1)
+    # Also from no film at all (factor 0): a plain Schlick metal of the target's normal-incidence colour.
+    plain = np.array([[THICKNESS_RANGE[1] / 3.0, 1.5, 0.0, *np.clip(target[0], 0.0, 1.0)]])
+    grid, cost = np.vstack([plain, grid]), np.concatenate([[-1.0], cost])
+    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, 0.0, 0.0, 0.0])
+    upper = np.array([THICKNESS_RANGE[1], IOR_RANGE[1], 1.0, 1.0, 1.0, 1.0])
+    fits = [_refine(start, lower, upper, True, target_lab, cos) for start in grid[np.argsort(cost)[:starts]]]
+    return _film_of(min(fits, key=lambda f: f[1])[0], True, "fit", target)
+
+
+def refine_film(film: Film, target: np.ndarray) -> Film:
+    """
+    ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour, the
+    dielectric's index) moved to the nearest minimum of the ΔE2000 to ``target``; ``film`` itself where
+    that is no closer.
+    """
+    cos = np.cos(np.radians(THETA_DEG))
+    target = np.asarray(target, np.float64)
+    metallic = film.metallic >= 0.5
+    start = np.array([film.thickness, film.ior, film.factor, *(film.base_color if metallic else (film.base_ior,))])
+    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0,))])
+    upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0, *((1.0,) * 3 if metallic else (3.0,))])
+    params, _ = _refine(start, lower, upper, metallic, _lab(target), cos)
+    refined = _film_of(params, metallic, "refined", target)
+    return refined if np.sum(refined.delta_e**2) < np.sum(film.delta_e**2) else film

@@ -1,0 +1,235 @@
+"""
+Natural Bragg mirrors: the paper's mirror (Fourneau et al. 2024, Section 3; Appendix D with a host) with
+what its Section 6 says real structures have, absorbing layers (``k1``, ``k2``), dispersive layers (an
+index that names a medium of :mod:`explorer.physics.dispersion`) and thickness disorder (``sigma``), and
+its exact spectra (:func:`mirror_spectrum`, by :mod:`explorer.physics.multilayer`).
+
+The structure is the one of :class:`explorer.physics.bragg.BraggMirror`: a host ``nh`` above, then ``N``
+cells of ``n2`` (``d2 = (1 - delta) Lambda``) over ``n1`` (``d1 = delta Lambda``), on a base of ``n1``.
+Light comes from a lossless host: where the host is ``n1`` (``nh`` unset) and ``n1`` absorbs, the host is
+``Re n1`` (a semi-infinite absorbing incidence medium would leave nothing to reflect); a host naming an
+absorbing medium is refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from explorer.physics import multilayer
+from explorer.physics.dispersion import RANGE_NM, Dispersion, complex_index
+
+IndexValue = float | Dispersion
+
+#: The spectra's default wavelength step (nm): the 1-nm grid of the CMFs.
+DEFAULT_STEP_NM = 1.0
+#: The finest step a grid takes (a CSV medium's rows or a reference's step may ask for finer).
+MIN_STEP_NM = 0.01
+
+
+@dataclass(frozen=True)
+class NaturalMirror:
+    """
+    A Bragg mirror with complex, dispersive indices and thickness disorder.
+
+    Parameters
+    ----------
+    n1, n2 : float or Dispersion
+        The layers' indices (a number, or a medium giving ``n + i k`` over wavelength).
+    Lambda, delta, N
+        As :class:`explorer.physics.bragg.BraggMirror`.
+    nh : float, Dispersion or None
+        The host above; None: ``n1`` (its real part).
+    k1, k2 : float
+        Extinction coefficients added to ``n1``, ``n2`` (>= 0).
+    sigma : float
+        Relative thickness disorder: layer ``i`` is ``d_i (1 + sigma eps_i)`` (:mod:`explorer.physics.multilayer`).
+    """
+
+    n1: IndexValue = 1.0
+    n2: IndexValue = 1.5
+    Lambda: float = 500.0
+    delta: float = 0.5
+    N: int = 20
+    nh: IndexValue | None = None
+    k1: float = 0.0
+    k2: float = 0.0
+    sigma: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.k1 < 0.0 or self.k2 < 0.0:
+            raise ValueError("k1 and k2 must be >= 0")
+        if not 0.0 <= self.sigma <= 1.0 / multilayer.TRUNCATION:
+            raise ValueError(f"sigma must be in [0, {1.0 / multilayer.TRUNCATION:g}] (a thickness stays >= 0)")
+        if isinstance(self.nh, Dispersion) and self.nh.absorbing:
+            raise ValueError(f"the host {self.nh.name} absorbs: light comes from a lossless host")
+
+    @property
+    def d1(self) -> float:
+        return self.delta * self.Lambda
+
+    @property
+    def d2(self) -> float:
+        return (1.0 - self.delta) * self.Lambda
+
+    def index_1(self, wavelength_nm: ArrayLike) -> np.ndarray:
+        return complex_index(self.n1, self.k1, wavelength_nm)
+
+    def index_2(self, wavelength_nm: ArrayLike) -> np.ndarray:
+        return complex_index(self.n2, self.k2, wavelength_nm)
+
+    def index_host(self, wavelength_nm: ArrayLike) -> np.ndarray:
+        """The lossless host's index: ``nh``, or the real part of ``n1``."""
+        if self.nh is None:
+            return self.index_1(wavelength_nm).real.astype(np.complex128)
+        return complex_index(self.nh, 0.0, wavelength_nm)
+
+    def layer_stack(self, wavelength_nm: ArrayLike) -> tuple[np.ndarray, list[np.ndarray], np.ndarray, np.ndarray]:
+        """``(host, layer indices, thicknesses, base)`` as :func:`explorer.physics.multilayer.stack_optics` takes them."""
+        n1, n2 = self.index_1(wavelength_nm), self.index_2(wavelength_nm)
+        return self.index_host(wavelength_nm), [n2, n1] * int(self.N), np.array([self.d2, self.d1] * int(self.N)), n1
+
+    @property
+    def dispersive(self) -> bool:
+        return any(isinstance(v, Dispersion) for v in (self.n1, self.n2, self.nh))
+
+
+def wavelength_grid(mirror: NaturalMirror, step_nm: float | None = None) -> np.ndarray:
+    """
+    360 to 830 nm every ``min(1 nm, step_nm, a tabulated medium's step)``, the ends included: the grid of
+    the ``spectrum`` command.
+    """
+    steps = [DEFAULT_STEP_NM] + ([step_nm] if step_nm else [])
+    steps += [v.step_nm for v in (mirror.n1, mirror.n2, mirror.nh) if isinstance(v, Dispersion) and v.step_nm]
+    step = max(min(steps), MIN_STEP_NM)
+    count = int(round((RANGE_NM[1] - RANGE_NM[0]) / step))
+    return np.linspace(RANGE_NM[0], RANGE_NM[1], count + 1)
+
+
+def mirror_spectrum(mirror: NaturalMirror, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> dict[str, np.ndarray]:
+    """
+    The exact spectra of ``mirror`` at incidence angles ``theta_deg`` (degrees, in the host), one row per
+    angle: ``R`` (unpolarised), ``Rs``, ``Rp``, ``T`` (into the base, unpolarised) and ``A = 1 - R - T``
+    (absorbed in the layers). With ``sigma > 0`` each is the ensemble mean over
+    :data:`explorer.physics.multilayer.REALISATIONS` seeded realisations.
+    """
+    wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
+    thetas = np.atleast_1d(np.asarray(theta_deg, dtype=np.float64))
+    if np.any((thetas < 0.0) | (thetas > 90.0)) or not np.all(np.isfinite(thetas)):
+        raise ValueError("incidence angles are in [0, 90] degrees")
+    host, indices, thicknesses, base = mirror.layer_stack(wavelength_nm)
+    realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma)
+    out = {key: np.zeros((thetas.size, wavelength_nm.size)) for key in ("R", "Rs", "Rp", "T", "A")}
+    for row, theta in enumerate(thetas):
+        if theta == 90.0:  # exact grazing: every interface reflects totally
+            out["Rs"][row] = out["Rp"][row] = out["R"][row] = 1.0
+            continue
+        sin_theta = np.sin(np.radians(theta))
+        T = 0.0
+        for pol in ("s", "p"):
+            R_pol, T_pol = multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)
+            out["R" + pol][row] = R_pol
+            T = T + 0.5 * T_pol
+        out["R"][row] = 0.5 * (out["Rs"][row] + out["Rp"][row])
+        out["T"][row] = T
+    out["A"] = 1.0 - out["R"] - out["T"]
+    return out
+
+
+def band_gaps(mirror: NaturalMirror, wavelength_nm: ArrayLike, theta_deg: float) -> np.ndarray:
+    """
+    Where either polarisation is in a band gap at ``theta_deg``: ``|cos K Lambda| > 1`` (Eq. 8) with the
+    real parts of the indices at each wavelength (absorption blurs the edges; dispersion moves them).
+    """
+    wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
+    host = mirror.index_host(wavelength_nm).real
+    n1, n2 = mirror.index_1(wavelength_nm).real, mirror.index_2(wavelength_nm).real
+    n_sin = host * np.sin(np.radians(theta_deg))
+    kz1, kz2 = multilayer.forward_kz(n1, n_sin), multilayer.forward_kz(n2, n_sin)
+    omega = 2.0 * np.pi / wavelength_nm
+    psi, phi = omega * kz1 * mirror.d1, omega * kz2 * mirror.d2
+    gap = np.zeros(wavelength_nm.shape, dtype=bool)
+    for x in (kz2 / kz1, (n1 * n1 * kz2) / (n2 * n2 * kz1)):  # s, then p (Eqs. 6-7 with kz = n cos theta)
+        x = np.where(np.abs(x) < 1e-10, 1e-10, x)
+        a = np.real(np.cos(psi) * np.cos(phi) - 0.5 * (x + 1.0 / x) * np.sin(psi) * np.sin(phi))
+        gap |= np.abs(a) > 1.0
+    return gap
+
+
+# --------------------------------------------------------------------------------------------------
+# Colours: the exact spectra against the CMFs (the reference and the tabulated method of a natural mirror)
+
+#: Realisations per colour of a disordered mirror (a colour averages its spectrum's noise over wavelength:
+#: fewer than :data:`explorer.physics.multilayer.REALISATIONS`, measured by ``explorer.dev.natural_studies``).
+COLOUR_REALISATIONS = 128
+#: Entries of a natural mirror's table over cos theta (linear interpolation, as the tabulated method's); a
+#: disordered mirror's colour varies slowly with angle (no fringes) and costs realisations: fewer entries.
+NATURAL_TABLE_SIZE = 129
+DISORDERED_TABLE_SIZE = 33
+#: The finest sampling (samples per nm) of an ordered natural mirror's colour.
+NATURAL_MAX_SUBSTEPS = 64
+
+
+def _unpolarised(mirror: NaturalMirror, wavelength_nm: np.ndarray, cos_theta: ArrayLike, realised: np.ndarray) -> np.ndarray:
+    """Mean unpolarised R at ``wavelength_nm`` (broadcast against ``cos_theta``), over the rows of ``realised``."""
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    shape = np.broadcast_shapes(wavelength_nm.shape, cos_theta.shape)
+    wavelength_nm = np.broadcast_to(wavelength_nm, shape)
+    host, indices, _, base = mirror.layer_stack(wavelength_nm)
+    sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
+    R = 0.0
+    for pol in ("s", "p"):
+        R = R + 0.5 * multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)[0]
+    return np.where(cos_theta <= 0.0, 1.0, R)  # exact grazing: total reflection
+
+
+def natural_rgb(cos_theta: ArrayLike, mirror: NaturalMirror) -> np.ndarray:
+    """
+    The mirror's linear sRGB at incidence ``cos theta`` (in the host): its exact unpolarised ``R_lambda``
+    integrated against the CMFs. Ordered (``sigma = 0``): hat averages refined until the colour converges
+    (:func:`explorer.physics.colorimetry.converged_spectra`, from a sampling that resolves the fringes).
+    Disordered: the 1-nm sum over :data:`COLOUR_REALISATIONS` seeded realisations (disorder smooths the fringes).
+    """
+    from explorer.physics import colorimetry
+
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    flat = np.unique(np.round(cos_theta.ravel(), 12), return_inverse=True)
+    angles, inverse = flat
+    thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
+    if mirror.sigma > 0.0:
+        realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, COLOUR_REALISATIONS)
+        spectra = _unpolarised(mirror, colorimetry.WAVELENGTHS[np.newaxis, :], angles[:, np.newaxis], realised)
+    else:
+        realised = thicknesses[np.newaxis, :]
+
+        def spectrum(wavelengths, rows):
+            wavelengths = wavelengths if wavelengths.ndim == 2 else wavelengths[np.newaxis, :]
+            return _unpolarised(mirror, wavelengths, angles[rows][:, np.newaxis], realised)
+
+        n_max = max(float(np.max(mirror.index_1(360.0).real)), float(np.max(mirror.index_2(360.0).real)))
+        substeps = colorimetry.substeps_for_fringes(2.0 * int(mirror.N) * n_max * mirror.Lambda)
+        spectra, _ = colorimetry.converged_spectra(spectrum, angles.size, substeps_min=min(substeps, NATURAL_MAX_SUBSTEPS),
+                                                   substeps_max=NATURAL_MAX_SUBSTEPS)
+    rgb = colorimetry.spectrum_to_rgb(spectra)
+    return rgb[inverse.ravel()].reshape(cos_theta.shape + (3,))
+
+
+_TABLES: dict = {}
+
+
+def natural_rgb_table(mirror: NaturalMirror, size: int | None = None) -> np.ndarray:
+    """
+    :func:`natural_rgb` at ``cos theta = k / (size - 1)``, float32 (a 1D texture; cached, 16 mirrors); ``size``
+    :data:`NATURAL_TABLE_SIZE`, or :data:`DISORDERED_TABLE_SIZE` with ``sigma > 0``.
+    """
+    size = size or (DISORDERED_TABLE_SIZE if mirror.sigma > 0.0 else NATURAL_TABLE_SIZE)
+    key = (mirror, size)
+    if key not in _TABLES:
+        if len(_TABLES) >= 16:
+            _TABLES.pop(next(iter(_TABLES)))
+        table = natural_rgb(np.linspace(0.0, 1.0, size), mirror).astype(np.float32)
+        table.setflags(write=False)
+        _TABLES[key] = table
+    return _TABLES[key]
