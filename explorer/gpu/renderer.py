@@ -189,18 +189,8 @@ class Renderer:
 
         key = (id(material), material.shader, tuple(sorted((k, str(v)) for k, v in values.items())))
         if self._fill_table is None or self._fill_table[0] != key:
-            # One theta_h node per draw, summed here: in one draw of every node, llvmpipe stopped adding after
-            # ~256 BRDF calls per fragment whose own loops (the Bragg approximations, a stack's wavelengths)
-            # ran long: its loop limiter counts iterations across loops (the albedo came out ~1e-2 of its value).
-            # Each draw adds the Dirac term (no node: alone), so it is counted once.
-            uniforms = fill_uniforms()
-            nodes, theta_h, d_theta = uniforms["albedo_nodes"], uniforms["albedo_theta_h"], uniforms["albedo_d_theta"]
-            padding = (0.0,) * (len(theta_h) - 1)
-            dirac = self.render(material, values, "albedo", FILL_ANGLES, 1, uniforms={**uniforms, "albedo_nodes": 0})[0]
-            row = dirac.astype(np.float64)
-            for k in range(nodes):
-                node = {**uniforms, "albedo_nodes": 1, "albedo_theta_h": (theta_h[k], *padding), "albedo_d_theta": (d_theta[k], *padding)}
-                row += self.render(material, values, "albedo", FILL_ANGLES, 1, uniforms=node)[0] - dirac
+            # The albedo view sums its terms on the host (one node a fragment: see _render_summed).
+            row = self.render(material, values, "albedo", FILL_ANGLES, 1, uniforms=fill_uniforms())[0]
             self._fill_table = (key, tuple(tuple(float(c) for c in texel) for texel in row))
         return self._fill_table[1]
 
