@@ -155,10 +155,22 @@ def check_view(raw, where: str, line: int | None = None) -> dict:
 
 
 def _display(path: os.PathLike[str] | str) -> str:
+    """A parameter file's path as the user typed it (an absolute one stays absolute)."""
+    return os.fspath(path)
+
+
+def named_material(path: os.PathLike[str] | str) -> str | None:
+    """The material a parameter set names (JSON ``"material"``, a ``.bparam``'s first line), or None."""
+    where = _display(path)
+    text = _read_text(path, where)
+    if str(path).lower().endswith(".bparam"):
+        return parse_bparam(text, where)[0]
     try:
-        return os.path.relpath(path)
-    except ValueError:
-        return str(path)
+        document = json.loads(text)
+    except (json.JSONDecodeError, RecursionError):
+        raise ParameterFileError(where, None, "not valid JSON") from None
+    material = document.get("material") if isinstance(document, dict) else None
+    return material if isinstance(material, str) and material else None
 
 
 def _json_value(value):

@@ -24,7 +24,7 @@ from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
 from explorer.cli.design import DEFAULT_TRIES, MAX_TRIES
-from explorer.cli.materials import PROG, resolve_values
+from explorer.cli.materials import PROG, SuggestingChoice, command_prefix, resolve_values
 from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
 MAX_SIZE = 1 << 16
@@ -340,13 +340,15 @@ def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() befor
 
 
 @cli.command("open")
-@click.argument("materials", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("materials", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets).")
-@click.option("--script", type=click.Path(dir_okay=False), hidden=True, help="A scripted session (JSON list of actions; tests, bench --app).")
-@click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
-@click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
+@click.option("--script", type=click.Path(dir_okay=False), metavar="FILE.json",
+              help="Play a scripted session (a JSON list of actions, docs/app.md), then close: screenshots, tests, bench --app.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="FILE.json", help="Write the session's JSON report (frame times, values).")
+@click.option("--window-size", metavar="WxH", help="Window size in pixels (default 1280x800).")
 def open_material(materials, preset, script, report, window_size):
-    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names).
+    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names; none:
+    the default Bragg mirror).
 
     Several materials are listed in the Materials window, each with its colour; the plots overlay the
     visible ones and the sphere shows the chosen one (the first; --preset applies to it).
@@ -354,6 +356,7 @@ def open_material(materials, preset, script, report, window_size):
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
+    materials = materials or (str(DEFAULT_MATERIAL),)
     try:
         loaded = _load(materials[0])
         more = [_load(other).path for other in materials[1:]]
@@ -376,7 +379,7 @@ def open_material(materials, preset, script, report, window_size):
                 raise click.BadParameter(f"{window_size!r} is not WxH (at least 200x200)", param_hint="--window-size") from None
         if not display_available():
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
-                           "for images without a window use: bragg-explorer render")
+                           f"for images without a window use: {command_prefix()} render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
                          is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
     except ImportError as error:
@@ -403,8 +406,8 @@ def _errors(function):
 
 
 @cli.command()
-@click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(list(VIEWS)), default="sphere", show_default=True)
+@click.argument("material", type=click.Path(dir_okay=False), required=False)
+@click.option("--view", type=SuggestingChoice(list(VIEWS)), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
@@ -440,7 +443,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
            ndotl, mapping):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
-    to a PNG, .npy or .exr.
+    to a PNG, .npy or .exr. Without MATERIAL, the one --params names.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
@@ -454,6 +457,14 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     """
     from explorer.views.geometry import scatter_circles, view_named
 
+    if material is None:
+        if params_file is None:
+            raise click.UsageError("Missing argument 'MATERIAL' (or a --params file that names one).")
+        from explorer.app.parameter_files import named_material
+
+        material = named_material(params_file)
+        if material is None:
+            raise click.UsageError(f"--params {params_file} names no material: give MATERIAL")
     check_output(Path(out))
     saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
     view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
@@ -595,7 +606,10 @@ def info(material, as_json, dispersions):
         bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
         opens = (f" (every command and the app open it on {labels.get(opening, opening)})"
                  if p.name == "method" and opening is not None and opening != shown["default"] else "")
-        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
+        unit = f" {p.unit}" if p.unit and p.unit != "1" else ""
+        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{unit}{opens}")
+        if p.doc:
+            click.echo(f"  {'':5} {'':{width}} {p.doc}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
     from explorer.materials.twins import capabilities_of

@@ -206,7 +206,9 @@ def render_command(material_name: str, values: dict, material=None) -> str:
     methods = capabilities_of(material).methods if material is not None else None
     best = methods.preferred_member() if methods is not None else None
     method = f" --set method={int(best)}" if best is not None else ""
-    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
+    from explorer.cli.materials import command_prefix
+
+    return f"{command_prefix()} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")

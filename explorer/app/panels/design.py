@@ -121,7 +121,7 @@ class DesignPanel(Panel):
 
     def _start(self) -> None:
         material = self.state.material
-        if self.running or material.model not in inverse_design.DESIGN_MODELS:
+        if self.running or not capabilities_of(material).design:
             return
         ranges = {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
         fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and capabilities_of(material).bragg_spectrum else {}
@@ -196,7 +196,7 @@ class DesignPanel(Panel):
 
     def draw(self, imgui) -> None:
         state = self.state
-        designable = state.material.model in inverse_design.DESIGN_MODELS
+        designable = capabilities_of(state.material).design
         if not designable:
             imgui.text_wrapped(f"Design works on {', '.join(supporting('design'))}.")
             if imgui.button(f"Open {DEFAULT_MATERIAL.stem}"):

@@ -11,6 +11,14 @@ from explorer.app.badge import BadgeWorker
 from explorer.app.panels.base import Panel, combo, record
 
 
+def parameter_tooltip(parameter) -> str:
+    """A slider's tooltip: the parameter's meaning and unit (its ``.brd`` line's comment), its range and default."""
+    bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
+    unit = f" {parameter.unit}" if parameter.unit and parameter.unit != "1" else ""
+    meaning = f"{parameter.doc}\n" if parameter.doc else ""
+    return f"{meaning}{parameter.name}: {parameter.type}{bounds}{unit}, default {parameter.default}; Ctrl-click resets"
+
+
 class ParametersPanel(Panel):
     title = "Parameters"
     dock = "left"
@@ -163,8 +171,7 @@ class ParametersPanel(Panel):
         if imgui.is_item_clicked() and io.key_ctrl:
             new = parameter.default
         if imgui.is_item_hovered():
-            bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
-            imgui.set_tooltip(f"{name}: {parameter.type}{bounds}, default {parameter.default}; Ctrl-click resets")
+            imgui.set_tooltip(parameter_tooltip(parameter))
         if kind in ("int", "float") and not labels:
             imgui.same_line()
             imgui.set_next_item_width(-1)
