@@ -84,7 +84,7 @@ def test_no_import_cycles():
 
 #: The packages from the bottom up: a package imports only packages of a lower rank (or its own).
 #: ``errors`` is the foundation, ``resources`` (paths) and ``files`` (atomic outputs) stand on it; the
-#: store ``tables`` knows no physics; ``views`` (what each pixel of a view shows, without GL) comes below
+#: store ``tables`` knows no physics; ``plugins`` (the public API of material plugins) re-exports ``materials``; ``views`` (what each pixel of a view shows, without GL) comes below
 #: ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared with the GL views) above it; ``cli`` opens the ``app``; ``dev`` (the checkout's set-up and
 #: regeneration scripts, not in the wheel) and ``__main__`` stand outside.
 LAYERS = {
@@ -93,7 +93,7 @@ LAYERS = {
     "tables": 2,
     "physics": 3,
     "materials": 4,
-    "views": 5,
+    "plugins": 5, "views": 5,
     "gpu": 6,
     "mitsuba": 7, "blender": 7,
     "app": 8,

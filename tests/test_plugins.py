@@ -78,7 +78,7 @@ PLUGIN_FILES = {"explorer/materials/models.py", "explorer/materials/thinfilm_mod
                 "explorer/materials/lobes_model.py", "explorer/materials/lobes_presets.py"}
 DEFAULT_FILE = "explorer/resources.py"
 #: Modules whose literals are still to go (studies and benchmarks that pick their materials).
-NOT_YET = {"explorer/cli/bench.py", "explorer/cli/markdown_tables.py", "explorer/physics/design.py"}
+NOT_YET = {"explorer/physics/design.py"}
 NAME_RE = re.compile(r"(?<![A-Za-z0-9_])(" + "|".join(map(re.escape, BUILTIN_NAMES)) + r")(?![A-Za-z0-9_])")
 
 
@@ -171,6 +171,20 @@ def test_the_broken_plugin_error_reaches_the_cli_as_one_line(tmp_path):
     source.write_text(source.read_text().replace("return {}", "return {}\n  oops"))
     line = one_line_error(_cli("info", path.name, cwd=path.parent))
     assert f"{source.name}:" in line and "IndentationError" in line
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", ["ggx_schlick", "bragg_layer"])
+def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, name):
+    """``check``'s comparisons are the harness's: a built-in twin is within the named tolerance in each view."""
+    from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
+
+    material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
+    assert check_views(material) == tuple(CHECK_SIZES)
+    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}))
+    assert [r.view for r in results] == list(CHECK_SIZES)
+    for result in results:
+        assert result.passed and 0.0 < result.max_difference, result.message()
 
 
 @pytest.mark.gl

@@ -128,7 +128,9 @@ def _export(material, target, preset, params_file, assignments, env_file, mesh, 
         path = Path(out)
         if path.suffix.lower() != ".exr":
             raise TableExportError(path, None, "the table is an OpenEXR file: name it .exr")
-        table = material_table(loaded, values)
+        from explorer.cli.albedo import progress_printer
+
+        table = material_table(loaded, values, progress_printer("table", "rows"))
         write_image(table, path)  # atomically
         click.echo(f"wrote {path} ({table.shape[1]}x{table.shape[0]} RGB, docs/export.md)")
     else:

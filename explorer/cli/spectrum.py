@@ -93,10 +93,9 @@ def split_natural(loaded, assignments, preset_values: dict | None = None) -> tup
 def natural_mirror(values: dict, natural: dict) -> NaturalMirror:
     """The mirror of a material's values (a ``bragg_mirror`` or ``bragg_layer``'s), with the natural ones over them."""
     from explorer.materials.media import index_value
+    from explorer.materials.models import host_index
 
-    nh = natural.get("nh", index_value(values, "nh") if "nh" in values else 0.0)
-    if not isinstance(nh, dispersion.Dispersion) and nh < 1.0:
-        nh = None  # below 1 the host is n1 (bragg_mirror.brd)
+    nh = host_index(natural.get("nh", index_value(values, "nh") if "nh" in values else 0.0))
     try:
         return NaturalMirror(
             n1=natural.get("n1", index_value(values, "n1")), n2=natural.get("n2", index_value(values, "n2")),

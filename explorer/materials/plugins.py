@@ -19,14 +19,14 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
+from explorer.errors import LocatedError
 from explorer.materials import twins
-from explorer.materials.brd import MaterialError
 
 #: The suffix of a material's twin module beside it.
 PLUGIN_SUFFIX = ".py"
 
 
-class PluginError(MaterialError):
+class PluginError(LocatedError):
     """A plugin's Python file fails to load (one line: the file, the line, what went wrong)."""
 
 

@@ -493,11 +493,14 @@ def check_target_rgb(rgb: ArrayLike, what: str = "colour") -> np.ndarray:
     return rgb
 
 
-def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5) -> list["Target"]:
+def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5,
+                       clipped: np.ndarray | None = None) -> list["Target"]:
     """
     ``count`` targets from a strip of linear RGB ``(H, W, 3)`` whose column ``i`` shows
     ``theta_a + (theta_b - theta_a)(i + 0.5) / W`` degrees (as the gradient view draws 0 to 90): evenly
-    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped.
+    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped. ``clipped``
+    ``(H, W, 3)``: -1 where an integer image holds its lowest code, +1 its highest, 0 elsewhere; a channel
+    clipped in every row of its column becomes a bound (:class:`Target`), not a value.
     """
     if not (np.isfinite(theta_a) and np.isfinite(theta_b) and 0.0 <= min(theta_a, theta_b)
             and max(theta_a, theta_b) <= 90.0 and theta_a != theta_b):
@@ -510,7 +513,11 @@ def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count:
         if theta >= 90.0:
             continue
         rgb = check_target_rgb(np.asarray(image)[:, i, :3].mean(axis=0), f"strip column {i}")
-        targets.append(Target(float(theta), tuple(float(c) for c in rgb)))
+        bounds = (0, 0, 0)
+        if clipped is not None:
+            column = np.asarray(clipped)[:, i, :3]
+            bounds = tuple(int(column[0, c]) if np.all(column[:, c] == column[0, c]) else 0 for c in range(3))
+        targets.append(Target(float(theta), tuple(float(c) for c in rgb), bounds))
     if not targets:
         raise DesignError("the strip has no column below 90 degrees")
     return targets
@@ -522,10 +529,19 @@ def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count:
 
 @dataclass(frozen=True)
 class Target:
-    """A wanted colour (linear RGB of this convention) at an angle (degrees, in the outer medium)."""
+    """
+    A wanted colour (linear RGB of this convention) at an angle (degrees, in the outer medium). ``bounds``
+    per channel: 0 the value itself; -1 at most it, +1 at least it (a channel an 8-bit image clipped at 0 or
+    255: the true colour lies beyond). A bounded channel costs nothing on its side of the bound.
+    """
 
     theta_deg: float
     rgb: tuple[float, float, float]
+    bounds: tuple[int, int, int] = (0, 0, 0)
+
+    @property
+    def bounded(self) -> bool:
+        return any(self.bounds)
 
 
 @dataclass
@@ -565,6 +581,8 @@ class DesignResult:
             "set": dict(self.values),
             "targets": [
                 {"theta_deg": t.theta_deg, "target_rgb": [float(c) for c in t.rgb],
+                 **({"target_bounds": ["at most" if b < 0 else "at least" if b > 0 else "equal" for b in t.bounds]}
+                    if t.bounded else {}),
                  "achieved_rgb": [float(c) for c in a], "delta_e2000": float(d)}
                 for t, a, d in zip(self.targets, self.achieved_rgb, self.delta_e2000)
             ],
@@ -617,7 +635,9 @@ class _Problem:
             host is None or host in names or self.fixed.get(host, 0.0) < model.host_threshold)
         self.targets = list(targets)
         self.cos_theta = np.cos(np.radians([t.theta_deg for t in self.targets]))
-        self.target_lab = rgb_to_lab(np.array([t.rgb for t in self.targets]))
+        self.target_rgb = np.array([t.rgb for t in self.targets], dtype=np.float64)
+        self.target_lab = rgb_to_lab(self.target_rgb)
+        self.bounds = np.array([t.bounds for t in self.targets], dtype=np.int8)
         self.cancelled = cancelled
         self.evaluations = 0
         self._lock = threading.Lock()  # the scans run in threads (:func:`_threaded_scan`)
@@ -781,7 +801,7 @@ class _Problem:
             rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
             s_rows = s_first[:, None] * ratio ** np.arange(G)[None, :]
             # CIEDE2000 at the scales whose CIELAB distance (cheap) is among the SCAN_KEPT smallest.
-            proxy = np.sum((rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab) ** 2, axis=(-1, -2))
+            proxy = np.sum((rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab_for(rgb)) ** 2, axis=(-1, -2))
             # Lambda at k = 1 (or the scale) against the box's top, which k_high stretches.
             top = s_rows * per_period[:, None]
             inside = (top <= k_high[:, None] * high * (1.0 + 1e-9)) & (top >= k_low[:, None] * low * (1.0 - 1e-9))
@@ -802,15 +822,29 @@ class _Problem:
     def residuals_of(self, rgb: np.ndarray) -> np.ndarray:
         """``(..., A, 3)`` colours -> ``(..., 3 A)`` residuals whose squared norm per target is CIEDE2000^2."""
         lab = rgb_to_lab(np.maximum(rgb, -1.0))
-        difference = lab - self.target_lab
+        target_lab = np.broadcast_to(self.target_lab_for(rgb), lab.shape)
+        difference = lab - target_lab
         e76 = np.linalg.norm(difference, axis=-1)
-        e00 = delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+        e00 = delta_E_2000_lab(lab, target_lab)
         scale = np.where(e76 > 1e-9, e00 / np.maximum(e76, 1e-300), 1.0)
         return (difference * scale[..., None]).reshape(rgb.shape[:-2] + (-1,))
 
+    def target_lab_for(self, rgb: np.ndarray) -> np.ndarray:
+        """
+        The targets in CIELAB as seen from colours ``rgb`` ``(..., A, 3)``: a bounded channel (``Target.bounds``)
+        takes the colour's own value where it lies beyond the bound, so that only the exact channels and the
+        wrong side of a bound cost (one-sided).
+        """
+        if not self.bounds.any():
+            return self.target_lab
+        rgb = np.asarray(rgb, dtype=np.float64)
+        target = np.where(self.bounds < 0, np.minimum(rgb, self.target_rgb),
+                          np.where(self.bounds > 0, np.maximum(rgb, self.target_rgb), self.target_rgb))
+        return rgb_to_lab(np.maximum(target, -1.0))
+
     def delta_e(self, rgb) -> np.ndarray:
         lab = rgb_to_lab(rgb)
-        return delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+        return delta_E_2000_lab(lab, np.broadcast_to(self.target_lab_for(rgb), lab.shape))
 
     def fine_values(self, u: np.ndarray) -> dict[str, float]:
         """The structure of one unit row, integer parameters whole (fixed ones are: :func:`design` checks)."""

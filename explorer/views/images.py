@@ -26,7 +26,8 @@ def check_output(out: Path) -> Path:
     return _check_output(out, OUTPUT_SUFFIXES)
 
 
-def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
+def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0,
+                tonemap: str = "none") -> None:
     """
     Write a linear RGB image atomically (:func:`explorer.files.atomic_output`): never a partial file.
 
@@ -36,15 +37,17 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
         Linear RGB.
     out : Path
         ``.npy``: float32 linear RGB; ``.exr``: OpenEXR, float32 linear RGB (through OpenCV); ``.png``:
-        8-bit sRGB of ``exposure * image``, clamped.
+        8-bit sRGB of ``tonemap(exposure * image)``.
     overlay : ndarray of bool, HxW, optional
         Pixels painted red in the PNG only (the scatter view's circles).
     exposure : float
         The PNG's multiplier before the sRGB encode, as the app's exposure (linear outputs keep the values).
+    tonemap : str
+        The PNG's display curve after the exposure (:mod:`explorer.views.tonemap`); ``none`` clamps.
     """
-    from PIL import Image
+    from explorer.views.tonemap import display_srgb8
 
-    from explorer.physics.colorimetry import encode_srgb8
+    from PIL import Image
 
     suffix = Path(out).suffix.lower()
     with atomic_output(out, OUTPUT_SUFFIXES) as temporary:
@@ -55,7 +58,7 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
             if suffix == ".npy":
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
             else:
-                pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
+                pixels = display_srgb8(image, exposure, tonemap)
                 if overlay is not None:
                     pixels[overlay] = OVERLAY_RGB
                 Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")
@@ -103,6 +106,29 @@ def read_linear_image(path) -> np.ndarray:
     if not np.all(np.isfinite(image[..., :3])):
         raise ValueError(f"{path}: non-finite values")
     return image[..., :3]
+
+
+def clipped_codes(path) -> np.ndarray | None:
+    """
+    Where an integer image (PNG, 8 or 16 bits) holds its lowest code (-1) or its highest (+1), per channel
+    ``(H, W, 3)`` int8: there the encoding clipped a colour that may lie beyond (a vivid channel below 0 or
+    above 1). None for the linear formats (``.npy``, ``.exr``, ``.hdr``), which hold colours exactly.
+    """
+    file = Path(path)
+    if file.suffix.lower() == ".npy" or file.suffix.lower() in LINEAR_INPUT_SUFFIXES:
+        return None
+    try:
+        pixels = _opencv_read(file)
+    except OSError:
+        from PIL import Image
+
+        with Image.open(file) as picture:
+            pixels = np.asarray(picture.convert("RGB"))
+    if not np.issubdtype(pixels.dtype, np.integer):
+        return None
+    pixels = pixels[..., :3]
+    top = np.iinfo(pixels.dtype).max
+    return (np.where(pixels >= top, 1, 0) - np.where(pixels <= 0, 1, 0)).astype(np.int8)
 
 
 def _opencv_read(file: Path) -> np.ndarray:
