@@ -364,7 +364,7 @@ class BraggStackModel:
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.stack = self.stack_of(values)
-        self.multiple_scattering = bool(values.get("multiple_scattering", True))
+        self.multiple_scattering = bool(values.get("multiple_scattering", False))
         self._tables: tuple | None = None
         self._compensation: tuple | None = None
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
