@@ -113,7 +113,7 @@ def parse_exposure(text: str | None, out: Path) -> float | None:
 def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     """
     What ``--params FILE`` saved of the app's view (:func:`explorer.app.parameter_files.check_view`), as
-    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment``, ``env_rotation`` and ``light``
+    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``tonemap``, ``fill``, ``environment``, ``env_rotation`` and ``light``
     (``(theta, phi)``: the app's light turned by its orbit camera into view space). Only for the options
     the command line leaves unset; ``{}`` without a file or a saved view.
     """
@@ -122,13 +122,17 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     from explorer.app.parameter_files import load_view
 
     view = load_view(params_file) or {}
-    given = {name for name in ("view", "light", "exposure", "env_file", "env_rotation")
+    given = {name for name in ("view", "light", "exposure", "env_file", "env_rotation", "tonemap", "fill")
              if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE}
     result: dict = {}
     if "view" in view and "view" not in given:
         result["view"] = view["view"]
     if "exposure" in view and "exposure" not in given:
         result["exposure"] = repr(view["exposure"])
+    if "tonemap" in view and "tonemap" not in given:
+        result["tonemap"] = view["tonemap"]
+    if "fill" in view and "fill" not in given and result.get("view", "lit") == "lit":
+        result["fill"] = view["fill"]
     if "environment" in view and "env_file" not in given and result.get("view") in ("env", "lit"):  # lit: a smooth mirror's
         result["environment"] = view["environment"]
     if "env_rotation" in view and "env_rotation" not in given and result.get("view") in ("env", "lit"):
@@ -145,14 +149,15 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
-    mesh=None, background: bool = False, plot=None,
+    mesh=None, background: bool = False, plot=None, fill: float = 0.0,
 ) -> np.ndarray:
     """
     One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
     :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
     :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view; ``mesh``
     (an :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views.
-    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) for the plot views.
+    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) for the plot views. ``fill``: the ``lit`` view's
+    environment fill (:mod:`explorer.views.fill`), 0 without.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -189,7 +194,8 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment,
+                            fill=fill)
     from explorer.gpu import Renderer
 
     renderer = Renderer()
@@ -201,12 +207,13 @@ def render_material(
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 
-        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment)
+        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment,
+                           uniforms={"fill": float(fill)})
     if view_named(view).plot is not None:
         from explorer.views.plots import gl_uniforms
 
         return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
-    return renderer.render(material, values, view, width, height, light=light, environment=environment)
+    return renderer.render(material, values, view, width, height, light=light, environment=environment, uniforms={"fill": float(fill)})
 
 
 def parse_plot(view: str, **options):
@@ -410,6 +417,10 @@ def _errors(function):
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
 @click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter), or auto: the bright end of the object to white.")
+@click.option("--tonemap", type=click.Choice(["none", "agx", "aces"]),
+              help="PNG only: the display curve after the exposure: agx (Sobotka's AgX, Blender's default; the default of the lit, env and textured views: vivid colours and highlights roll off to white), aces (Narkowicz's ACES fit), none (clamp; the default of the colour views and plots). .npy and .exr stay linear.")
+@click.option("--fill", type=click.FloatRange(min=0.0), metavar="X",
+              help="lit view: the radiance of a uniform white environment beside the point light (default 0.15; 0: the light alone). A smooth mirror reflects --env instead.")
 @click.option("--texture", metavar="FILE", help="textured and env views: grey image of a film's D_inc or a mirror's T (default shaders/textures/thickness_noise.png; env: none).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
@@ -428,7 +439,7 @@ def _errors(function):
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @_errors
-def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
+def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
            ndotl, mapping):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
@@ -457,7 +468,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     check_output(Path(out))
     saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
     view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
-    env_rotation = saved.get("env_rotation", env_rotation)
+    env_rotation, tonemap, fill = saved.get("env_rotation", env_rotation), saved.get("tonemap", tonemap), saved.get("fill", fill)
     exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
     light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
@@ -470,6 +481,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
     if plot is not None and exposure is not None:
         raise click.BadParameter("a plot's values are not exposed (use --log)", param_hint="--exposure")
+    if plot is not None and tonemap is not None:
+        raise click.BadParameter("a plot's values are not tone mapped (use --log)", param_hint="--tonemap")
+    from explorer.views.tonemap import default_tonemap
+
+    tonemap = tonemap or default_tonemap(view)
+    if fill is not None and view != "lit":
+        raise click.BadParameter("the environment fill is the lit view's", param_hint="--fill")
     thickness = None
     surface_given = texture is not None or dinc_range is not None or mapping is not None
     if view == "textured" or (view == "env" and surface_given):
@@ -524,8 +542,11 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 
         image = render_position_free(loaded, values, view, width, height, light_angles, spp)
     else:
+        from explorer.views.fill import DEFAULT_FILL, has_fill
+
+        fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant, mesh=mesh_shape, background=background, plot=plot)
+                                variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
         return
@@ -533,9 +554,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if exposure_factor is None:  # --exposure auto
         from explorer.views.exposure import auto_exposure
 
-        exposure_factor = auto_exposure(image)
+        exposure_factor = auto_exposure(image, tonemap)
         click.echo(f"{PROG}: exposure auto: {exposure_factor:.3g}", err=True)
-    write_image(image, Path(out), circles, exposure_factor)
+    write_image(image, Path(out), circles, exposure_factor, tonemap)
     bad = int((~np.isfinite(image)).sum())
     method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
