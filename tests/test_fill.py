@@ -67,3 +67,15 @@ def test_render_fills_by_default_and_not_with_fill_zero(tmp_path):
     np.testing.assert_allclose(np.load(tmp_path / "alone.npy"), render_numpy(model, "lit", 24, 24), atol=1e-6)
     bad = run_cli("render", "ggx_schlick", "--view", "sphere", "--fill", "0.1", "--engine", "numpy", "--out", str(tmp_path / "x.npy"))
     assert bad.returncode != 0 and "lit view" in bad.stderr and "Traceback" not in bad.stderr
+
+
+@pytest.mark.gl
+def test_fill_table_drafts_while_dragging(gl_renderer):
+    """A dragged slider's previews reuse the material's last table (no albedo pass per frame); released, its own."""
+    material = load_material(REPO_ROOT / "shaders" / "ggx_schlick.brd")
+    before, after = material.resolve({"F0": 0.2}), material.resolve({"F0": 0.9})
+    first = gl_renderer.fill_table(material, before)
+    assert gl_renderer.fill_table(material, after, draft=True) == first
+    own = gl_renderer.fill_table(material, after)
+    assert np.asarray(own).mean() > np.asarray(first).mean() + 0.1  # a brighter Fresnel, a larger albedo
+    assert gl_renderer.fill_table(material, after, draft=True) == own

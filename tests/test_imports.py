@@ -95,7 +95,7 @@ LAYERS = {
     "materials": 4,
     "plugins": 5, "views": 5,
     "gpu": 6,
-    "mitsuba": 7,
+    "mitsuba": 7, "blender": 7,
     "app": 8,
     "cli": 9,
     "dev": 10, "__main__": 11,
