@@ -131,9 +131,9 @@ def _render_env(material: Material, values: dict, width: int, height: int, engin
 def _render_env_mitsuba(material: Material, values: dict, width: int, height: int, environment, spp: int,
                         variant: str | None, warn) -> np.ndarray:
     """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), its LLVM fallback told to ``warn``."""
-    from explorer.mitsuba import BSDF_NAMES
+    from explorer.materials.twins import capabilities_of, supporting
     from explorer.mitsuba.scene import render_env_mitsuba
 
-    if material.model not in BSDF_NAMES:
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(BSDF_NAMES)})")
+    if not capabilities_of(material).supports("mitsuba"):
+        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
     return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)

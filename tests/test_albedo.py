@@ -14,7 +14,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import BRDF_DATA, one_line_error, run_cli
+from conftest import BRDF_DATA, one_line_error, run_cli, run_cli_process
 from test_position_free import fresnel_unpolarised, internal_diffuse_reflectance
 
 from explorer.materials.brd import load_material
@@ -119,3 +119,64 @@ def test_render_position_free_lit(tmp_path):
     assert run.returncode == 0, run.stderr
     image = np.load(out)
     assert image.shape == (12, 12, 3) and np.isfinite(image).all() and image.max() > 0.0
+
+
+# -- the albedo view against the albedo command ---------------------------------------------------------
+
+#: The view and the command agree on each incidence angle's luminance within this (relative).
+VIEW_COMMAND_RTOL = 0.01
+
+
+def _luminance(rgb) -> np.ndarray:
+    from explorer.physics.colorimetry import rgb_to_xyz
+
+    return rgb_to_xyz(np.asarray(rgb, dtype=np.float64))[..., 1]
+
+
+def _view_command_cases():
+    """Every built-in material at its default, and at method 0 where it has methods."""
+    from explorer.resources import builtin_materials
+
+    cases = []
+    for name, path in sorted(builtin_materials().items()):
+        cases.append((name, ()))
+        if any(p.name == "method" for p in load_material(path).parameters):
+            cases.append((name, ("--set", "method=0")))
+    return cases
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name, args", _view_command_cases())
+def test_albedo_view_equals_the_albedo_command(gl_renderer, name, args):
+    """The albedo view (GL and its numpy twin) at one column (theta_i = 45 deg) equals ``albedo --theta 45``
+    within 1 % luminance. A fragment that summed a whole hemisphere of a spectral BRDF outran llvmpipe's loop
+    limit and showed ~1e-7."""
+    from explorer.cli.materials import resolve_values
+    from explorer.views.render import render_numpy
+
+    run = run_cli("albedo", name, "--theta", "45", "--json", *args)
+    assert run.returncode == 0, run.stderr
+    command = np.asarray(json.loads(run.stdout)["rgb"][0])
+    material = load_material(material_path(name))
+    values = resolve_values(material, None, None, args[1:])  # as the command resolves them
+    gl = gl_renderer.render(material, values, "albedo", 1, 1)[0, 0]
+    twin = render_numpy(model_for(material, values), "albedo", 1, 1)[0, 0]
+    assert _luminance(command) > 1e-3, command
+    for engine, rgb in (("gl", gl), ("numpy", twin)):
+        assert abs(_luminance(rgb) - _luminance(command)) <= VIEW_COMMAND_RTOL * _luminance(command), (engine, rgb, command)
+        np.testing.assert_allclose(rgb, command, atol=2e-3, err_msg=engine)
+
+
+@pytest.mark.gl
+def test_render_albedo_view_of_a_spectral_layer_is_the_albedo(tmp_path):
+    """``render bragg_layer --view albedo`` (GL) at a method with loops (the basic approximation's boxes, as the
+    reference's wavelengths) equals the ``albedo`` command."""
+    out = tmp_path / "albedo.npy"
+    run = run_cli_process("render", "bragg_layer", "--view", "albedo", "--set", "method=1", "--size", "2", "--out", out)
+    assert run.returncode == 0, run.stderr
+    curve = np.load(out)
+    np.testing.assert_allclose(curve[:, 0], [22.5, 67.5])
+    command = run_cli("albedo", "bragg_layer", "--set", "method=1", "--theta", "22.5,67.5", "--json")
+    rgb = np.asarray(json.loads(command.stdout)["rgb"])
+    np.testing.assert_allclose(_luminance(curve[:, 1:]), _luminance(rgb), rtol=VIEW_COMMAND_RTOL)
+    assert _luminance(rgb).min() > 0.05  # not the 1e-7 of a truncated sum

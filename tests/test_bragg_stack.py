@@ -16,6 +16,7 @@ from conftest import REPO_ROOT, one_line_error, run_cli
 from explorer.physics import bragg, colorimetry, layered
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggStackModel, model_for
+from explorer.views.geometry import brdf_view_geometry
 from test_bragg_layer import directions
 from test_brdf_views import SIZE
 from twins import BRDF_TOLERANCE, FLOOR, Tolerance, assert_twins_equal, render_both
@@ -24,6 +25,7 @@ STACK_MATERIAL = REPO_ROOT / "shaders" / "bragg_stack.brd"
 #: The slice view's last row and column reach theta_h, theta_d = 89 deg, where float32 directions lose
 #: ~5e-3 of Eq. 17's value (G1 / cos and D at grazing angles): those pixels get this tolerance.
 GRAZING_RTOL = 1e-2
+GRAZING_COS = 1e-2
 GRAZING_TOLERANCE = Tolerance(f"{GRAZING_RTOL:g} x max(value, {FLOOR:g}) at grazing", atol=GRAZING_RTOL * FLOOR, rtol=GRAZING_RTOL)
 
 #: One to three layers, a coating, Appendix D's host (the jewel beetle of Table 3), coloured bases.
@@ -48,12 +50,17 @@ def stack_material():
 def test_gl_equals_numpy_twin(gl_renderer, stack_material, case, view):
     twins = render_both(gl_renderer, stack_material, stack_material.resolve(CASES[case]), view, SIZE)
     what = f"bragg_stack {case}, {view}"
+    width, height = SIZE
     if view == "slice":
-        width, height = SIZE
         grazing = np.zeros((height, width), bool)
         grazing[-1, :] = grazing[:, -1] = True
-        assert_twins_equal(twins.where(twins.compared & grazing), what, GRAZING_TOLERANCE)
-        twins = twins.where(twins.compared & ~grazing)
+    else:
+        # Light or view within 0.6 deg of the horizon: the multiple-scattering lobe's m(theta) rises steeply
+        # there and float32 directions lose ~1e-2 of it (a lit pixel at cos theta_i = 3e-4: 0.9 %).
+        L, V, N = brdf_view_geometry(view, width, height, twins.light)[:3]
+        grazing = np.minimum(np.sum(L * N, axis=-1), np.sum(V * N, axis=-1)) < GRAZING_COS
+    assert_twins_equal(twins.where(twins.compared & grazing), what, GRAZING_TOLERANCE)
+    twins = twins.where(twins.compared & ~grazing)
     assert_twins_equal(twins, what, BRDF_TOLERANCE)
     assert np.abs(twins.reference).max() > 0.05, "an empty image"
 
@@ -103,9 +110,13 @@ def test_twin_is_eq34_of_the_layered_module(stack_material):
         n1=1.35, rho_d=0.5,
     )
     L, V = directions(16, 3), directions(16, 4)
+    frame = np.eye(3)[2], np.eye(3)[0], np.eye(3)[1]
     np.testing.assert_allclose(
-        model.brdf(L, V, np.eye(3)[2], np.eye(3)[0], np.eye(3)[1]), layered.single_reflection_brdf(by_hand, L, V), rtol=1e-9
+        model.brdf(L, V, *frame), layered.single_reflection_brdf(by_hand, L, V, compensation=layered.stack_compensation(by_hand)),
+        rtol=1e-6,
     )
+    published = model_for(stack_material, {**values, "multiple_scattering": False})
+    np.testing.assert_allclose(published.brdf(L, V, *frame), layered.single_reflection_brdf(by_hand, L, V), rtol=1e-9)
 
 
 @pytest.mark.parametrize("case", list(CASES))

@@ -53,7 +53,7 @@ def test_info_names_the_methods_and_prints_integers():
     assert re.search(r"\bdefault 3 in \[1, 8\]", lines["s"]), lines["s"]
     names = ", ".join(f"{int(m)} {m.label}" for m in BraggMethod)  # from the enumeration, not restated
     assert f"methods: {names}" in run.stdout
-    assert f"open it on {int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label}" in lines["method"]
+    assert f"default {int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label} in" in lines["method"]
     film = run_cli("info", "thin_film", "--json")
     import json
 
@@ -122,3 +122,33 @@ def test_open_several_materials_names_the_one_that_fails(tmp_path):
     line = one_line_error(run_cli("open", "ggx_schlick", broken))
     assert line.startswith(f"bragg-explorer: error: {broken}:3: "), line
     assert "Missing argument" in one_line_error(run_cli("open"))
+
+
+def test_every_bragg_material_opens_on_the_tabulated_method_whatever_its_name(tmp_path):
+    """A built-in Bragg material and a copy under another name (even one whose file still declares the
+    1-nm reference) open on the tabulated method in render, albedo and the app; method 0 stays a choice."""
+    from explorer.app.state import initial_values
+    from explorer.materials.brd import load_material
+    from explorer.resources import builtin_materials
+
+    tabulated = f"method {int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label})"
+    layer = builtin_materials()["bragg_layer"]
+    copy = tmp_path / "my_layer.brd"
+    copy.write_text(layer.read_text().replace("int method 0 4 3", "int method 0 4 0"))
+    assert "int method 0 4 0" in copy.read_text()
+    for path in (layer, builtin_materials()["bragg_mirror"], copy):
+        assert int(initial_values(load_material(path), None, False)["method"]) == int(BraggMethod.TABULATED), path
+        run = run_cli("render", path, "--engine", "numpy", "--view", "gradient", "--size", "8x1", "--out", tmp_path / "g.npy")
+        assert run.returncode == 0 and tabulated in run.stdout, (path, run.stdout, run.stderr)
+    plain = run_cli("albedo", copy, "--theta", "30", "--json")
+    chosen = run_cli("albedo", copy, "--theta", "30", "--json", "--set", f"method={int(BraggMethod.TABULATED)}")
+    assert plain.returncode == 0 and plain.stdout == chosen.stdout, plain.stderr
+    reference = run_cli("render", copy, "--engine", "numpy", "--view", "gradient", "--size", "8x1", "--set", "method=0",
+                        "--out", tmp_path / "r.npy")
+    assert f"method 0 {BraggMethod.REFERENCE.label})" in reference.stdout
+
+
+def test_strips_list_the_methods_in_their_order():
+    from explorer.app.data import BRAGG_STRIP_METHODS
+
+    assert [int(m) for m in BRAGG_STRIP_METHODS] == sorted(int(m) for m in BraggMethod)

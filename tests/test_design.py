@@ -425,3 +425,35 @@ def test_a_cancelled_design_stops_within_its_threaded_scan():
         design.design("bragg_mirror", targets, RANGES, cancelled=lambda: time.perf_counter() - start > 0.3,
                       progress=lambda fraction, stage: stages.append(stage))
     assert time.perf_counter() - start < 2.0 and "done" not in stages and "descent" not in stages, stages
+
+
+def test_a_clipped_png_strip_is_a_set_of_bounds_and_round_trips(tmp_path):
+    """The tool's own 8-bit strip (vivid channels clipped at 0 and 255) designs back to its Lambda: the
+    clipped channels are one-sided targets, said on stderr with the advice to use .npy or .exr."""
+    strip = tmp_path / "strip.png"
+    run = run_cli("render", "bragg_mirror", "--view", "gradient", "--set", "Lambda=300", "--set", "method=4",
+                  "--engine", "numpy", "--out", strip)
+    assert run.returncode == 0, run.stderr
+    run = run_cli("design", "bragg_mirror", "--target-strip", strip, "--theta-range", "0,90", "--tries", "1", "--json")
+    assert run.returncode == 0, run.stderr
+    assert "bounds, not values" in run.stderr and ".npy or .exr" in run.stderr
+    document = json.loads(run.stdout)
+    assert any("target_bounds" in t for t in document["targets"])
+    assert max(t["delta_e2000"] for t in document["targets"]) <= 1.0, document["targets"]
+    assert abs(document["set"]["Lambda"] - 300.0) <= 3.0, document["set"]
+
+
+def test_a_bounded_channel_costs_only_on_the_wrong_side():
+    """One-sided: a colour beyond an "at least" bound has the cost of the colour at the bound's side only."""
+    from explorer.design import ranges_of
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    model = design.design_model("bragg_mirror")
+    box = design.parameter_box(model, ranges_of(load_material(material_path("bragg_mirror"))))
+    problem = design._Problem(model, box, {}, [design.Target(30.0, (1.0, 0.2, 0.0), (1, 0, -1))], None)
+    beyond = np.array([[[1.3, 0.2, -0.1]]])
+    short = np.array([[[0.8, 0.2, 0.1]]])
+    assert problem.delta_e(beyond[0])[0] < 1e-6
+    assert problem.delta_e(short[0])[0] > 1.0
+    assert np.sum(problem.residuals_of(beyond) ** 2) < 1e-10

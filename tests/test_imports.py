@@ -84,19 +84,20 @@ def test_no_import_cycles():
 
 #: The packages from the bottom up: a package imports only packages of a lower rank (or its own).
 #: ``errors`` is the foundation, ``resources`` (paths) and ``files`` (atomic outputs) stand on it; the
-#: store ``tables`` knows no physics; ``design`` (the inverse design, over the physics' forward models) stands on
-#: ``materials``; ``views`` (what each pixel of a view shows, without GL) comes below
-#: ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared with the GL views) above it; ``rendering`` (any view
-#: by any engine, the render service) dispatches to all three; ``bench`` (the benchmarks and accuracy studies, the
-#: app's frame times among them) stands on the ``app``; ``cli`` opens the ``app``; ``dev`` (the checkout's
-#: set-up and regeneration scripts, not in the wheel) and ``__main__`` stand outside.
+#: store ``tables`` knows no physics; ``plugins`` (the public API of material plugins) re-exports ``materials``;
+#: ``design`` (the inverse design, over the physics' forward models) stands on ``materials`` too; ``views`` (what each
+#: pixel of a view shows, without GL) comes below ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared
+#: with the GL views) above it; ``rendering`` (any view by any engine, the render service) dispatches to all three;
+#: ``bench`` (the benchmarks and accuracy studies, the app's frame times among them) stands on the ``app``; ``cli``
+#: opens the ``app``; ``dev`` (the checkout's set-up and regeneration scripts, not in the wheel) and ``__main__``
+#: stand outside.
 LAYERS = {
     "errors": 0,
     "resources": 1, "files": 1,
     "tables": 2,
     "physics": 3,
     "materials": 4,
-    "design": 5,
+    "plugins": 5, "design": 5,
     "views": 6,
     "gpu": 7,
     "mitsuba": 8,

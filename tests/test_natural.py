@@ -187,7 +187,7 @@ def test_spectrum_command_files_and_errors(tmp_path, capsys):
     assert lines[0].startswith("wavelength_nm,R@0,Rs@0,Rp@0,T@0,A@0,R@45") and len(lines) == 472
     assert png.stat().st_size > 10_000
     for argv, message in ((["--set", "n2=unobtainium"], "neither a number nor a dispersion"),
-                          (["--set", "sigma=0.5"], "sigma='0.5': a number in [0, 0.3]"),
+                          (["--set", "sigma=0.5"], "parameter 'sigma': value 0.5 is outside its range [0, 0.3]"),
                           (["--theta", "95"], "--theta"),
                           (["--set", f"n1={tmp_path / 'missing.csv'}"], "missing.csv: no such file")):
         with pytest.raises(SystemExit):

@@ -17,9 +17,8 @@ from explorer.materials.methods import BraggMethod, methods_for
 from explorer.materials.models import mirror_of
 from explorer.materials.twins import capabilities_of
 
-#: The gradient rows of Figure 4: the reference, the paper's approximations, ours, the tabulated colours.
-BRAGG_STRIP_METHODS = (BraggMethod.REFERENCE, BraggMethod.BASIC, BraggMethod.SUBDIVIDED, BraggMethod.IMPROVED,
-                       BraggMethod.TABULATED)
+#: The gradient rows of Figure 4, one per method in the methods' order (as the combo and ``info`` list them).
+BRAGG_STRIP_METHODS = tuple(sorted(BraggMethod))
 
 
 def method_names(material) -> dict[int, str]:

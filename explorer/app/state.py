@@ -43,8 +43,8 @@ def has_reflectance(material: Material) -> bool:
 
 
 def initial_values(material: Material, preset: str | None, is_default: bool) -> dict:
-    """The values the app starts with: defaults, the default material's tabulated method, a preset."""
-    overrides: dict = dict(opening_values(material)) if is_default else {}  # as render opens it
+    """The values the app starts with: defaults, a Bragg material's tabulated method, a preset."""
+    overrides: dict = dict(opening_values(material))  # as render, export and albedo open it
     if preset is not None:
         from explorer.materials.presets import presets_for
 

@@ -13,6 +13,7 @@ import numpy as np
 from explorer.bench.common import _progress
 from explorer.materials.methods import BraggMethod
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggStackModel
 
 # --------------------------------------------------------------------------------------------------
 # bench --app: the explorer's frame times while a slider is dragged
@@ -25,7 +26,7 @@ APP_METHODS = tuple((int(m), name) for m, name in (
 #: The sphere's modes timed per method (the env mode is timed on the stack: :data:`APP_ENV_VALUES`).
 APP_MODES = ("sphere", "lit")
 #: The env mode's material (``shaders/bragg_stack.brd``) and values: the two-layer stack, Lambda_1 dragged.
-APP_ENV_MATERIAL = "bragg_stack.brd"
+APP_ENV_MATERIAL = f"{BraggStackModel.name}.brd"
 APP_ENV_VALUES = {"layers": 2}
 APP_ENV_SLIDER = "param:Lambda_1"
 #: The goals of issue 22: frames while a slider moves, and the env view's first pass.

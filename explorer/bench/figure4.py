@@ -16,6 +16,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel
 
 # --------------------------------------------------------------------------------------------------
 # The Figure 4 grid
@@ -103,7 +104,7 @@ def figure4_strips(path: Path, width: int = 360, strip: int = 14) -> None:
     from explorer.physics.colorimetry import encode_srgb8
 
     renderer = Renderer()
-    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    material = load_material(SHADER_DIR / f"{BraggMirrorModel.name}.brd")
     gap = 6
     rows = []
     for Lambda in FIGURE4_LAMBDAS:

@@ -14,6 +14,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggLayerModel, BraggStackModel
 
 # --------------------------------------------------------------------------------------------------
 # Rough layers: host-table timings and the slice view's accuracy
@@ -42,7 +43,7 @@ def slice_accuracy(alpha: float, size: int = 64) -> dict:
     from explorer.materials.models import model_for
     from explorer.views.render import render_numpy
 
-    material = load_material(SHADER_DIR / "bragg_layer.brd")
+    material = load_material(SHADER_DIR / f"{BraggLayerModel.name}.brd")
 
     def image(method: int, converged: bool = False) -> np.ndarray:
         values = material.resolve({**FIGURE8_LAYER, "alpha": alpha, "method": method})
@@ -78,7 +79,7 @@ def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64, ma
     for alpha in LAYER_ALPHAS:
         _progress(f"bench --layers: slice view {size}x{size}, alpha = {alpha:g}")
         accuracy.append(slice_accuracy(alpha, size))
-    _progress("bench --layers: bragg_stack.brd, Figure 7's presets and Table 3's green area")
+    _progress(f"bench --layers: {BraggStackModel.name}.brd, Figure 7's presets and Table 3's green area")
     document = {
         "timings": {**timings, "goal_ms": LAYER_GOALS, "paper_ms": LAYER_PAPER},
         "slice": {"configuration": {k: v for k, v in FIGURE8_LAYER.items() if k != "s"},
@@ -113,7 +114,7 @@ def stack_study(repeats: int = 2, size: int = 256, presets=STACK_PRESETS) -> lis
     from explorer.materials.presets import load_presets
     from explorer.physics import layered
 
-    preset_file = load_presets(SHADER_DIR / "presets" / "bragg_stack.toml")
+    preset_file = load_presets(SHADER_DIR / "presets" / f"{BraggStackModel.name}.toml")
     material = preset_file.material
     renderer = Renderer()
     rng = np.random.default_rng(2024)
@@ -160,7 +161,7 @@ def format_layers(document: dict) -> str:
             lines.append(f"{label:<20} {name:<44} {ms:>7.1f} ms  (goal {goal:g} ms; paper {paper:g} ms)")
     study = document["slice"]
     rows = study["rows"]
-    lines += ["", f"slice view {rows[0]['size']}x{rows[0]['size']} (numpy twin of bragg_layer.brd, Λ = 500 nm, δ = 0.5, "
+    lines += ["", f"slice view {rows[0]['size']}x{rows[0]['size']} (numpy twin of {BraggLayerModel.name}.brd, Λ = 500 nm, δ = 0.5, "
               f"n1 = 1, n2 = 1.5, N = 20, rho_d = 0): median / max ΔE2000 against the spectral reference over pixels "
               f"with reference Y > {study['luminance_threshold']:g}", ""]
     names = [name for name, _ in SLICE_METHODS]
@@ -171,7 +172,7 @@ def format_layers(document: dict) -> str:
         lines.append(f"{r['alpha']:>6g} {r['pixels']:>7}{cells}{r['tabulated']['max_abs']:>15.3g}{r['tabulated']['max_relative']:>15.2e}")
     stack = document.get("stack")
     if stack:
-        lines += ["", f"bragg_stack.brd (Eq. 34, 471 wavelengths per pixel): host table rebuild (all layers), GL lit frame "
+        lines += ["", f"{BraggStackModel.name}.brd (Eq. 34, 471 wavelengths per pixel): host table rebuild (all layers), GL lit frame "
                   f"{stack[0]['size']}x{stack[0]['size']} (this machine's renderer), and ΔE2000 of the tabulated R_λ (Model-LUT) "
                   f"against Yeh's R_λ at the exact half-vector angle (Model), median / max over random pairs with Y > "
                   f"{SLICE_LUMINANCE_THRESHOLD:g}", ""]

@@ -152,6 +152,8 @@ def thin_film_markdown(document: dict) -> str:
 
 def layers_markdown(document: dict) -> str:
     """``bench --layers``: host-table timings, the slice view's accuracy and the stacks' study (three tables)."""
+    from explorer.materials.models import BraggLayerModel, BraggStackModel
+
     timings = document["timings"]
     rows = []
     for key, label in (("transmission_filter_ms", "F_α"), ("layer_tables_ms", "layer tables")):
@@ -166,7 +168,7 @@ def layers_markdown(document: dict) -> str:
     body = [[f"{r['alpha']:g}", str(r["pixels"])] + [f"{r[n]['dE_median']:.2f} / {r[n]['dE_max']:.1f}" for n in names]
             + [f"{r['tabulated']['max_abs']:.3g} / {r['tabulated']['max_relative']:.1e}"] for r in slice_rows]
     size = slice_rows[0]["size"]
-    out += [f"Slice view {size}×{size} (numpy twin of `bragg_layer.brd`), median / max ΔE2000 against the converged "
+    out += [f"Slice view {size}×{size} (numpy twin of `{BraggLayerModel.name}.brd`), median / max ΔE2000 against the converged "
             f"reference over pixels with Y > {study['luminance_threshold']:g}; tabulated: max abs / max relative.", "",
             markdown_table(["α", "pixels", *names, "tabulated"], body)]
     stack = document.get("stack")
@@ -174,7 +176,7 @@ def layers_markdown(document: dict) -> str:
         size = stack[0]["size"]
         body = [[r["preset"], str(r["layers"]), f"{r['tables_ms']:.0f} ms", f"{r['frame_ms'] / 1e3:.2f} s", str(r["pairs"]),
                  f"{r['lut_dE_median']:.2f} / {r['lut_dE_max']:.2f}"] for r in stack]
-        out += ["", f"`bragg_stack.brd`: host table rebuild, GL `lit` frame {size}², and Model-LUT vs Model "
+        out += ["", f"`{BraggStackModel.name}.brd`: host table rebuild, GL `lit` frame {size}², and Model-LUT vs Model "
                 "(ΔE2000 median / max over random direction pairs).", "",
                 markdown_table(["preset", "layers", "tables", f"frame {size}²", "pairs", "Model-LUT vs Model"], body)]
     return "\n".join(out)

@@ -13,6 +13,7 @@ import numpy as np
 from explorer.bench.common import _progress
 from explorer.materials.brd import load_material
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggStackModel
 
 #: The position-free benchmark: 9 incidence angles, a standard-error goal, a time goal (this 2-core machine).
 POSITION_FREE_THETA = tuple(float(t) for t in np.linspace(0.0, 80.0, 9))
@@ -21,7 +22,7 @@ POSITION_FREE_GOAL_S = 30.0
 #: Its configurations: bragg_stack.brd's three default layers (no shipped preset has three) over a black
 #: base, and the same three over Figure 7's grey base under Figure 7's coating (the hard case: many bounces).
 POSITION_FREE_CASES = (
-    ("bragg_stack defaults, layers = 3 (rho_d = 0, nh = 1)", {"layers": 3}),
+    (f"{BraggStackModel.name} defaults, layers = 3 (rho_d = 0, nh = 1)", {"layers": 3}),
     ("figure7_A_prime's host and base with three layers (nh = 1.35, rho_d = 0.5)",
      {"preset": "figure7_A_prime", "layers": 3}),
 )
@@ -46,7 +47,7 @@ def run_position_free_bench(as_json: bool = False, target: float = POSITION_FREE
     from explorer.materials.presets import presets_for
     from explorer.physics.position_free import PositionFree
 
-    material = load_material(SHADER_DIR / "bragg_stack.brd")
+    material = load_material(SHADER_DIR / f"{BraggStackModel.name}.brd")
     rows = []
     for name, spec in POSITION_FREE_CASES:
         spec = dict(spec)

@@ -15,6 +15,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 # --------------------------------------------------------------------------------------------------
 # bench --scaling: how the table and the shading cost grow (issue 22)
@@ -63,8 +64,8 @@ def scaling_study(repeats: int = 3, renderer=None) -> dict:
                     times.setdefault(("angles", N, n), []).append(measured)
         _progress(f"bench --scaling: table against its size, round {round_}/{repeats}")
     renderer = Renderer() if renderer is None else renderer
-    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
-    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    mirror_material = load_material(SHADER_DIR / f"{BraggMirrorModel.name}.brd")
+    schlick_material = load_material(SHADER_DIR / f"{SchlickFresnelModel.name}.brd")
     cases = [("tabulated", mirror_material, mirror_material.resolve({**TABLES_MIRROR, "N": 20, "method": int(BraggMethod.TABULATED)})),
              ("schlick", schlick_material, schlick_material.resolve({}))]
     for _, material, values in cases:
@@ -117,17 +118,13 @@ def plot_scaling(document: dict, path: Path) -> None:
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=8)
     figure.tight_layout()
-    # Atomically: a temporary file beside the plot, renamed over it.
-    import os
-    import tempfile
+    # Atomically: a temporary file beside the plot, renamed over it (mode 0644 under the usual umask).
+    from explorer.files import atomic_output
 
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
     try:
-        with os.fdopen(handle, "wb") as stream:
-            figure.savefig(stream, dpi=110, format="png")
-        os.replace(temporary, path)
+        with atomic_output(path) as temporary:
+            figure.savefig(temporary, dpi=110, format="png")
     finally:
-        Path(temporary).unlink(missing_ok=True)
         plt.close(figure)
 
 

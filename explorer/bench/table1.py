@@ -17,6 +17,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 
 def delta_E_over_theta(mirror: bragg.BraggMirror, rgb_function) -> tuple[float, float]:
@@ -68,8 +69,8 @@ def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3, markdown
     from explorer.gpu import Renderer
 
     renderer = Renderer()
-    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
-    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    mirror_material = load_material(SHADER_DIR / f"{BraggMirrorModel.name}.brd")
+    schlick_material = load_material(SHADER_DIR / f"{SchlickFresnelModel.name}.brd")
     device = renderer.ctx.info.get("GL_RENDERER", "unknown")
     _progress(f"bench: {size}x{size} sphere on {device}, {repeats} interleaved repeats per method")
 

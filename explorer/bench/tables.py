@@ -14,6 +14,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 # --------------------------------------------------------------------------------------------------
 # bench --tables: host table rebuilds and the tabulated method's per-pixel cost (issue 22)
@@ -97,8 +98,8 @@ def tabulated_over_schlick(size: int = 512, repeats: int = 5) -> tuple[dict, str
     renderer = Renderer()
     texture_renderer = Renderer(renderer.ctx)  # the same context, tables as 2D textures
     texture_renderer.buffer_tables = False
-    mirror_material = load_material(SHADER_DIR / "bragg_mirror.brd")
-    schlick_material = load_material(SHADER_DIR / "schlick_fresnel.brd")
+    mirror_material = load_material(SHADER_DIR / f"{BraggMirrorModel.name}.brd")
+    schlick_material = load_material(SHADER_DIR / f"{SchlickFresnelModel.name}.brd")
     schlick_values = schlick_material.resolve({})
     ratios: dict[str, dict] = {key: {} for key in ("tabulated_over_schlick", "tabulated_over_schlick_cpu",
                                                    "tabulated_2d_over_schlick", "tabulated_2d_over_schlick_cpu")}

@@ -14,6 +14,8 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import ThinFilmMethod
 from explorer.physics import colorimetry
 from explorer.resources import SHADER_DIR
+from explorer.materials.models import GGXSchlickModel
+from explorer.materials.thinfilm_model import ThinFilmModel
 
 # --------------------------------------------------------------------------------------------------
 # Thin films (Belcour & Barla 2017): accuracy of each method and its cost relative to GGX + Schlick
@@ -49,8 +51,8 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
     from explorer.gpu import Renderer
     from explorer.materials.presets import presets_for
 
-    film_material = load_material(SHADER_DIR / "thin_film.brd")
-    presets = presets_for(SHADER_DIR / "thin_film.brd").presets
+    film_material = load_material(SHADER_DIR / f"{ThinFilmModel.name}.brd")
+    presets = presets_for(SHADER_DIR / f"{ThinFilmModel.name}.brd").presets
     configurations = [("figure7", film_material.resolve({}))]  # the material's defaults are Figure 7's film
     configurations += [(name, p.resolve()) for name, p in presets.items() if name != "figure7"]
     accuracy = []
@@ -60,7 +62,7 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
             accuracy.append({"configuration": name, "method": method, "dE_median": median, "dE_max": maximum})
 
     renderer = Renderer()
-    baseline_material = load_material(SHADER_DIR / "ggx_schlick.brd")
+    baseline_material = load_material(SHADER_DIR / f"{GGXSchlickModel.name}.brd")
     device = renderer.ctx.info.get("GL_RENDERER", "unknown")
     figure7 = presets["figure7"].resolve() if "figure7" in presets else film_material.resolve({})
     cases = [(name, film_material, {**figure7, "method": float(m)}) for name, m in THIN_FILM_METHODS]

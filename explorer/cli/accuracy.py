@@ -55,7 +55,8 @@ class PresetMirror:
 
 def preset_mirrors(preset_files=None) -> list[PresetMirror]:
     """Every distinct Bragg mirror of the shipped presets (see the module docstring), in file order."""
-    from explorer.materials.models import BraggStackModel, model_for
+    from explorer.materials.models import model_for
+    from explorer.materials.twins import capabilities_of, twin_class
     from explorer.materials.presets import all_preset_files
 
     found: dict[bragg.BraggMirror, PresetMirror] = {}
@@ -67,11 +68,12 @@ def preset_mirrors(preset_files=None) -> list[PresetMirror]:
 
     for preset_file in all_preset_files() if preset_files is None else preset_files:
         kind = preset_file.material.model
+        capabilities = capabilities_of(preset_file.material)
         for name, preset in preset_file.presets.items():
-            if kind in ("bragg_mirror", "bragg_layer"):
+            if capabilities.bragg_spectrum:  # one Bragg mirror
                 add(model_for(preset_file.material, preset.resolve()).mirror, name, kind)
-            elif kind == "bragg_stack":
-                stack = BraggStackModel.stack_of(preset_file.material.typed_values(preset.resolve()))
+            elif capabilities.supports("position-free"):  # a layered Bragg structure: each layer's mirror
+                stack = twin_class(preset_file.material).stack_of(preset_file.material.typed_values(preset.resolve()))
                 for k, layer in enumerate(stack.layers, start=1):
                     add(layer.mirror(stack.n1), f"{name}/layer {k}", kind)
     return list(found.values())

@@ -58,7 +58,7 @@ def _fail(message: str) -> None:
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--theta", default=DEFAULT_THETA, show_default=True, metavar="DEG,DEG,...", help="Incidence angles in degrees (in the outer medium).")
 @click.option("--engine", type=click.Choice(["gl", "numpy", "position-free"]), default="numpy", show_default=True,
-              help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (bragg_stack).")
+              help="The GLSL BRDF on the GPU (scatter view), its numpy twin, or the position-free reference (layered Bragg stacks).")
 @click.option("--samples", type=int, metavar="N", help=f"position-free: paths per angle (default {DEFAULT_SAMPLES}).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="position-free: the random generator's seed (>= 0).")
 @click.option("--microsurface", type=click.Choice(["single", "walk"]), default="single", show_default=True,

@@ -294,7 +294,7 @@ def _errors(function):
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
 @click.option("--engine", type=click.Choice(["gl", "numpy", "position-free", "mitsuba"]), default="gl", show_default=True,
-              help="The GPU shader, its numpy twin, (bragg_stack, lit and slice) the position-free reference, or (env view) Mitsuba 3 with the explorer's BSDF plugins.")
+              help="The GPU shader, its numpy twin, (layered Bragg stacks, lit and slice) the position-free reference, or (env view) Mitsuba 3 with the explorer's BSDF plugins.")
 @click.option("--light", metavar="THETA,PHI", help="Light direction in degrees for lit, scatter and textured (default 45,0).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
@@ -342,9 +342,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
     light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
-    from explorer.materials.methods import method_labels, opening_values
+    from explorer.materials.methods import method_labels
 
-    values = resolve_values(loaded, preset, params_file, assignments, opening=opening_values(loaded))  # as the app opens it
+    values = resolve_values(loaded, preset, params_file, assignments)  # as the app opens it
     width, height = parse_size(size, view)
     plot = parse_plot(view, theta_d=theta_d, theta_h=theta_h, phi_v=phi_v, log=log_scale, channel=channel, ndotl=ndotl)
     if plot is not None and Path(out).suffix.lower() not in (".png", ".npy"):
@@ -468,10 +468,14 @@ def info(material, as_json, dispersions):
             shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
         default = labels.get(shown["default"], shown["default"]) if p.name == "method" else shown["default"]
         bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
-        opens = f" (the app and render open it on {labels.get(opening, opening)})" if p.name == "method" and opening is not None else ""
+        opens = (f" (every command and the app open it on {labels.get(opening, opening)})"
+                 if p.name == "method" and opening is not None and opening != shown["default"] else "")
         click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
+    from explorer.materials.twins import capabilities_of
+
+    click.echo(f"  supports: {capabilities_of(loaded).summary()}")
 
 
 @cli.command()
@@ -512,7 +516,7 @@ def presets(material, as_json):
 @click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
 @click.option("--size", default=512, show_default=True, type=click.IntRange(min=1), help="Sphere size for GPU timings.")
 @click.option("--repeats", default=3, show_default=True, type=click.IntRange(min=1), help="Interleaved repeats per method (medians).")
-@click.option("--thin-film", "thin_film", is_flag=True,
+@click.option("--thin-film", "film", is_flag=True,
               help="Instead: ΔE2000 of the thin-film methods (Figure 7, the presets) and their cost relative to GGX + Schlick.")
 @click.option("--layers", is_flag=True,
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
@@ -536,7 +540,7 @@ def presets(material, as_json):
               help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
 @click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
 @_errors
-def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
+def bench(as_json, size, repeats, film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
           plot, markdown, mitsuba, spp):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
@@ -585,12 +589,12 @@ def bench(as_json, size, repeats, thin_film, layers, app, position_free, design_
         run_app_bench(as_json=as_json, size=size)
         return
     if layers:
-        if thin_film:
+        if film:
             raise click.UsageError("--layers and --thin-film are exclusive")
         source = click.get_current_context().get_parameter_source("repeats")
         run_layers_bench(as_json=as_json, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5, markdown=markdown)
         return
-    if thin_film:
+    if film:
         run_thin_film_bench(as_json=as_json, size=size, repeats=repeats, markdown=markdown)
         return
     run_bench(as_json=as_json, size=size, repeats=repeats, markdown=markdown)

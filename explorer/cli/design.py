@@ -113,7 +113,7 @@ def parse_target(text: str):
 def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS):
     """Targets read from a strip image over ``theta_range`` (``A,B`` degrees)."""
     from explorer.design import DesignError, targets_from_strip
-    from explorer.views.images import read_linear_image
+    from explorer.views.images import clipped_codes, read_linear_image
 
     if theta_range is None:
         raise click.UsageError("--target-strip needs --theta-range A,B (degrees at its left and right edges)")
@@ -122,9 +122,20 @@ def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS
     except ValueError:
         raise click.UsageError(f"--theta-range {theta_range!r}: expected A,B in degrees") from None
     try:
-        return targets_from_strip(read_linear_image(path), a, b, count)
+        image = read_linear_image(path)
+        targets = targets_from_strip(image, a, b, count, clipped_codes(path))
     except (ValueError, DesignError) as error:
         raise click.UsageError(f"--target-strip {error}") from None
+    bounded = [t for t in targets if t.bounded]
+    if bounded:
+        words = {-1: "at most", 1: "at least"}
+        described = "; ".join(f"{t.theta_deg:.3g} deg " + ", ".join(f"{'rgb'[c]} {words[b]} {t.rgb[c]:.3g}"
+                                                                    for c, b in enumerate(t.bounds) if b)
+                              for t in bounded)
+        click.echo(f"{PROG}: note: {path}: channels at the image's limit (0 or 255) are clipped colours, taken as "
+                   f"bounds, not values: {described}. For exact targets, render the strip to .npy or .exr "
+                   "(linear, unclipped).", err=True)
+    return targets
 
 
 def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE") -> dict[str, float]:
@@ -181,15 +192,16 @@ def parse_guess(text: str, material) -> dict[str, float]:
     return {name: guess.get(name, float(defaults[name])) for name in model.parameters}
 
 
-def render_command(material_name: str, values: dict) -> str:
-    """The ``render`` command line that shows the designed structure's θ strip (tabulated colours)."""
-    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
-    from explorer.materials.methods import BraggMethod, ThinFilmMethod
+def render_command(material_name: str, values: dict, material=None) -> str:
+    """The ``render`` command line that shows the designed structure's θ strip (the material's preferred method:
+    Bragg's converged table, the film's Fourier m = 3, within ~0.002 of the reference)."""
+    from explorer.materials.twins import capabilities_of
 
-    # Bragg: the converged table; thin film: Fourier m = 3 (within ~0.002 of the reference).
-    best = ThinFilmMethod.FOURIER_3 if "thin_film" in material_name else BraggMethod.TABULATED
-    method = f"--set method={int(best)}"
-    return f"{PROG} render {material_name} --view gradient {sets} {method} --out design.png"
+    sets = " ".join(f"--set {k}={v:.6g}" if isinstance(v, float) else f"--set {k}={v}" for k, v in values.items())
+    methods = capabilities_of(material).methods if material is not None else None
+    best = methods.preferred_member() if methods is not None else None
+    method = f" --set method={int(best)}" if best is not None else ""
+    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")
@@ -272,7 +284,7 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         click.echo(f"not reachable: {len(unreachable)} of {len(result.targets)} targets (ΔE2000 > {REACHABLE_DELTA_E:g}); "
                    "the structure above is the closest found")
         click.echo(SEARCH_CAVEAT)
-    click.echo(f"render: {render_command(name, result.values)}")
+    click.echo(f"render: {render_command(name, result.values, loaded)}")
 
 
 def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None,
@@ -283,8 +295,9 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
     figures (median of the medians, share at most 1) and the median time.
     """
     from explorer.design import ranges_of, round_trip
+    from explorer.materials.models import BraggMirrorModel
 
-    material = load("bragg_mirror")
+    material = load(BraggMirrorModel.name)
     ranges = ranges_of(material)
     draw = None if max_lambda is None else {"Lambda": (ranges["Lambda"][0], float(max_lambda))}
     rows = []
@@ -299,7 +312,7 @@ def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_
                        f"{row['median_delta_e2000']:.3f}, max {row['max_delta_e2000']:.2f}, {row['seconds']:.2f} s "
                        f"({row['cpu_seconds']:.2f} s CPU{f', {result.tries} searches' if result.tries > 1 else ''})")
 
-    round_trip("bragg_mirror", ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
+    round_trip(BraggMirrorModel.name, ranges, count, seed=seed, report=report, draw_ranges=draw, tries=tries)
     medians = np.array([r["median_delta_e2000"] for r in rows])
     seconds = np.array([r["seconds"] for r in rows])
     cpu = np.array([r["cpu_seconds"] for r in rows])

@@ -25,7 +25,7 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
 @click.argument("material", type=click.Path(dir_okay=False))
 @click.option("--to", "target", type=click.Choice(TARGETS), required=True,
               help="mitsuba: a scene directory; brdf: one self-contained BRDF Explorer file; "
-                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (thin_film); "
+                   "table: an EXR of reflectance(cos theta[, roughness]); materialx: a .mtlx (a thin film); "
                    "gltf: a .glb sphere with KHR_materials_iridescence (a thin film, or the nearest one).")
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material; --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON or .bparam); over --preset, under --set.")
@@ -100,7 +100,9 @@ def _export(material, target, preset, params_file, assignments, env_file, mesh, 
         path = Path(out)
         if path.suffix.lower() != ".exr":
             raise TableExportError(path, None, "the table is an OpenEXR file: name it .exr")
-        table = material_table(loaded, values)
+        from explorer.cli.albedo import progress_printer
+
+        table = material_table(loaded, values, progress_printer("table", "rows"))
         write_image(table, path)  # atomically
         click.echo(f"wrote {path} ({table.shape[1]}x{table.shape[0]} RGB, docs/export.md)")
     else:

@@ -95,14 +95,14 @@ def _solve(lobe_specs, tir=False):
 @click.option("--lobe", "lobe_specs", multiple=True, metavar='"R=.. sigma=.. [layers=1|2] [base=..] [choices]"',
               help="A lobe at normal incidence, top first (repeatable).")
 @click.option("--json", "as_json", is_flag=True, help="Print the stack, its material values and the check as JSON.")
-@click.option("--tir", is_flag=True, help="Use the stack's TIR term (shaders/layered_lobes.brd's tir; off in Bati et al.).")
+@click.option("--tir", is_flag=True, help="Use the stack's TIR term (the layered lobes material's tir; off in Bati et al.).")
 def inverse_command(lobe_specs, as_json, tir):
     """Layer stacks from BRDF lobes (Bati, Barla & Pacanowski 2021, Algorithms 1-5).
 
     Prints the stack (top first: eta, alpha, tau of the medium below), the --set values of
     shaders/layered_lobes.brd, and the forward model's lobes at normal incidence against the request.
     """
-    from explorer.materials.lobes_model import values_from_stack
+    from explorer.materials.lobes_model import LayeredLobesModel, values_from_stack
 
     lobe_list, stack, energies, variances = _solve(lobe_specs, tir)
     values = values_from_stack(stack)
@@ -112,7 +112,7 @@ def inverse_command(lobe_specs, as_json, tir):
         for k, lobe in enumerate(lobe_list)
     ]
     if as_json:
-        click.echo(json.dumps({"stack": stack.as_dict(), "material": "shaders/layered_lobes.brd", "values": values, "lobes": check}, indent=2))
+        click.echo(json.dumps({"stack": stack.as_dict(), "material": f"shaders/{LayeredLobesModel.name}.brd", "values": values, "lobes": check}, indent=2))
         return
     for i, layer in enumerate(stack.as_dict()["interfaces"], start=1):
         click.echo(f"interface {i}: " + ", ".join(f"{k} = {v}" for k, v in layer.items()))
@@ -120,7 +120,7 @@ def inverse_command(lobe_specs, as_json, tir):
         click.echo(f"lobe {k}: requested R = {np.round(entry['requested']['R'], 5).tolist()}, sigma = {entry['requested']['sigma']:g}; "
                    f"forward R = {np.round(entry['forward']['R'], 5).tolist()}, sigma = {np.round(entry['forward']['sigma'], 5).tolist()}")
     sets = " ".join(f"--set {k}={','.join(f'{x:.6g}' for x in np.atleast_1d(v))}" for k, v in values.items())
-    click.echo(f"render: bragg-explorer render shaders/layered_lobes.brd {sets} --view env --out lobes.png")
+    click.echo(f"render: bragg-explorer render shaders/{LayeredLobesModel.name}.brd {sets} --view env --out lobes.png")
 
 
 @click.command("figure")

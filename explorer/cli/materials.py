@@ -31,10 +31,14 @@ def load(path: str | Path) -> Material:
 
 def resolve_values(loaded: Material, preset: str | None, params_file: str | None, assignments, opening: dict | None = None) -> dict:
     """
-    The material's values: its defaults, under ``opening`` (the app's opening values,
-    :func:`explorer.materials.methods.opening_values`, for ``render``), under ``--preset``, under
-    ``--params``, under ``--set``.
+    The material's values: its defaults, under ``opening`` (default: the app's opening values,
+    :func:`explorer.materials.methods.opening_values`, as every command opens a material), under
+    ``--preset``, under ``--params``, under ``--set``.
     """
+    if opening is None:
+        from explorer.materials.methods import opening_values
+
+        opening = opening_values(loaded)
     overrides = dict(parse_assignment(a) for a in assignments) if assignments else {}
     if params_file is not None:
         from explorer.app.parameter_files import load_values

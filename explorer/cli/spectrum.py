@@ -23,8 +23,22 @@ from explorer.files import atomic_output, check_output, write_text_atomic
 from explorer.physics import dispersion
 from explorer.physics.natural import NaturalMirror, band_gaps, mirror_spectrum, wavelength_grid
 
-#: The materials whose structure is a Bragg mirror (the rough layer's spectrum is its smooth mirror's).
-MIRROR_MODELS = ("bragg_mirror", "bragg_layer")
+
+
+def is_mirror_material(loaded) -> bool:
+    """Whether the material's structure is a Bragg mirror (its twin declares ``bragg_spectrum``; a rough layer's
+    spectrum is its smooth mirror's)."""
+    from explorer.materials.twins import capabilities_of
+
+    return capabilities_of(loaded).bragg_spectrum
+
+
+def mirror_models() -> str:
+    """The registered materials whose structure is a Bragg mirror, for messages."""
+    from explorer.materials.twins import names_with
+
+    return ", ".join(names_with(lambda c: c.bragg_spectrum))
+
 #: Index parameters that may name a medium.
 INDEX_PARAMETERS = ("n1", "n2", "nh")
 #: What natural structures add to a mirror, with their ranges (taken here where the material does not declare them).
@@ -57,7 +71,11 @@ def split_natural(loaded, assignments, preset_values: dict | None = None) -> tup
     for text in assignments:
         name, value = parse_assignment(text)
         if name in INDEX_PARAMETERS and dispersion.is_dispersion_text(value):
-            natural[name] = dispersion.dispersion_named(value, origin=f"--set {name}")
+            medium = dispersion.dispersion_named(value, origin=f"--set {name}")
+            if f"medium_{name}" in declared and medium.name in dispersion.LIBRARY:
+                passed.append(text)  # the material selects it (medium_NAME)
+            else:
+                natural[name] = medium
         elif name in NATURAL_PARAMETERS and name not in declared:
             low, high = NATURAL_PARAMETERS[name]
             try:
@@ -74,12 +92,13 @@ def split_natural(loaded, assignments, preset_values: dict | None = None) -> tup
 
 def natural_mirror(values: dict, natural: dict) -> NaturalMirror:
     """The mirror of a material's values (a ``bragg_mirror`` or ``bragg_layer``'s), with the natural ones over them."""
-    nh = natural.get("nh", float(values.get("nh", 0.0)))
-    if not isinstance(nh, dispersion.Dispersion) and nh < 1.0:
-        nh = None  # below 1 the host is n1 (bragg_mirror.brd)
+    from explorer.materials.media import index_value
+    from explorer.materials.models import host_index
+
+    nh = host_index(natural.get("nh", index_value(values, "nh") if "nh" in values else 0.0))
     try:
         return NaturalMirror(
-            n1=natural.get("n1", float(values["n1"])), n2=natural.get("n2", float(values["n2"])),
+            n1=natural.get("n1", index_value(values, "n1")), n2=natural.get("n2", index_value(values, "n2")),
             Lambda=float(values["Lambda"]), delta=float(values["delta"]), N=int(round(float(values["N"]))), nh=nh,
             k1=natural.get("k1", float(values.get("k1", 0.0))), k2=natural.get("k2", float(values.get("k2", 0.0))),
             sigma=natural.get("sigma", float(values.get("sigma", 0.0))),
@@ -171,8 +190,8 @@ def spectrum_command(material, preset, params_file, assignments, theta_text, as_
         if out is not None:
             check_output(out, suffixes)
     loaded = load(material)
-    if loaded.model not in MIRROR_MODELS:
-        raise LocatedError(loaded.path, None, f"spectrum takes a Bragg mirror ({', '.join(MIRROR_MODELS)}), not model {loaded.model}")
+    if not is_mirror_material(loaded):
+        raise LocatedError(loaded.path, None, f"spectrum takes a Bragg mirror ({mirror_models()}), not model {loaded.model}")
     passed, natural = split_natural(loaded, assignments)
     values = resolve_values(loaded, preset, params_file, passed)
     mirror = natural_mirror(values, natural)

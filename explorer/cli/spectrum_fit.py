@@ -16,7 +16,7 @@ import click
 import numpy as np
 
 from explorer.cli.materials import load, warn
-from explorer.cli.spectrum import INDEX_PARAMETERS, MIRROR_MODELS, NATURAL_PARAMETERS, describe
+from explorer.cli.spectrum import INDEX_PARAMETERS, NATURAL_PARAMETERS, describe, is_mirror_material, mirror_models
 from explorer.errors import LocatedError
 from explorer.files import atomic_output, check_output
 from explorer.physics import dispersion
@@ -131,8 +131,8 @@ def fit_command(material: str, path: str, theta: float, fixes, as_json: bool, pl
     if plot_out is not None:
         check_output(plot_out, (".png",))
     loaded = load(material)
-    if loaded.model not in MIRROR_MODELS:
-        raise LocatedError(loaded.path, None, f"--target-spectrum fits a Bragg mirror ({', '.join(MIRROR_MODELS)}), not model {loaded.model}")
+    if not is_mirror_material(loaded):
+        raise LocatedError(loaded.path, None, f"--target-spectrum fits a Bragg mirror ({mirror_models()}), not model {loaded.model}")
     wavelengths, measured, note = read_measured(path)
     fixed = parse_fixed(fixes)
     fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed)

@@ -73,7 +73,9 @@ class _Problem:
             host is None or host in names or self.fixed.get(host, 0.0) < model.host_threshold)
         self.targets = list(targets)
         self.cos_theta = np.cos(np.radians([t.theta_deg for t in self.targets]))
-        self.target_lab = colorimetry.rgb_to_lab(np.array([t.rgb for t in self.targets]))
+        self.target_rgb = np.array([t.rgb for t in self.targets], dtype=np.float64)
+        self.target_lab = colorimetry.rgb_to_lab(self.target_rgb)
+        self.bounds = np.array([t.bounds for t in self.targets], dtype=np.int8)
         self.cancelled = cancelled
         self.evaluations = 0
         self._lock = threading.Lock()  # the scans run in threads (:func:`_threaded_scan`)
@@ -237,7 +239,7 @@ class _Problem:
             rgb = colorimetry.xyz_to_rgb(xyz).transpose(0, 2, 1, 3)  # (B, G, A, 3)
             s_rows = s_first[:, None] * ratio ** np.arange(G)[None, :]
             # CIEDE2000 at the scales whose CIELAB distance (cheap) is among the SCAN_KEPT smallest.
-            proxy = np.sum((colorimetry.rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab) ** 2, axis=(-1, -2))
+            proxy = np.sum((colorimetry.rgb_to_lab(np.maximum(rgb, -1.0)) - self.target_lab_for(rgb)) ** 2, axis=(-1, -2))
             # Lambda at k = 1 (or the scale) against the box's top, which k_high stretches.
             top = s_rows * per_period[:, None]
             inside = (top <= k_high[:, None] * high * (1.0 + 1e-9)) & (top >= k_low[:, None] * low * (1.0 - 1e-9))
@@ -258,15 +260,29 @@ class _Problem:
     def residuals_of(self, rgb: np.ndarray) -> np.ndarray:
         """``(..., A, 3)`` colours -> ``(..., 3 A)`` residuals whose squared norm per target is CIEDE2000^2."""
         lab = colorimetry.rgb_to_lab(np.maximum(rgb, -1.0))
-        difference = lab - self.target_lab
+        target_lab = np.broadcast_to(self.target_lab_for(rgb), lab.shape)
+        difference = lab - target_lab
         e76 = np.linalg.norm(difference, axis=-1)
-        e00 = colorimetry.delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+        e00 = colorimetry.delta_E_2000_lab(lab, target_lab)
         scale = np.where(e76 > 1e-9, e00 / np.maximum(e76, 1e-300), 1.0)
         return (difference * scale[..., None]).reshape(rgb.shape[:-2] + (-1,))
 
+    def target_lab_for(self, rgb: np.ndarray) -> np.ndarray:
+        """
+        The targets in CIELAB as seen from colours ``rgb`` ``(..., A, 3)``: a bounded channel (``Target.bounds``)
+        takes the colour's own value where it lies beyond the bound, so that only the exact channels and the
+        wrong side of a bound cost (one-sided).
+        """
+        if not self.bounds.any():
+            return self.target_lab
+        rgb = np.asarray(rgb, dtype=np.float64)
+        target = np.where(self.bounds < 0, np.minimum(rgb, self.target_rgb),
+                          np.where(self.bounds > 0, np.maximum(rgb, self.target_rgb), self.target_rgb))
+        return colorimetry.rgb_to_lab(np.maximum(target, -1.0))
+
     def delta_e(self, rgb) -> np.ndarray:
         lab = colorimetry.rgb_to_lab(rgb)
-        return colorimetry.delta_E_2000_lab(lab, np.broadcast_to(self.target_lab, lab.shape))
+        return colorimetry.delta_E_2000_lab(lab, np.broadcast_to(self.target_lab_for(rgb), lab.shape))
 
     def fine_values(self, u: np.ndarray) -> dict[str, float]:
         """The structure of one unit row, integer parameters whole (fixed ones are: :func:`design` checks)."""

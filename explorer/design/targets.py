@@ -32,11 +32,14 @@ def check_target_rgb(rgb: ArrayLike, what: str = "colour") -> np.ndarray:
     return rgb
 
 
-def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5) -> list["Target"]:
+def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count: int = 5,
+                       clipped: np.ndarray | None = None) -> list["Target"]:
     """
     ``count`` targets from a strip of linear RGB ``(H, W, 3)`` whose column ``i`` shows
     ``theta_a + (theta_b - theta_a)(i + 0.5) / W`` degrees (as the gradient view draws 0 to 90): evenly
-    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped.
+    spaced columns, each the mean of its rows; columns at 90 degrees and beyond are skipped. ``clipped``
+    ``(H, W, 3)``: -1 where an integer image holds its lowest code, +1 its highest, 0 elsewhere; a channel
+    clipped in every row of its column becomes a bound (:class:`Target`), not a value.
     """
     if not (np.isfinite(theta_a) and np.isfinite(theta_b) and 0.0 <= min(theta_a, theta_b)
             and max(theta_a, theta_b) <= 90.0 and theta_a != theta_b):
@@ -49,7 +52,11 @@ def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count:
         if theta >= 90.0:
             continue
         rgb = check_target_rgb(np.asarray(image)[:, i, :3].mean(axis=0), f"strip column {i}")
-        targets.append(Target(float(theta), tuple(float(c) for c in rgb)))
+        bounds = (0, 0, 0)
+        if clipped is not None:
+            column = np.asarray(clipped)[:, i, :3]
+            bounds = tuple(int(column[0, c]) if np.all(column[:, c] == column[0, c]) else 0 for c in range(3))
+        targets.append(Target(float(theta), tuple(float(c) for c in rgb), bounds))
     if not targets:
         raise DesignError("the strip has no column below 90 degrees")
     return targets
@@ -61,10 +68,19 @@ def targets_from_strip(image: np.ndarray, theta_a: float, theta_b: float, count:
 
 @dataclass(frozen=True)
 class Target:
-    """A wanted colour (linear RGB of this convention) at an angle (degrees, in the outer medium)."""
+    """
+    A wanted colour (linear RGB of this convention) at an angle (degrees, in the outer medium). ``bounds``
+    per channel: 0 the value itself; -1 at most it, +1 at least it (a channel an 8-bit image clipped at 0 or
+    255: the true colour lies beyond). A bounded channel costs nothing on its side of the bound.
+    """
 
     theta_deg: float
     rgb: tuple[float, float, float]
+    bounds: tuple[int, int, int] = (0, 0, 0)
+
+    @property
+    def bounded(self) -> bool:
+        return any(self.bounds)
 
 
 @dataclass
@@ -104,6 +120,8 @@ class DesignResult:
             "set": dict(self.values),
             "targets": [
                 {"theta_deg": t.theta_deg, "target_rgb": [float(c) for c in t.rgb],
+                 **({"target_bounds": ["at most" if b < 0 else "at least" if b > 0 else "equal" for b in t.bounds]}
+                    if t.bounded else {}),
                  "achieved_rgb": [float(c) for c in a], "delta_e2000": float(d)}
                 for t, a, d in zip(self.targets, self.achieved_rgb, self.delta_e2000)
             ],

@@ -23,9 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -54,15 +52,12 @@ MAP_KEYS = ("map_single", "map_reference", "map_reference_stderr")
 
 
 def _write_atomic(path: Path, write) -> None:
+    """``write(temporary)`` then the rename (:func:`explorer.files.atomic_output`: mode 0644 under the usual umask)."""
+    from explorer.files import atomic_output
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
-    os.close(handle)
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
+    with atomic_output(path) as temporary:
+        write(str(temporary))
 
 
 def plane_directions(theta_i_deg, theta_o_deg) -> tuple[np.ndarray, np.ndarray]:

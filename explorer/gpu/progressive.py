@@ -79,6 +79,7 @@ class ProgressiveView:
         self.dragging = False
         self.generation = 0  # bumped on every restart (callers cache derived data by it)
         self.last_draw_ms = 0.0
+        self._summed = None  # a summed view's image (VIEW_REGISTRY's summed)
 
     # -- what to draw ------------------------------------------------------------------------------
 
@@ -112,6 +113,7 @@ class ProgressiveView:
         self.refined_rows = 0
         self.complete = False
         self.error = None
+        self._summed = None
         self.generation += 1
 
     def _allocate(self, size: tuple[int, int]) -> None:
@@ -164,6 +166,16 @@ class ProgressiveView:
             return 0.0
         spent = 0.0
         try:
+            from explorer.views.geometry import VIEW_REGISTRY
+
+            if self.view in VIEW_REGISTRY and VIEW_REGISTRY[self.view].summed:
+                # Terms the host sums (the albedo curve): drawn whole, then read from the sum.
+                import time
+
+                start = time.perf_counter()
+                self._summed = self.renderer.render(self.material, self.values, self.view, *self.size, uniforms=self.uniforms)
+                self.refined_rows, self.complete = self.size[1], True
+                return (time.perf_counter() - start) * 1e3
             if not self.has_preview and self.refined_rows == 0:
                 preview = self._preview_size(max(budget_ms, 4.0))
                 if preview is None:
@@ -200,6 +212,8 @@ class ProgressiveView:
 
     def read(self) -> np.ndarray:
         """The full image, ``(height, width, 3)`` float32 linear RGB, rows from the top (as ``Renderer.render``)."""
+        if self._summed is not None:
+            return self._summed.copy()
         width, height = self.size
         data = self.full.read(components=4, dtype="f4")
         image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]

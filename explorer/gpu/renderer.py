@@ -349,6 +349,14 @@ class Renderer:
         :meth:`explorer.views.thickness.ThicknessTexture.gl_inputs`). ``environment``: what a smooth mirror reflects
         in the ``lit`` view (an :class:`explorer.views.env.EnvironmentMap`; default the env view's).
         """
+        from explorer.views.geometry import view_named
+
+        if view_named(view).summed:
+            return self._render_summed(material, values, view, width, height, uniforms)
+        return self._render_image(material, values, view, width, height, light, inputs, uniforms, environment)
+
+    def _render_image(self, material, values, view, width, height, light=None, inputs=None, uniforms=None, environment=None):
+        """One draw of ``view``'s program into a ``width x height`` float target, read back (rows from the top)."""
         program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms, environment)
         try:
             framebuffer.use()
@@ -359,6 +367,26 @@ class Renderer:
             self.resources.release(framebuffer)
         image = np.frombuffer(data, dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
         return np.ascontiguousarray(image)
+
+    def _render_summed(self, material, values, view, width, height, uniforms) -> np.ndarray:
+        """
+        The albedo view (``shaders/views/albedo.glsl``): its terms drawn one quadrature node a fragment, in
+        batches of incidence columns that fit a render target, and summed per column in float64.
+        """
+        from explorer.views.albedo import sum_albedo_terms
+        from explorer.views.plots import albedo_uniforms
+
+        bound = {**albedo_uniforms(), **(uniforms or {})}
+        nodes, azimuths = int(bound["albedo_nodes"]), int(bound["albedo_phi_nodes"])
+        rows = min(self.limits.max_target_side[1], self.limits.max_pixels(4) // azimuths)
+        batch = max(1, rows // nodes)
+        curve = np.zeros((width, 3))
+        for first in range(0, width, batch):
+            count = min(batch, width - first)
+            terms = self._render_image(material, values, view, azimuths, count * nodes,
+                                       uniforms={**bound, "albedo_first_column": first, "albedo_columns": width})
+            curve[first:first + count] = sum_albedo_terms(terms, count)
+        return np.ascontiguousarray(np.broadcast_to(curve[None].astype(np.float32), (height, width, 3)))
 
     def time_frame(
         self, material: Material, values: Mapping[str, object], view: str, width: int, height: int,

@@ -82,6 +82,9 @@ class AccuracyBadge:
 
     method: int
     methods: dict[int, MethodAccuracy]
+    #: Absorbing, dispersive or disordered layers: the approximations' landmarks assume none, so every method
+    #: shows the exact table (``shaders/bragg_mirror.brd``'s natural_structure()).
+    natural: bool = False
 
     @property
     def current(self) -> MethodAccuracy:
@@ -101,6 +104,8 @@ class AccuracyBadge:
 
     def text(self) -> str:
         """One line for the app: the current method's ΔE2000 and, when it is off, the accurate methods."""
+        if self.natural:
+            return f"natural layers (k, media, sigma): every method shows the exact table ({METHOD_NAMES[3]}, method 3)"
         c = self.current
         head = f"ΔE2000 vs converged: median {c.dE_median:.1f}, max {c.dE_max:.1f}"
         if c.accurate:
@@ -151,6 +156,9 @@ def accuracy_badge(material, values: Mapping[str, object]) -> AccuracyBadge | No
     model = model_for(material, values)
     if model.method not in METHOD_NAMES:
         return None
+    if getattr(model, "natural", None) is not None:  # the exact table whatever the method
+        exact = MethodAccuracy(model.method, 0.0, 0.0)
+        return AccuracyBadge(model.method, {model.method: exact}, natural=True)
     options = dict(s=model.s, wavelength_step=model.wavelength_step)
     accuracies = mirror_accuracy(model.mirror, (model.method,), **options)
     if not accuracies[model.method].accurate:  # only then are the others needed (render's note, the app's hint)

@@ -448,6 +448,17 @@ class Material:
         """
         values: dict[str, Value] = {p.name: p.default for p in self.parameters}
         for name, value in overrides.items():
+            if isinstance(value, str) and f"medium_{name}" in values and not _NUMBER_RE.match(value.strip()):
+                # An index naming a medium (n2=chitin): the material's medium_NAME selects it (explorer.materials.media).
+                from explorer.materials.media import medium_values
+
+                try:
+                    values.update(medium_values(self, name, value))
+                except LocatedError as exc:
+                    raise MaterialError(self.path, self.parameter(name).line, f"parameter {name!r}: {exc.message}") from None
+                continue
+            if f"medium_{name}" in values and f"medium_{name}" not in overrides:
+                values[f"medium_{name}"] = 0.0  # a number replaces a medium
             p = self.parameter(name)
             try:
                 values[name] = p.coerce(value)
@@ -798,7 +809,8 @@ def load_material(path: str | os.PathLike[str]) -> Material:
     Notes
     -----
     A MERL ``.binary`` table (by suffix, or by its header and size) loads as a measured material without
-    parameters (:mod:`explorer.materials.merl`).
+    parameters (:mod:`explorer.materials.merl`). A Python file of the same stem beside a material file is its
+    plugin twin, loaded here (:mod:`explorer.materials.plugins`; its errors are a ``PluginError`` with file and line).
     """
     name = os.fspath(path)
     try:
@@ -817,13 +829,15 @@ def load_material(path: str | os.PathLike[str]) -> Material:
     except merl.MerlFileError as error:  # a MaterialError for every caller of the loader
         raise MaterialError(error.path, error.line, error.message) from None
     try:
-        return parse_material(data.decode("utf-8-sig"), name)
+        material = parse_material(data.decode("utf-8-sig"), name)
     except UnicodeDecodeError:
-        pass
-    # Old files may carry Latin-1 comments; BRDF Explorer reads bytes and
-    # does not care, so neither do we (but say so).
-    material = parse_material(data.decode("latin-1"), name)
-    material.warnings.insert(0, f"{name}:1: file is not UTF-8; read as Latin-1")
+        # Old files may carry Latin-1 comments; BRDF Explorer reads bytes and
+        # does not care, so neither do we (but say so).
+        material = parse_material(data.decode("latin-1"), name)
+        material.warnings.insert(0, f"{name}:1: file is not UTF-8; read as Latin-1")
+    from explorer.materials import plugins
+
+    plugins.attach(material)  # a Python file of the same stem beside it: its twin (explorer.materials.plugins)
     return material
 
 

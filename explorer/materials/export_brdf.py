@@ -297,6 +297,10 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
     defined = dict(special.get("defines", {}))
     for name in special.get("drop_tables", ()):
         tables.pop(name, None)
+    for name, table in special.get("tables", {}).items():  # baked whatever the exported method
+        table = np.asarray(table, dtype=np.float64)
+        tables[name] = table.reshape(1, -1, 3) if table.ndim == 2 else table
+    baked = special.get("baked", {})
     # The methods' names, which the host #defines in every program: substituted by their values, as PI is
     # (a `const int BRAGG_REFERENCE` would break the explorer's own loading of the file, whose host
     # #defines the same names).
@@ -306,16 +310,47 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
     flat = flatten(shader, str(material.path), defined)
     if special.get("coarse_envelope", False):
         flat = _coarse_envelope(flat)
-    flat = _forward_declare(inline_tables(flat, tables), list(tables))
+    flat = inline_tables(flat, tables)
+    for name, bake in baked.items():
+        flat = _fall_back(flat, name, bake)
+    flat = _forward_declare(flat, list(tables))
     flat = "\n".join(line for line in flat.splitlines() if line.strip())
     if any(line.lstrip().startswith("#") for line in flat.splitlines()):
         raise BrdfExportError(material.path, None, "a preprocessor line is left in the exported shader")
-    header = ("analytic\n\n"
+    notes = [f"{material.model} exported by bragg-explorer (export --to brdf): self-contained, no preprocessor;",
+             "the tables are computed for the exported values."]
+    notes += [baked_note(name, bake) for name, bake in baked.items()]
+    header = ("analytic\n\n" + "".join(f"# {line}\n" for line in notes) + "\n"
               "::begin parameters\n" + "\n".join(_parameter_lines(material, values)) + "\n::end parameters\n\n")
-    return (header + "::begin shader\n"
-            f"// {material.model} exported by bragg-explorer (export --to brdf): self-contained, no preprocessor;\n"
-            "// the tables are baked for the exported values.\n"
-            f"{flat}\n::end shader\n")
+    return (header + "::begin shader\n" + "".join(f"// {line}\n" for line in notes) + f"{flat}\n::end shader\n")
+
+
+def _baked_values(bake: Mapping) -> str:
+    return ", ".join(f"{name} = {value:.9g}" for name, value in bake["values"].items())
+
+
+def baked_note(name: str, bake: Mapping) -> str:
+    """The header's line on a baked table: what it holds for, and what the file reads elsewhere."""
+    return (f"{name}: method {bake['label']}'s table, baked for {_baked_values(bake)}; where one of these moves, "
+            f"method {bake['label']} falls back to method {bake['fallback_label']} (never a stale or black table).")
+
+
+def _fall_back(flat: str, name: str, bake: Mapping) -> str:
+    """
+    Guard ``tabulated_rgb_NAME`` (:func:`inline_tables`) by the values its table was baked for: elsewhere it
+    returns ``bake["fallback"]`` (GLSL of ``cos_theta``). Floats compare within 1e-6 relative (float32
+    uniforms), integers within 0.5.
+    """
+    head = f"vec3 tabulated_rgb_{name}(float cos_theta) {{\n"
+    if head not in flat:
+        raise BrdfExportError("<export>", None, f"the baked table {name} has no lookup to guard")
+    tests = []
+    for parameter, value in bake["values"].items():
+        tolerance = 0.5 if parameter in bake.get("integers", ()) else 1e-6 * max(1.0, abs(value))
+        tests.append(f"abs({parameter} - {value:.9g}) <= {tolerance:.9g}")
+    guard = (f"// {name}: baked for {_baked_values(bake)}; elsewhere method {bake['fallback_label']}.\n"
+             f"bool {name}_baked() {{\n    return " + "\n        && ".join(tests) + ";\n}\n")
+    return flat.replace(head, guard + head + f"    if (!{name}_baked()) return {bake['fallback']};\n", 1)
 
 
 def bparam_text(brdf_file: str, parameters, values: Mapping[str, object]) -> str:

@@ -78,10 +78,13 @@ def roughness_of(material, values) -> float:
 def film_for(material, values) -> gltf_film.Film:
     """The film written for ``material`` at ``values``: the direct mapping where one exists, else the fit."""
     from explorer.materials.models import model_for
+    from explorer.materials.twins import capabilities_of, supporting
 
     model = model_for(material, values)
     if model is None or not callable(getattr(model, "reflectance", None)):
         raise GltfExportError(material.path, None, "this material has no numpy twin to fit a film to (no known '# model:' line)")
+    if not capabilities_of(material).supports("gltf"):
+        raise GltfExportError(material.path, None, f"its twin declares no glTF export (exports: {', '.join(supporting('gltf'))})")
     target = gltf_film.target_rgb(model)
     direct = gltf_film.direct_film(model)
     if direct is None:

@@ -54,7 +54,7 @@ def materialx_document(material, values) -> str:
         inputs += [("base", "float", "0"), ("metalness", "float", "0"), ("specular_IOR", "float", f"{eta3:.9g}")]
     lines = "\n".join(f'    <input name="{n}" type="{t}" value="{v}" />' for n, t, v in inputs)
     return f"""<?xml version="1.0"?>
-<!-- thin_film (Belcour & Barla 2017) exported by bragg-explorer: d = {d:g} nm, eta2 = {eta2:g}, eta3 = {eta3:g}, kappa3 = {kappa3:g}, alpha = {alpha:g} -->
+<!-- {material.model} (Belcour & Barla 2017) exported by bragg-explorer: d = {d:g} nm, eta2 = {eta2:g}, eta3 = {eta3:g}, kappa3 = {kappa3:g}, alpha = {alpha:g} -->
 <materialx version="1.39">
   <standard_surface name="SR_thin_film" type="surfaceshader">
 {lines}
@@ -111,7 +111,9 @@ if __name__ == "__main__":
     from explorer.materials.presets import presets_for
     from explorer.resources import material_path
 
-    material = load_material(material_path("thin_film"))
+    from explorer.materials.thinfilm_model import ThinFilmModel
+
+    material = load_material(material_path(ThinFilmModel.name))
     print("| preset | mean ΔE2000 | max ΔE2000 |\n|---|---|---|")
     for name, preset in presets_for(material.path).presets.items():
         mean, top = airy_delta_e(material.resolve(preset.values))

@@ -17,6 +17,7 @@ visible normals (Heitz 2018) and a cosine lobe, the estimator of the env view; u
 
 from __future__ import annotations
 
+from typing import Callable
 
 import numpy as np
 
@@ -66,20 +67,64 @@ def _albedo(model, cos_v: np.ndarray, alpha: float) -> np.ndarray:
     return out
 
 
-def material_table(material, values) -> np.ndarray:
-    """The table (``(rows, COLUMNS, 3)`` float32) described in the module's docstring."""
+#: Nodes in cos theta of the dense copy of a material's ``reflectance`` its rough rows read (the BRDF's Fresnel
+#: factor at theta_d, where the model takes it from ``reflectance``): computed once for all rows, read linearly.
+#: A film's or a tabulated mirror's colour varies over a few fringes across cos theta at most; 4097 nodes keep
+#: the linear reading within ~1e-6 of it, and a spectral method costs 4097 sums instead of ~10^6.
+DENSE_NODES = 4097
+
+
+def _dense_reflectance(base) -> Callable[[np.ndarray], np.ndarray]:
+    """``reflectance(cos_theta)`` of ``base`` read linearly from :data:`DENSE_NODES` nodes (the same method's values)."""
+    nodes = np.linspace(0.0, 1.0, DENSE_NODES)
+    table = np.asarray(base.reflectance(nodes), dtype=np.float64)
+
+    def reflectance(cos_theta):
+        c = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+        return np.stack([np.interp(c, nodes, table[:, k]) for k in range(3)], axis=-1)
+
+    return reflectance
+
+
+def table_values(material, values) -> dict:
+    """
+    The values a table is baked at: ``values``, a Bragg material on its tabulated method whatever the file's
+    (the converged colours, within 0.01 of the 1-nm sum and many times faster: a table bakes ~10^6 BRDF
+    samples, each a 471-wavelength sum at method 0).
+    """
+    from explorer.materials.methods import BraggMethod, methods_for
+
+    values = dict(values)
+    if "method" in values and methods_for(material) is BraggMethod:
+        values["method"] = int(BraggMethod.TABULATED)
+    return values
+
+
+def material_table(material, values, progress: Callable[[int, int], None] | None = None) -> np.ndarray:
+    """
+    The table (``(rows, COLUMNS, 3)`` float32) described in the module's docstring, at :func:`table_values`;
+    ``progress(done, total)`` after each row.
+    """
     from explorer.materials.models import model_for
 
+    values = table_values(material, values)
     names = roughness_names(material)
     cos = np.linspace(0.0, 1.0, COLUMNS)
     base = model_for(material, values)
     if base is None or not callable(getattr(base, "reflectance", None)):
         raise TableExportError(material.path, None, "this material has no numpy twin to bake (no known '# model:' line)")
     smooth = np.asarray(base.reflectance(cos), dtype=np.float64)
+    total = ROWS if names else 1
+    if progress is not None:
+        progress(1, total)
     if not names:
         return smooth[None].astype(np.float32)
     rows = [smooth]
-    for alpha in np.linspace(0.0, 1.0, ROWS)[1:]:
+    dense = _dense_reflectance(base)  # the roughness changes the lobe, not the smooth colour: built once
+    for k, alpha in enumerate(np.linspace(0.0, 1.0, ROWS)[1:], start=2):
         model = model_for(material, {**values, **{n: float(alpha) for n in names}})
+        model.reflectance = dense
         rows.append(_albedo(model, cos, float(alpha)))
+        if progress is not None:
+            progress(k, total)
     return np.asarray(rows, dtype=np.float32)

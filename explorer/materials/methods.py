@@ -23,6 +23,7 @@ def _member(cls, value: int, label: str, options: dict):
     member.needs_table = bool(options.get("table", False))  # the host builds a table for it
     member.approximate = bool(options.get("approximate", True))  # an approximation (else exact colours)
     member.source = str(options.get("source", ""))  # the paper and equations it follows
+    member.preferred = bool(options.get("preferred", False))  # the family's best colours at a table lookup (design's render line)
     return member
 
 
@@ -33,8 +34,14 @@ class _Method(enum.IntEnum):
         return _member(cls, value, label, options)
 
     @classmethod
+    def preferred_member(cls):
+        """The member declared ``preferred`` (the best colours at a table lookup), or None."""
+        return next((m for m in cls if m.preferred), None)
+
+    @classmethod
     def glsl_prefix(cls) -> str:
-        raise NotImplementedError
+        """The prefix of its members' ``#define`` names (``BRAGG_`` …): by default the class name's, upper case."""
+        return cls.__name__.upper().removesuffix("METHOD") + "_"
 
 
 class BraggMethod(_Method):
@@ -43,7 +50,7 @@ class BraggMethod(_Method):
     REFERENCE = (0, "reference", dict(approximate=False, source="Fourneau et al. 2024, Eqs. 2, 9, 10 (the 1-nm sum)"))
     BASIC = (1, "basic", dict(source="Fourneau et al. 2024, Eqs. 11-16, Appendix B"))
     SUBDIVIDED = (2, "subdivided", dict(source="Fourneau et al. 2024, Section 3.2 (quality s)"))
-    TABULATED = (3, "tabulated", dict(table=True, approximate=False, source="ours: the converged spectral colour over cos theta"))
+    TABULATED = (3, "tabulated", dict(table=True, approximate=False, preferred=True, source="ours: the converged spectral colour over cos theta"))
     IMPROVED = (4, "improved", dict(source="ours: fringe-averaged, graded boxes"))
 
     @classmethod
@@ -57,7 +64,7 @@ class ThinFilmMethod(_Method):
     REFERENCE = (0, "reference", dict(approximate=False, source="Belcour & Barla 2017, Eq. 4 (the 1-nm sum)"))
     FOURIER_1 = (1, "Fourier m=1", dict(source="Belcour & Barla 2017, Eq. 10, m = 1, with its remainder"))
     FOURIER_2 = (2, "Fourier m=2", dict(source="Belcour & Barla 2017, Eq. 10, m = 2, with its remainder"))
-    FOURIER_3 = (3, "Fourier m=3", dict(source="Belcour & Barla 2017, Eq. 10, m = 3, with its remainder"))
+    FOURIER_3 = (3, "Fourier m=3", dict(preferred=True, source="Belcour & Barla 2017, Eq. 10, m = 3, with its remainder"))
     GAUSSIAN = (4, "Gaussian fits", dict(source="Belcour & Barla 2017, Eq. 10, m = 3, Gaussian XYZ fits"))
     NAIVE = (5, "naive RGB", dict(source="Belcour & Barla 2017, Section 4 (one wavelength per channel)"))
 
@@ -107,19 +114,16 @@ def method_labels(material) -> dict[int, str]:
 
 def opening_values(material) -> dict[str, int]:
     """
-    The overrides a material opens with, in the app and in ``render`` alike: the default material
-    (``bragg_mirror.brd``) on its fastest exact method, the tabulated one (its file's default is the
-    reference, 1-nm sum); ``{}`` for every other material.
+    The overrides a material opens with, in the app, ``render``, ``export`` and ``albedo`` alike: every
+    Bragg material (a ``# model:`` whose methods are :class:`BraggMethod`, built-in or a copy, whatever its
+    name) on the tabulated method, exact and fast; the built-in files declare it as their default, and an
+    older copy that declares the 1-nm reference opens on it too. The reference stays a choice
+    (``--set method=0``). ``{}`` for every other material.
     """
-    from pathlib import Path
-
-    from explorer.resources import DEFAULT_MATERIAL
-
-    path = getattr(material, "path", None)
-    if path is None or not any(p.name == "method" for p in material.parameters):
+    parameter = next((p for p in getattr(material, "parameters", ()) if p.name == "method"), None)
+    if parameter is None or methods_for(getattr(material, "model", None)) is not BraggMethod:
         return {}
-    try:
-        same = Path(path).resolve() == DEFAULT_MATERIAL.resolve()
-    except OSError:
-        same = False
-    return {"method": int(BraggMethod.TABULATED)} if same else {}
+    tabulated = int(BraggMethod.TABULATED)
+    if parameter.min is not None and not (parameter.min <= tabulated <= parameter.max):
+        return {}
+    return {"method": tabulated}

@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, microfacet
+from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter, natural
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
@@ -53,15 +53,22 @@ def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray
     return layered.integrated_transmissivity(F, 1.0 - R)
 
 
+def host_index(nh):
+    """
+    The host a mirror's ``nh`` value stands for: a number below 1 means the host is ``n1`` (None), as the shaders
+    have it; any other value (an index, a dispersive medium) is the host. The one place of this rule.
+    """
+    return None if isinstance(nh, (int, float)) and float(nh) < 1.0 else nh
+
+
 def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
     """
-    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: below 1 the host
-    is ``n1``, as the shaders have it): the one reading of these values, for the twins, the app and design.
+    The Bragg mirror a material's values describe (``n1, n2, Lambda, delta, N``, and ``nh``: :func:`host_index`):
+    the one reading of these values, for the twins, the app and design.
     """
-    nh = float(values.get("nh", 0.0))
     return bragg.BraggMirror(
         n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
-        N=round_integer(values["N"]), nh=nh if nh >= 1.0 else None,
+        N=round_integer(values["N"]), nh=host_index(float(values.get("nh", 0.0))),
     )
 
 
@@ -71,13 +78,15 @@ class BraggMirrorModel:
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.mirror = mirror_of(values)
         self.method = BraggMethod(round_integer(values.get("method", 0)))
         self.s = round_integer(values.get("s", 3))
+        #: Absorbing, dispersive or disordered layers (explorer.physics.natural): every method shows their exact table.
+        self.natural = natural_mirror_of(values)
         # The reference's wavelength step (nm): 1 is the paper's 1-nm sum (bragg_layer.brd has no such parameter).
         self.wavelength_step = float(values.get("wavelength_step", 1.0))
         self._table: np.ndarray | None = None
@@ -86,11 +95,13 @@ class BraggMirrorModel:
     def table(self) -> np.ndarray:
         """The tabulated method's RGB over cos(theta) (built once per parameter set)."""
         if self._table is None:
-            self._table = bragg.tabulated_rgb_table(self.mirror)
+            self._table = bragg.tabulated_rgb_table(self.mirror) if self.natural is None else natural.natural_rgb_table(self.natural)
         return self._table
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """Linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
+        if self.natural is not None:  # the shader's natural_structure(): the exact table whatever the method
+            return bragg.tabulated_rgb(self.table, np.asarray(cos_theta, dtype=np.float64))
         return BRAGG_REFLECTANCE[self.method](self, np.asarray(cos_theta, dtype=np.float64))
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
@@ -143,17 +154,59 @@ class BraggMirrorModel:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
         return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
 
+    #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
+    #: where the file declares them), and the integer ones among them.
+    MIRROR_PARAMETERS = ("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma", "medium_n1", "medium_n2", "medium_nh")
+    INTEGER_MIRROR_PARAMETERS = ("N", "medium_n1", "medium_n2", "medium_nh")
+    #: The shader's improved approximation (method 4, its ``reflectance`` branch): what an exported table
+    #: falls back to away from its values.
+    IMPROVED_GLSL = "approximate_rgb(cos_theta, bragg_mirror(), s, false, true)"
+
+    def brdf_export(self) -> dict:
+        """
+        How ``export --to brdf`` bakes the mirror (:mod:`explorer.materials.export_brdf`): the tabulated method's
+        table for the exported mirror, whatever the exported method, and the values it holds for: where a
+        mirror parameter moves away from them, the file's method 3 reads method 4 (the improved approximation).
+        """
+        baked = {name: float(self.values[name]) for name in self.MIRROR_PARAMETERS if name in self.values}
+        integers = tuple(name for name in self.INTEGER_MIRROR_PARAMETERS if name in baked)
+        return {"tables": {"bragg_table": self.table},
+                "baked": {"bragg_table": {"values": baked, "integers": integers, "fallback": self.IMPROVED_GLSL,
+                                          "fallback_label": f"{int(BraggMethod.IMPROVED)} {BraggMethod.IMPROVED.label}",
+                                          "label": f"{int(BraggMethod.TABULATED)} {BraggMethod.TABULATED.label}"}}}
+
     def textures(self) -> dict[str, np.ndarray]:
         """Tables for the shader's samplers, as ``(width, 3)`` float arrays."""
         # Only the tabulated method reads its table; the others get a placeholder texel.
-        return {"bragg_table": self.table if self.method.needs_table else np.zeros((1, 3), np.float32)}
+        needed = self.method.needs_table or self.natural is not None
+        return {"bragg_table": self.table if needed else np.zeros((1, 3), np.float32)}
 
     def draft_textures(self) -> dict[str, np.ndarray] | None:
         """
         Quick stand-ins for :meth:`textures` while a slider moves (the tabulated method's draft table,
         :func:`explorer.physics.bragg.draft_rgb_table`); None when the tables are cheap anyway.
         """
+        if self.natural is not None:
+            return None  # the exact table only (no draft of complex, dispersive spectra)
         return {"bragg_table": bragg.draft_rgb_table(self.mirror)} if self.method.needs_table else None
+
+
+def natural_mirror_of(values: Mapping[str, object]) -> "natural.NaturalMirror | None":
+    """
+    The natural mirror of a ``bragg_mirror``'s (or ``bragg_layer``'s) values when they have absorbing, dispersive
+    or disordered layers (``k1``, ``k2``, ``sigma``, ``medium_*``), else None (the paper's mirror).
+    """
+    from explorer.materials.media import index_value
+
+    k1, k2, sigma = (float(values.get(name, 0.0)) for name in ("k1", "k2", "sigma"))
+    n1, n2 = index_value(values, "n1"), index_value(values, "n2")
+    nh_value = index_value(values, "nh") if "nh" in values else 0.0
+    media = any(not isinstance(v, float) for v in (n1, n2, nh_value))
+    if not (k1 > 0.0 or k2 > 0.0 or sigma > 0.0 or media):
+        return None
+    nh = host_index(nh_value)
+    return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+                                 N=round_integer(values["N"]), nh=nh, k1=k1, k2=k2, sigma=sigma)
 
 
 #: The Bragg mirror's reflectance per method (the shader's branches on BRAGG_* in bragg_mirror.brd).
@@ -196,7 +249,7 @@ class BraggLayerModel(BraggMirrorModel):
 
     name = "bragg_layer"
     capabilities = Capabilities(methods=BraggMethod, dirac=False, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
     # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
@@ -264,6 +317,21 @@ def _layer_tables(layer: layered.RoughBraggLayer, n1: float) -> layered.LayerTab
     return layered.layer_tables(layer, n1)
 
 
+@functools.lru_cache(maxsize=32)
+def _layer_compensation(layer: layered.RoughBraggLayer, n1: float):
+    """A layer's multiple-scattering compensation from its cached tables, cached likewise."""
+    table = _layer_tables(layer, n1)
+    return multiscatter.compensation_tables(table.reflectance, table.transmissivity, table.theta, layer.alpha)
+
+
+def _flat_tables(table: layered.LayerTables, R: float) -> layered.LayerTables:
+    """``table`` with facets reflecting ``R`` everywhere (the furnace hook of :class:`BraggStackModel`)."""
+    reflectance = np.full_like(table.reflectance, R)
+    transmissivity = (layered.transmission_filter_for(table.layer.alpha).weights.astype(np.float32)
+                      @ (np.float32(1.0) - reflectance)).astype(np.float32)
+    return layered.LayerTables(table.layer, table.n1, table.theta, reflectance, transmissivity)
+
+
 def _number(values: Mapping[str, object], name: str) -> float:
     return float(values[name])
 
@@ -280,13 +348,19 @@ class BraggStackModel:
     """
 
     name = "bragg_stack"
+    #: The furnace's test hook: when set (a number in [0, 1]), every layer's facets reflect this at every angle
+    #: and wavelength (``R_lambda = value``, the transmissivity of Eq. 28 from ``1 - value``), in the numpy twin
+    #: and in the textures the shader reads alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
+    facet_reflectance_override: float | None = None
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table"), design=False)
+                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.stack = self.stack_of(values)
+        self.multiple_scattering = bool(values.get("multiple_scattering", True))
         self._tables: tuple | None = None
+        self._compensation: tuple | None = None
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
 
     @staticmethod
@@ -306,6 +380,7 @@ class BraggStackModel:
             ))
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
+            tau_h=float(values.get("tau_h", 0.0)),
         )
 
     @property
@@ -313,7 +388,21 @@ class BraggStackModel:
         """Every layer's tables (:func:`explorer.physics.layered.layer_tables`, cached per layer), built on first use."""
         if self._tables is None:
             self._tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+            if self.facet_reflectance_override is not None:
+                self._tables = tuple(_flat_tables(t, float(self.facet_reflectance_override)) for t in self._tables)
         return self._tables
+
+    @property
+    def compensation(self) -> tuple | None:
+        """Every layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter`), or None when off."""
+        if not self.multiple_scattering:
+            return None
+        if self._compensation is None:
+            if self.facet_reflectance_override is None:
+                self._compensation = tuple(_layer_compensation(layer, self.stack.n1) for layer in self.stack.layers)
+            else:
+                self._compensation = layered.stack_compensation(self.stack, self.tables)
+        return self._compensation
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
@@ -326,7 +415,7 @@ class BraggStackModel:
             return np.stack([np.sum(d * X, axis=-1), np.sum(d * Y, axis=-1), np.sum(d * N, axis=-1)], axis=-1)
 
         X, Y, N = (np.asarray(a, dtype=np.float64) for a in (X, Y, N))
-        return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables)
+        return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables, compensation=self.compensation)
 
     def mirror_reflection(self, V, N) -> np.ndarray:
         """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
@@ -358,27 +447,35 @@ class BraggStackModel:
         columns the wavelengths, channel l layer l (zeros beyond the used layers); ``stack_sampling``:
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator).
         """
-        return self._textures_of(self.tables)
+        return self._textures_of(self.tables, self.compensation)
 
     def draft_textures(self) -> dict[str, np.ndarray]:
         """
         Quick stand-ins for :meth:`textures` while a slider moves: the layers' tables from ``R_lambda`` at
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
-        return self._textures_of(tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers))
+        tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
+        return self._textures_of(tables, layered.stack_compensation(self.stack, tables) if self.multiple_scattering else None)
 
     @staticmethod
-    def _textures_of(tables) -> dict[str, np.ndarray]:
+    def _textures_of(tables, compensation=None) -> dict[str, np.ndarray]:
         shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
         reflectance = np.zeros(shape, np.float32)
         transmissivity = np.zeros(shape, np.float32)
         for l, table in enumerate(tables):
             reflectance[..., l] = table.reflectance
             transmissivity[..., l] = table.transmissivity
+        # stack_missing: rows theta = k 2 deg (46) of m(theta), then r and r / (pi m_avg) (zeros: no compensation).
+        missing = np.zeros((multiscatter.COMPENSATION_ROWS + 2, colorimetry.WAVELENGTHS.size, 3), np.float32)
+        for l, c in enumerate(compensation or ()):
+            missing[:-2, :, l] = c.missing
+            missing[-2, :, l] = c.up
+            missing[-1, :, l] = c.up / (np.pi * np.maximum(c.missing_average, 1e-12))
         return {
             "stack_reflectance": reflectance,
             "stack_transmissivity": transmissivity,
             "stack_sampling": transmissivity.mean(axis=1, dtype=np.float64).astype(np.float32),
+            "stack_missing": missing,
         }
 
 
@@ -388,7 +485,7 @@ class SchlickFresnelModel:
 
     name = "schlick_fresnel"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.F0 = float(values["F0"])
@@ -414,7 +511,7 @@ class GGXSchlickModel:
 
     name = "ggx_schlick"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table",), design=False)
+                                exports=("table", "gltf"), design=False)
 
     def __init__(self, values: Mapping[str, object]):
         self.alpha = float(values["alpha"])

@@ -49,7 +49,7 @@ class ThinFilmModel:
 
     name = "thin_film"
     capabilities = Capabilities(methods=ThinFilmMethod, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx"), design=True)
+                                albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx", "gltf"), design=True)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)

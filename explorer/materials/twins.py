@@ -25,7 +25,7 @@ import numpy as np
 #: position-free Monte Carlo reference of layered Bragg structures.
 ALBEDO_ENGINES = ("numpy", "gl", "position-free")
 #: The export targets a twin may declare (``export --to``).
-EXPORT_TARGETS = ("mitsuba", "brdf", "table", "materialx")
+EXPORT_TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -56,6 +56,15 @@ class Capabilities:
         if unknown:
             raise ValueError(f"unknown engine or export {unknown[0]!r} (albedo engines: {', '.join(ALBEDO_ENGINES)}; "
                              f"exports: {', '.join(EXPORT_TARGETS)})")
+
+    def summary(self) -> str:
+        """One line for ``info``: the engines, the exports, design, and what kind of reflector it is."""
+        if not self.numpy:
+            return f"GL only (no numpy twin); albedo {', '.join(self.albedo)}"
+        kinds = [k for k, on in (("a Dirac reflector", self.dirac), ("a Bragg spectrum", self.bragg_spectrum)) if on]
+        parts = ["render gl, numpy", f"albedo {', '.join(self.albedo)}", f"export {', '.join(self.exports) or 'none'}",
+                 f"design {'yes' if self.design else 'no'}"]
+        return "; ".join(parts + kinds)
 
     def supports(self, what: str) -> bool:
         """Whether ``what`` (an albedo engine, an export target, ``numpy`` or ``design``) is declared."""

@@ -44,7 +44,6 @@ def render_file(path, variant: str | None = None, spp: int | None = None, seed: 
     scene = load_file(path, variant)
     import mitsuba as mi
 
-    mi.set_log_level(mi.LogLevel.Error)
     image = render_in_passes(mi, scene, spp, seed)
     if is_spectral(mi.variant()):
         image = xyz_to_explorer_rgb(image)

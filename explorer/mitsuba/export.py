@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from pathlib import Path
 from typing import Mapping
 from xml.sax.saxutils import quoteattr
@@ -37,6 +36,13 @@ def _value_xml(p, value) -> str:
     return f'<float name="{p.name}" value="{float(value):.9g}"/>'
 
 
+def xml_comment(text: str) -> str:
+    """``text`` made safe inside an XML comment, which may not hold ``--`` nor end in ``-`` (XML 1.0, section 2.5)."""
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text + " " if text.endswith("-") else text
+
+
 def scene_xml(material, values: Mapping[str, object], spp: int = 256, size: tuple[int, int] = (256, 256),
               mesh: str | None = None) -> str:
     """The env view's scene, with ``material`` at ``values``, as Mitsuba 3 XML text."""
@@ -48,7 +54,7 @@ def scene_xml(material, values: Mapping[str, object], spp: int = 256, size: tupl
         shape = (f'    <shape type="{kind}">\n        <string name="filename" value={quoteattr(mesh)}/>\n'
                  '        <ref id="material"/>\n    </shape>')
     return f"""<?xml version="1.0" encoding="utf-8"?>
-<!-- {material.model}: the explorer's env view (bragg-explorer export --to mitsuba). Load it with
+<!-- {xml_comment(f"{material.model}: the explorer's env view, written by its export command (target mitsuba). Load it with")}
      explorer.mitsuba.load_file(path), which registers the explorer's BSDF plugins first. -->
 <scene version="3.0.0">
     <default name="spp" value="{int(spp)}"/>
@@ -84,14 +90,11 @@ def scene_xml(material, values: Mapping[str, object], spp: int = 256, size: tupl
 
 
 def _write_atomically(path: Path, write) -> None:
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(handle)
-    try:
-        write(Path(temporary))
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    """``write(temporary)`` then the rename, through :func:`explorer.files.atomic_output` (mode 0644 under the usual umask)."""
+    from explorer.files import atomic_output
+
+    with atomic_output(path) as temporary:
+        write(temporary)
 
 
 def export_scene(material, values: Mapping[str, object], directory: str | os.PathLike[str],

@@ -22,7 +22,11 @@ XYZ under illuminant E, adapted to D65 by Bradford and scaled so that white is R
 
 from __future__ import annotations
 
-from typing import Callable, Mapping
+import contextlib
+import math
+import re
+import sys
+from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -96,19 +100,79 @@ def env_scene_dict(material, values: Mapping[str, object], environment: Environm
     }
 
 
-def render_in_passes(mi, scene, spp: int | None = None, seed: int = 0) -> np.ndarray:
+_INVALID_SAMPLE = re.compile(r"Invalid sample value: \[([^\]]*)\]")
+
+
+def out_of_gamut_sample(text: str) -> bool:
+    """Whether a Mitsuba log line is ImageBlock's "Invalid sample value" for a finite sample (a negative channel)."""
+    match = _INVALID_SAMPLE.search(text)
+    if match is None:
+        return False
+    try:
+        values = [float(x) for x in match.group(1).split(",")]
+    except ValueError:
+        return False
+    return bool(values) and all(math.isfinite(x) for x in values)
+
+
+@contextlib.contextmanager
+def out_of_gamut_counted(mi, note: Callable[[str], None] | None = None) -> Iterator[None]:
+    """
+    While rendering: Mitsuba's "Invalid sample value" warnings for finite samples (the scalar RGB variants'
+    ImageBlock warns for each sample with a channel below 0, one line per sample) are counted, not printed,
+    and summed up in one ``note`` afterwards (stderr by default). A vivid Bragg colour has negative
+    linear-sRGB channels: the GL view and the numpy twin keep them, so the render keeps them too (colours
+    unchanged). Every other message, NaN and infinite samples included, passes through.
+    """
+    logger = mi.logger() if hasattr(mi, "logger") else mi.Thread.thread().logger()
+    appenders = [logger.appender(k) for k in range(logger.appender_count())]
+
+    class Counting(mi.Appender):
+        def __init__(self):
+            super().__init__()
+            self.count = 0
+
+        def append(self, level, text):
+            if level == mi.LogLevel.Warn and out_of_gamut_sample(text):
+                self.count += 1
+                return
+            for appender in appenders:
+                appender.append(level, text)
+
+        def log_progress(self, progress, name, formatted, eta, ptr=None):
+            for appender in appenders:
+                appender.log_progress(progress, name, formatted, eta, ptr)
+
+    counting = Counting()
+    logger.clear_appenders()
+    logger.add_appender(counting)
+    try:
+        yield
+    finally:
+        logger.clear_appenders()
+        for appender in appenders:
+            logger.add_appender(appender)
+        if counting.count:
+            (note or (lambda m: print(m, file=sys.stderr)))(
+                f"note: {counting.count} samples had negative linear-sRGB channels (out-of-gamut colours, kept as the "
+                "GL view keeps them; Mitsuba's 'Invalid sample value' warnings for them not shown)")
+
+
+def render_in_passes(mi, scene, spp: int | None = None, seed: int = 0, note: Callable[[str], None] | None = None) -> np.ndarray:
     """
     ``mi.render(scene, spp)``'s first three channels (float64), rendered in passes of at most
     :data:`PATHS_PER_PASS` paths with seeds of their own and averaged, weighted by their spp (the same
-    estimator, bounded memory). ``spp`` None or 0: the scene's sampler's count.
+    estimator, bounded memory). ``spp`` None or 0: the scene's sampler's count. Out-of-gamut samples'
+    warnings become one ``note`` (:func:`out_of_gamut_counted`).
     """
     sensor = scene.sensors()[0]
     spp = int(spp or sensor.sampler().sample_count())
     width, height = (int(c) for c in sensor.film().crop_size())
     passes = max(1, -(-spp * width * height // PATHS_PER_PASS))  # ceil
     counts = [spp // passes + (k < spp % passes) for k in range(passes)]
-    return sum(count * np.asarray(mi.render(scene, spp=count, seed=int(seed) * passes + k), dtype=np.float64)[..., :3]
-               for k, count in enumerate(counts) if count) / spp
+    with out_of_gamut_counted(mi, note):
+        return sum(count * np.asarray(mi.render(scene, spp=count, seed=int(seed) * passes + k), dtype=np.float64)[..., :3]
+                   for k, count in enumerate(counts) if count) / spp
 
 
 def xyz_to_explorer_rgb(xyz: np.ndarray) -> np.ndarray:
@@ -128,10 +192,9 @@ def render_env_mitsuba(material, values: Mapping[str, object], width: int, heigh
 
     variant = choose_variant(variant, note)
     mi = register(variant)
-    mi.set_log_level(mi.LogLevel.Error)  # out-of-gamut (negative) RGB samples are expected, not warnings
     environment = environment if environment is not None else EnvironmentMap.default()
     scene = mi.load_dict(env_scene_dict(material, values, environment, width, height, spp, variant))
-    image = render_in_passes(mi, scene, int(spp), seed)
+    image = render_in_passes(mi, scene, int(spp), seed, note)
     if is_spectral(variant):
         image = xyz_to_explorer_rgb(image)
     return image.astype(np.float32)

@@ -37,7 +37,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from explorer.physics import bragg, colorimetry, microfacet
+from explorer.physics import bragg, colorimetry, microfacet, multiscatter
 from explorer.physics.fresnel import fresnel_reflectance
 
 #: At most this many rough Bragg layers in a stack.
@@ -119,12 +119,17 @@ class LayeredBragg:
     coating : bool
         ``False`` drops the coating's interface (no Fresnel reflection, no refraction, no ``1/n1^2``):
         the stack seen from inside its host. With ``n1 = 1`` both give the same BRDF.
+    tau_h : float
+        The host's optical depth, at normal incidence, of each gap a path crosses: below the coating,
+        between consecutive layers, above the base. Crossing one at ``theta_t`` in the host attenuates by
+        ``exp(-tau_h / cos theta_t)`` (Beer-Lambert; Section 6's absorption between the layers). >= 0.
     """
 
     layers: tuple = ()
     n1: float = 1.0
     rho_d: tuple = (0.0, 0.0, 0.0)
     coating: bool = True
+    tau_h: float = 0.0
 
     def __post_init__(self):
         layers = tuple(self.layers) if not isinstance(self.layers, RoughBraggLayer) else (self.layers,)
@@ -144,6 +149,20 @@ class LayeredBragg:
         object.__setattr__(self, "layers", layers)
         object.__setattr__(self, "rho_d", tuple(float(x) for x in rho_d))
         object.__setattr__(self, "n1", float(self.n1))
+        if not (float(self.tau_h) >= 0.0 and np.isfinite(self.tau_h)):
+            raise ValueError(f"tau_h must be >= 0, got {self.tau_h}")
+        object.__setattr__(self, "tau_h", float(self.tau_h))
+
+
+#: Cosines of the host angles are kept above this in the gaps' attenuation (exp(-tau / cos) is 0 there anyway).
+GAP_COS_MIN = 1e-6
+
+
+def gap_transmittance(tau_h: float, cos_theta_host: ArrayLike) -> np.ndarray:
+    """``exp(-tau_h / cos theta)``: one crossing of a host gap at ``theta`` in the host (1 when ``tau_h = 0``)."""
+    if tau_h == 0.0:
+        return np.ones(np.shape(cos_theta_host))
+    return np.exp(-tau_h / np.maximum(np.asarray(cos_theta_host, dtype=np.float64), GAP_COS_MIN))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -399,7 +418,8 @@ class SingleReflectionSpectra:
 
 
 def single_reflection_spectra(
-    stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False
+    stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False,
+    compensation: Sequence[multiscatter.CompensationTables] | None = None,
 ) -> SingleReflectionSpectra:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34), spectrally:
@@ -419,6 +439,10 @@ def single_reflection_spectra(
     exact_reflectance : bool
         ``True`` evaluates Yeh's ``R_lambda`` at the exact half-vector angle (Table 2's "Model"),
         ``False`` interpolates the layer's table (Table 2's "Model-LUT").
+    compensation : sequence of explorer.physics.multiscatter.CompensationTables, optional
+        One per layer (:func:`stack_compensation`): multiple scattering among each layer's facets
+        (:mod:`explorer.physics.multiscatter`: Eq. 17's masking by transparent occluders, their ballistic
+        transmission and Kulla & Conty's lobe for the rest). ``None``: Eq. 34 as published.
 
     Returns
     -------
@@ -454,8 +478,16 @@ def single_reflection_spectra(
     theta_d = np.arctan2(np.linalg.norm(i_host - o_host, axis=-1), np.linalg.norm(i_host + o_host, axis=-1))
     cos_i_host = np.maximum(i_host[..., 2], 0.0)
     cos_o_host = np.maximum(o_host[..., 2], 0.0)
+    # The host's absorption: each gap above a layer (and above the base) crossed down along i' and up along o'.
+    gap = (gap_transmittance(stack.tau_h, cos_i_host) * gap_transmittance(stack.tau_h, cos_o_host))[..., None]
     layers = 0.0
-    for layer, table in zip(stack.layers, tables):
+    for l, (layer, table) in enumerate(zip(stack.layers, tables)):
+        path = path * gap
+        if compensation is not None:
+            layer_term, t_i, t_o = _compensated_layer(layer, table, compensation[l], h, theta_d, theta_i, theta_o, cos_i_host, cos_o_host)
+            layers = layers + layer_term * path
+            path = path * t_i * t_o
+            continue
         # Eq. 17: D(h) G1(i) G1(o) R(i.h) / (4 cos_i cos_o), G1/cos finite at grazing angles.
         lobe = (
             0.25
@@ -471,11 +503,41 @@ def single_reflection_spectra(
             R = lookup(table.reflectance, theta_d)
         layers = layers + lobe[..., None] * R * path
         path = path * lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o)
+    path = path * gap
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
+
+
+def _compensated_layer(layer, table, compensation, h, theta_d, theta_i, theta_o, cos_i, cos_o):
+    """
+    One layer's reflection with multiple scattering (:mod:`explorer.physics.multiscatter`) and its transmissions
+    along ``i`` and ``o`` as the layers below see them, per wavelength.
+    """
+    alpha = layer.alpha
+    t_i, t_o = lookup(table.transmissivity, theta_i), lookup(table.transmissivity, theta_o)
+    rho_i = multiscatter.occluder_reflectance(t_i, cos_i, alpha)
+    rho_o = multiscatter.occluder_reflectance(t_o, cos_o, alpha)
+    # Eq. 17 with G_eff for G1: D(h) G_eff(i) G_eff(o) R(i.h) / (4 cos_i cos_o).
+    lobe = 0.25 * microfacet.ggx_D(h[..., 2], alpha)[..., None]
+    reflection = (lobe * multiscatter.masking_over_cos(cos_i, alpha, rho_i) * multiscatter.masking_over_cos(cos_o, alpha, rho_o)
+                  * lookup(table.reflectance, theta_d))
+    m_i, m_o = multiscatter.missing_energy(compensation, theta_i), multiscatter.missing_energy(compensation, theta_o)
+    through_i = multiscatter.compensated_transmissivity(
+        multiscatter.ballistic_transmissivity(rho_i, multiscatter.effective_masking(cos_i, alpha, rho_i)), m_i, compensation)
+    through_o = multiscatter.compensated_transmissivity(
+        multiscatter.ballistic_transmissivity(rho_o, multiscatter.effective_masking(cos_o, alpha, rho_o)), m_o, compensation)
+    return reflection + multiscatter.compensation_lobe(m_i, m_o, compensation), through_i, through_o
+
+
+def stack_compensation(stack: LayeredBragg, tables: Sequence[LayerTables] | None = None) -> tuple[multiscatter.CompensationTables, ...]:
+    """Every layer's multiple-scattering compensation (:func:`explorer.physics.multiscatter.compensation_tables`), top to bottom."""
+    tables = stack_tables(stack) if tables is None else tuple(tables)
+    return tuple(multiscatter.compensation_tables(t.reflectance, t.transmissivity, t.theta, layer.alpha)
+                 for layer, t in zip(stack.layers, tables))
 
 
 def single_reflection_brdf(
     stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False,
+    compensation: Sequence[multiscatter.CompensationTables] | None = None,
 ) -> np.ndarray:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34) in linear sRGB (1/sr): the Bragg
@@ -500,7 +562,7 @@ def single_reflection_brdf(
     ----------
     Fourneau et al. (2024), Eq. 34; the colour convention of :mod:`explorer.physics.colorimetry`.
     """
-    spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance)
+    spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance, compensation)
     return colorimetry.spectrum_to_rgb(spectra.layers) + np.asarray(stack.rho_d) * colorimetry.spectrum_to_rgb(spectra.base)
 
 
@@ -534,8 +596,10 @@ def stack_specular_rgb(stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequen
     tables = stack_tables(stack) if tables is None else tuple(tables)
     theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
     through = ((1.0 - F) ** 2)[..., None]
+    gap = (gap_transmittance(stack.tau_h, np.cos(theta)) ** 2)[..., None]  # a gap down and up at theta'
     spectrum = 0.0
     for table in tables:
+        through = through * gap
         R = lookup(table.reflectance, theta)
         spectrum = spectrum + through * R
         through = through * (1.0 - R) ** 2

@@ -71,11 +71,11 @@ class StackOptics:
 
 
 def stack_optics(polarisation: str, n0: ArrayLike, indices: list, thicknesses: ArrayLike, n_base: ArrayLike,
-                 wavelength_nm: ArrayLike, sin_theta0: float) -> StackOptics:
+                 wavelength_nm: ArrayLike, sin_theta0: ArrayLike) -> StackOptics:
     """
     Coherent ``r, t, R, T`` of layers ``indices[j]`` (complex, each broadcast against ``wavelength_nm``)
     of thicknesses ``thicknesses[..., j]`` (nm), top first, between a lossless ``n0`` above and ``n_base``
-    below, lit from ``n0`` at ``sin theta0``.
+    below, lit from ``n0`` at ``sin theta0`` (a number, or an array broadcast against ``wavelength_nm``).
 
     ``thicknesses`` may have leading axes (realisations): the results then have shape
     ``thicknesses.shape[:-1] + wavelength_nm.shape``. ``T`` is the power entering the base (``tmm``'s
@@ -106,10 +106,13 @@ def stack_optics(polarisation: str, n0: ArrayLike, indices: list, thicknesses: A
     n_b = media[-1]
     cos_0 = kz[0] / media[0]
     cos_b = kz[-1] / n_b
-    if polarisation == "s":
-        T = np.abs(t) ** 2 * (n_b * cos_b).real / (media[0] * cos_0).real
-    else:
-        T = np.abs(t) ** 2 * (n_b * np.conj(cos_b)).real / (media[0] * np.conj(cos_0)).real
+    incident = (media[0] * (cos_0 if polarisation == "s" else np.conj(cos_0))).real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if polarisation == "s":
+            T = np.abs(t) ** 2 * (n_b * cos_b).real / incident
+        else:
+            T = np.abs(t) ** 2 * (n_b * np.conj(cos_b)).real / incident
+    T = np.where(incident > 0.0, T, 0.0)  # exact grazing: nothing enters
     return StackOptics(r=r, t=t, R=R, T=T)
 
 
@@ -139,7 +142,7 @@ def disordered_thicknesses(thicknesses: ArrayLike, sigma: float, realisations: i
 
 
 def mean_optics(polarisation: str, n0: ArrayLike, indices: list, thicknesses: np.ndarray, n_base: ArrayLike, wavelength_nm: np.ndarray,
-                sin_theta0: float) -> tuple[np.ndarray, np.ndarray]:
+                sin_theta0: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """The mean ``R`` and ``T`` over the rows of ``thicknesses`` (realisations), in blocks of :data:`REALISATION_BLOCK`."""
     R = np.zeros(np.shape(wavelength_nm))
     T = np.zeros(np.shape(wavelength_nm))

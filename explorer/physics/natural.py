@@ -156,3 +156,80 @@ def band_gaps(mirror: NaturalMirror, wavelength_nm: ArrayLike, theta_deg: float)
         a = np.real(np.cos(psi) * np.cos(phi) - 0.5 * (x + 1.0 / x) * np.sin(psi) * np.sin(phi))
         gap |= np.abs(a) > 1.0
     return gap
+
+
+# --------------------------------------------------------------------------------------------------
+# Colours: the exact spectra against the CMFs (the reference and the tabulated method of a natural mirror)
+
+#: Realisations per colour of a disordered mirror (a colour averages its spectrum's noise over wavelength:
+#: fewer than :data:`explorer.physics.multilayer.REALISATIONS`, measured by ``explorer.dev.natural_studies``).
+COLOUR_REALISATIONS = 128
+#: Entries of a natural mirror's table over cos theta (linear interpolation, as the tabulated method's); a
+#: disordered mirror's colour varies slowly with angle (no fringes) and costs realisations: fewer entries.
+NATURAL_TABLE_SIZE = 129
+DISORDERED_TABLE_SIZE = 33
+#: The finest sampling (samples per nm) of an ordered natural mirror's colour.
+NATURAL_MAX_SUBSTEPS = 64
+
+
+def _unpolarised(mirror: NaturalMirror, wavelength_nm: np.ndarray, cos_theta: ArrayLike, realised: np.ndarray) -> np.ndarray:
+    """Mean unpolarised R at ``wavelength_nm`` (broadcast against ``cos_theta``), over the rows of ``realised``."""
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    shape = np.broadcast_shapes(wavelength_nm.shape, cos_theta.shape)
+    wavelength_nm = np.broadcast_to(wavelength_nm, shape)
+    host, indices, _, base = mirror.layer_stack(wavelength_nm)
+    sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
+    R = 0.0
+    for pol in ("s", "p"):
+        R = R + 0.5 * multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)[0]
+    return np.where(cos_theta <= 0.0, 1.0, R)  # exact grazing: total reflection
+
+
+def natural_rgb(cos_theta: ArrayLike, mirror: NaturalMirror) -> np.ndarray:
+    """
+    The mirror's linear sRGB at incidence ``cos theta`` (in the host): its exact unpolarised ``R_lambda``
+    integrated against the CMFs. Ordered (``sigma = 0``): hat averages refined until the colour converges
+    (:func:`explorer.physics.colorimetry.converged_spectra`, from a sampling that resolves the fringes).
+    Disordered: the 1-nm sum over :data:`COLOUR_REALISATIONS` seeded realisations (disorder smooths the fringes).
+    """
+    from explorer.physics import colorimetry
+
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    flat = np.unique(np.round(cos_theta.ravel(), 12), return_inverse=True)
+    angles, inverse = flat
+    thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
+    if mirror.sigma > 0.0:
+        realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, COLOUR_REALISATIONS)
+        spectra = _unpolarised(mirror, colorimetry.WAVELENGTHS[np.newaxis, :], angles[:, np.newaxis], realised)
+    else:
+        realised = thicknesses[np.newaxis, :]
+
+        def spectrum(wavelengths, rows):
+            wavelengths = wavelengths if wavelengths.ndim == 2 else wavelengths[np.newaxis, :]
+            return _unpolarised(mirror, wavelengths, angles[rows][:, np.newaxis], realised)
+
+        n_max = max(float(np.max(mirror.index_1(360.0).real)), float(np.max(mirror.index_2(360.0).real)))
+        substeps = colorimetry.substeps_for_fringes(2.0 * int(mirror.N) * n_max * mirror.Lambda)
+        spectra, _ = colorimetry.converged_spectra(spectrum, angles.size, substeps_min=min(substeps, NATURAL_MAX_SUBSTEPS),
+                                                   substeps_max=NATURAL_MAX_SUBSTEPS)
+    rgb = colorimetry.spectrum_to_rgb(spectra)
+    return rgb[inverse.ravel()].reshape(cos_theta.shape + (3,))
+
+
+_TABLES: dict = {}
+
+
+def natural_rgb_table(mirror: NaturalMirror, size: int | None = None) -> np.ndarray:
+    """
+    :func:`natural_rgb` at ``cos theta = k / (size - 1)``, float32 (a 1D texture; cached, 16 mirrors); ``size``
+    :data:`NATURAL_TABLE_SIZE`, or :data:`DISORDERED_TABLE_SIZE` with ``sigma > 0``.
+    """
+    size = size or (DISORDERED_TABLE_SIZE if mirror.sigma > 0.0 else NATURAL_TABLE_SIZE)
+    key = (mirror, size)
+    if key not in _TABLES:
+        if len(_TABLES) >= 16:
+            _TABLES.pop(next(iter(_TABLES)))
+        table = natural_rgb(np.linspace(0.0, 1.0, size), mirror).astype(np.float32)
+        table.setflags(write=False)
+        _TABLES[key] = table
+    return _TABLES[key]

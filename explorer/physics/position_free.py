@@ -156,6 +156,7 @@ class PositionFree:
         self.rho = np.asarray(stack.rho_d, dtype=np.float64)
         self.n1 = stack.n1 if stack.coating else 1.0
         self.refracts = stack.coating and stack.n1 != 1.0
+        self.tau_h = float(stack.tau_h)
 
     # ----------------------------------------------------------------------------------------------
     # Tables and interfaces
@@ -267,14 +268,18 @@ class PositionFree:
             o_host = self._into_host(o_air)
             exit_weight = (1.0 - self._coating_F_air(np.clip(o_air[:, 2], 0.0, 1.0))) / (self.n1 * self.n1)
             exit_weight = np.where((o_air[:, 2] > 0.0) & (i_air[:, 2] > 0.0), exit_weight, 0.0)
-            E = [np.repeat(exit_weight[:, None], K, axis=1)]
+            # The host's gaps (tau_h): the one above a vertex and every one above it, crossed along o'.
+            gap_o = layered.gap_transmittance(self.tau_h, o_host[:, 2])[:, None]
+            E = [np.repeat(exit_weight[:, None], K, axis=1) * gap_o]
             for table in self.transmissivity:
-                E.append(E[-1] * self._lookup(table, o_host[:, 2], wl))
+                E.append(E[-1] * self._lookup(table, o_host[:, 2], wl) * gap_o)
         for event in range(MAX_EVENTS):
             if pid.size == 0:
                 break
             going_down = d[:, 2] < 0.0
             interface = np.where(going_down, gap + 1, gap)
+            if self.tau_h > 0.0:  # every path crosses its gap to the next interface: Beer-Lambert in the host
+                beta *= layered.gap_transmittance(self.tau_h, np.abs(d[:, 2]))[:, None]
             alive = np.ones(pid.size, dtype=bool)
             born = []  # the reflected branches of this event's splits
             # -- the coating, from inside: deterministic split (escape 1 - F, reflect F)

@@ -120,6 +120,16 @@ def albedo_numpy(model, theta_deg) -> np.ndarray:
     return result
 
 
+def sum_albedo_terms(terms: np.ndarray, columns: int) -> np.ndarray:
+    """
+    The albedo of ``columns`` incidence angles from the albedo view's terms (``shaders/views/albedo.glsl``:
+    rows from the top, ``columns`` blocks of one row per ``theta_h`` node, a column per azimuth), summed
+    in float64: ``(columns, 3)``.
+    """
+    terms = np.asarray(terms, dtype=np.float64)
+    return terms.reshape(columns, -1, terms.shape[-1])[..., :3].sum(axis=1)
+
+
 def scatter_solid_angles(width: int, height: int) -> np.ndarray:
     """
     Each pixel's solid angle (sr) in the scatter view's disc (:func:`explorer.views.geometry.brdf_view_geometry`:

@@ -39,6 +39,9 @@ class View:
     plot: str | None = None
     #: Reads the surface texture of a material that declares ``# texture:`` (the host #defines SURFACE_TEXTURE).
     surface_texture: bool = False
+    #: Its shader draws one term a fragment (one BRDF call) that the host sums per column
+    #: (:meth:`explorer.gpu.Renderer.render`): a sum inside one fragment would outrun llvmpipe's loop limit.
+    summed: bool = False
 
     @property
     def takes_light(self) -> bool:
@@ -59,7 +62,7 @@ VIEW_REGISTRY: dict[str, View] = {view.name: view for view in (
     View("theta_h", "brdf_plot", default_size=(512, 1), square=False, plot="curve"),
     View("theta_d", "brdf_plot", default_size=(512, 1), square=False, plot="curve"),
     View("lobe3d", "brdf_plot", default_size=(128, 32), square=False, light_theta_max=90.0, plot="lobe"),
-    View("albedo", "albedo", default_size=(90, 1), square=False, plot="curve"),
+    View("albedo", "albedo", default_size=(90, 1), square=False, plot="curve", summed=True),
 )}
 VIEWS = tuple(VIEW_REGISTRY)
 DEFAULT_SIZES = {name: view.default_size for name, view in VIEW_REGISTRY.items()}

@@ -105,6 +105,29 @@ def read_linear_image(path) -> np.ndarray:
     return image[..., :3]
 
 
+def clipped_codes(path) -> np.ndarray | None:
+    """
+    Where an integer image (PNG, 8 or 16 bits) holds its lowest code (-1) or its highest (+1), per channel
+    ``(H, W, 3)`` int8: there the encoding clipped a colour that may lie beyond (a vivid channel below 0 or
+    above 1). None for the linear formats (``.npy``, ``.exr``, ``.hdr``), which hold colours exactly.
+    """
+    file = Path(path)
+    if file.suffix.lower() == ".npy" or file.suffix.lower() in LINEAR_INPUT_SUFFIXES:
+        return None
+    try:
+        pixels = _opencv_read(file)
+    except OSError:
+        from PIL import Image
+
+        with Image.open(file) as picture:
+            pixels = np.asarray(picture.convert("RGB"))
+    if not np.issubdtype(pixels.dtype, np.integer):
+        return None
+    pixels = pixels[..., :3]
+    top = np.iinfo(pixels.dtype).max
+    return (np.where(pixels >= top, 1, 0) - np.where(pixels <= 0, 1, 0)).astype(np.int8)
+
+
 def _opencv_read(file: Path) -> np.ndarray:
     """The file's pixels as OpenCV decodes them (their depth kept), as RGB (:func:`opencv_rgb`), or OSError."""
     from explorer.views.env import _cv2, opencv_rgb

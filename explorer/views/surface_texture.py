@@ -105,6 +105,14 @@ def textured_draft_table(mirror, mapping: str, rows: int | None = None) -> np.nd
     return table
 
 
+def textured_builtins() -> str:
+    """The built-in materials that declare a ``# texture:`` (for messages), comma-separated."""
+    from explorer.materials.brd import load_material
+    from explorer.resources import builtin_materials
+
+    return ", ".join(name for name, path in builtin_materials().items() if load_material(path).texture is not None)
+
+
 def check_texture_kind(material) -> str:
     """The material's declared texture kind, or a one-line :class:`LocatedError` saying which materials have a textured view."""
     from explorer.materials.brd import MaterialError
@@ -112,7 +120,7 @@ def check_texture_kind(material) -> str:
     kind = getattr(material, "texture", None)
     if kind is None:
         raise MaterialError(material.path, None, "the textured view needs a material that declares '# texture: "
-                            f"{'|'.join(TEXTURE_KINDS)}' (thin_film, bragg_mirror)")
+                            f"{'|'.join(TEXTURE_KINDS)}' ({textured_builtins()})")
     if kind not in TEXTURE_KINDS:
         raise MaterialError(material.path, None, f"'# texture: {kind}' is not one of {', '.join(TEXTURE_KINDS)}")
     return kind

@@ -40,8 +40,13 @@ vec3 layer_mask(int layer_count) { return vec3(1.0, layer_count >= 2 ? 1.0 : 0.0
 // The single-reflection BRDF (Eq. 34) in linear sRGB, from the host's tables. i, o: unit directions in
 // air in the local frame (n = +z). Each wavelength's paths through the layers are multiplied before the
 // CMF integration; the base's RGB albedo multiplies the RGB of its spectral term (it has no spectrum).
+// The host's absorption: one crossing of a gap of optical depth tau_h at cos theta in the host (Beer-Lambert).
+float gap_transmittance(float tau_h, float cos_theta_host) {
+    return tau_h == 0.0 ? 1.0 : exp(-tau_h / max(cos_theta_host, 1e-6));
+}
+
 vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                           sampler2D reflectance_table, sampler2D transmissivity_table) {
+                           sampler2D reflectance_table, sampler2D transmissivity_table, float tau_h) {
     if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
     float path = 1.0;
     vec3 ih = i, oh = o;
@@ -59,6 +64,9 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
         lobe[l] = used[l] * 0.25 * ggx_D(h.z, alphas[l]) * smith_G1_over_cos(max(ih.z, 0.0), alphas[l])
                 * smith_G1_over_cos(max(oh.z, 0.0), alphas[l]);
     }
+    // Each gap above a layer, and above the base, crossed down along i' and up along o' (tau_h).
+    float gap = gap_transmittance(tau_h, max(ih.z, 0.0)) * gap_transmittance(tau_h, max(oh.z, 0.0));
+    path *= gap;
     int k_i, k_o, k_d;
     float f_i, f_o, f_d;
     table_row(polar_angle(ih), k_i, f_i);
@@ -68,11 +76,90 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k_d, f_d);
         vec3 t = mix(vec3(1.0), table_fetch(transmissivity_table, j, k_i, f_i) * table_fetch(transmissivity_table, j, k_o, f_o), used);
-        float p2 = path * t.x, p3 = p2 * t.y;  // the paths down to layers 2 and 3
+        // The paths down to layers 2 and 3 and to the base (a layer beyond layer_count passes 1 and no gap).
+        vec3 g = mix(vec3(1.0), vec3(gap), used);
+        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
         float layers_term = lobe.x * R.x * path + lobe.y * R.y * p2 + lobe.z * R.z * p3;
         vec3 cmf = colour_matching_functions(j);
         xyz_layers += cmf * layers_term;
-        xyz_base += cmf * (p3 * t.z);
+        xyz_base += cmf * (p3 * t.z * gap);
+    }
+    return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
+}
+
+// Multiple scattering among a layer's facets (twin of explorer/physics/multiscatter.py and of
+// explorer.physics.layered.single_reflection_spectra with its compensation): per wavelength and layer, the
+// occluders' reflectance rho = 1 - f_t cos / G1 (Eqs. 28, 30), their masking G_eff = 1 / (1 + Lambda rho), Eq. 17
+// with G_eff for G1, the ballistic transmission (1 - rho) G_eff^2 plus the downward share (1 - r) m(theta) of
+// the missing light m, and Kulla & Conty's lobe r m(i) m(o) / (pi m_avg) for its upward share.
+// missing_table: rows theta = k 2 deg (k = 0..45) of m, row 46 r, row 47 r / (pi m_avg); channel l layer l.
+float smith_lambda(float c, float alpha) {
+    c = clamp(c, 1e-6, 1.0);
+    return (sqrt(c * c + alpha * alpha * (1.0 - c * c)) - c) / (2.0 * c);
+}
+
+vec3 masking_over_cos(float c, vec3 root_minus_c, vec3 rho) {
+    return c > 0.0 ? 2.0 / max(2.0 * c + rho * root_minus_c, vec3(1e-6)) : vec3(0.0);
+}
+
+void compensation_row(float theta, out int k, out float f) {
+    float x = clamp(theta, 0.0, 0.5 * PI) / radians(COMPENSATION_STEP_DEG);
+    k = min(int(floor(x)), COMPENSATION_ROWS - 2);
+    f = x - float(k);
+}
+
+vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table, float tau_h) {
+    if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
+    float path = 1.0;
+    vec3 ih = i, oh = o;
+    if (coating) {
+        path = (1.0 - coating_reflectance(i.z, nh)) * (1.0 - coating_reflectance(o.z, nh)) / (nh * nh);
+        ih = refract_into_host(i, nh);
+        oh = refract_into_host(o, nh);
+    }
+    vec3 used = layer_mask(layer_count);
+    vec3 h = normalize(ih + oh);
+    float ci = max(ih.z, 0.0), co = max(oh.z, 0.0);
+    // The host's gaps (tau_h), as in single_reflection_brdf.
+    float gap = gap_transmittance(tau_h, ci) * gap_transmittance(tau_h, co);
+    path *= gap;
+    vec3 g = mix(vec3(1.0), vec3(gap), used);
+    vec3 lobe, G1_i, G1_o, lambda_i, lambda_o, root_i, root_o;  // per layer, wavelength-independent
+    for (int l = 0; l < MAX_LAYERS; ++l) {
+        float a = alphas[l];
+        lobe[l] = used[l] * 0.25 * ggx_D(h.z, a);
+        G1_i[l] = smith_G1(ci, a);
+        G1_o[l] = smith_G1(co, a);
+        lambda_i[l] = smith_lambda(ci, a);
+        lambda_o[l] = smith_lambda(co, a);
+        root_i[l] = sqrt(ci * ci + a * a * (1.0 - ci * ci)) - ci;
+        root_o[l] = sqrt(co * co + a * a * (1.0 - co * co)) - co;
+    }
+    int k_i, k_o, k_d, c_i, c_o;
+    float f_i, f_o, f_d, g_i, g_o;
+    float theta_i = polar_angle(ih), theta_o = polar_angle(oh);
+    table_row(theta_i, k_i, f_i);
+    table_row(theta_o, k_o, f_o);
+    table_row(atan(length(ih - oh), length(ih + oh)), k_d, f_d);
+    compensation_row(theta_i, c_i, g_i);
+    compensation_row(theta_o, c_o, g_o);
+    vec3 xyz_layers = vec3(0.0), xyz_base = vec3(0.0);
+    for (int j = 0; j < CMF_COUNT; ++j) {
+        vec3 R = table_fetch(reflectance_table, j, k_d, f_d);
+        vec3 t_i = table_fetch(transmissivity_table, j, k_i, f_i), t_o = table_fetch(transmissivity_table, j, k_o, f_o);
+        vec3 m_i = table_fetch(missing_table, j, c_i, g_i), m_o = table_fetch(missing_table, j, c_o, g_o);
+        vec3 up = texelFetch(missing_table, ivec2(j, COMPENSATION_ROWS), 0).rgb;
+        vec3 scale = texelFetch(missing_table, ivec2(j, COMPENSATION_ROWS + 1), 0).rgb;
+        vec3 rho_i = clamp(1.0 - t_i / max(G1_i, vec3(1e-12)), 0.0, 1.0), rho_o = clamp(1.0 - t_o / max(G1_o, vec3(1e-12)), 0.0, 1.0);
+        vec3 Ge_i = 1.0 / (1.0 + lambda_i * rho_i), Ge_o = 1.0 / (1.0 + lambda_o * rho_o);
+        vec3 layer = lobe * masking_over_cos(ci, root_i, rho_i) * masking_over_cos(co, root_o, rho_o) * R + scale * m_i * m_o;
+        vec3 t = mix(vec3(1.0), ((1.0 - rho_i) * Ge_i * Ge_i + (1.0 - up) * m_i) * ((1.0 - rho_o) * Ge_o * Ge_o + (1.0 - up) * m_o), used);
+        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
+        float layers_term = used.x * layer.x * path + used.y * layer.y * p2 + used.z * layer.z * p3;
+        vec3 cmf = colour_matching_functions(j);
+        xyz_layers += cmf * layers_term;
+        xyz_base += cmf * (p3 * t.z * gap);
     }
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
@@ -81,7 +168,7 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
 // F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2, theta' the refracted angle (without a
 // coating: theta' = theta, F = 0). Smooth layers transmit 1 - R (the rough layer's integrated
 // transmissivity would exceed it beside band edges: see explorer.physics.layered.stack_specular_rgb).
-vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table) {
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h) {
     float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
     float F = 0.0, through = 1.0;
     if (coating) {
@@ -94,10 +181,13 @@ vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count
     float f;
     table_row(atan(s, c), k, f);
     vec3 used = layer_mask(layer_count);
+    float g = gap_transmittance(tau_h, c);
+    g *= g;  // a gap down and up at theta'
+    through *= g;
     vec3 xyz = vec3(0.0);
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k, f) * used;
-        vec3 t = (1.0 - R) * (1.0 - R);
+        vec3 t = (1.0 - R) * (1.0 - R) * g;
         xyz += colour_matching_functions(j) * (through * (R.x + t.x * (R.y + t.y * R.z)));
     }
     return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)

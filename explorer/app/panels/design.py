@@ -17,6 +17,9 @@ import numpy as np
 from explorer.app.panels.base import Panel, record
 from explorer.physics import colorimetry
 from explorer import design as inverse_design
+from explorer.materials.models import BraggMirrorModel
+from explorer.materials.twins import capabilities_of, supporting
+from explorer.resources import DEFAULT_MATERIAL
 
 #: The default targets: the colours at these angles of the jewel beetle's green/blue cuticle area
 #: (Fourneau et al. 2024, Table 3 (a), smooth, in air), a gradient a mirror is known to make.
@@ -61,7 +64,7 @@ class DesignPanel(Panel):
 
     def __init__(self, app):
         super().__init__(app)
-        colours = inverse_design.forward_rgb("bragg_mirror", DEFAULT_STRUCTURE, DEFAULT_ANGLES)
+        colours = inverse_design.forward_rgb(BraggMirrorModel.name, DEFAULT_STRUCTURE, DEFAULT_ANGLES)
         self.targets = [_target(theta, rgb) for theta, rgb in zip(DEFAULT_ANGLES, colours)]
         self.strip_path = ""
         self.strip_range = [0.0, 90.0]
@@ -121,7 +124,7 @@ class DesignPanel(Panel):
         if self.running or material.model not in inverse_design.DESIGN_MODELS:
             return
         ranges = {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
-        fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and material.model != "thin_film" else {}
+        fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and capabilities_of(material).bragg_spectrum else {}
         targets = self.target_list()
         parameters = inverse_design.design_model(material.model).parameters
         current = {name: float(self.state.values[name]) for name in parameters if name in self.state.values}
@@ -182,7 +185,7 @@ class DesignPanel(Panel):
                   "nh": (0.0, 0.0)}
 
         def work():
-            xy, _ = inverse_design.reachable_chromaticities("bragg_mirror", key[0], ranges, fixed={"nh": 0.0},
+            xy, _ = inverse_design.reachable_chromaticities(BraggMirrorModel.name, key[0], ranges, fixed={"nh": 0.0},
                                                             samples=REACHABLE_SAMPLES)
             self.reachable = (key, xy)
 
@@ -195,11 +198,9 @@ class DesignPanel(Panel):
         state = self.state
         designable = state.material.model in inverse_design.DESIGN_MODELS
         if not designable:
-            imgui.text_wrapped("Design works on bragg_mirror, bragg_layer and thin_film.")
-            if imgui.button("Open bragg_mirror"):
-                from explorer.resources import builtin_materials
-
-                self.app.reload(builtin_materials()["bragg_mirror"])
+            imgui.text_wrapped(f"Design works on {', '.join(supporting('design'))}.")
+            if imgui.button(f"Open {DEFAULT_MATERIAL.stem}"):
+                self.app.reload(DEFAULT_MATERIAL)
             record(state, "design:open")
         imgui.separator_text("targets (theta in degrees, sRGB colour)")
         remove = None

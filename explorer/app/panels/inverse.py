@@ -20,10 +20,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from explorer.app.panels.base import Panel, record
+from explorer.materials.lobes_model import LayeredLobesModel
 from explorer.physics import lobes
 from explorer.physics.inverse import InverseError, Lobe, fgd_normal, invert_lobes, lobe_class
 
-MATERIAL = "layered_lobes"
+#: The material whose parameters the retrieved stacks are (the layered lobes plugin).
+MATERIAL = LayeredLobesModel.name
 #: Pixels per class sample in the 2-layer plot's texture (the hatching needs a few).
 CELL_PX = 5
 #: The recomputation period while a widget is dragged (seconds): a 2-layer class costs ~40 ms.
@@ -227,8 +229,8 @@ class InversePanel(Panel):
     def draw(self, imgui) -> None:
         state = self.state
         if not self._is_lobes_material():
-            imgui.text_wrapped("The stacks retrieved here are shaders/layered_lobes.brd's parameters.")
-            if imgui.button("Open layered_lobes"):
+            imgui.text_wrapped(f"The stacks retrieved here are shaders/{MATERIAL}.brd's parameters.")
+            if imgui.button(f"Open {MATERIAL}"):
                 self._open_lobes_material()
             record(state, "inverse:open")
         remove = None

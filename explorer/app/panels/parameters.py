@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from explorer.errors import LocatedError
 from explorer.materials.brd import round_integer
 from explorer.materials.methods import method_labels
 from explorer.app.parameter_files import inactive_parameters, slider_format, widget_kind
@@ -155,8 +156,11 @@ class ParametersPanel(Panel):
                     state.status = f"{name}: {error}"
         imgui.pop_id()
         if new != value:
-            state.values = {**state.values, name: new}
-            state.preset = None
+            try:  # the typed values every consumer reads (Material.resolve), the widget's range checked again
+                state.values = state.material.resolve({**state.values, name: new})
+                state.preset = None
+            except LocatedError as error:
+                state.status = str(error)
 
 
 def _shown_path(path) -> str:

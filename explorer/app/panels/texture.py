@@ -12,7 +12,7 @@ from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.errors import LocatedError
 from explorer.resources import DEFAULT_TEXTURE
-from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture
+from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture, textured_builtins
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
 
 #: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
@@ -63,7 +63,7 @@ class TexturePanel(Panel):
         state = self.state
         kind = state.material.texture
         if kind not in TEXTURE_KINDS:
-            imgui.text_wrapped(f"this material declares no '# texture: {'|'.join(TEXTURE_KINDS)}' (thin_film and bragg_mirror do)")
+            imgui.text_wrapped(f"this material declares no '# texture: {'|'.join(TEXTURE_KINDS)}' ({textured_builtins()} do)")
             return
         _, self.path = imgui.input_text("texture (grey image)", self.path)
         if kind == "bragg":
