@@ -5,6 +5,14 @@ from __future__ import annotations
 import os
 
 
+def did_you_mean(word: str, choices) -> str:
+    """``" (did you mean 'X'?)"`` for the closest of ``choices`` to a mistyped ``word`` (difflib), else ``""``."""
+    import difflib
+
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 class LocatedError(Exception):
     """
     Something is wrong at a place in a file.

@@ -37,7 +37,7 @@ def check_numpy_size(width: int, height: int) -> None:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int | None = None,
-    variant: str | None = None, mesh=None, background: bool = False, plot=None,
+    variant: str | None = None, mesh=None, background: bool = False, plot=None, fill: float = 0.0,
     progress_printer: ProgressPrinter | None = None, warn: Callable[[str], None] | None = None,
 ) -> np.ndarray:
     """
@@ -48,8 +48,9 @@ def render_material(
     surface); ``environment`` (an :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp``
     (samples per pixel; default 64) for the ``env`` view and the position-free engine; ``mesh`` (an
     :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views; ``plot`` (an
-    :class:`explorer.views.plots.PlotSettings`) for the plot views. ``progress_printer(label, unit)`` reports long
-    renders; ``warn(message)`` is told of samples dropped.
+    :class:`explorer.views.plots.PlotSettings`) for the plot views; ``fill``, the ``lit`` view's environment fill
+    (:mod:`explorer.views.fill`), 0 without. ``progress_printer(label, unit)`` reports long renders; ``warn(message)``
+    is told of samples dropped.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -89,7 +90,8 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment)
+        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment,
+                            fill=fill)
     from explorer.gpu import Renderer
     from explorer.views.geometry import view_named
 
@@ -102,12 +104,13 @@ def render_material(
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 
-        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment)
+        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment,
+                           uniforms={"fill": float(fill)})
     if view_named(view).plot is not None:
         from explorer.views.plots import gl_uniforms
 
         return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
-    return renderer.render(material, values, view, width, height, light=light, environment=environment)
+    return renderer.render(material, values, view, width, height, light=light, environment=environment, uniforms={"fill": float(fill)})
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh,

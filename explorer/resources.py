@@ -116,8 +116,10 @@ def material_path(text: str | os.PathLike[str]) -> Path:
     stem = path.stem if path.suffix in MATERIAL_SUFFIXES else path.name
     if stem in builtins and path.suffix in ("", ".brd"):
         return builtins[stem]
+    from explorer.errors import did_you_mean
+
     names = ", ".join(builtins) or "(none installed)"
-    raise UnknownMaterial(text, None, f"no such file, nor a built-in material; built-in materials: {names}")
+    raise UnknownMaterial(text, None, f"no such file, nor a built-in material{did_you_mean(stem, builtins)}; built-in materials: {names}")
 
 
 def display_path(path: str | os.PathLike[str]) -> str:

@@ -24,6 +24,13 @@ from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, running_in_ci
 from explorer.app.parameter_files import load_values, parse_bparam, save_values
 from explorer.materials.brd import load_material
 from explorer.physics.colorimetry import encode_srgb8
+from explorer.views.fill import DEFAULT_FILL, has_fill
+from explorer.views.tonemap import default_tonemap, display_srgb8
+
+
+def lit_fill(material) -> dict:
+    """The app's lit view uniforms: its default environment fill (none for a smooth mirror)."""
+    return {"fill": DEFAULT_FILL} if has_fill(material) else {}
 
 WINDOW = "1000x720"
 
@@ -105,9 +112,9 @@ def test_f12_saves_the_active_view_with_the_exposure(x_display, tmp_path, gl_ren
     assert report["screenshots"] == [f"screenshots/bragg_mirror_{view}_1.png"]
     linear = np.load(tmp_path / "screenshots" / shots[0])
     png = np.asarray(Image.open(tmp_path / "screenshots" / shots[1]).convert("RGB")).astype(int)
-    # The PNG is the linear image times the exposure, encoded; the .npy holds the values without it.
-    assert np.abs(png - encode_srgb8(linear * np.float32(exposure)).astype(int)).max() <= 1
-    assert np.abs(png - encode_srgb8(linear).astype(int)).max() > 10
+    # The PNG is the linear image times the exposure, tone mapped as the view is shown, encoded; the .npy holds the values.
+    assert np.abs(png - display_srgb8(linear, exposure, default_tonemap(view)).astype(int)).max() <= 1
+    assert np.abs(png - display_srgb8(linear, 1.0, default_tonemap(view)).astype(int)).max() > 10
     if view == "sphere":
         headless = gl_renderer.render(bragg_material, bragg_material.resolve(report["values"]), "sphere", *linear.shape[1::-1])
         np.testing.assert_allclose(linear, headless, atol=2e-3)
@@ -126,9 +133,10 @@ def test_open_brdf_explorer_file(x_display, tmp_path, gl_renderer):
     values = report["values"]
     assert values["divide_by_NdotL"] is True and values["albedo"] == [0.82, 0.67, 0.16]
     material = load_material(material_path)
-    headless = gl_renderer.render(material, material.resolve(values), "lit", report["view_size"], report["view_size"])
+    headless = gl_renderer.render(material, material.resolve(values), "lit", report["view_size"], report["view_size"],
+                                  uniforms=lit_fill(material))
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
-    assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
+    assert np.abs(png - display_srgb8(headless, 1.0, default_tonemap("lit")).astype(int)).max() <= 2
 
 
 def test_no_display_falls_back_to_the_headless_render(tmp_path):
@@ -185,9 +193,10 @@ def test_reload_of_a_broken_file_keeps_the_last_good_shader(x_display, tmp_path,
     error = report["error"]
     assert re.match(rf"{re.escape(str(material_path))}:\d+: ", error) and len(error.splitlines()) == 1, error
     material = load_material(BRDF_DATA / "lambert.brdf")
-    headless = gl_renderer.render(material, material.resolve({}), "lit", report["view_size"], report["view_size"])
+    headless = gl_renderer.render(material, material.resolve({}), "lit", report["view_size"], report["view_size"],
+                                  uniforms=lit_fill(material))
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
-    assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
+    assert np.abs(png - display_srgb8(headless, 1.0, default_tonemap("lit")).astype(int)).max() <= 2
 
 
 def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, bragg_material):
@@ -202,7 +211,8 @@ def test_compare_two_methods_mean_delta_e(x_display, tmp_path, gl_renderer, brag
     _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
     assert "clicked compare_on" in report["script_log"], report["script_log"]
     values = bragg_material.resolve(report["values"])
-    size = report["view_size"] // 2
+    size = report["compare_size"][0]  # the pair fits its window
+    assert report["compare_size"] == [size, size] and size >= 256, report["compare_size"]
     reference = gl_renderer.render(bragg_material, {**values, "method": 0.0}, "sphere", size, size)
     improved = gl_renderer.render(bragg_material, {**values, "method": 4.0}, "sphere", size, size)
     inside = view_cos_theta("sphere", size, size)[1]
@@ -275,7 +285,9 @@ def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):
     png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
 
     def lambert(direction):
-        return encode_srgb8(np.repeat((0.8 / np.pi * np.maximum(normal @ direction, 0.0))[..., None], 3, -1)).astype(int)
+        # plus the default environment fill: a Lambertian's albedo is its reflectance
+        radiance = np.repeat((0.8 / np.pi * np.maximum(normal @ direction, 0.0) + DEFAULT_FILL * 0.8)[..., None], 3, -1)
+        return display_srgb8(radiance, 1.0, default_tonemap("lit")).astype(int)
 
     assert np.abs(png[inside] - lambert(turned)[inside]).max() <= 2
     assert np.abs(png[inside] - lambert(backwards)[inside]).max() > 10
@@ -327,12 +339,13 @@ def test_switching_materials_keeps_the_app_alive(x_display, tmp_path, gl_rendere
             assert info["samples"] >= 1
             headless = render_env(material, values, size, size, spp=info["samples"], renderer=gl_renderer)
         else:
-            headless = gl_renderer.render(material, values, expected_view, size, size)
+            headless = gl_renderer.render(material, values, expected_view, size, size,
+                                          uniforms=lit_fill(material) if expected_view == "lit" else None)
         linear = np.load(shot.with_suffix(".npy"))
         assert linear.shape == (size, size, 3)
         np.testing.assert_allclose(linear, headless, rtol=1e-3, atol=2e-3, err_msg=f"{mode}: {material_path.name}")
         png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
-        assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2, (mode, material_path.name)
+        assert np.abs(png - display_srgb8(headless, 1.0, default_tonemap(expected_view)).astype(int)).max() <= 2, (mode, material_path.name)
         assert np.abs(headless).max() > 0.05, "an empty image"
 
 
@@ -382,9 +395,9 @@ def test_inverse_panel_walks_an_equivalence_class(x_display, tmp_path, gl_render
         stacks.append(stack)
         values = material.resolve(values_from_stack(stack))
         assert same_values(material.resolve(info["values"]), values), "the sphere shows the retrieved stack"
-        headless = gl_renderer.render(material, values, "lit", INVERSE_VIEW_SIZE, INVERSE_VIEW_SIZE)
+        headless = gl_renderer.render(material, values, "lit", INVERSE_VIEW_SIZE, INVERSE_VIEW_SIZE, uniforms=lit_fill(material))
         png = np.asarray(Image.open(shot).convert("RGB")).astype(int)
-        assert np.abs(png - encode_srgb8(headless).astype(int)).max() <= 2
+        assert np.abs(png - display_srgb8(headless, 1.0, default_tonemap("lit")).astype(int)).max() <= 2
         np.testing.assert_allclose(np.load(shot.with_suffix(".npy")), headless, rtol=1e-3, atol=2e-3)
         assert np.abs(headless).max() > 0.05, "an empty image"
         energies, _ = forward_lobes(stack, [2])

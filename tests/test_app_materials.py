@@ -78,11 +78,14 @@ def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_rend
     assert shown[0] == "thin_film.brd" and sorted(shown) == sorted(strips), shown
     # Side by side: the layer | the Disney BRDF, each its own material, lit; the mean ΔE is theirs.
     assert "compare_colour_bar" in report["items"]
+    from explorer.views.fill import DEFAULT_FILL
+
     layer, disney = load_material(LAYER), load_material(DISNEY)
     values = {entry["path"]: entry["values"] for entry in report["materials"]}
     size = VIEW
-    a = gl_renderer.render(layer, layer.resolve(values[str(LAYER)]), "lit", size, size, light=(45.0, 0.0))
-    b = gl_renderer.render(disney, disney.resolve(values[str(DISNEY)]), "lit", size, size, light=(45.0, 0.0))
+    fill = {"fill": DEFAULT_FILL}  # the app's lit view: the default environment fill
+    a = gl_renderer.render(layer, layer.resolve(values[str(LAYER)]), "lit", size, size, light=(45.0, 0.0), uniforms=fill)
+    b = gl_renderer.render(disney, disney.resolve(values[str(DISNEY)]), "lit", size, size, light=(45.0, 0.0), uniforms=fill)
     inside = view_cos_theta("sphere", size, size)[1]
     expected = float(np.mean(delta_E_2000(a[inside].astype(np.float64), b[inside].astype(np.float64))))
     assert report["mean_delta_e"] == pytest.approx(expected, rel=1e-3) and expected > 1.0

@@ -444,7 +444,7 @@ def test_int_parameter_is_a_float_uniform_holding_an_integer() -> None:
     assert (N.type, N.min, N.max, N.default, N.line) == ("int", 1.0, 1000.0, 20.0, 3)
     assert N.glsl_type == "float"
     assert m.uniform_declarations() == "uniform float N;\nuniform float method;\n"
-    assert N.info() == {"name": "N", "type": "int", "min": 1.0, "max": 1000.0, "default": 20.0}
+    assert N.info() == {"name": "N", "type": "int", "min": 1.0, "max": 1000.0, "default": 20.0, "unit": "", "doc": ""}
 
 
 @pytest.mark.parametrize(
@@ -503,10 +503,10 @@ def test_info_is_json_ready() -> None:
     info = material(MIXED).info()
     assert json.loads(json.dumps(info)) == {
         "parameters": [
-            {"name": "n", "type": "float", "min": 1.0, "max": 1000.0, "default": 100.0},
-            {"name": "rough", "type": "float", "min": 0.0, "max": 1.0, "default": 0.5},
-            {"name": "flag", "type": "bool", "min": None, "max": None, "default": True},
-            {"name": "tint", "type": "color", "min": 0.0, "max": 1.0, "default": [0.8, 0.6, 0.4]},
+            {"name": "n", "type": "float", "min": 1.0, "max": 1000.0, "default": 100.0, "unit": "", "doc": ""},
+            {"name": "rough", "type": "float", "min": 0.0, "max": 1.0, "default": 0.5, "unit": "", "doc": ""},
+            {"name": "flag", "type": "bool", "min": None, "max": None, "default": True, "unit": "", "doc": ""},
+            {"name": "tint", "type": "color", "min": 0.0, "max": 1.0, "default": [0.8, 0.6, 0.4], "unit": "", "doc": ""},
         ]
     }
 

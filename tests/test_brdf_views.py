@@ -218,7 +218,9 @@ def test_malformed_light_is_one_line(tmp_path, case):
 
 @pytest.mark.gl
 def test_cli_lit_npy_equals_numpy_twin(gl_renderer, tmp_path):
-    """A BRDF Explorer file with a bool, lit from --light 30,0, on the GPU through the CLI."""
+    """A BRDF Explorer file with a bool, lit from --light 30,0 and the default environment fill, on the GPU through the CLI."""
+    from explorer.views.fill import DEFAULT_FILL
+
     path = BRDF_DATA / "blinn_phong.brdf"
     out = tmp_path / "lit.npy"
     width, height = 40, 24
@@ -229,7 +231,8 @@ def test_cli_lit_npy_equals_numpy_twin(gl_renderer, tmp_path):
     image = np.load(out)
     material = MATERIAL(path)
     values = material.resolve({"divide_by_NdotL": "0"})
-    reference = render_numpy(model_for(material, values), "lit", width, height, light=(30.0, 0.0))
+    # render's lit view fills with a uniform environment by default (explorer.views.fill)
+    reference = render_numpy(model_for(material, values), "lit", width, height, light=(30.0, 0.0), fill=DEFAULT_FILL)
     assert_twins_equal(Twins.of(image, reference, "lit"), "CLI lit")
 
 

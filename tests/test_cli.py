@@ -44,7 +44,7 @@ def parameters_section(path: Path) -> list[list[str]]:
         elif stripped.startswith("::end"):
             inside = False
         elif inside and stripped and not stripped.startswith("#"):
-            rows.append(stripped.split())
+            rows.append(stripped.split("#", 1)[0].split())  # the trailing "# UNIT: meaning" apart
     return rows
 
 
@@ -209,7 +209,7 @@ def test_info_json_schema(cli_runs, name):
     rows = parameters_section(INFO_FILES[name])
     assert [p["name"] for p in info["parameters"]] == [row[1] for row in rows]
     for parameter, row in zip(info["parameters"], rows):
-        assert set(parameter) == {"name", "type", "min", "max", "default"}
+        assert set(parameter) == {"name", "type", "min", "max", "default", "unit", "doc"}
         assert parameter["type"] == row[0]
         if row[0] in ("float", "int"):
             assert [parameter["min"], parameter["max"], parameter["default"]] == [float(t) for t in row[2:5]]

@@ -100,7 +100,7 @@ LAYERS = {
     "plugins": 5, "design": 5,
     "views": 6,
     "gpu": 7,
-    "mitsuba": 8,
+    "mitsuba": 8, "blender": 8,
     "rendering": 9,
     "app": 10,
     "bench": 11,

@@ -245,7 +245,8 @@ def test_cli_numpy_render_and_colour_views(tmp_path, analytic_file):
 @pytest.mark.gl
 def test_cli_gl_render_equals_numpy(tmp_path, analytic_file, analytic_material):
     out = tmp_path / "lit.npy"
-    run = run_cli_process("render", analytic_file, "--view", "lit", "--size", "48", "--out", out)
+    # The light alone (--fill 0): each pixel is then one bin's value, as assert_lookup_twins matches them.
+    run = run_cli_process("render", analytic_file, "--view", "lit", "--size", "48", "--fill", "0", "--out", out)
     assert run.returncode == 0, run.stderr
     from explorer.views.render import render_numpy
 

@@ -125,6 +125,39 @@ def polar_curve(scatter_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return theta, row / np.maximum(cos_theta, 1e-3)[:, None]
 
 
+#: The Polar window's log scale: radius log10(1 + x / floor), decades above this value (1/sr, or a reflectance).
+#: BRDF Explorer's log10(1 + x) (floor 1) squeezes a GGX lobe of 0.2 / sr beside a Bragg lobe of 5 / sr to
+#: 0.08 / 0.8; above 0.01 they are 1.3 / 2.7: both visible, their ratio still read in decades.
+POLAR_LOG_FLOOR = 0.01
+
+
+def polar_radius(brdf: np.ndarray, log: bool = False, normalise: bool = False) -> np.ndarray:
+    """
+    The Polar window's radius of a curve's values (negative ones, outside sRGB, as 0): ``normalise`` divides by
+    the curve's own peak (each material's lobe fills the plot); ``log`` is ``log10(1 + x / POLAR_LOG_FLOOR)``, the
+    decades above :data:`POLAR_LOG_FLOOR` (a wide, dim lobe stays visible beside a narrow, bright one).
+    Normalised then logged: ``log10(1 + (x / peak) / POLAR_LOG_FLOOR)``.
+    """
+    r = np.clip(np.asarray(brdf, dtype=np.float64), 0.0, None)
+    if normalise:
+        peak = float(r.max()) if r.size else 0.0
+        r = r / peak if peak > 0.0 else r
+    return np.log10(1.0 + r / POLAR_LOG_FLOOR) if log else r
+
+
+def polar_limits(curves, margin: float = 0.05) -> tuple[float, float, float, float]:
+    """
+    The Polar plot's axes ``(x_min, x_max, y_min, y_max)``: every point of ``curves`` (pairs of x and y arrays) inside,
+    with ``margin`` of the span around, as a square (the plot keeps its aspect: a lobe is not stretched, nor cut).
+    """
+    xs = np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x, _ in curves] + [np.zeros(1)])
+    ys = np.concatenate([np.asarray(y, dtype=np.float64).ravel() for _, y in curves] + [np.zeros(1)])
+    x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
+    half = 0.5 * max(x1 - x0, y1 - y0, 1e-9) * (1.0 + 2.0 * margin)
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    return cx - half, cx + half, cy - half, cy + half
+
+
 def disc_mask(width: int, height: int) -> np.ndarray:
     """The pixels of the sphere views' disc (as the shaders test ``r^2 < 1``)."""
     from explorer.views.geometry import view_cos_theta

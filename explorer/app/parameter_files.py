@@ -80,7 +80,7 @@ class LoadedValues:
 
 
 #: What a parameter set may save beside the values: the app's view, so that ``render --params`` shows it.
-VIEW_KEYS = ("view", "light", "camera", "exposure", "environment", "env_rotation")
+VIEW_KEYS = ("view", "light", "camera", "exposure", "environment", "env_rotation", "tonemap", "fill")
 
 
 def check_view(raw, where: str, line: int | None = None) -> dict:
@@ -88,7 +88,7 @@ def check_view(raw, where: str, line: int | None = None) -> dict:
     A saved view, checked: ``view`` (a view's name), ``light`` ``[theta, phi]`` (degrees, theta in
     [0, 180]), ``camera`` ``[yaw, pitch]`` (degrees, pitch in [-89, 89]), ``exposure`` (> 0),
     ``environment`` (a file or a name of :data:`explorer.views.env.ENVIRONMENTS`, or None), ``env_rotation`` (degrees,
-    finite). Missing keys are absent from the result; unknown ones are errors.
+    finite), ``tonemap`` (a curve of :data:`explorer.views.tonemap.TONEMAPS`), ``fill`` (the lit view's environment fill, >= 0). Missing keys are absent from the result; unknown ones are errors.
     """
     import math
 
@@ -137,14 +137,40 @@ def check_view(raw, where: str, line: int | None = None) -> dict:
         if not math.isfinite(rotation):
             raise ParameterFileError(where, line, f"view 'env_rotation': {raw['env_rotation']!r} is not a finite angle in degrees")
         view["env_rotation"] = rotation
+    if raw.get("tonemap") is not None:
+        from explorer.views.tonemap import TONEMAPS
+
+        if raw["tonemap"] not in TONEMAPS:
+            raise ParameterFileError(where, line, f"view 'tonemap': {raw['tonemap']!r} is not one of {', '.join(TONEMAPS)}")
+        view["tonemap"] = raw["tonemap"]
+    if raw.get("fill") is not None:
+        try:
+            fill = float(raw["fill"])
+        except (TypeError, ValueError):
+            fill = math.nan
+        if not (math.isfinite(fill) and fill >= 0.0):
+            raise ParameterFileError(where, line, f"view 'fill': {raw['fill']!r} is not a radiance >= 0")
+        view["fill"] = fill
     return view
 
 
 def _display(path: os.PathLike[str] | str) -> str:
+    """A parameter file's path as the user typed it (an absolute one stays absolute)."""
+    return os.fspath(path)
+
+
+def named_material(path: os.PathLike[str] | str) -> str | None:
+    """The material a parameter set names (JSON ``"material"``, a ``.bparam``'s first line), or None."""
+    where = _display(path)
+    text = _read_text(path, where)
+    if str(path).lower().endswith(".bparam"):
+        return parse_bparam(text, where)[0]
     try:
-        return os.path.relpath(path)
-    except ValueError:
-        return str(path)
+        document = json.loads(text)
+    except (json.JSONDecodeError, RecursionError):
+        raise ParameterFileError(where, None, "not valid JSON") from None
+    material = document.get("material") if isinstance(document, dict) else None
+    return material if isinstance(material, str) and material else None
 
 
 def _json_value(value):

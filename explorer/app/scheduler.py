@@ -28,6 +28,9 @@ DRAG_BUDGET_MS = 12.0
 #: windows, whose views draw from the prefetcher's values and so build no table on the spot).
 SIDE_DRAG_BUDGET_MS = 0.0
 
+#: The displayed views the tone map applies to: the sphere's and the Compare window's.
+TONEMAPPED_KEYS = ("main", "compare")
+
 
 class TablePrefetcher:
     """
@@ -230,7 +233,11 @@ class Scheduler:
             panel.after_gl()
         for key, (a, b) in self._requests.items():
             if a.full is not None:
-                self.display.draw(key, a, b, split=0.5 if b is not None else 2.0, exposure=state.exposure, gamut=state.gamut)
+                # The sphere's and Compare's images under the chosen tone map (a radiance view's AgX by default);
+                # the strips, slice and texture views show colours as they are.
+                tonemap = state.tonemap_for(getattr(a, "view", "env")) if key in TONEMAPPED_KEYS else "none"
+                self.display.draw(key, a, b, split=0.5 if b is not None else 2.0, exposure=state.exposure, gamut=state.gamut,
+                                  tonemap=tonemap)
         self._requests = {}
         return (time.perf_counter() - start) * 1e3
 

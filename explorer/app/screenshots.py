@@ -18,9 +18,9 @@ SCREENSHOT_DIR = Path("screenshots")
 
 
 def screenshot_name(state: AppState) -> str:
-    """The next free ``screenshots/MATERIAL_VIEW_N.png``."""
+    """The next free ``screenshots/MATERIAL_VIEW_N.png`` of the active view (``compare`` when Compare is in front)."""
     SCREENSHOT_DIR.mkdir(exist_ok=True)
-    stem = f"{Path(state.material_path).stem}_{state.main_view()}"
+    stem = f"{Path(state.material_path).stem}_{'compare' if state.active_view == 'compare' else state.main_view()}"
     index = 1
     while (SCREENSHOT_DIR / f"{stem}_{index}.png").exists():
         index += 1
@@ -52,7 +52,13 @@ def take_screenshot(state: AppState, scheduler: Scheduler) -> None:
     if state.pending_screenshot is None:
         return
     samples = None
-    if state.mode == "env":
+    view = "env" if state.mode == "env" else state.main_view()
+    if state.active_view == "compare" and state.compare.on:
+        image = compare_image(state, scheduler)
+        if image is None:
+            return  # written when both sides are refined
+        view = "compare"
+    elif state.mode == "env":
         render = scheduler.env.render
         if render is None or render.material is not state.material or render.samples == 0 or render._band_rows:
             return  # written at the first whole sample of the material shown (every pixel the same count)
@@ -70,14 +76,34 @@ def take_screenshot(state: AppState, scheduler: Scheduler) -> None:
     path = Path(state.pending_screenshot)
     state.pending_screenshot = None
     try:
-        write_image(image, path.with_suffix(".png"), exposure=state.exposure)
+        tonemap = state.tonemap_for(scheduler.job("compare_a").view if view == "compare" else view)
+        write_image(image, path.with_suffix(".png"), exposure=state.exposure, tonemap=tonemap)
         write_image(image, path.with_suffix(".npy"))
     except OutputError as error:
         state.status = str(error)
         return
     state.screenshots.append(str(path.with_suffix(".png")))
     state.screenshot_info[str(path.with_suffix(".png"))] = {
-        "material": str(state.material_path), "view": "env" if samples is not None else state.main_view(),
+        "material": str(state.material_path), "view": view,
         "values": state.json_values(), "samples": samples, "inverse": state.inverse,
     }
     state.status = f"wrote {path.with_suffix('.png')} and {path.with_suffix('.npy')}"
+
+
+def compare_image(state: AppState, scheduler: Scheduler):
+    """
+    The Compare window's split image as it shows it, linear: A left of the middle column, B from it on (the display
+    pass's ``x >= split``); None until both are complete. An error is reported in the status line (and the shot dropped).
+    """
+    a, b = scheduler.job("compare_a"), scheduler.job("compare_b")
+    for job in (a, b):
+        if job.error is not None:
+            state.status = f"no screenshot: {job.error}"
+            state.pending_screenshot = None
+            return None
+    if not (a.complete and b.complete):
+        return None
+    left, right = a.read(), b.read()
+    width = left.shape[1]
+    columns = (np.arange(width) + 0.5) / width >= 0.5
+    return np.where(columns[None, :, None], right, left)

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.views.fill import DEFAULT_FILL
+
 from explorer.materials.methods import opening_values
 from explorer.materials.brd import Material
 
@@ -64,6 +66,7 @@ class CompareState:
     kind: str = "methods"  # or "sets", "materials"
     a: int = 0
     b: int = 4
+    size: list = field(default_factory=list)  # the pair's resolution, fitted to the window (reported)
     material_b: int = 0  # an index in AppState.materials
     heat: bool = False  # the ΔE2000 heat-map instead of the split sphere
 
@@ -77,6 +80,8 @@ class MaterialEntry:
     values: dict
     colour: tuple
     visible: bool = True
+    polar_log: bool = False  # the Polar window's scale of this material's curve (explorer.app.data.polar_radius)
+    polar_normalise: bool = False
 
     @property
     def name(self) -> str:
@@ -84,6 +89,7 @@ class MaterialEntry:
 
     def report(self) -> dict:
         return {"path": str(self.path), "visible": self.visible, "colour": list(self.colour),
+                "polar": {"log": self.polar_log, "normalise": self.polar_normalise},
                 "values": {k: list(v) if isinstance(v, tuple) else v for k, v in self.values.items()}}
 
 
@@ -115,6 +121,8 @@ class AppState:
     camera: list = field(default_factory=lambda: [0.0, 0.0])  # yaw, pitch: turns the light relative to the view
     zoom: float = 1.0
     exposure: float = 1.0
+    tonemap: str = "auto"  # "auto" (explorer.views.tonemap.default_tonemap of the view) or one of TONEMAPS
+    fill: float = DEFAULT_FILL  # the lit view's environment fill (explorer.views.fill), 0: the light alone
     # The env mode (explorer.app.scheduler.EnvSphere): its environment (a name of explorer.views.env.ENVIRONMENTS),
     # the probe's turn (degrees), the environment behind the object, the samples per pixel that make it
     # converged (no more are drawn), and its progress (samples, target, converged) for the status and report.
@@ -140,6 +148,11 @@ class AppState:
     error: str = ""  # the material's load/compile error, shown in red; the last good shader stays
     # Requests, served when the frame allows.
     pending_screenshot: str | None = None
+    active_view: str = "sphere"  # the view in front, that F12 saves: "sphere" (the Sphere window) or "compare"
+    focused_view: str = "Sphere"  # the last of the Sphere and Compare windows focused (both undocked: it is in front)
+    strip_rows: list = field(default_factory=list)  # the Strips window's rows, top to bottom (reported)
+    polar_report: dict | None = None  # the Polar window's curves' peaks, scales and axes (reported)
+    spectrum_legend: str = ""  # where the Spectrum plot's legend is (reported)
     pending_window_shot: str | None = None
     pending_slice_save: str | None = None
     focus_request: str | None = None
@@ -191,7 +204,21 @@ class AppState:
         reflects = self.mode == "env" or (self.main_view() == "lit" and is_mirror_only(self.material))
         return {"view": "env" if self.mode == "env" else self.main_view(), "light": list(self.light),
                 "camera": list(self.camera), "exposure": float(self.exposure),
+                "tonemap": self.tonemap_for("env" if self.mode == "env" else self.main_view()),
+                "fill": float(self.fill) if self.main_view() == "lit" and self.mode != "env" else None,
                 "environment": self.environment if reflects else None, "env_rotation": float(self.env_rotation) if reflects and self.env_rotation else None}
+
+    def lit_uniforms(self, material, view: str) -> dict:
+        """The lit view's environment fill for ``material`` (none for a smooth mirror, nor in other views)."""
+        from explorer.views.fill import has_fill
+
+        return {"fill": float(self.fill)} if view.rsplit("/", 1)[-1] == "lit" and has_fill(material) else {}
+
+    def tonemap_for(self, view: str) -> str:
+        """The display curve of ``view`` (a template such as ``mesh/lit`` counts as its view): the chosen one, or its default."""
+        from explorer.views.tonemap import default_tonemap
+
+        return default_tonemap(view.rsplit("/", 1)[-1]) if self.tonemap == "auto" else self.tonemap
 
     def main_view(self) -> str:
         """The sphere's view: ``sphere`` when chosen and the material has a reflectance, else ``lit``."""

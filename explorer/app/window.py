@@ -320,7 +320,9 @@ class App:
             "view_size_auto": s.view_size_auto, "materials": [entry.report() for entry in s.materials], "selected": s.selected,
             "visible": sorted(s.visible), "slice": s.slice_report, "plotted": s.plotted, "plotted_log": s.plotted_log,
             "first_screen": s.first_screen, "items": sorted(s.rects), "dialog": self.dialog.log,
-            "plots": s.plots, "texture_view": s.texture_view,
+            "plots": s.plots, "texture_view": s.texture_view, "active_view": s.active_view, "strip_rows": s.strip_rows,
+            "compare_size": s.compare.size, "rects": {name: list(rect) for name, rect in s.rects.items()},
+            "polar": s.polar_report, "spectrum_legend": s.spectrum_legend,
         }
         from explorer.files import write_text_atomic
 
@@ -363,8 +365,15 @@ class App:
             expanded, _ = imgui.begin(panel.title)
             if expanded:
                 state.visible.add(panel.title)
+                pos, size = imgui.get_window_pos(), imgui.get_window_size()  # for scripted checks: nothing cut
+                state.rects[f"window:{panel.title}"] = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
+                if panel.title in ("Sphere", "Compare") and imgui.is_window_focused(imgui.FocusedFlags_.root_and_child_windows):
+                    state.focused_view = panel.title
                 panel.draw(imgui)
             imgui.end()
+        # The active view (F12's): Compare when its tab is in front (and on), or focused beside a visible Sphere.
+        compare_shown = "Compare" in state.visible and state.compare.on
+        state.active_view = "compare" if compare_shown and ("Sphere" not in state.visible or state.focused_view == "Compare") else "sphere"
         if state.focus_request:
             imgui.set_window_focus(state.focus_request)
             state.focus_request = None

@@ -159,7 +159,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
 
 def print_view_frames(views: list[dict], size: int) -> None:
     """The table of :func:`summarise_view_frames`."""
-    print(f"New views (issue 18) in their windows beside the {size}x{size} sphere, tabulated method, Lambda dragged "
+    print(f"New views (Plots, Texture) in their windows beside the {size}x{size} sphere, tabulated method, Lambda dragged "
           f"(goal >= {APP_GOAL_FPS:g} fps; the textured view shows draft tables while dragging):")
     print(f"{'view':<10} {'shown':>9} {'median':>8} {'p90':>8} {'max':>8} {'fps':>6} {'sphere/s':>9} {'view/s':>7} {'draft':>6}")
     for row in views:

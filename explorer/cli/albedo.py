@@ -90,7 +90,8 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
             model = twin_of(loaded, values) if loaded.model else None
             from explorer.gpu import Renderer
 
-            rgb = albedo_views.albedo_gl(loaded, values, angles, Renderer(), size=albedo_views.gl_size_for(model), model=model)
+            rgb = albedo_views.albedo_gl(loaded, values, angles, Renderer(), size=albedo_views.gl_size_for(model), model=model,
+                                         progress=progress_printer("albedo", "angles"))
         else:
             from explorer.materials.brd import MaterialError
 
@@ -98,7 +99,7 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
             if model is None:
                 raise MaterialError(loaded.path, None, "this material has no numpy twin (no known '# model:' line): use --engine gl")
             if engine == "numpy":
-                rgb = albedo_views.albedo_numpy(model, angles)
+                rgb = albedo_views.albedo_numpy(model, angles, progress_printer("albedo", "angles"))
             else:
                 check_position_free(loaded, model)
                 result = albedo_views.albedo_position_free(

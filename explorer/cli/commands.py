@@ -24,7 +24,7 @@ from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
 from explorer.cli.design import DEFAULT_TRIES, MAX_TRIES
-from explorer.cli.materials import PROG, resolve_values, warn
+from explorer.cli.materials import PROG, SuggestingChoice, command_prefix, resolve_values, warn
 from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
 MAX_SIZE = 1 << 16
@@ -113,7 +113,7 @@ def parse_exposure(text: str | None, out: Path) -> float | None:
 def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     """
     What ``--params FILE`` saved of the app's view (:func:`explorer.app.parameter_files.check_view`), as
-    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``environment``, ``env_rotation`` and ``light``
+    ``render``'s own options: ``view``, ``exposure`` (a string, as typed), ``tonemap``, ``fill``, ``environment``, ``env_rotation`` and ``light``
     (``(theta, phi)``: the app's light turned by its orbit camera into view space). Only for the options
     the command line leaves unset; ``{}`` without a file or a saved view.
     """
@@ -122,13 +122,17 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     from explorer.app.parameter_files import load_view
 
     view = load_view(params_file) or {}
-    given = {name for name in ("view", "light", "exposure", "env_file", "env_rotation")
+    given = {name for name in ("view", "light", "exposure", "env_file", "env_rotation", "tonemap", "fill")
              if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE}
     result: dict = {}
     if "view" in view and "view" not in given:
         result["view"] = view["view"]
     if "exposure" in view and "exposure" not in given:
         result["exposure"] = repr(view["exposure"])
+    if "tonemap" in view and "tonemap" not in given:
+        result["tonemap"] = view["tonemap"]
+    if "fill" in view and "fill" not in given and result.get("view", "lit") == "lit":
+        result["fill"] = view["fill"]
     if "environment" in view and "env_file" not in given and result.get("view") in ("env", "lit"):  # lit: a smooth mirror's
         result["environment"] = view["environment"]
     if "env_rotation" in view and "env_rotation" not in given and result.get("view") in ("env", "lit"):
@@ -225,13 +229,15 @@ def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() befor
 
 
 @cli.command("open")
-@click.argument("materials", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("materials", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets).")
-@click.option("--script", type=click.Path(dir_okay=False), hidden=True, help="A scripted session (JSON list of actions; tests, bench --app).")
-@click.option("--report", type=click.Path(dir_okay=False), hidden=True, help="Write the session's JSON report (frame times, values).")
-@click.option("--window-size", metavar="WxH", hidden=True, help="Window size in pixels (default 1280x800).")
+@click.option("--script", type=click.Path(dir_okay=False), metavar="FILE.json",
+              help="Play a scripted session (a JSON list of actions, docs/app.md), then close: screenshots, tests, bench --app.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="FILE.json", help="Write the session's JSON report (frame times, values).")
+@click.option("--window-size", metavar="WxH", help="Window size in pixels (default 1280x800).")
 def open_material(materials, preset, script, report, window_size):
-    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names).
+    """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names; none:
+    the default Bragg mirror).
 
     Several materials are listed in the Materials window, each with its colour; the plots overlay the
     visible ones and the sphere shows the chosen one (the first; --preset applies to it).
@@ -239,6 +245,7 @@ def open_material(materials, preset, script, report, window_size):
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
+    materials = materials or (str(DEFAULT_MATERIAL),)
     try:
         loaded = _load(materials[0])
         more = [_load(other).path for other in materials[1:]]
@@ -261,7 +268,7 @@ def open_material(materials, preset, script, report, window_size):
                 raise click.BadParameter(f"{window_size!r} is not WxH (at least 200x200)", param_hint="--window-size") from None
         if not display_available():
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
-                           "for images without a window use: bragg-explorer render")
+                           f"for images without a window use: {command_prefix()} render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
                          is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
     except ImportError as error:
@@ -288,8 +295,8 @@ def _errors(function):
 
 
 @cli.command()
-@click.argument("material", type=click.Path(dir_okay=False))
-@click.option("--view", type=click.Choice(list(VIEWS)), default="sphere", show_default=True)
+@click.argument("material", type=click.Path(dir_okay=False), required=False)
+@click.option("--view", type=SuggestingChoice(list(VIEWS)), default="sphere", show_default=True)
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a material parameter (repeatable).")
 @click.option("--size", metavar="W[xH]", help="Image size in pixels (default 256x256; gradient 256x32).")
 @click.option("--out", required=True, type=click.Path(), help="FILE.png (8-bit sRGB), FILE.npy or FILE.exr (linear float32 RGB).")
@@ -299,6 +306,10 @@ def _errors(function):
 @click.option("--preset", metavar="NAME", help="Start from a preset of the material (bragg-explorer presets); --set overrides it.")
 @click.option("--params", "params_file", metavar="FILE", help="A parameter set (JSON, or BRDF Explorer's .bparam, as the app's Files tab saves); over --preset, under --set.")
 @click.option("--exposure", metavar="X", help="PNG only: multiply the linear values by X before the 8-bit sRGB encode (the app's exposure; 2 = one stop brighter), or auto: the bright end of the object to white.")
+@click.option("--tonemap", type=click.Choice(["none", "agx", "aces"]),
+              help="PNG only: the display curve after the exposure: agx (Sobotka's AgX, Blender's default; the default of the lit, env and textured views: vivid colours and highlights roll off to white), aces (Narkowicz's ACES fit), none (clamp; the default of the colour views and plots). .npy and .exr stay linear.")
+@click.option("--fill", type=click.FloatRange(min=0.0), metavar="X",
+              help="lit view: the radiance of a uniform white environment beside the point light (default 0.15; 0: the light alone). A smooth mirror reflects --env instead.")
 @click.option("--texture", metavar="FILE", help="textured and env views: grey image of a film's D_inc or a mirror's T (default shaders/textures/thickness_noise.png; env: none).")
 @click.option("--dinc-range", metavar="MIN,MAX", help="textured view: D_inc (nm) at black and white (default 0,1125).")
 @click.option("--prefilter", type=click.Choice(["on", "off"]), default="off", show_default=True, help="textured view: Section 5's prefiltering (methods 1-3).")
@@ -317,11 +328,11 @@ def _errors(function):
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @_errors
-def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, texture, dinc_range,
+def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
            ndotl, mapping):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
-    to a PNG, .npy or .exr.
+    to a PNG, .npy or .exr. Without MATERIAL, the one --params names.
 
     Views: gradient and sphere show a material's reflectance(cos_theta); lit (a sphere under one
     directional light), slice (BRDF Explorer's image slice, theta_h across, theta_d down) and scatter
@@ -335,10 +346,18 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     """
     from explorer.views.geometry import scatter_circles, view_named
 
+    if material is None:
+        if params_file is None:
+            raise click.UsageError("Missing argument 'MATERIAL' (or a --params file that names one).")
+        from explorer.app.parameter_files import named_material
+
+        material = named_material(params_file)
+        if material is None:
+            raise click.UsageError(f"--params {params_file} names no material: give MATERIAL")
     check_output(Path(out))
     saved = saved_view(params_file, click.get_current_context())  # the app's view saved with the parameters
     view, exposure, env_file = saved.get("view", view), saved.get("exposure", exposure), saved.get("environment", env_file)
-    env_rotation = saved.get("env_rotation", env_rotation)
+    env_rotation, tonemap, fill = saved.get("env_rotation", env_rotation), saved.get("tonemap", tonemap), saved.get("fill", fill)
     exposure_factor = parse_exposure(exposure if Path(out).suffix.lower() == ".png" or "exposure" not in saved else None, Path(out))
     light_angles = parse_light(light, view) if light is not None or "light" not in saved or not view_named(view).takes_light else saved["light"]
     loaded = _load(material)
@@ -351,6 +370,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("a plot is a chart (.png) or its values (.npy)", param_hint="--out")
     if plot is not None and exposure is not None:
         raise click.BadParameter("a plot's values are not exposed (use --log)", param_hint="--exposure")
+    if plot is not None and tonemap is not None:
+        raise click.BadParameter("a plot's values are not tone mapped (use --log)", param_hint="--tonemap")
+    from explorer.views.tonemap import default_tonemap
+
+    tonemap = tonemap or default_tonemap(view)
+    if fill is not None and view != "lit":
+        raise click.BadParameter("the environment fill is the lit view's", param_hint="--fill")
     thickness = None
     surface_given = texture is not None or dinc_range is not None or mapping is not None
     if view == "textured" or (view == "env" and surface_given):
@@ -405,11 +431,16 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 
         if view not in POSITION_FREE_VIEWS:
             raise click.BadParameter(f"the position-free engine renders the {' and '.join(POSITION_FREE_VIEWS)} views", param_hint="--view")
+        fill = 0.0
+    else:
+        from explorer.views.fill import DEFAULT_FILL, has_fill
+
+        fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
     from explorer.cli.albedo import progress_printer
     from explorer.rendering import render_material
 
     image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
-                            variant=variant, mesh=mesh_shape, background=background, plot=plot,
+                            variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
                             progress_printer=progress_printer, warn=warn)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
@@ -418,9 +449,9 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if exposure_factor is None:  # --exposure auto
         from explorer.views.exposure import auto_exposure
 
-        exposure_factor = auto_exposure(image)
+        exposure_factor = auto_exposure(image, tonemap)
         click.echo(f"{PROG}: exposure auto: {exposure_factor:.3g}", err=True)
-    write_image(image, Path(out), circles, exposure_factor)
+    write_image(image, Path(out), circles, exposure_factor, tonemap)
     bad = int((~np.isfinite(image)).sum())
     method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
@@ -470,7 +501,10 @@ def info(material, as_json, dispersions):
         bounds = "" if p.min is None else f" in [{shown['min']:g}, {shown['max']:g}]"
         opens = (f" (every command and the app open it on {labels.get(opening, opening)})"
                  if p.name == "method" and opening is not None and opening != shown["default"] else "")
-        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{opens}")
+        unit = f" {p.unit}" if p.unit and p.unit != "1" else ""
+        click.echo(f"  {p.type:5} {p.name:{width}} default {default}{bounds}{unit}{opens}")
+        if p.doc:
+            click.echo(f"  {'':5} {'':{width}} {p.doc}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
     from explorer.materials.twins import capabilities_of

@@ -201,7 +201,9 @@ def render_command(material_name: str, values: dict, material=None) -> str:
     methods = capabilities_of(material).methods if material is not None else None
     best = methods.preferred_member() if methods is not None else None
     method = f" --set method={int(best)}" if best is not None else ""
-    return f"{PROG} render {material_name} --view gradient {sets}{method} --out design.png"
+    from explorer.cli.materials import command_prefix
+
+    return f"{command_prefix()} render {material_name} --view gradient {sets}{method} --out design.png"
 
 
 @click.command("design")
@@ -226,8 +228,10 @@ def render_command(material_name: str, values: dict, material=None) -> str:
 @click.option("--tries", type=click.IntRange(min=1, max=MAX_TRIES), default=DEFAULT_TRIES, show_default=True, metavar="K",
               help="Search up to K times until every target is within ΔE2000 1, each from fresh samples and the best "
                    "structure so far (~4 s each; 1: one search).")
+@click.option("--save", metavar="FILE", help="Also write the structure as a parameter set (FILE.json, or BRDF Explorer's .bparam) "
+              "that render, export and open take with --params.")
 def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
-                   spectrum_theta, spectrum_plot, seed, tries):
+                   spectrum_theta, spectrum_plot, seed, tries, save):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -264,6 +268,8 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         _fail(str(error))
     name = display_path(loaded.path)
     unreachable = [t for t, ok in zip(result.targets, result.reachable) if not ok]
+    if save is not None:
+        _save_structure(loaded, result.values, save)
     if as_json:
         click.echo(json.dumps(result.as_json(name), indent=2))
         for t, d in zip(result.targets, result.delta_e2000):
@@ -285,6 +291,18 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
                    "the structure above is the closest found")
         click.echo(SEARCH_CAVEAT)
     click.echo(f"render: {render_command(name, result.values, loaded)}")
+
+
+def _save_structure(material, values: dict, path: str) -> None:
+    """The designed structure as a parameter set at ``path`` (the file's other values at its opening ones: the tabulated method)."""
+    from explorer.app.parameter_files import ParameterFileError, save_values
+    from explorer.materials.methods import opening_values
+
+    try:
+        save_values(path, material, material.resolve({**opening_values(material), **values}))
+    except (OSError, ParameterFileError) as error:
+        _fail(f"{path}: cannot write the parameter set ({' '.join(str(error).split())[:160]})")
+    click.echo(f"{PROG}: wrote {path} (render, export and open take it with --params {path})", err=True)
 
 
 def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None,

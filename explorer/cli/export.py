@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from explorer.cli.materials import PROG, load, resolve_values, warn  # noqa: F401
-TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
+TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf", "blender")
 
 
 def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
@@ -43,6 +43,9 @@ def export_command(material, target, preset, params_file, assignments, env_file,
     try:
         if texture_table and target != "gltf":
             raise click.BadParameter("--texture-table is for --to gltf", param_hint="--texture-table")
+        if target == "blender":
+            _export_blender(material, preset, params_file, assignments, env_file, out, load(material))
+            return
         if target == "gltf":
             _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, load(material))
             return
@@ -50,6 +53,19 @@ def export_command(material, target, preset, params_file, assignments, env_file,
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
+
+
+def _export_blender(material, preset, params_file, assignments, env_file, out, loaded):
+    """``--to blender``: the preview scene (.blend) and the script that rebuilds the material (.py)."""
+    from explorer.blender import export_blender
+    from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+
+    for warning in loaded.warnings:
+        warn(warning)
+    values = resolve_values(loaded, preset, params_file, assignments)
+    environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+    blend, script = export_blender(loaded, values, Path(out), environment)
+    click.echo(f"wrote {blend} (Cycles preview: the env view's scene) and {script} (rebuilds the material on yours)")
 
 
 def _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, loaded):

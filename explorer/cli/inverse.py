@@ -120,7 +120,9 @@ def inverse_command(lobe_specs, as_json, tir):
         click.echo(f"lobe {k}: requested R = {np.round(entry['requested']['R'], 5).tolist()}, sigma = {entry['requested']['sigma']:g}; "
                    f"forward R = {np.round(entry['forward']['R'], 5).tolist()}, sigma = {np.round(entry['forward']['sigma'], 5).tolist()}")
     sets = " ".join(f"--set {k}={','.join(f'{x:.6g}' for x in np.atleast_1d(v))}" for k, v in values.items())
-    click.echo(f"render: bragg-explorer render shaders/{LayeredLobesModel.name}.brd {sets} --view env --out lobes.png")
+    from explorer.cli.materials import command_prefix
+
+    click.echo(f"render: {command_prefix()} render {LayeredLobesModel.name} {sets} --view env --out lobes.png")
 
 
 @click.command("figure")

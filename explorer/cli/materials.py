@@ -16,6 +16,29 @@ from explorer.resources import material_path
 PROG = "bragg-explorer"
 
 
+def command_prefix() -> str:
+    """How to run a command as printed: ``bragg-explorer`` where the console script is on PATH (an installed
+    package), else ``python3 -m explorer`` (a checkout, as the README runs it)."""
+    import shutil
+
+    return PROG if shutil.which(PROG) else "python3 -m explorer"
+
+
+class SuggestingChoice(click.Choice):
+    """A :class:`click.Choice` whose refusal names the closest choice (difflib): ``(did you mean 'sphere'?)``."""
+
+    def convert(self, value, param, ctx):
+        try:
+            return super().convert(value, param, ctx)
+        except click.BadParameter as error:
+            from explorer.errors import did_you_mean
+
+            hint = did_you_mean(value, self.choices)
+            if hint:
+                error.message = f"{error.message.rstrip('.')}{hint}"
+            raise
+
+
 def warn(message: str) -> None:
     """A one-line warning on stderr."""
     click.echo(f"{PROG}: warning: {message}", err=True)

@@ -1,6 +1,6 @@
 """
 ``python -m explorer.dev.lookup_profile [SIZE] [REPEATS]``: what a per-pixel table lookup costs against
-Schlick's Fresnel on this GL (issue 22 item 3; docs/performance.md, *Tabulated shading, re-profiled*).
+Schlick's Fresnel on this GL (docs/performance.md, *Tabulated shading, re-profiled*).
 
 Each variant is the sphere view's pixel (``shaders/views/sphere.glsl``: ``reflectance(sqrt(1 - r^2))``
 inside the disc) with one way of reading a 257-entry RGB table over cos theta: the tabulated method's own

@@ -13,9 +13,10 @@ from explorer.gpu.progressive import ProgressiveView
 from explorer.gpu.renderer import Renderer
 
 
-DISPLAY_SHADER = f"""#version {GLSL_VERSION}
-// Linear float images -> 8-bit sRGB for the screen: exposure, the gamut overlay, the compare split.
-// Rows above `refined` (a GL v coordinate) come from the full image, the others from the preview.
+DISPLAY_SHADER = """
+// Linear float images -> 8-bit sRGB for the screen: exposure, the gamut overlay, the tone map, the compare
+// split. Rows above `refined` (a GL v coordinate) come from the full image, the others from the preview.
+#include "lib/tonemap.glsl"
 uniform sampler2D full_a;
 uniform sampler2D preview_a;
 uniform float refined_a;
@@ -25,36 +26,39 @@ uniform float refined_b;
 uniform float split;      // x in [0, 1] where image b starts; > 1: image a only
 uniform float exposure;
 uniform bool gamut;       // mark colours outside sRGB (a negative channel or above white)
+uniform int tonemap_curve;  // TONEMAP_NONE, TONEMAP_AGX, TONEMAP_ACES (lib/tonemap.glsl)
 uniform vec2 resolution;
 out vec4 frag_colour;
 
 uniform bool accumulated_a;  // the full image holds sums of samples with their count in alpha (env)
 uniform bool accumulated_b;
 
-vec3 sample_image(sampler2D full, sampler2D preview, float refined, bool accumulated, vec2 uv) {{
+vec3 sample_image(sampler2D full, sampler2D preview, float refined, bool accumulated, vec2 uv) {
     if (uv.y < refined) return texture(preview, uv).rgb;
     vec4 texel = texelFetch(full, ivec2(gl_FragCoord.xy), 0);
     return accumulated ? texel.rgb / max(texel.a, 1.0) : texel.rgb;
-}}
+}
 
-float encode(float c) {{
+float encode(float c) {
     c = clamp(c, 0.0, 1.0);
     return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
-}}
+}
 
-void main() {{
+void main() {
     vec2 uv = gl_FragCoord.xy / resolution;
     bool b = uv.x >= split;
     vec3 rgb = exposure * (b ? sample_image(full_b, preview_b, refined_b, accumulated_b, uv)
                              : sample_image(full_a, preview_a, refined_a, accumulated_a, uv));
-    vec3 colour = vec3(encode(rgb.r), encode(rgb.g), encode(rgb.b));
-    if (gamut && (any(lessThan(rgb, vec3(-1e-6))) || any(greaterThan(rgb, vec3(1.0 + 1e-6))))) {{
+    vec3 shown = tonemap(rgb, tonemap_curve);
+    vec3 colour = vec3(encode(shown.r), encode(shown.g), encode(shown.b));
+    // The overlay judges the exposed linear colour, before the tone map (which brings everything into [0, 1]).
+    if (gamut && (any(lessThan(rgb, vec3(-1e-6))) || any(greaterThan(rgb, vec3(1.0 + 1e-6))))) {
         // A magenta and black hatching: visible on any colour, and the colour still shows in between.
         colour = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 3.0), 2.0) < 1.0 ? vec3(1.0, 0.0, 1.0) : colour * 0.5;
-    }}
+    }
     if (split <= 1.0 && abs(gl_FragCoord.x - split * resolution.x) < 0.5) colour = vec3(1.0);
     frag_colour = vec4(colour, 1.0);
-}}
+}
 """
 
 
@@ -67,6 +71,16 @@ out vec4 frag_colour;
 
 void main() {{ frag_colour = texture(encoded, gl_FragCoord.xy / resolution); }}
 """
+
+
+def display_shader_source() -> str:
+    """:data:`DISPLAY_SHADER` with the shader library's ``#include``s expanded (the tone map's GLSL twin)."""
+    from explorer.materials.glsl import ShaderBuilder
+    from explorer.resources import SHADER_DIR
+
+    builder = ShaderBuilder(include_dirs=[SHADER_DIR], version=GLSL_VERSION)
+    builder.add_source(DISPLAY_SHADER, "display pass (explorer/gpu/display.py)")
+    return builder.build().code
 
 
 class AccumulatedImage:
@@ -97,7 +111,7 @@ class DisplayPass:
     def __init__(self, renderer: Renderer):
         self.renderer = renderer
         self.ctx = ctx = renderer.ctx
-        self.program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=DISPLAY_SHADER)
+        self.program = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=display_shader_source())
         self.upscale = ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=UPSCALE_SHADER)
         self._targets: dict[object, object] = {}
         self._encoded: dict[object, object] = {}  # per key, a preview encoded at its own size (see draw)
@@ -128,15 +142,21 @@ class DisplayPass:
         uniforms[f"accumulated_{suffix}"] = isinstance(view, AccumulatedImage)
 
     def draw(self, key, a: ProgressiveView, b: ProgressiveView | None = None, *, split: float = 2.0,
-             exposure: float = 1.0, gamut: bool = False):
-        """The display texture of ``a`` (left of ``split``) and ``b`` (right of it); returns the texture."""
+             exposure: float = 1.0, gamut: bool = False, tonemap: str = "none"):
+        """
+        The display texture of ``a`` (left of ``split``) and ``b`` (right of it), exposed and tone mapped by
+        ``tonemap`` (:data:`explorer.views.tonemap.TONEMAPS`); returns the texture.
+        """
+        from explorer.views.tonemap import TONEMAPS, check_tonemap
+
         texture = self.target(key, a.size)
         state = tuple((id(v), v.generation, v.refined_rows, v.has_preview) for v in (a, b) if v is not None)
-        state += (split, exposure, gamut, texture.glo)
+        state += (split, exposure, gamut, tonemap, texture.glo)
         if self._drawn.get(key) == state:
             return texture
         self._drawn[key] = state
-        uniforms = {"split": float(split) if b is not None else 2.0, "exposure": float(exposure), "gamut": bool(gamut)}
+        uniforms = {"split": float(split) if b is not None else 2.0, "exposure": float(exposure), "gamut": bool(gamut),
+                    "tonemap_curve": TONEMAPS.index(check_tonemap(tonemap))}
         textures: dict[str, object] = {}
         self._bindings(a, "a", uniforms, textures)
         self._bindings(b if b is not None else a, "b", uniforms, textures)

@@ -76,8 +76,9 @@ def mesh_normals(renderer, mesh: Mesh, width: int, height: int) -> np.ndarray:
         renderer.resources.release(framebuffer, depth, colour, array, indices, vertices)
 
 
-def render_mesh(renderer, material, values, view: str, mesh: Mesh, width: int, height: int, *, light=None, environment=None) -> np.ndarray:
+def render_mesh(renderer, material, values, view: str, mesh: Mesh, width: int, height: int, *, light=None, environment=None,
+                uniforms=None) -> np.ndarray:
     """The ``lit`` view of ``mesh``: ``(height, width, 3)`` float32 linear RGB, rows from the top (see :meth:`Renderer.render`)."""
     surface = mesh_normals(renderer, mesh, width, height)
     return renderer.render(material, values, MESH_TEMPLATES[view], width, height, light=light, inputs={"mesh_normals": surface},
-                           environment=environment)
+                           environment=environment, uniforms=uniforms)

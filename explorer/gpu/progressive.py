@@ -134,7 +134,7 @@ class ProgressiveView:
         """Draw into ``framebuffer`` (rows ``[top, bottom)`` from the top only); returns ms (glFinish-bounded)."""
         program = self._program()
         uniforms, textures = self.renderer.bindings(program, self.material, self.values, getattr(self, "inputs", None), self.uniforms,
-                                                    getattr(self, "environment", None))
+                                                    getattr(self, "environment", None), draft=self.dragging)
         if self.light is not None:
             uniforms["light_direction"] = self.light
         elapsed = self.renderer.draw(program, framebuffer, uniforms=uniforms, textures=textures, rows=rows)

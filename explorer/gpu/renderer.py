@@ -28,7 +28,9 @@ from explorer.gpu.resources import (
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
 #: program is shared: the app's Slice window may have set another phi_d on it).
-VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2)}
+VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2), "fill": 0.0}
+#: Fill tables kept (explorer.views.fill): the shown material's, Compare's two, a few more.
+FILL_TABLES_KEPT = 8
 
 #: GL's sampler types (1D ... 2D rectangle shadow, the array/buffer/integer ones, the multisample ones).
 SAMPLER_TYPES = frozenset([*range(0x8B5D, 0x8B65), *range(0x8DC0, 0x8DD9), *range(0x9108, 0x910E)])
@@ -69,6 +71,8 @@ class Renderer:
         self.last_table_ms: float | None = None
         #: What a smooth mirror reflects in the lit view (:meth:`mirror_environment`): (pixels, texture), or None.
         self._mirror_environment: tuple | None = None
+        self._fill_tables: dict = {}  # (material, values) -> the lit view's fill table, least recently used first
+        self._fill_last: dict = {}  # id(material) -> its last fill table (a dragged slider's previews)
         self._default_environment = None
 
     # -- resources ---------------------------------------------------------------------------------
@@ -179,9 +183,34 @@ class Renderer:
 
     # -- bindings and the draw primitive ------------------------------------------------------------
 
+    def fill_table(self, material: Material, values: Mapping[str, object], draft: bool = False) -> tuple:
+        """
+        The lit view's fill table (:mod:`explorer.views.fill`): the albedo view drawn at the fill's angles on its
+        quadrature, as the shader's ``vec3 fill_albedo[]``; the last few kept (Compare's two materials, a slider's
+        other views). ``draft`` (a preview while a slider moves): the material's last table when these values have
+        none yet; the image drawn once the slider is released gets its own.
+        """
+        from explorer.views.fill import FILL_ANGLES, fill_uniforms
+
+        key = (id(material), material.shader, tuple(sorted((k, str(v)) for k, v in values.items())))
+        table = self._fill_tables.get(key)
+        if table is None and draft and id(material) in self._fill_last:
+            return self._fill_last[id(material)]
+        if table is None:
+            # The albedo view sums its terms on the host (one node a fragment: see _render_summed).
+            row = self.render(material, values, "albedo", FILL_ANGLES, 1, uniforms=fill_uniforms())[0]
+            table = tuple(tuple(float(c) for c in texel) for texel in row)
+            if len(self._fill_tables) >= FILL_TABLES_KEPT:
+                self._fill_tables.pop(next(iter(self._fill_tables)))
+        else:
+            self._fill_tables.pop(key)  # to the back: the most recently used
+        self._fill_tables[key] = self._fill_last[id(material)] = table
+        return table
+
     def bindings(
         self, program, material: Material, values: Mapping[str, object],
         inputs: Mapping[str, np.ndarray] | None = None, uniforms: Mapping[str, object] | None = None, environment=None,
+        draft: bool = False,
     ) -> tuple[dict[str, object], dict[str, object]]:
         """
         ``(uniforms, textures)`` of ``material`` at ``values`` for ``program``, as :meth:`draw` takes them:
@@ -190,6 +219,7 @@ class Renderer:
         the textured view's D_inc) and ``uniforms`` (a view's flags) added. A smooth mirror's lit view
         (``MIRROR_ONLY``) gets ``environment`` (default: the env view's) and its glint (:mod:`explorer.views.mirror`).
         """
+        given_values = values
         values = material.typed_values(values)
         bound: dict[str, object] = {}
         for parameter in material.parameters:
@@ -206,6 +236,8 @@ class Renderer:
             bound["xyz_to_rgb_matrix"] = tuple(float(v) for v in colorimetry.xyz_to_rgb_matrix().T.ravel())  # column-major
         bound.update({name: value for name, value in VIEW_UNIFORM_DEFAULTS.items() if name in program})
         bound.update(uniforms or {})
+        if "fill_albedo" in program and float(bound.get("fill", 0.0)) > 0.0:  # the lit view's environment fill
+            bound["fill_albedo"] = self.fill_table(material, given_values, draft)
         textures = dict(self._library)
         if "sensitivity_fourier_prefiltered" in program:  # Section 5's table: built on first use
             if "sensitivity_fourier_prefiltered" not in self._library:

@@ -48,6 +48,7 @@ This module never imports GL: it only turns text into data and GLSL snippets.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 import os
@@ -91,6 +92,8 @@ _GLSL_DIRECTIVE_RE = re.compile(
     r"|extension|version|line|include)\b.*)?\Z"
 )
 _NEWLINE_RE = re.compile(r"\r\n|\r|\n")
+#: A parameter line's trailing ``# UNIT: what it means`` (the unit one token: ``nm``, ``1``, ``1/nm``).
+_DESCRIBED_RE = re.compile(r"\s*(\S+?):\s+(.*?)\s*\Z")
 
 # Keywords and reserved words of GLSL 3.30 up to 4.60: a uniform with one of
 # these names would not compile (now or when the shaders move to a newer GLSL).
@@ -229,6 +232,9 @@ class Parameter:
         The value used when nothing overrides it.
     line : int
         1-based line of the declaration in the material file.
+    unit, doc : str
+        From the line's trailing comment ``# UNIT: what it means`` (BRDF Explorer ignores what follows the
+        fields): the unit (``1`` for a pure number, ``nm``, ...) and one line of meaning; empty without one.
     """
 
     name: str
@@ -237,6 +243,8 @@ class Parameter:
     max: float | None
     default: Value
     line: int
+    unit: str = ""
+    doc: str = ""
 
     @property
     def glsl_type(self) -> str:
@@ -345,7 +353,14 @@ class Parameter:
     def info(self) -> dict[str, Any]:
         """JSON-friendly description: name, type, min, max, default."""
         default: Any = list(self.default) if isinstance(self.default, tuple) else self.default
-        return {"name": self.name, "type": self.type, "min": self.min, "max": self.max, "default": default}
+        return {"name": self.name, "type": self.type, "min": self.min, "max": self.max, "default": default,
+                "unit": self.unit, "doc": self.doc}
+
+    @property
+    def meaning(self) -> str:
+        """``"doc (unit)"`` for a tooltip or ``info``: what the parameter means; empty without a comment."""
+        unit = f" ({self.unit})" if self.unit and self.unit != "1" else ""
+        return f"{self.doc}{unit}" if self.doc else self.unit
 
 
 class Values(dict):
@@ -421,8 +436,11 @@ class Material:
         for p in self.parameters:
             if p.name == name:
                 return p
+        from explorer.errors import did_you_mean
+
         valid = ", ".join(p.name for p in self.parameters) or "(none)"
-        raise UnknownParameterError(self.path, None, f"unknown parameter {name!r}; valid names: {valid}")
+        hint = did_you_mean(name, [p.name for p in self.parameters])
+        raise UnknownParameterError(self.path, None, f"unknown parameter {name!r}{hint}; valid names: {valid}")
 
     def resolve(
         self, overrides: Mapping[str, str | float | bool | Sequence[float]] = MappingProxyType({})
@@ -729,6 +747,12 @@ class _Parser:
                 param = Parameter(name, kind, lo, hi, default, number)
             else:
                 param = self.color(number, name, values, brdf_explorer_file)
+        comment = stripped.split("#", 1)[1] if "#" in stripped else ""
+        described = _DESCRIBED_RE.match(comment)
+        if described:
+            param = dataclasses.replace(param, unit=described.group(1), doc=described.group(2))
+        elif comment.strip():
+            param = dataclasses.replace(param, doc=comment.strip())
         self.names[name] = number
         self.parameters.append(param)
 

@@ -251,15 +251,19 @@ def round_int_parameters(shader: str, names: list[str]) -> str:
 
 
 def _parameter_lines(material, values: Mapping[str, object]) -> list[str]:
+    """The parameter section, each line with its unit and meaning as a trailing comment (BRDF Explorer ignores it)."""
     lines = []
     for p in material.parameters:
         value = values[p.name]
         if p.type == "color":
-            lines.append(f"color {p.name} {' '.join(f'{float(c):.9g}' for c in value)}")
+            line = f"color {p.name} {' '.join(f'{float(c):.9g}' for c in value)}"
         elif p.type == "bool":
-            lines.append(f"bool {p.name} {1 if value else 0}")
+            line = f"bool {p.name} {1 if value else 0}"
         else:
-            lines.append(f"float {p.name} {p.min:.9g} {p.max:.9g} {float(value):.9g}")
+            line = f"float {p.name} {p.min:.9g} {p.max:.9g} {float(value):.9g}"
+        if p.doc:
+            line += f"  # {p.unit or '1'}: {p.doc}"
+        lines.append(line)
     return lines
 
 

@@ -26,7 +26,7 @@ from explorer.physics import microfacet
 
 COLUMNS = 64
 ROWS = 32
-STRATA = 24
+STRATA = 16
 #: The cosine lobe's share of the samples (the base's diffuse light).
 COSINE_SHARE = 0.25
 

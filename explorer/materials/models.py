@@ -424,11 +424,12 @@ class BraggStackModel:
         return np.repeat(np.asarray(F)[..., None], 3, axis=-1)
 
     def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
-        """Eq. 34 per wavelength for Mitsuba (its layers and its base, the base's RGB albedo upsampled), in chunks."""
+        """Eq. 34 per wavelength for Mitsuba (its layers and its base, the base's RGB albedo upsampled; with the
+        multiple-scattering compensation when on, as :meth:`brdf`), in chunks."""
         value = np.empty(wavelengths.shape)
         for start in range(0, i.shape[0], SPECTRAL_CHUNK):
             part = slice(start, start + SPECTRAL_CHUNK)
-            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables)
+            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables, compensation=self.compensation)
             layers = _interp_wavelength(spectra.layers, wavelengths[part])
             base = _interp_wavelength(spectra.base, wavelengths[part])
             value[part] = layers + rgb_upsample(np.broadcast_to(self.rho_d, (base.shape[0], 3)), wavelengths[part]) * base

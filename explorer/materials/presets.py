@@ -62,8 +62,10 @@ class PresetFile:
     def get(self, name: str) -> Preset:
         """The preset called ``name``, or a one-line :class:`PresetError` listing the valid names."""
         if name not in self.presets:
+            from explorer.errors import did_you_mean
+
             valid = ", ".join(self.presets) or "(none)"
-            raise PresetError(_display(self.path), None, f"unknown preset {name!r}; valid names: {valid}")
+            raise PresetError(_display(self.path), None, f"unknown preset {name!r}{did_you_mean(name, self.presets)}; valid names: {valid}")
         return self.presets[name]
 
 

@@ -1,6 +1,6 @@
 """
 Automatic exposure for 8-bit images: the multiplier that brings an image's bright end (not its single
-brightest pixel) to white. Display scaling only: the linear values (``.npy``, ``.exr``) never change.
+brightest pixel) to white (or near it, under a tone map). Display scaling only: the linear values (``.npy``, ``.exr``) never change.
 """
 
 from __future__ import annotations
@@ -14,18 +14,25 @@ AUTO_EXPOSURE_PERCENTILE = 99.5
 BACKGROUND_LEVEL = 1e-6
 
 
-def auto_exposure(image: np.ndarray) -> float:
+#: The exposed value auto-exposure brings the bright end to, per tone map: 1 (white) when clamped; under a
+#: curve that rolls off, where it is near white (AgX's 4 shows at 0.86 of white, ACES's at 0.93).
+AUTO_WHITE = {"none": 1.0, "agx": 4.0, "aces": 4.0}
+
+
+def auto_exposure(image: np.ndarray, tonemap: str = "none") -> float:
     """
-    The exposure that maps :data:`AUTO_EXPOSURE_PERCENTILE` of the drawn pixels' largest channel to 1;
-    1 for an image with nothing drawn (all black, or no finite value).
+    The exposure that maps :data:`AUTO_EXPOSURE_PERCENTILE` of the drawn pixels' largest channel to
+    ``AUTO_WHITE[tonemap]`` (1 without a tone map); 1 for an image with nothing drawn (all black, or no
+    finite value).
 
     Parameters
     ----------
     image : (H, W, 3) linear RGB.
+    tonemap : the display curve the exposure is for (:mod:`explorer.views.tonemap`).
     """
     peak = np.asarray(image, dtype=np.float64).max(axis=-1)
     drawn = peak[np.isfinite(peak) & (peak > BACKGROUND_LEVEL)]
     if drawn.size == 0:
         return 1.0
     level = float(np.percentile(drawn, AUTO_EXPOSURE_PERCENTILE))
-    return 1.0 / level if level > BACKGROUND_LEVEL else 1.0
+    return AUTO_WHITE[tonemap] / level if level > BACKGROUND_LEVEL else 1.0

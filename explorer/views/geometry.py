@@ -78,7 +78,9 @@ def view_named(name: str) -> View:
     try:
         return VIEW_REGISTRY[name]
     except KeyError:
-        raise ValueError(f"unknown view {name!r} (views: {', '.join(VIEWS)})") from None
+        from explorer.errors import did_you_mean
+
+        raise ValueError(f"unknown view {name!r}{did_you_mean(name, VIEWS)} (views: {', '.join(VIEWS)})") from None
 
 
 #: (theta, phi) in degrees, theta from +z, phi from +x.

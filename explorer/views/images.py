@@ -26,7 +26,8 @@ def check_output(out: Path) -> Path:
     return _check_output(out, OUTPUT_SUFFIXES)
 
 
-def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0) -> None:
+def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None, exposure: float = 1.0,
+                tonemap: str = "none") -> None:
     """
     Write a linear RGB image atomically (:func:`explorer.files.atomic_output`): never a partial file.
 
@@ -36,15 +37,17 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
         Linear RGB.
     out : Path
         ``.npy``: float32 linear RGB; ``.exr``: OpenEXR, float32 linear RGB (through OpenCV); ``.png``:
-        8-bit sRGB of ``exposure * image``, clamped.
+        8-bit sRGB of ``tonemap(exposure * image)``.
     overlay : ndarray of bool, HxW, optional
         Pixels painted red in the PNG only (the scatter view's circles).
     exposure : float
         The PNG's multiplier before the sRGB encode, as the app's exposure (linear outputs keep the values).
+    tonemap : str
+        The PNG's display curve after the exposure (:mod:`explorer.views.tonemap`); ``none`` clamps.
     """
-    from PIL import Image
+    from explorer.views.tonemap import display_srgb8
 
-    from explorer.physics.colorimetry import encode_srgb8
+    from PIL import Image
 
     suffix = Path(out).suffix.lower()
     with atomic_output(out, OUTPUT_SUFFIXES) as temporary:
@@ -55,7 +58,7 @@ def write_image(image: np.ndarray, out: Path, overlay: np.ndarray | None = None,
             if suffix == ".npy":
                 np.save(stream, np.ascontiguousarray(image, dtype=np.float32))
             else:
-                pixels = encode_srgb8(np.asarray(image) * np.float32(exposure))
+                pixels = display_srgb8(image, exposure, tonemap)
                 if overlay is not None:
                     pixels[overlay] = OVERLAY_RGB
                 Image.fromarray(pixels, mode="RGB").save(stream, format="PNG")

@@ -29,7 +29,7 @@ def _chunked(function, *arrays) -> np.ndarray:
 
 def render_numpy(
     model, view: str, width: int, height: int, *, light: tuple[float, float] | None = None, thickness=None,
-    environment=None, mesh=None, slice_phi_d: float = 90.0, plot=None,
+    environment=None, mesh=None, slice_phi_d: float = 90.0, plot=None, fill: float = 0.0,
 ) -> np.ndarray:
     """
     The view of a material's numpy twin: ``(height, width, 3)`` float32 linear RGB, unclamped.
@@ -46,6 +46,7 @@ def render_numpy(
     by :func:`explorer.views.mesh.rasterise`.
     ``slice_phi_d`` (``slice``): phi_d in degrees (the app's Slice window; 90 as BRDF Explorer).
     ``plot`` (the plots, :mod:`explorer.views.plots`): a :class:`explorer.views.plots.PlotSettings` (default: its defaults).
+    ``fill`` (``lit``, not a smooth mirror): the environment fill's radiance (:mod:`explorer.views.fill`); 0: the light alone.
     """
     evaluates = view_named(view).evaluates
     if mesh is not None and view not in ("lit", "env"):
@@ -104,6 +105,10 @@ def render_numpy(
             return image
         vectors = [a[inside] for a in (L, V, N, X, Y)]
         image[inside] = _chunked(lambda *a: view_brdf(model.brdf, *a), *vectors) * factor[inside][:, None]
+        if view == "lit" and fill > 0.0:  # the environment fill (explorer.views.fill), lit.glsl's fill_radiance
+            from explorer.views.fill import fill_albedo_numpy, fill_radiance
+
+            image[inside] += fill_radiance(fill_albedo_numpy(model), np.sum(N[inside] * V[inside], axis=-1), fill).astype(np.float32)
         return image
     cos_theta, inside = view_cos_theta(view, width, height)
     image = np.zeros((height, width, 3), dtype=np.float32)

@@ -100,12 +100,13 @@ class Twins:
 _VIEW_LIGHT = object()
 
 
-def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, thickness=None, plot=None) -> Twins:
+def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, thickness=None, plot=None, fill: float = 0.0) -> Twins:
     """
     ``material`` at ``values`` (as given: resolve them first, or not) in ``view`` at ``size = (W, H)``, on
     the GPU and in numpy. ``light`` defaults to the view's in :data:`LIGHTS` (none for the colour
     views); ``thickness`` (an :class:`explorer.views.thickness.ThicknessTexture`) is the textured view's,
-    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) the plot views'.
+    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) the plot views'; ``fill`` the lit view's environment
+    fill (:mod:`explorer.views.fill`; 0, the light alone, by default).
     """
     width, height = size
     if light is _VIEW_LIGHT:
@@ -121,6 +122,8 @@ def render_both(renderer, material, values, view: str, size, light=_VIEW_LIGHT, 
 
         gl_inputs = {"uniforms": gl_uniforms(view, plot)}
         numpy_inputs = {"plot": plot}
+    if fill:
+        gl_inputs, numpy_inputs = {**gl_inputs, "uniforms": {"fill": float(fill)}}, {**numpy_inputs, "fill": float(fill)}
     gl = renderer.render(material, values, view, width, height, light=light, **gl_inputs)
     reference = render_numpy(model_for(material, values), view, width, height, light=light, **numpy_inputs)
     if gl.shape != reference.shape or reference.shape != (height, width, 3):

@@ -12,6 +12,11 @@
 // view's environment by default, turned by mirror_environment_turn), plus the light as a small glint of unit
 // irradiance (light_glint: a disc of angular radius rho, sin^2 rho = glint_sin2; both uniforms from the host).
 // Twin: explorer.views.mirror.mirror_lit.
+//
+// Any other material adds the environment fill (explorer.views.fill): a uniform white environment of radiance
+// `fill` sends fill a(theta_v) toward the eye, a the directional albedo, from the host's table fill_albedo at
+// theta_k = 90 (k + 0.5) / FILL_ANGLES degrees, linear in theta between them and clamped at the ends. fill = 0:
+// the point light alone. Twin: explorer.views.fill.fill_radiance.
 #include "lib/views.glsl"
 #if defined(MIRROR_ONLY) && defined(HAS_MIRROR_REFLECTION)
 #define LIT_MIRROR
@@ -35,6 +40,19 @@ uniform vec2 resolution;
 uniform vec3 light_direction;
 out vec4 frag_colour;
 
+#ifndef LIT_MIRROR
+#define FILL_ANGLES 16
+uniform float fill;
+uniform vec3 fill_albedo[FILL_ANGLES];
+
+vec3 fill_radiance(float cos_view) {
+    float t = clamp(degrees(acos(clamp(cos_view, 0.0, 1.0))) / 90.0 * float(FILL_ANGLES) - 0.5, 0.0, float(FILL_ANGLES - 1));
+    int k = int(floor(t));
+    int k1 = min(k + 1, FILL_ANGLES - 1);
+    return fill * mix(fill_albedo[k], fill_albedo[k1], t - float(k));
+}
+#endif
+
 void main() {
     vec3 normal, tangent, bitangent;
     if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh (views/mesh/lit.glsl)
@@ -49,6 +67,7 @@ void main() {
     vec3 radiance = finite_or_zero(mirror_reflection(view, normal)) * incoming;
 #else
     vec3 radiance = view_brdf(light_direction, view, normal, tangent, bitangent) * max(0.0, dot(normal, light_direction));
+    if (fill > 0.0) radiance += fill_radiance(dot(normal, view));
 #endif
     frag_colour = vec4(radiance, 1.0);
 }

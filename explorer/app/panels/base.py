@@ -84,3 +84,24 @@ def show_image(state, texture, size, label: str, interactive: bool = False, side
     record(state, label)
     if interactive:
         sphere_mouse(state, imgui, label)
+
+
+def checkbox_width(imgui, label: str) -> float:
+    """The width a checkbox labelled ``label`` takes (its box, the gap, the text)."""
+    style = imgui.get_style()
+    box = imgui.get_frame_height()
+    return box + style.item_inner_spacing.x + imgui.calc_text_size(label.split("##")[0]).x
+
+
+def button_width(imgui, label: str) -> float:
+    """The width a button labelled ``label`` takes (its text and frame padding)."""
+    return imgui.calc_text_size(label.split("##")[0]).x + 2.0 * imgui.get_style().frame_padding.x
+
+
+def flow(imgui, width: float) -> None:
+    """Put the next item of ``width`` pixels on the current line when it fits there, else on the next (no item cut)."""
+    right = imgui.get_item_rect_max().x + imgui.get_style().item_spacing.x + width
+    # Before same_line the cursor is at the start of the next line: the region's right edge is avail.x beyond it.
+    limit = imgui.get_cursor_screen_pos().x + imgui.get_content_region_avail().x
+    if right <= limit:
+        imgui.same_line()

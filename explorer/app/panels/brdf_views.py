@@ -18,9 +18,9 @@ class BrdfViewPanel(Panel):
     caption = ""
     dock = "centre"
 
-    def request(self, uniforms=None):
+    def request(self, uniforms=None, size=(SIDE_VIEW_SIZE, SIDE_VIEW_SIZE)):
         state = self.state
-        size = (SIDE_VIEW_SIZE, SIDE_VIEW_SIZE)
+        size = tuple(size)
         job = self.scheduler.job(self.view)
         job.request(state.material, state.values, self.view, size, light=light_vector(state.light, state.camera),
                     dragging=self.app.dragging, uniforms=uniforms)
@@ -30,13 +30,26 @@ class BrdfViewPanel(Panel):
         imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + (f"  {job.error}" if job.error else ""))
 
     def draw(self, imgui) -> None:
-        imgui.text(self.caption)
-        job, size = self.request()
+        from explorer.app.state import auto_view_size
+
+        imgui.text_wrapped(self.caption)
+        avail = imgui.get_content_region_avail()  # the image fills the window, less its progress line
+        side = auto_view_size(avail.x, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
+        job, size = self.request(size=(side, side))
         show_image(self.state, self.scheduler.show(self.view, size, job), size, f"{self.view}_image")
         self.progress(imgui, job)
 
     def gl_jobs(self) -> list:
         return [self.scheduler.job(self.view)]
+
+
+def slice_quantity(material) -> str:
+    """What the Slice window's colours are: a BRDF, or for a smooth mirror (a Dirac) its reflectance R(theta_d)."""
+    from explorer.views.mirror import is_mirror_only
+
+    if is_mirror_only(material):
+        return "reflectance R(theta_d) of the smooth mirror (the weight of its mirror reflection, not a density per sr)"
+    return "BRDF (1/sr)"
 
 
 class SlicePanel(BrdfViewPanel):
@@ -59,6 +72,8 @@ class SlicePanel(BrdfViewPanel):
         from imgui_bundle import implot
 
         state = self.state
+        quantity = slice_quantity(state.material)
+        imgui.text_wrapped(f"colour = {quantity}")
         imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.45)
         _, state.slice_phi_d = imgui.slider_float("phi_d", state.slice_phi_d, 0.0, 180.0, "%.1f deg")
         record(state, "slice_phi_d")
@@ -80,7 +95,7 @@ class SlicePanel(BrdfViewPanel):
                 rgba = data.slice_display(raw, state.exposure, state.slice_gamma, state.slice_chroma)
                 self._texture = self.app.renderer.resources.replace(self._texture, rgba, dtype="f1", linear=True, origin="slice")
                 self._shown = key
-                state.slice_report = {"phi_d": state.slice_phi_d, "gamma": state.slice_gamma, "chroma": state.slice_chroma,
+                state.slice_report = {"quantity": quantity, "phi_d": state.slice_phi_d, "gamma": state.slice_gamma, "chroma": state.slice_chroma,
                                       "exposure": state.exposure, "size": list(size), "raw_mean": raw.mean(axis=(0, 1)).tolist(),
                                       "shown_mean": rgba[..., :3].mean(axis=(0, 1)).tolist()}
         progressive = self.scheduler.show(self.view, size, job)  # the refining image (exposure, sRGB) until complete

@@ -17,6 +17,20 @@ from explorer.app.state import has_reflectance
 COLOUR_BAR_WIDTH = 70
 
 
+def compare_size(imgui, state, side: float) -> tuple[int, int]:
+    """
+    The pair's resolution: fitted to the window (less ``side`` pixels, the heat-map's colour bar, and the mean
+    line under it) as the sphere's, when the resolution follows the windows; else half the sphere's above 256.
+    """
+    from explorer.app.state import auto_view_size
+
+    if state.view_size_auto:
+        avail = imgui.get_content_region_avail()
+        side_px = auto_view_size(avail.x - side, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
+        return side_px, side_px
+    return (state.view_size // 2, state.view_size // 2) if state.view_size > 256 else (state.view_size, state.view_size)
+
+
 class ComparePanel(Panel):
     title = "Compare"
     dock = "centre"
@@ -63,7 +77,8 @@ class ComparePanel(Panel):
         if not c.on:
             imgui.text("(off)")
             return
-        size = (state.view_size // 2, state.view_size // 2) if state.view_size > 256 else (state.view_size, state.view_size)
+        size = compare_size(imgui, state, COLOUR_BAR_WIDTH + 8 if c.heat else 0.0)
+        c.size = list(size)
         if c.kind == "materials":
             values_a, values_b = state.values, None  # B: the entry's own values, below
         elif c.kind == "methods" and names:
@@ -83,8 +98,10 @@ class ComparePanel(Panel):
         a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
         # What a smooth mirror reflects in the lit view: the Sphere window's environment and probe turn.
         environment = self.scheduler.env.environment(state.environment).rotated(state.env_rotation)
-        a.request(state.material, values_a, view, size, light=light, dragging=dragging, environment=environment)
-        b.request(material_b, values_b, view, size, light=light, dragging=dragging, environment=environment)
+        a.request(state.material, values_a, view, size, light=light, dragging=dragging, environment=environment,
+                  uniforms=state.lit_uniforms(state.material, view))
+        b.request(material_b, values_b, view, size, light=light, dragging=dragging, environment=environment,
+                  uniforms=state.lit_uniforms(material_b, view))
         if c.heat and self._heat_texture is not None:
             show_image(state, self._heat_texture, size, "compare_image", side=COLOUR_BAR_WIDTH + 8)
             imgui.same_line()

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from explorer.app.panels.base import Panel, record
+from explorer.app.panels.base import Panel, checkbox_width, flow, record
 from explorer.physics import colorimetry
 from explorer import design as inverse_design
 from explorer.materials.models import BraggMirrorModel
@@ -121,7 +121,7 @@ class DesignPanel(Panel):
 
     def _start(self) -> None:
         material = self.state.material
-        if self.running or material.model not in inverse_design.DESIGN_MODELS:
+        if self.running or not capabilities_of(material).design:
             return
         ranges = {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
         fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and capabilities_of(material).bragg_spectrum else {}
@@ -196,7 +196,7 @@ class DesignPanel(Panel):
 
     def draw(self, imgui) -> None:
         state = self.state
-        designable = state.material.model in inverse_design.DESIGN_MODELS
+        designable = capabilities_of(state.material).design
         if not designable:
             imgui.text_wrapped(f"Design works on {', '.join(supporting('design'))}.")
             if imgui.button(f"Open {DEFAULT_MATERIAL.stem}"):
@@ -226,10 +226,10 @@ class DesignPanel(Panel):
             last = self.targets[-1]
             self.targets.append([min(last[0] + 15.0, 89.0), list(last[1]), last[2]])
         record(state, "design:add")
-        imgui.same_line()
+        flow(imgui, checkbox_width(imgui, "air layers (n1 = 1)"))  # on the line when it fits: nothing cut at 1280x800
         _, self.fixed_n1_air = imgui.checkbox("air layers (n1 = 1)", self.fixed_n1_air)
         record(state, "design:air")
-        imgui.same_line()
+        flow(imgui, checkbox_width(imgui, "from the current structure"))
         _, self.from_current = imgui.checkbox("from the current structure", self.from_current)
         record(state, "design:from_current")
         imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.5)

@@ -55,5 +55,9 @@ def apply_view(state, view: dict | None) -> None:
         state.camera = list(view["camera"])
     if "exposure" in view:
         state.exposure = float(view["exposure"])
+    if "tonemap" in view:
+        state.tonemap = view["tonemap"]
+    if "fill" in view:
+        state.fill = float(view["fill"])
     if view.get("view") in MODES:
         state.mode = view["view"]

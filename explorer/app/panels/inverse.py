@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from explorer.app.panels.base import Panel, record
+from explorer.app.panels.base import Panel, button_width, checkbox_width, flow, record
 from explorer.materials.lobes_model import LayeredLobesModel
 from explorer.physics import lobes
 from explorer.physics.inverse import InverseError, Lobe, fgd_normal, invert_lobes, lobe_class
@@ -251,7 +251,7 @@ class InversePanel(Panel):
             self.edits.append(LobeEdit(energy=[0.12, 0.08, 0.04], sigma=0.05, layers=1))
             self.member_b = None
         record(state, "inverse:add")
-        imgui.same_line()
+        flow(imgui, checkbox_width(imgui, "tir"))  # on the line when it fits: nothing cut at 1280x800
         _, self.tir = imgui.checkbox("tir", self.tir)
         self._update()
         s = self.solution
@@ -262,11 +262,11 @@ class InversePanel(Panel):
         if imgui.button("apply") and s.stack is not None:
             self._apply()
         record(state, "inverse:apply")
-        imgui.same_line()
+        flow(imgui, button_width(imgui, "keep as B"))
         if imgui.button("keep as B"):
             self.member_b = [(e.t, e.u) for e in self.edits]
         record(state, "inverse:keep_b")
-        imgui.same_line()
+        flow(imgui, button_width(imgui, "compare two members"))
         if imgui.button("compare two members") and self._is_lobes_material():  # A = this point | B
             self._compare()
         record(state, "inverse:compare")
@@ -276,7 +276,9 @@ class InversePanel(Panel):
 
     def _lobe_widgets(self, imgui, k: int, edit: LobeEdit, bottom: bool) -> None:
         state = self.state
-        changed, colour = imgui.color_edit3("R (energy at normal incidence)", list(edit.energy), imgui.ColorEditFlags_.float)
+        imgui.text("R (energy at normal incidence)")  # above its fields: beside them it was cut at 1280x800
+        imgui.set_next_item_width(-1)
+        changed, colour = imgui.color_edit3("##R", list(edit.energy), imgui.ColorEditFlags_.float)
         if changed:
             edit.energy = [float(c) for c in colour]
         record(state, f"inverse:R_colour_{k}")
@@ -313,6 +315,8 @@ class InversePanel(Panel):
             imgui.same_line()
         if bottom:
             conductor = edit.base == "conductor"
+            imgui.new_line()
+            flow(imgui, checkbox_width(imgui, "conductor base"))
             changed, conductor = imgui.checkbox("conductor base", conductor)
             if changed:
                 edit.base = "conductor" if conductor else "dielectric"

@@ -11,6 +11,14 @@ from explorer.app.badge import BadgeWorker
 from explorer.app.panels.base import Panel, combo, record
 
 
+def parameter_tooltip(parameter) -> str:
+    """A slider's tooltip: the parameter's meaning and unit (its ``.brd`` line's comment), its range and default."""
+    bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
+    unit = f" {parameter.unit}" if parameter.unit and parameter.unit != "1" else ""
+    meaning = f"{parameter.doc}\n" if parameter.doc else ""
+    return f"{meaning}{parameter.name}: {parameter.type}{bounds}{unit}, default {parameter.default}; Ctrl-click resets"
+
+
 class ParametersPanel(Panel):
     title = "Parameters"
     dock = "left"
@@ -50,7 +58,29 @@ class ParametersPanel(Panel):
         record(state, "exposure")
         if changed:
             state.exposure = exposure
+        if state.lit_uniforms(state.material, state.main_view()) or (state.mode == "lit" and state.fill != 0.0):
+            changed, fill = imgui.slider_float("environment fill", state.fill, 0.0, 1.0, "%.2f")
+            record(state, "fill")
+            if changed:
+                state.fill = fill
+            if imgui.is_item_hovered():
+                imgui.set_tooltip("lit view: the radiance of a uniform white environment beside the point light (its colour is "
+                                  "the material's albedo); 0: the light alone")
+        from explorer.views.tonemap import TONEMAPS
+
+        shown = state.tonemap_for("env" if state.mode == "env" else state.main_view())
+        labels = {"auto": f"auto ({shown})", "none": "none (clamp)", "agx": "AgX", "aces": "ACES (Narkowicz)"}
+        imgui.set_next_item_width(min(imgui.get_content_region_avail().x * 0.5, 160.0))
+        chosen = combo(state, "tone map", labels[state.tonemap], [(k, labels[k]) for k in ("auto", *TONEMAPS)], state.tonemap,
+                       "tonemap", "tonemap_combo")
+        if chosen is not None:
+            state.tonemap = chosen
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("The display curve after the exposure (sphere, Compare, F12's PNG): AgX rolls vivid colours and "
+                              "highlights off to white; none clamps. Auto: AgX for lit and env, none for the colour views.")
         _, state.gamut = imgui.checkbox("gamut overlay (outside sRGB)", state.gamut)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("hatch the colours outside sRGB (a negative channel, or above white), judged before the tone map")
         sizes = ["fit the window"] + [str(s) for s in VIEW_SIZES]
         current = 0 if state.view_size_auto else 1 + (VIEW_SIZES.index(state.view_size) if state.view_size in VIEW_SIZES else 2)
         changed, index = imgui.combo("resolution", current, sizes)
@@ -141,8 +171,7 @@ class ParametersPanel(Panel):
         if imgui.is_item_clicked() and io.key_ctrl:
             new = parameter.default
         if imgui.is_item_hovered():
-            bounds = "" if parameter.min is None else f" in [{parameter.min:g}, {parameter.max:g}]"
-            imgui.set_tooltip(f"{name}: {parameter.type}{bounds}, default {parameter.default}; Ctrl-click resets")
+            imgui.set_tooltip(parameter_tooltip(parameter))
         if kind in ("int", "float") and not labels:
             imgui.same_line()
             imgui.set_next_item_width(-1)

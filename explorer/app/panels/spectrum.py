@@ -8,8 +8,10 @@ import numpy as np
 
 from explorer.materials.brd import round_integer
 from explorer.app import data
-from explorer.app.panels.base import Panel, record
+from explorer.app.panels.base import Panel, checkbox_width, flow, record
 
+#: Where the plot's legend is (reported): outside the plot's area, which it never covers.
+SPECTRUM_LEGEND = "right of the plot, outside its area"
 #: The plot's refresh period while a slider is dragged (seconds).
 DRAG_SPECTRUM_S = 0.1
 
@@ -34,16 +36,18 @@ class SpectrumPanel(Panel):
             return
         _, state.spectrum_theta = imgui.slider_float("theta", state.spectrum_theta, 0.0, 89.0, "%.1f deg")
         record(state, "spectrum_theta")
-        for key in state.spectrum_show:
+        for index, key in enumerate(state.spectrum_show):  # as many on a line as fit: none cut at 1280x800
+            if index:
+                flow(imgui, checkbox_width(imgui, key))
             _, state.spectrum_show[key] = imgui.checkbox(key, state.spectrum_show[key])
-            imgui.same_line()
-        imgui.new_line()
+            record(state, f"spectrum_show:{key}")
         selected = state.materials[state.selected] if state.materials else None
         shown = selected is None or (selected.visible and data.has_bragg_spectrum(state.material))
         if shown:
             self._update()
         overlays = [(entry, self._other(entry)) for entry in others]
         state.plotted["Spectrum"] = ([state.material_path.name] if shown else []) + [entry.name for entry in others]
+        state.spectrum_legend = SPECTRUM_LEGEND
         self._plot(imgui, self._spectrum if shown else None, state.spectrum_show, overlays,
                    selected.colour if selected is not None and overlays else None)
 
@@ -85,6 +89,9 @@ class SpectrumPanel(Panel):
             return
         implot.setup_axes("wavelength (nm)", "reflectance")
         implot.setup_axes_limits(360, 830, 0, 1.05)
+        # The legend right of the plot: inside, it covered the short-wavelength end (a band near 420 nm); in a row
+        # above, a narrow window cut its last entries.
+        implot.setup_legend(implot.Location_.east, implot.LegendFlags_.outside)
         for entry, other in overlays:
             implot.plot_line(f"{entry.name} average##{id(entry)}", other.wavelengths, 0.5 * (other.R["s"] + other.R["p"]),
                              implot.Spec(line_color=imgui.ImVec4(*entry.colour, 1.0), line_weight=2.0))

@@ -52,7 +52,8 @@ class SpherePanel(Panel):
                     self._normals_key = (state.model, size)
                 view, inputs = MESH_TEMPLATES["lit"], {"mesh_normals": self._normals}
             job.request(state.material, values, view, size, light=light_vector(state.light, state.camera), dragging=dragging,
-                        inputs=inputs, inputs_key=state.model, environment=self._mirror_environment())
+                        inputs=inputs, inputs_key=state.model, environment=self._mirror_environment(),
+                        uniforms=state.lit_uniforms(state.material, view))
             texture = scheduler.show("main", size, job)
         show_image(state, texture, size, "sphere_image", interactive=True)
         if state.mode == "env":  # the env mode's own progress: samples per pixel, converged at the target

@@ -30,10 +30,12 @@ class StripsPanel(Panel):
         else:
             methods = list(names) or [None]
         imgui.text("theta from 0 deg (left) to 90 deg (right)")
+        state.strip_rows = []
         for method in methods:
             values = state.values if method is None else {**state.values, "method": float(method)}
             label = "" if method is None else f"{method} {names.get(method, '')}"
             self._strip(imgui, f"strip{method}", state.material, values, label)
+            state.strip_rows.append(label)
         # The other visible materials with a reflectance: one strip each, at their own method, in their colour.
         others = [e for e in state.visible_entries() if e.material is not state.material and has_reflectance(e.material)]
         if others:

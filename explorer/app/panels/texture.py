@@ -6,6 +6,8 @@ Figure 7), from a grey image (the shipped noise by default), lit by the app's li
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from explorer.app.camera import light_vector
@@ -17,6 +19,19 @@ from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessText
 
 #: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
 ENV_SAMPLES = 256
+
+
+@functools.cache
+def _textured_builtins() -> str:
+    """:func:`textured_builtins`, read once (it loads every built-in material)."""
+    return textured_builtins()
+
+
+def no_texture_text(name: str) -> str:
+    """What the Texture tab says for a material whose surface no image can vary (in words, not the file's syntax)."""
+    return (f"{name} looks the same all over its surface: nothing in it follows an image. This tab shows a material "
+            "whose look varies across the surface with a grey image: a thin film whose thickness follows it, or a smooth "
+            f"Bragg mirror whose period and layer ratio follow it: File > Open... one ({_textured_builtins()} do).")
 
 
 class TexturePanel(Panel):
@@ -63,7 +78,9 @@ class TexturePanel(Panel):
         state = self.state
         kind = state.material.texture
         if kind not in TEXTURE_KINDS:
-            imgui.text_wrapped(f"this material declares no '# texture: {'|'.join(TEXTURE_KINDS)}' ({textured_builtins()} do)")
+            text = no_texture_text(state.material_path.name)
+            imgui.text_wrapped(text)
+            state.texture_view = {"message": text}
             return
         _, self.path = imgui.input_text("texture (grey image)", self.path)
         if kind == "bragg":
