@@ -84,8 +84,9 @@ class ScriptRobot:
 
     @staticmethod
     def _target_point(state, label: str, fraction: float = 0.5) -> tuple[float, float] | None:
+        state.script_target = label
         rect = state.rects.get(label)
-        if rect is None:
+        if rect is None or label in state.hidden:
             return None
         x0, y0, x1, y1 = rect
         return x0 + fraction * (x1 - x0), 0.5 * (y0 + y1)

@@ -161,6 +161,8 @@ class AppState:
     orbit_drag: bool = False
     visible: set = field(default_factory=set)  # titles of the windows drawn this frame
     rects: dict = field(default_factory=dict)  # label -> screen rectangle of the item (for scripted input)
+    script_target: str | None = None  # the label scripted input is aiming at: scrolled into view when hidden
+    hidden: set = field(default_factory=set)  # labels of recorded items outside their panel's visible part
     # What a session reports.
     frame_times: list = field(default_factory=list)
     screenshots: list = field(default_factory=list)

@@ -47,6 +47,14 @@ def record(state, label: str) -> None:
 
     lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
     state.rects[label] = (lo.x, lo.y, hi.x, hi.y)
+    top, size = imgui.get_window_pos(), imgui.get_window_size()
+    if top.y <= lo.y and hi.y <= top.y + size.y:  # wholly inside its window (a half-hidden slider can't be dragged)
+        state.hidden.discard(label)
+    else:
+        state.hidden.add(label)
+        if label == state.script_target:
+            # A scripted click or drag on an item scrolled out of its panel: scroll it into view, as a user would.
+            imgui.set_scroll_here_y(0.5)
 
 
 def combo(state, label: str, shown: str, options, current, item: str, recorded_as: str):
