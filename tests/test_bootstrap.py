@@ -466,3 +466,6 @@ def test_blender_installs_without_dependencies_once(tmp_path, monkeypatch):
     assert len(calls) == 1 and "--no-deps" in calls[0] and calls[0][-1] == bs.BLENDER_REQUIREMENT
     bs.ensure_blender(bs.MODE_TEST, [], tmp_path, runner)
     assert len(calls) == 1
+    monkeypatch.setenv(bs.ENV_NO_BLENDER, "1")
+    bs.ensure_blender(bs.MODE_TEST, [], tmp_path / "other", runner)
+    assert len(calls) == 1  # kept out of this test set-up

@@ -74,12 +74,18 @@ def mapping_of(material, values) -> str:
     raise BlenderExportError(material.path, None, "no Blender mapping for this material yet (a smooth Bragg mirror or a thin film)")
 
 
-def material(bpy_material, material, values) -> None:
-    """Build ``material`` at ``values`` into ``bpy_material`` (its node tree replaced): the function FILE.py calls."""
+def material(bpy_material, material, values, film: str = "principled") -> None:
+    """
+    Build ``material`` at ``values`` into ``bpy_material`` (its node tree replaced): the function FILE.py calls.
+    ``film``: a thin film through Principled's Thin Film (``"principled"``), or its table (``"table"``: the
+    reflectance at the view angle colouring a GGX Glossy of roughness ``sqrt(alpha)``).
+    """
     bpy = _bpy()
     from explorer.materials.models import model_for
 
     kind = mapping_of(material, values)
+    if kind == "principled" and film == "table":
+        kind = "table"
     model = model_for(material, values)
     bpy_material.use_nodes = True
     tree = bpy_material.node_tree
@@ -105,7 +111,9 @@ def material(bpy_material, material, values) -> None:
         lookup = _node(tree, "ShaderNodeTexImage", (0, 0))
         lookup.image, lookup.interpolation, lookup.extension = image, "Linear", "EXTEND"
         tree.links.new(uv.outputs["Vector"], lookup.inputs["Vector"])
-        glossy = _node(tree, "ShaderNodeBsdfGlossy", (300, 0), Roughness=0.0)
+        glossy = _node(tree, "ShaderNodeBsdfGlossy", (300, 0), Roughness=math.sqrt(max(float(getattr(model, "alpha", 0.0)), 0.0)))
+        if "distribution" in dir(glossy):
+            glossy.distribution = "GGX"  # single scattering, as the env view's lobe
         tree.links.new(lookup.outputs["Color"], glossy.inputs["Color"])
         tree.links.new(glossy.outputs["BSDF"], out.inputs["Surface"])
     else:
@@ -148,7 +156,7 @@ def _world(bpy, scene, environment) -> None:
     scene.world = world
 
 
-def preview_scene(material_file, values, environment, size: int = 64, samples: int = 64):
+def preview_scene(material_file, values, environment, size: int = 64, samples: int = 64, film: str = "principled"):
     """A fresh scene (factory settings, nothing else) holding the env view's preview of ``material_file``."""
     bpy = _bpy()
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -174,7 +182,7 @@ def preview_scene(material_file, values, environment, size: int = 64, samples: i
     bm.free()
     mesh.shade_smooth()
     bpy_material = bpy.data.materials.new(Path(str(material_file.path)).stem)
-    material(bpy_material, material_file, values)
+    material(bpy_material, material_file, values, film)
     mesh.materials.append(bpy_material)
     camera = bpy.data.cameras.new("camera")
     camera.type, camera.ortho_scale, camera.clip_end = "ORTHO", 2.0, 10.0

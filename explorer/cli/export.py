@@ -9,8 +9,6 @@ from pathlib import Path
 
 import click
 
-from explorer.materials.brd import MaterialError
-
 from explorer.cli.materials import PROG, load, resolve_values, warn  # noqa: F401
 TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf", "blender")
 
@@ -21,16 +19,6 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
         raise click.BadParameter("--engine mitsuba renders the env view (--view env)", param_hint="--engine")
     if variant is not None and engine != "mitsuba":
         raise click.BadParameter("--variant is for --engine mitsuba", param_hint="--variant")
-
-
-def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
-    """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
-    from explorer.materials.twins import capabilities_of, supporting
-    from explorer.mitsuba.scene import render_env_mitsuba
-
-    if not capabilities_of(material).supports("mitsuba"):
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
-    return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
 @click.command("export")

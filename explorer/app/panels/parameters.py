@@ -58,7 +58,7 @@ class ParametersPanel(Panel):
         record(state, "exposure")
         if changed:
             state.exposure = exposure
-        if state.lit_uniforms(state.material, state.main_view()) or (state.mode == "lit" and state.fill != 0.0):
+        if state.mode == "lit" and state.lit_uniforms(state.material, state.main_view()):  # not a mirror: it reflects the sky
             changed, fill = imgui.slider_float("environment fill", state.fill, 0.0, 1.0, "%.2f")
             record(state, "fill")
             if changed:
