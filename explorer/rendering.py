@@ -37,8 +37,8 @@ def check_numpy_size(width: int, height: int) -> None:
 def render_material(
     material: Material, values: dict, view: str, width: int, height: int, engine: str,
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int | None = None,
-    variant: str | None = None, mesh=None, background: bool = False, plot=None,
-    progress_printer: ProgressPrinter | None = None, warn: Callable[[str], None] | None = None, fill: float = 0.0,
+    variant: str | None = None, mesh=None, background: bool = False, plot=None, fill: float = 0.0,
+    progress_printer: ProgressPrinter | None = None, warn: Callable[[str], None] | None = None,
 ) -> np.ndarray:
     """
     One view of a material as a linear float RGB image ``(height, width, 3)``, by ``engine`` (:data:`ENGINES`): on the
@@ -48,9 +48,9 @@ def render_material(
     surface); ``environment`` (an :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp``
     (samples per pixel; default 64) for the ``env`` view and the position-free engine; ``mesh`` (an
     :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views; ``plot`` (an
-    :class:`explorer.views.plots.PlotSettings`) for the plot views. ``progress_printer(label, unit)`` reports long
-    renders; ``warn(message)`` is told of samples dropped. ``fill``: the ``lit`` view's environment fill
-    (:mod:`explorer.views.fill`), 0 without.
+    :class:`explorer.views.plots.PlotSettings`) for the plot views; ``fill``, the ``lit`` view's environment fill
+    (:mod:`explorer.views.fill`), 0 without. ``progress_printer(label, unit)`` reports long renders; ``warn(message)``
+    is told of samples dropped.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY

@@ -167,7 +167,8 @@ def _star(a: tuple, b: tuple) -> tuple:
     return (ra + ta * rb * tu_a * D, ta * tb * D, rbb + tu_b * rb_a * tb * D, tu_b * tu_a * D)
 
 
-def periodic_optics(polarisation: str, n0, n1, n2, d1: float, d2: float, N: int, wavelength_nm, sin_theta0) -> StackOptics:
+def periodic_optics(polarisation: str, n0: ArrayLike, n1: ArrayLike, n2: ArrayLike, d1: float, d2: float, N: int,
+                    wavelength_nm: ArrayLike, sin_theta0: ArrayLike) -> StackOptics:
     """
     ``r, t, R, T`` of ``N`` cells of ``n2`` (``d2``) over ``n1`` (``d1``) between a lossless ``n0`` and an ``n1``
     base, as :func:`stack_optics` of ``[n2, n1] * N`` (to rounding), in ``O(log N)`` star products: a cell is the
