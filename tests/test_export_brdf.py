@@ -42,10 +42,12 @@ SIZE = (48, 32)
 
 def parse_brdf(text):
     """(parameters, shader) of a .brdf as BRDF Explorer reads it (BRDFBase::loadBRDF): lines whose first
-    non-blank character is '#' dropped everywhere, the shader section's other lines kept as they are."""
+    non-blank character is '#' dropped everywhere, a parameter line's fields read and anything after them
+    (a unit note) ignored, the shader section's other lines kept as they are."""
     lines = [line for line in text.splitlines() if not line.strip().startswith("#")]
     start, end = lines.index("::begin parameters"), lines.index("::end parameters")
-    parameters = [line.split() for line in lines[start + 1:end] if line.strip()]
+    fields = {"float": 5, "color": 5, "bool": 3}
+    parameters = [line.split()[:fields.get(line.split()[0], None)] for line in lines[start + 1:end] if line.strip()]
     s, e = lines.index("::begin shader"), lines.index("::end shader")
     return parameters, "".join(line + "\n" for line in lines[s + 1:e])
 

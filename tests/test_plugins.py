@@ -77,8 +77,6 @@ def test_capabilities_refuse_an_unknown_engine_or_export():
 PLUGIN_FILES = {"explorer/materials/models.py", "explorer/materials/thinfilm_model.py",
                 "explorer/materials/lobes_model.py", "explorer/materials/lobes_presets.py"}
 DEFAULT_FILE = "explorer/resources.py"
-#: Modules whose literals are still to go (studies and benchmarks that pick their materials).
-NOT_YET = {"explorer/design/forward.py"}
 NAME_RE = re.compile(r"(?<![A-Za-z0-9_])(" + "|".join(map(re.escape, BUILTIN_NAMES)) + r")(?![A-Za-z0-9_])")
 
 
@@ -109,7 +107,7 @@ def test_no_builtin_material_name_outside_its_plugin_files():
     default = found.pop(DEFAULT_FILE, [])
     assert len(default) == 1, f"{DEFAULT_FILE}: one default material, found {default}"
     stray = {path: hits for path, hits in found.items()
-             if path not in PLUGIN_FILES and path not in NOT_YET and not path.startswith("explorer/dev/")}
+             if path not in PLUGIN_FILES and not path.startswith("explorer/dev/")}
     assert not stray, "built-in material names as string literals: " + "; ".join(
         f"{path}:{line} {text[:50]!r}" for path, hits in stray.items() for line, text in hits)
 

@@ -13,6 +13,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.design.base import COARSE_STEP, DesignError, DesignModel
+from explorer.materials.models import BraggLayerModel, BraggMirrorModel, host_index
+from explorer.materials.thinfilm_model import ThinFilmModel
+from explorer.materials.twins import capabilities_of
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
@@ -232,11 +235,10 @@ def thin_film_spectra_batch(
 
 
 def mirror_of(values: Mapping[str, float]) -> bragg.BraggMirror:
-    """The :class:`explorer.physics.bragg.BraggMirror` of design values (``nh < 1``: the host is ``n1``)."""
-    nh = float(values["nh"])
+    """The :class:`explorer.physics.bragg.BraggMirror` of design values (``nh``: :func:`explorer.materials.models.host_index`)."""
     return bragg.BraggMirror(n1=float(values["n1"]), n2=float(values["n2"]), Lambda=float(values["Lambda"]),
                              delta=float(values["delta"]), N=max(1, int(round(float(values["N"])))),
-                             nh=nh if nh >= 1.0 else None)
+                             nh=host_index(float(values["nh"])))
 
 
 def bragg_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, final: bool = True) -> np.ndarray:
@@ -261,19 +263,19 @@ def thin_film_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, f
 _BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
               integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, host_parameter="nh",
               scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch)
-#: Every designable material model; its specular colour is what is designed (``bragg_layer``: the smooth
-#: mirror's colour, which its gradient view shows).
+#: The forward model of each twin that declares ``design`` (:mod:`explorer.materials.twins`); its specular
+#: colour is what is designed (the rough Bragg layer's: the smooth mirror's colour, which its gradient view shows).
 DESIGN_MODELS: dict[str, DesignModel] = {model.name: model for model in (
-    DesignModel("bragg_mirror", **_BRAGG),
-    DesignModel("bragg_layer", **_BRAGG),
-    DesignModel("thin_film", ("d", "eta1", "eta2", "eta3", "kappa3"), (), (), thin_film_rgb_batch, thin_film_converged_rgb,
+    DesignModel(BraggMirrorModel.name, **_BRAGG),
+    DesignModel(BraggLayerModel.name, **_BRAGG),
+    DesignModel(ThinFilmModel.name, ("d", "eta1", "eta2", "eta3", "kappa3"), (), (), thin_film_rgb_batch, thin_film_converged_rgb,
                 scale_parameter="d", spectra=thin_film_spectra_batch),
 )}
 DESIGNABLE = tuple(DESIGN_MODELS)
 
 
 def design_model(name: str | None) -> DesignModel:
-    """The :class:`DesignModel` of a material model name, or a :class:`DesignError`."""
-    if name not in DESIGN_MODELS:
+    """The :class:`DesignModel` of a material model name whose twin declares ``design``, or a :class:`DesignError`."""
+    if name not in DESIGN_MODELS or not capabilities_of(name).design:
         raise DesignError(f"model {name or '(none)'} cannot be designed (designable: {', '.join(DESIGNABLE)})")
     return DESIGN_MODELS[name]
