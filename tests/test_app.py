@@ -228,7 +228,7 @@ def test_bench_app_measures_drag_frames(x_display, tmp_path):
     changed it, and with each new view (the Plots window's plots, the Texture window) beside the sphere; then the
     two-layer stack's env mode: its first pass, and the frames of a drag of Lambda_1.
     """
-    from explorer.cli.bench import APP_MODES
+    from explorer.bench import APP_MODES
     from explorer.views.geometry import PLOT_VIEWS
 
     env = {**os.environ, "DISPLAY": x_display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(REPO_ROOT)}

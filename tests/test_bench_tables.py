@@ -26,7 +26,7 @@ def test_bench_tables_json(gl_renderer):
 
 @pytest.mark.gl
 def test_bench_scaling_document_and_plot(gl_renderer, monkeypatch, tmp_path, capsys):
-    from explorer.cli.bench import scaling as bench  # the study's module, whose globals scaling_study reads
+    from explorer.bench import scaling as bench  # the study's module, whose globals scaling_study reads
 
     monkeypatch.setattr(bench, "SCALING_N", (1, 20))
     monkeypatch.setattr(bench, "SCALING_ANGLES", (17, 33))

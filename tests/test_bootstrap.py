@@ -361,6 +361,7 @@ def test_main_execs_venv_pytest_from_repo_root(monkeypatch, tmp_path):
     monkeypatch.setattr(bs, "ensure_system_packages", lambda mode: None)
     monkeypatch.setattr(bs, "ensure_optional_packages", lambda extras: None)
     monkeypatch.setattr(bs, "ensure_node_packages", lambda mode: None)
+    monkeypatch.setattr(bs, "ensure_blender", lambda mode, args: None)
     monkeypatch.setattr(bs, "ensure_python_packages", lambda extras, inside: False)
     monkeypatch.setattr(bs, "in_venv", lambda venv_dir: False)
     monkeypatch.chdir(tmp_path)
@@ -446,3 +447,25 @@ def test_node_packages_only_for_tests_and_skipped_when_installed(tmp_path, monke
     assert calls[0][-1] == "gltf-validator@" + bs.NODE_PACKAGES["gltf-validator"]
     bs.ensure_node_packages(bs.MODE_TEST, which, runner)
     assert len(calls) == 1  # the second time: nothing to do
+
+
+def test_blender_installs_without_dependencies_once(tmp_path, monkeypatch):
+    """bpy (numpy < 2 in its metadata) goes in alone, for `--to blender` and the tests, and only while missing."""
+    calls = []
+    monkeypatch.setattr(bs.sys, "version_info", (3, 11, 7))
+
+    def runner(cmd, env=None):
+        calls.append(cmd)
+        (tmp_path / "lib" / "python3.11" / "site-packages" / "bpy-5.0.1.dist-info").mkdir(parents=True)
+        return 0, ""
+
+    bs.ensure_blender(bs.MODE_RUN, ["export", "x", "--to", "gltf", "o.glb"], tmp_path, runner)
+    assert calls == []
+    assert bs.wants_blender(["export", "x", "--to", "blender", "o.blend"]) and bs.wants_blender(["--to=blender"])
+    bs.ensure_blender(bs.MODE_RUN, ["export", "x", "--to", "blender", "o.blend"], tmp_path, runner)
+    assert len(calls) == 1 and "--no-deps" in calls[0] and calls[0][-1] == bs.BLENDER_REQUIREMENT
+    bs.ensure_blender(bs.MODE_TEST, [], tmp_path, runner)
+    assert len(calls) == 1
+    monkeypatch.setenv(bs.ENV_NO_BLENDER, "1")
+    bs.ensure_blender(bs.MODE_TEST, [], tmp_path / "other", runner)
+    assert len(calls) == 1  # kept out of this test set-up

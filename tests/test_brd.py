@@ -413,7 +413,7 @@ def test_unknown_parameter_lists_valid_names() -> None:
     m = material(MIXED)
     with pytest.raises(MaterialError) as info:
         m.resolve({"roughness": "0.5"})
-    assert "unknown parameter 'roughness'; valid names: n, rough, flag, tint" in str(info.value)
+    assert "unknown parameter 'roughness' (did you mean 'rough'?); valid names: n, rough, flag, tint" in str(info.value)
     with pytest.raises(KeyError):  # parameter() also behaves like a mapping lookup
         m.parameter("roughness")
     assert isinstance(info.value, UnknownParameterError)

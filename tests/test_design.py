@@ -1,5 +1,5 @@
 """
-Inverse design (explorer.physics.design, ``bragg-explorer design``): the batch forward model against Yeh's
+Inverse design (explorer.design, ``bragg-explorer design``): the batch forward model against Yeh's
 and the film's exact reflectance, the search's achieved colours against the converged reference, the
 CLI's JSON schema, unreachable targets and its one-line errors.
 """
@@ -13,7 +13,8 @@ import pytest
 
 from conftest import one_line_error, run_cli
 
-from explorer.physics import bragg, design, thinfilm
+from explorer import design
+from explorer.physics import bragg, thinfilm
 
 
 def test_batch_reflectance_equals_yeh_at_integer_N():
@@ -404,7 +405,8 @@ def test_design_bench_draws_its_mirrors_from_the_seed():
     report = json.loads(run.stdout)
     assert report["summary"]["seed"] == 3 and report["summary"]["tries"] == 2
     assert report["mirrors"][0]["tries"] in (1, 2)
-    from explorer.cli.design import load, ranges_of
+    from explorer.cli.design import load
+    from explorer.design import ranges_of
 
     ranges = ranges_of(load("bragg_mirror"))
     assert report["mirrors"][0]["truth"] == design.random_structure("bragg_mirror", ranges, np.random.default_rng(3))
@@ -443,7 +445,7 @@ def test_a_clipped_png_strip_is_a_set_of_bounds_and_round_trips(tmp_path):
 
 def test_a_bounded_channel_costs_only_on_the_wrong_side():
     """One-sided: a colour beyond an "at least" bound has the cost of the colour at the bound's side only."""
-    from explorer.cli.design import ranges_of
+    from explorer.design import ranges_of
     from explorer.materials.brd import load_material
     from explorer.resources import material_path
 

@@ -10,7 +10,7 @@ import numpy as np
 from conftest import BRAGG_MATERIAL
 from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
 
-from explorer.physics.design import forward_rgb
+from explorer.design import forward_rgb
 
 
 def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  # noqa: F811
@@ -42,7 +42,7 @@ def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  
 def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_display, tmp_path):  # noqa: F811
     # A render-style .npy strip of a vivid mirror (a negative red: outside sRGB): its colours are the
     # targets as they are, not the pickers' sRGB clipping of them.
-    from explorer.physics.design import targets_from_strip
+    from explorer.design import targets_from_strip
 
     truth = {"n1": 1.38, "n2": 1.6, "Lambda": 175.0, "delta": 0.5, "N": 15, "nh": 1.0}
     theta = 90.0 * (np.arange(32) + 0.5) / 32

@@ -85,6 +85,8 @@ def _cheap(name: str, values: dict) -> dict:
     values = dict(values)
     if name in ("bragg_mirror", "bragg_layer") and values.get("method") == 3:
         values["N"] = min(values["N"], 100.0)
+    if values.get("sigma", 0.0) > 0.0:  # a disordered mirror's table: realisations x layers (explorer.physics.natural)
+        values["N"] = min(values["N"], 10.0)
     if "wavelength_step" in values:
         values["wavelength_step"] = max(values["wavelength_step"], 0.25)
     if name == "bragg_stack":

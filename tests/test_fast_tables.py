@@ -173,7 +173,7 @@ def test_table_rule_under_total_reflection_at_the_host(mirror):
     """Beyond the host interface's critical angle (nh > n1) n1 is evanescent below the mirror too: R = 1 (white)."""
     cos_theta = np.array([0.0, 0.2, 0.5])
     assert (bragg.cell_geometry(cos_theta, mirror, "s").cos_theta_1.imag != 0).all()
-    np.testing.assert_allclose(bragg._converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror), atol=1e-12)
+    np.testing.assert_allclose(bragg.converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror), atol=1e-12)
 
 
 def test_band_pieces_under_a_host_cost_is_bounded_in_N(monkeypatch):
@@ -206,7 +206,7 @@ def test_table_equals_converged_reference_on_random_mirrors(draw, N, host):
                                float(nh) if host else None)
     cos_theta = rng.uniform(0.0, 1.0, 3)
     reference = bragg.reference_rgb(cos_theta, mirror)
-    error = relative_error(bragg._converged_rgb(cos_theta, mirror), reference)
+    error = relative_error(bragg.converged_rgb(cos_theta, mirror), reference)
     assert error.max() <= NODE_RTOL, (mirror, error.max(), cos_theta[error.argmax()])
     table = bragg.tabulated_rgb_table(mirror)
     assert table.dtype == np.float32 and table.shape[1] == 3 and not table.flags.writeable
@@ -222,5 +222,5 @@ def test_table_equals_converged_reference_on_random_mirrors(draw, N, host):
 def test_table_rule_with_wide_fringes(mirror):
     """Short periods: few fringes, each wider than the CMFs' features, where averaging over them is wrong."""
     cos_theta = np.array([0.95, 0.649, 0.3, 0.076])
-    error = relative_error(bragg._converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror))
+    error = relative_error(bragg.converged_rgb(cos_theta, mirror), bragg.reference_rgb(cos_theta, mirror))
     assert error.max() <= NODE_RTOL, (error.max(), cos_theta[error.argmax()])

@@ -69,7 +69,7 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
 def test_the_graph_sees_relative_and_function_level_imports():
     graph = import_graph()
     assert "explorer.materials.brd" in graph["explorer.cli.commands"]  # module level, relative
-    assert "explorer.cli.bench" in graph["explorer.cli.commands"]  # inside a function
+    assert "explorer.bench" in graph["explorer.cli.commands"]  # inside a function
 
 
 def test_find_cycle_finds_one():
@@ -84,21 +84,28 @@ def test_no_import_cycles():
 
 #: The packages from the bottom up: a package imports only packages of a lower rank (or its own).
 #: ``errors`` is the foundation, ``resources`` (paths) and ``files`` (atomic outputs) stand on it; the
-#: store ``tables`` knows no physics; ``plugins`` (the public API of material plugins) re-exports ``materials``; ``views`` (what each pixel of a view shows, without GL) comes below
-#: ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared with the GL views) above it; ``cli`` opens the ``app``; ``dev`` (the checkout's set-up and
-#: regeneration scripts, not in the wheel) and ``__main__`` stand outside.
+#: store ``tables`` knows no physics; ``plugins`` (the public API of material plugins) re-exports ``materials``;
+#: ``design`` (the inverse design, over the physics' forward models) stands on ``materials`` too; ``views`` (what each
+#: pixel of a view shows, without GL) comes below ``gpu``, which draws the views; ``mitsuba`` (the plugins, compared
+#: with the GL views) above it; ``rendering`` (any view by any engine, the render service) dispatches to all three;
+#: ``bench`` (the benchmarks and accuracy studies, the app's frame times among them) stands on the ``app``; ``cli``
+#: opens the ``app``; ``dev`` (the checkout's set-up and regeneration scripts, not in the wheel) and ``__main__``
+#: stand outside.
 LAYERS = {
     "errors": 0,
     "resources": 1, "files": 1,
     "tables": 2,
     "physics": 3,
     "materials": 4,
-    "plugins": 5, "views": 5,
-    "gpu": 6,
-    "mitsuba": 7,
-    "app": 8,
-    "cli": 9,
-    "dev": 10, "__main__": 11,
+    "plugins": 5, "design": 5,
+    "views": 6,
+    "gpu": 7,
+    "mitsuba": 8, "blender": 8,
+    "rendering": 9,
+    "app": 10,
+    "bench": 11,
+    "cli": 12,
+    "dev": 13, "__main__": 14,
 }
 
 
@@ -137,3 +144,25 @@ def test_packages_import_only_packages_below():
 def test_the_package_check_sees_an_upward_import():
     graph = {"explorer.tables.luts": {"explorer.physics.colorimetry"}, "explorer.physics.colorimetry": {"explorer.tables.luts"}}
     assert package_violations(graph) == ["explorer.tables.luts (tables) imports explorer.physics.colorimetry (physics)"]
+
+
+#: The one module outside ``cli`` that starts it: the checkout's launcher. The app and the scripts of ``dev`` reach
+#: rendering, studies and design through the packages below (``explorer.rendering``, ``explorer.bench``,
+#: ``explorer.design``), never through the command line's modules.
+CLI_LAUNCHERS = {"explorer.dev.bootstrap"}
+
+
+def cli_importers(graph: dict[str, set[str]]) -> list[str]:
+    """The modules of ``app`` and ``dev`` (launchers excepted) that import a module of ``cli``."""
+    return sorted(f"{module} imports {target}" for module, targets in graph.items() for target in targets
+                  if package_of(module) in ("app", "dev") and module not in CLI_LAUNCHERS and package_of(target) == "cli")
+
+
+def test_app_and_dev_do_not_import_the_cli():
+    importers = cli_importers(import_graph())
+    assert not importers, "\n".join(importers)
+
+
+def test_the_cli_check_sees_an_import():
+    graph = {"explorer.dev.figure7": {"explorer.cli.commands"}, "explorer.dev.bootstrap": {"explorer.cli.commands"}}
+    assert cli_importers(graph) == ["explorer.dev.figure7 imports explorer.cli.commands"]

@@ -27,7 +27,7 @@ from test_bragg_layer import directions
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 FURNACE_THETA = (0.0, 45.0, 70.0)
-ONE_LAYER = {"layers": 1, "nh": 1.0, "rho_d": 0.0, "N_1": 10}
+ONE_LAYER = {"layers": 1, "nh": 1.0, "rho_d": 0.0, "N_1": 10, "multiple_scattering": 1}
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +68,7 @@ def test_transparent_facets_over_a_white_base(stack_material, monkeypatch):
 
 
 def test_reciprocal_and_smooth_limit(stack_material):
-    values = stack_material.resolve({"layers": 2, "alpha_1": 0.9, "alpha_2": 0.5, "rho_d": "0.4,0.2,0.1"})
+    values = stack_material.resolve({"layers": 2, "alpha_1": 0.9, "alpha_2": 0.5, "rho_d": "0.4,0.2,0.1", "multiple_scattering": 1})
     model = model_for(stack_material, values)
     L, V = directions(32, 11), directions(32, 12)
     frame = np.eye(3)[2], np.eye(3)[0], np.eye(3)[1]
@@ -78,7 +78,7 @@ def test_reciprocal_and_smooth_limit(stack_material):
 
 
 def test_closer_to_the_random_walk_than_single_scattering(stack_material):
-    values = stack_material.resolve({"layers": 1, "nh": 1.0, "rho_d": 0.0, "alpha_1": 0.7})  # Figure 7's A, rougher
+    values = stack_material.resolve({"layers": 1, "nh": 1.0, "rho_d": 0.0, "alpha_1": 0.7, "multiple_scattering": 1})  # Figure 7's A, rougher
     model = model_for(stack_material, values)
     theta = (0.0, 40.0)
     reference = position_free.PositionFree(model.stack, model.tables, "walk").albedo(theta, samples=4096, seed=1)

@@ -13,7 +13,7 @@ import re
 import pytest
 
 from conftest import run_cli
-from explorer.cli import markdown_tables as md
+from explorer.bench import markdown_tables as md
 from explorer.dev import validation_doc
 
 
@@ -105,7 +105,7 @@ def test_layers_markdown_three_tables():
 
 def test_accuracy_markdown_on_a_reduced_grid_parses(monkeypatch):
     """``accuracy --markdown``: the real measurement on one mirror and s = 2..3 (the grid reduced for speed)."""
-    from explorer.cli.bench import figure4 as bench  # the study's module, whose globals run_accuracy reads
+    from explorer.bench import figure4 as bench  # the study's module, whose globals run_accuracy reads
 
     monkeypatch.setattr(bench, "FIGURE4_LAMBDAS", (500.0,))
     monkeypatch.setattr(bench, "FIGURE4_DELTAS", (0.5,))

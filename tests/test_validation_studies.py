@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from explorer.cli import markdown_tables as md
+from explorer.bench import markdown_tables as md
 from explorer.dev import validation_doc
 from explorer.dev import validation_studies as studies
 from test_validation_doc import tables_in

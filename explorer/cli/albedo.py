@@ -1,7 +1,6 @@
 """
-``bragg-explorer albedo``: a material's directional albedo per incidence angle (:mod:`explorer.views.albedo`),
-and ``render --engine position-free`` (the lit and slice views of a layered Bragg structure by the
-position-free reference, :mod:`explorer.physics.position_free`). Registered by :mod:`explorer.cli.commands`.
+``bragg-explorer albedo``: a material's directional albedo per incidence angle (:mod:`explorer.views.albedo`), and
+the progress lines of the long renders. Registered by :mod:`explorer.cli.commands`.
 """
 
 from __future__ import annotations
@@ -14,12 +13,11 @@ import click
 import numpy as np
 
 from explorer.cli.materials import PROG, load, resolve_values  # noqa: F401  (PROG: the messages)
+from explorer.views.position_free import check_position_free, twin_of
+
 DEFAULT_THETA = "0,15,30,45,60,75,85"
 #: Paths per angle (albedo) of the position-free engine by default.
 DEFAULT_SAMPLES = 20000
-#: The position-free render's views and its default paths per pixel.
-POSITION_FREE_VIEWS = ("lit", "slice")
-DEFAULT_SPP = 64
 
 
 def parse_theta(text: str) -> np.ndarray:
@@ -46,17 +44,6 @@ def progress_printer(label: str, unit: str):
             click.echo(f"{PROG}: {label}: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
 
     return progress
-
-
-def _twin(loaded, values):
-    from explorer.materials.brd import MaterialError
-    from explorer.materials.models import model_for
-
-    try:
-        model = model_for(loaded, values)
-    except ValueError as error:
-        raise MaterialError(loaded.path, None, str(error)) from None
-    return model
 
 
 def _fail(message: str) -> None:
@@ -100,20 +87,21 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         values = resolve_values(loaded, preset, params_file, assignments)
         stderr = None
         if engine == "gl":
-            model = _twin(loaded, values) if loaded.model else None
+            model = twin_of(loaded, values) if loaded.model else None
             from explorer.gpu import Renderer
 
-            rgb = albedo_views.albedo_gl(loaded, values, angles, Renderer(), size=albedo_views.gl_size_for(model), model=model)
+            rgb = albedo_views.albedo_gl(loaded, values, angles, Renderer(), size=albedo_views.gl_size_for(model), model=model,
+                                         progress=progress_printer("albedo", "angles"))
         else:
             from explorer.materials.brd import MaterialError
 
-            model = _twin(loaded, values)
+            model = twin_of(loaded, values)
             if model is None:
                 raise MaterialError(loaded.path, None, "this material has no numpy twin (no known '# model:' line): use --engine gl")
             if engine == "numpy":
-                rgb = albedo_views.albedo_numpy(model, angles)
+                rgb = albedo_views.albedo_numpy(model, angles, progress_printer("albedo", "angles"))
             else:
-                _check_position_free(loaded, model)
+                check_position_free(loaded, model)
                 result = albedo_views.albedo_position_free(
                     model, angles, samples or DEFAULT_SAMPLES, seed, progress_printer("position-free", "paths"), microsurface)
                 rgb, stderr = result.value, result.stderr
@@ -131,43 +119,3 @@ def albedo_command(material, preset, params_file, assignments, theta, engine, sa
         if stderr is not None:
             line += f"  (stderr {stderr[k, 0]:.2g} {stderr[k, 1]:.2g} {stderr[k, 2]:.2g})"
         click.echo(line)
-
-
-def _check_position_free(loaded, model) -> None:
-    """A one-line error unless the material's twin declares the position-free engine."""
-    from explorer.materials.brd import MaterialError
-    from explorer.materials.twins import capabilities_of, supporting
-
-    if not capabilities_of(model).supports("position-free"):
-        raise MaterialError(loaded.path, None, "the position-free engine simulates layered Bragg structures "
-                            f"({', '.join(supporting('position-free'))}) only")
-
-
-def render_position_free(loaded, values, view: str, width: int, height: int, light, spp: int | None) -> np.ndarray:
-    """
-    ``render --engine position-free``: the lit or slice view of a layered Bragg stack with its BRDF
-    estimated by the position-free reference (next-event estimation, ``spp`` paths per pixel), under the
-    views' rule; progress on stderr. Small sizes: each pixel costs ``spp`` random walks.
-    """
-    from explorer.physics.position_free import PositionFree
-    from explorer.views.geometry import brdf_view_geometry
-
-    if view not in POSITION_FREE_VIEWS:
-        raise click.BadParameter(f"the position-free engine renders the {' and '.join(POSITION_FREE_VIEWS)} views", param_hint="--view")
-    model = _twin(loaded, values)
-    _check_position_free(loaded, model)
-    L, V, N, X, Y, inside, factor = brdf_view_geometry(view, width, height, light)
-
-    def local(d):
-        d = np.asarray(d, dtype=np.float64)
-        return np.stack([np.sum(d * X, -1), np.sum(d * Y, -1), np.sum(d * N, -1)], axis=-1)
-
-    # The views' rule in the shaders' precision (float32): 0 unless N.L > 0 and N.V > 0.
-    shown = inside & (np.sum(N * L, -1) > 0) & (np.sum(N * V, -1) > 0)
-    image = np.zeros((height, width, 3), dtype=np.float32)
-    if shown.any():
-        walker = PositionFree(model.stack, model.tables)
-        result = walker.brdf(local(L)[shown], local(V)[shown], samples=spp or DEFAULT_SPP,
-                             progress=progress_printer("position-free", "paths"))
-        image[shown] = result.value * factor[shown][:, None]
-    return image

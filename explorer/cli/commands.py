@@ -17,14 +17,14 @@ from pathlib import Path
 import click
 import numpy as np
 
-from explorer.materials.brd import Material, MaterialError, round_integer
+from explorer.materials.brd import round_integer
 from explorer.errors import LocatedError
 from explorer.views.images import OutputError, check_output, write_image
 from explorer.resources import DEFAULT_MATERIAL, display_path, package_version
 from explorer.views.geometry import DEFAULT_LIGHT, VIEWS, view_named
 
 from explorer.cli.design import DEFAULT_TRIES, MAX_TRIES
-from explorer.cli.materials import PROG, SuggestingChoice, command_prefix, resolve_values
+from explorer.cli.materials import PROG, SuggestingChoice, command_prefix, resolve_values, warn
 from explorer.cli.materials import load as _load
 #: The largest ``--size`` side parsed at all; each engine then checks its own limits.
 MAX_SIZE = 1 << 16
@@ -146,76 +146,6 @@ def saved_view(params_file: str | None, ctx: click.Context) -> dict:
     return result
 
 
-def render_material(
-    material: Material, values: dict, view: str, width: int, height: int, engine: str,
-    light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int = 64, variant: str | None = None,
-    mesh=None, background: bool = False, plot=None, fill: float = 0.0,
-) -> np.ndarray:
-    """
-    One view of a material, on the GPU (``gl``) or by its numpy twin (``numpy``); ``thickness`` (an
-    :class:`explorer.views.thickness.ThicknessTexture`) for the ``textured`` view; ``environment`` (an
-    :class:`explorer.views.env.EnvironmentMap`, default the shipped one) and ``spp`` for the ``env`` view; ``mesh``
-    (an :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views.
-    ``plot`` (an :class:`explorer.views.plots.PlotSettings`) for the plot views. ``fill``: the ``lit`` view's
-    environment fill (:mod:`explorer.views.fill`), 0 without.
-    """
-    if material.measured is not None:
-        from explorer.views.geometry import VIEW_REGISTRY
-
-        if VIEW_REGISTRY[view].evaluates not in ("brdf", "environment"):
-            shown = ", ".join(name for name, v in VIEW_REGISTRY.items() if v.evaluates in ("brdf", "environment"))
-            raise MaterialError(material.path, None, f"a measured BRDF (MERL) has no {view} view (it has no reflectance(cos_theta) "
-                                                     f"nor film thickness); its views: {shown}")
-    if view == "env" and engine == "mitsuba":
-        from explorer.cli.export import render_env_with_mitsuba
-
-        if thickness is not None:
-            raise LocatedError("--engine", None, "the Mitsuba plugins have no surface texture: --engine gl or numpy")
-
-        return render_env_with_mitsuba(material, values, width, height, environment, spp, variant)
-    if view == "env":
-        return _render_env(material, values, width, height, engine, environment, spp, mesh, background, surface=thickness)
-    if view == "textured":
-        from explorer.views.surface_texture import check_texture_kind, default_texture
-        from explorer.views.thickness import check_prefilter
-
-        # What the texture varies is the material's declaration ('# texture:'), not its name.
-        check_texture_kind(material)
-        thickness = default_texture(material) if thickness is None else thickness
-        check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
-    if engine == "numpy":
-        from explorer.materials.models import model_for
-        from explorer.views.geometry import BRDF_VIEWS
-        from explorer.views.render import render_numpy
-
-        model = model_for(material, values)
-        if model is None:
-            raise MaterialError(material.path, None, "this material has no numpy twin (no known '# model:' line)")
-        if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
-            raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
-        check_numpy_size(width, height)
-        return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment,
-                            fill=fill)
-    from explorer.gpu import Renderer
-
-    renderer = Renderer()
-    renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
-    if view == "textured":
-        renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
-        return renderer.render(material, values, view, width, height, light=light,
-                               **thickness.gl_arguments(material, values, width, height))
-    if mesh is not None:
-        from explorer.gpu.mesh import render_mesh
-
-        return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment,
-                           uniforms={"fill": float(fill)})
-    if view_named(view).plot is not None:
-        from explorer.views.plots import gl_uniforms
-
-        return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
-    return renderer.render(material, values, view, width, height, light=light, environment=environment, uniforms={"fill": float(fill)})
-
-
 def parse_plot(view: str, **options):
     """
     The plot views' settings (:class:`explorer.views.plots.PlotSettings`) from the options given (None: not
@@ -251,47 +181,6 @@ def _write_plot(loaded, view: str, image, plot, out: Path, light, engine: str) -
     shown_light = (light or DEFAULT_LIGHT) if view_named(view).takes_light else None
     write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light)
     click.echo(f"wrote {out} ({view} plot, {width}x{height} samples, {engine})")
-
-
-def check_numpy_size(width: int, height: int) -> None:
-    """The numpy engine's image budget: the GL engine's (:data:`explorer.gpu.context.MAX_IMAGE_BYTES`), without a context."""
-    from explorer.gpu.context import MAX_IMAGE_BYTES
-
-    pixels = MAX_IMAGE_BYTES // 16
-    if width * height > pixels:
-        raise LocatedError("--size", None, f"{width}x{height} is more than the {pixels} pixels of an image "
-                                           f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
-
-
-def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh=None,
-                background: bool = False, surface=None) -> np.ndarray:
-    """The env view (:func:`explorer.gpu.env.render_env`), its progress on stderr every few seconds."""
-    import time
-
-    from explorer.gpu.env import render_env
-
-    if engine == "numpy":
-        from explorer.materials.models import model_for
-
-        model = model_for(material, values)
-        if model is None or not callable(getattr(model, "brdf", None)):
-            raise MaterialError(material.path, None, "its numpy twin has no brdf(): no env view with --engine numpy")
-        check_numpy_size(width, height)
-    start = last = time.perf_counter()
-    unit = "samples per pixel" if engine == "gl" else "pixels"
-
-    def progress(done: int, total: int) -> None:
-        nonlocal last
-        now = time.perf_counter()
-        if now - last >= 2.0 or (done == total and now - start >= 2.0):
-            last = now
-            click.echo(f"{PROG}: env: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
-
-    def warn(message: str) -> None:
-        click.echo(f"{PROG}: warning: {message}", err=True)
-
-    return render_env(material, values, width, height, engine=engine, environment=environment, spp=spp,
-                      progress=progress, warn=warn, mesh=mesh, background=background, surface=surface)
 
 
 def summary(command: click.Command) -> str:
@@ -538,15 +427,18 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 
         check_mitsuba_render(view, engine, variant)
     if engine == "position-free":
-        from explorer.cli.albedo import render_position_free
+        from explorer.views.position_free import POSITION_FREE_VIEWS
 
-        image = render_position_free(loaded, values, view, width, height, light_angles, spp)
-    else:
-        from explorer.views.fill import DEFAULT_FILL, has_fill
+        if view not in POSITION_FREE_VIEWS:
+            raise click.BadParameter(f"the position-free engine renders the {' and '.join(POSITION_FREE_VIEWS)} views", param_hint="--view")
+    from explorer.cli.albedo import progress_printer
+    from explorer.rendering import render_material
+    from explorer.views.fill import DEFAULT_FILL, has_fill
 
-        fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
-        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp or 64,
-                                variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill)
+    fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
+    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
+                            variant=variant, mesh=mesh_shape, background=background, plot=plot,
+                            progress_printer=progress_printer, warn=warn, fill=fill)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
         return
@@ -686,7 +578,7 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
     With --layers: the rough layers' host-table timings and the slice view's accuracy (64x64; --repeats, default 5 here).
     """
-    from explorer.cli.bench import run_bench, run_layers_bench, run_thin_film_bench
+    from explorer.bench import run_bench, run_layers_bench, run_thin_film_bench
 
     if markdown and (as_json or app or position_free or design_count is not None or tables or scaling or mitsuba):
         raise click.UsageError("--markdown goes with Table 1, --thin-film or --layers, without --json")
@@ -695,7 +587,7 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
     if design_tries is not None and design_count is None:
         raise click.UsageError("--tries goes with --design")
     if position_free:
-        from explorer.cli.bench import run_position_free_bench
+        from explorer.bench import run_position_free_bench
 
         run_position_free_bench(as_json=as_json)
         return
@@ -705,12 +597,12 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
         run_design_bench(design_count, seed=design_seed or 0, as_json=as_json, tries=design_tries or DEFAULT_TRIES)
         return
     if scaling:
-        from explorer.cli.bench import run_scaling_bench
+        from explorer.bench import run_scaling_bench
 
         run_scaling_bench(as_json=as_json, repeats=repeats, plot=Path(plot) if plot else None)
         return
     if tables:
-        from explorer.cli.bench import run_tables_bench
+        from explorer.bench import run_tables_bench
 
         source = click.get_current_context().get_parameter_source("repeats")
         run_tables_bench(as_json=as_json, size=size, repeats=repeats if source == click.core.ParameterSource.COMMANDLINE else 5)
@@ -723,7 +615,7 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
                           echo=click.echo)
         return
     if app:
-        from explorer.cli.bench import run_app_bench
+        from explorer.bench import run_app_bench
 
         run_app_bench(as_json=as_json, size=size)
         return
@@ -761,7 +653,7 @@ def accuracy(as_json, plot, strips, presets_, markdown):
 
         run_preset_accuracy(as_json=as_json, markdown=markdown)
         return
-    from explorer.cli.bench import FIGURE_SUFFIXES, STRIP_SUFFIXES, figure4_strips, run_accuracy
+    from explorer.bench import FIGURE_SUFFIXES, STRIP_SUFFIXES, figure4_strips, run_accuracy
     from explorer.files import check_output as check_file
 
     for path, suffixes in ((plot, FIGURE_SUFFIXES), (strips, STRIP_SUFFIXES)):

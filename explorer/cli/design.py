@@ -1,6 +1,6 @@
 """
 ``bragg-explorer design``: the structure of a Bragg mirror, rough Bragg layer or thin film from the colours
-wanted at a few angles (:mod:`explorer.physics.design`), registered by :mod:`explorer.cli.commands`.
+wanted at a few angles (:mod:`explorer.design`), registered by :mod:`explorer.cli.commands`.
 
 A target is ``--target THETA:COLOUR``: THETA in degrees in the outer medium, COLOUR ``#RRGGBB`` (sRGB) or
 ``r,g,b`` (linear RGB, the convention of ``render``'s ``.npy``, kept as it is even outside [0, 1]). A strip
@@ -73,7 +73,7 @@ def srgb_to_linear(encoded) -> np.ndarray:
 
 def parse_colour(text: str, where: str = "--target") -> np.ndarray:
     """``#RRGGBB`` (sRGB) or ``r,g,b`` (linear) as linear RGB; a :class:`click.UsageError` otherwise."""
-    from explorer.physics.design import DesignError, check_target_rgb
+    from explorer.design import DesignError, check_target_rgb
 
     text = text.strip()
     if text.startswith("#"):
@@ -95,8 +95,8 @@ def parse_colour(text: str, where: str = "--target") -> np.ndarray:
 
 
 def parse_target(text: str):
-    """``THETA:COLOUR`` as a :class:`explorer.physics.design.Target`."""
-    from explorer.physics.design import Target
+    """``THETA:COLOUR`` as a :class:`explorer.design.Target`."""
+    from explorer.design import Target
 
     theta_text, sep, colour_text = text.partition(":")
     if not sep:
@@ -112,7 +112,7 @@ def parse_target(text: str):
 
 def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS):
     """Targets read from a strip image over ``theta_range`` (``A,B`` degrees)."""
-    from explorer.physics.design import DesignError, targets_from_strip
+    from explorer.design import DesignError, targets_from_strip
     from explorer.views.images import clipped_codes, read_linear_image
 
     if theta_range is None:
@@ -162,7 +162,7 @@ def _named_values(option: str, items, model, material_model: str, expected: str 
 
 def parse_fixes(fixes, free, material):
     """``--fix NAME=VALUE`` and ``--free NAME,...`` as the fixed values (every design parameter not free)."""
-    from explorer.physics.design import design_model
+    from explorer.design import design_model
 
     model = design_model(material.model)
     values = material.resolve({})
@@ -184,17 +184,12 @@ def parse_fixes(fixes, free, material):
 
 def parse_guess(text: str, material) -> dict[str, float]:
     """``--guess NAME=VALUE,...``: a structure to start from, the parameters it omits at the material's defaults."""
-    from explorer.physics.design import design_model
+    from explorer.design import design_model
 
     model = design_model(material.model)
     defaults = material.resolve({})
     guess = _named_values("--guess", [part.strip() for part in text.split(",")], model, material.model, "NAME=VALUE,...")
     return {name: guess.get(name, float(defaults[name])) for name in model.parameters}
-
-
-def ranges_of(material) -> dict[str, tuple[float, float]]:
-    """The declared ``(min, max)`` of each parameter of the material file."""
-    return {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
 
 
 def render_command(material_name: str, values: dict, material=None) -> str:
@@ -245,7 +240,7 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     as not reachable, with the closest structure found.
     """
     from explorer.errors import LocatedError
-    from explorer.physics.design import REACHABLE_DELTA_E, DesignError, design, design_model
+    from explorer.design import REACHABLE_DELTA_E, DesignError, design, design_model, ranges_of
     from explorer.resources import display_path
 
     if target_spectrum is not None:
@@ -313,12 +308,11 @@ def _save_structure(material, values: dict, path: str) -> None:
 def run_design_bench(count: int = 50, seed: int = 0, as_json: bool = False, max_lambda: float | None = None,
                      tries: int = DEFAULT_TRIES) -> None:
     """
-    The round trip of :func:`explorer.physics.design.round_trip` on ``bragg_mirror``: per mirror the time of
+    The round trip of :func:`explorer.design.round_trip` on ``bragg_mirror``: per mirror the time of
     a 5-angle design (of at most ``tries`` searches) and its median / max CIEDE2000, then the acceptance
     figures (median of the medians, share at most 1) and the median time.
     """
-    from explorer.physics.design import round_trip
-
+    from explorer.design import ranges_of, round_trip
     from explorer.materials.models import BraggMirrorModel
 
     material = load(BraggMirrorModel.name)

@@ -9,10 +9,8 @@ from pathlib import Path
 
 import click
 
-from explorer.materials.brd import MaterialError
-
 from explorer.cli.materials import PROG, load, resolve_values, warn  # noqa: F401
-TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
+TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf", "blender")
 
 
 def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
@@ -21,16 +19,6 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
         raise click.BadParameter("--engine mitsuba renders the env view (--view env)", param_hint="--engine")
     if variant is not None and engine != "mitsuba":
         raise click.BadParameter("--variant is for --engine mitsuba", param_hint="--variant")
-
-
-def render_env_with_mitsuba(material, values, width, height, environment, spp, variant):
-    """The env view by Mitsuba (:func:`explorer.mitsuba.scene.render_env_mitsuba`), LLVM fallback noted on stderr."""
-    from explorer.materials.twins import capabilities_of, supporting
-    from explorer.mitsuba.scene import render_env_mitsuba
-
-    if not capabilities_of(material).supports("mitsuba"):
-        raise MaterialError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(supporting('mitsuba'))})")
-    return render_env_mitsuba(material, values, width, height, spp, environment, variant, note=warn)
 
 
 @click.command("export")
@@ -55,6 +43,9 @@ def export_command(material, target, preset, params_file, assignments, env_file,
     try:
         if texture_table and target != "gltf":
             raise click.BadParameter("--texture-table is for --to gltf", param_hint="--texture-table")
+        if target == "blender":
+            _export_blender(material, preset, params_file, assignments, env_file, out, load(material))
+            return
         if target == "gltf":
             _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, load(material))
             return
@@ -62,6 +53,19 @@ def export_command(material, target, preset, params_file, assignments, env_file,
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
+
+
+def _export_blender(material, preset, params_file, assignments, env_file, out, loaded):
+    """``--to blender``: the preview scene (.blend) and the script that rebuilds the material (.py)."""
+    from explorer.blender import export_blender
+    from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
+
+    for warning in loaded.warnings:
+        warn(warning)
+    values = resolve_values(loaded, preset, params_file, assignments)
+    environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
+    blend, script = export_blender(loaded, values, Path(out), environment)
+    click.echo(f"wrote {blend} (Cycles preview: the env view's scene) and {script} (rebuilds the material on yours)")
 
 
 def _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, loaded):

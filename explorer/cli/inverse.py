@@ -141,7 +141,7 @@ def figure_command(lobe_spec, out, samples):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from explorer.cli.bench import FIGURE_SUFFIXES, save_figure
+    from explorer.bench import FIGURE_SUFFIXES, save_figure
     from explorer.files import OutputError, check_output
     from explorer.physics.inverse import one_layer_class, two_layer_class
 

@@ -500,6 +500,42 @@ def ensure_node_packages(mode: str, which: Callable[[str], str | None] | None = 
         log(f"note: npm install failed (exit {code}): the glTF export's validation tests will fail")
 
 
+# Blender as a Python module for `export --to blender` and its tests (docs/blender.md). Its wheel asks for
+# numpy < 2, which the pinned numpy 2 excludes, so it cannot be an extra resolved with the constraints: it is
+# installed alone, without dependencies (it imports and renders with numpy 2; its own numpy modules do not
+# load). CPython 3.11 only, about 1 GB installed: on first use (`--to blender`) and for the tests.
+BLENDER_REQUIREMENT = "bpy==5.0.1"
+#: Set (to anything but 0) to keep bpy out of a test set-up (a shared machine's disk).
+ENV_NO_BLENDER = "BRAGG_EXPLORER_NO_BLENDER"
+
+
+def wants_blender(argv: Sequence[str]) -> bool:
+    argv = list(argv)
+    return "--to=blender" in argv or any(a == "--to" and k + 1 < len(argv) and argv[k + 1] == "blender" for k, a in enumerate(argv))
+
+
+def ensure_blender(mode: str, argv: Sequence[str], venv_dir: Path | None = None,
+                   runner: Callable[..., tuple[int, str]] | None = None) -> None:
+    """pip-install :data:`BLENDER_REQUIREMENT` (no dependencies) into the venv when a command or the tests need it."""
+    if mode != MODE_TEST and not wants_blender(argv):
+        return
+    if mode == MODE_TEST and os.environ.get(ENV_NO_BLENDER, "") not in ("", "0"):
+        return  # a developer's choice: the Blender tests then skip (CI=true: they fail)
+    venv_dir = venv_dir or VENV_DIR
+    name, _, version = BLENDER_REQUIREMENT.partition("==")
+    if glob.glob(str(venv_dir / "lib" / "python*" / "site-packages" / f"{name}-{version}.dist-info")):
+        return
+    if sys.version_info[:2] != (3, 11):
+        log(f"note: {BLENDER_REQUIREMENT} is built for CPython 3.11 only: the Blender export and its tests need it")
+        return
+    log(f"installing {BLENDER_REQUIREMENT} (Blender as a Python module, about 1 GB; first use only)…")
+    code, out = (runner or _run_quiet)([str(venv_python(venv_dir)), "-m", "pip", "install", "--disable-pip-version-check",
+                                        "--no-input", "--no-deps", BLENDER_REQUIREMENT])
+    if code != 0:
+        print(_tail(out), file=sys.stderr)
+        log(f"note: pip install {BLENDER_REQUIREMENT} failed (exit {code}): the Blender export is unavailable")
+
+
 # --------------------------------------------------------------------------
 # Virtual environment and Python packages
 
@@ -728,6 +764,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         ensure_node_packages(mode)
         inside = in_venv(VENV_DIR)
         installed = ensure_python_packages(extras, inside)
+        ensure_blender(mode, args)
     except SetupError as exc:
         print(str(exc), file=sys.stderr)
         return 1

@@ -26,7 +26,7 @@ LIGHT = (0.0, 0.0)
 def main(argv=None) -> None:
     from PIL import Image, ImageDraw
 
-    from explorer.cli.commands import render_material
+    from explorer.rendering import render_material
     from explorer.files import atomic_output
     from explorer.materials.brd import load_material
     from explorer.physics.colorimetry import encode_srgb8
@@ -77,7 +77,7 @@ def accuracy(size: int = 128) -> None:
     ΔE2000 (median, 99th percentile, max over the disc) of the textured sphere by methods 1, 3 and 4 against the
     spectral reference at 1/4 nm (method 0), per mapping, light head-on, on the GPU; and the table's build time.
     """
-    from explorer.cli.commands import render_material
+    from explorer.rendering import render_material
     from explorer.materials.brd import load_material
     from explorer.physics import bragg
     from explorer.physics.colorimetry import delta_E_2000

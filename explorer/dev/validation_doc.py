@@ -5,7 +5,7 @@ of ``docs/validation.md`` in-process and write the file atomically, so that its 
 Each table is a :class:`Section` of :data:`SECTIONS` (one registry; ``--only`` and the file's order derive
 from it): a heading, the command that regenerates the table, the date and machine (GL renderer, CPU count),
 the short fixed prose that explains it, and the Markdown the command prints (``bench``/``accuracy
---markdown`` through :mod:`explorer.cli.markdown_tables`, or :mod:`explorer.dev.validation_studies` for the
+--markdown`` through :mod:`explorer.bench.markdown_tables`, or :mod:`explorer.dev.validation_studies` for the
 measurements no user command makes: under a host, exactness, the layered lobes). Slow measurements run reduced (a smaller sphere, fewer repeats), and
 the reduction is written beside the table. With ``--only``, the other sections keep their text from the
 existing file.
@@ -68,7 +68,7 @@ def _app() -> str:
     import json
     import subprocess
 
-    from explorer.cli.markdown_tables import app_markdown
+    from explorer.bench.markdown_tables import app_markdown
     from explorer.resources import SOURCE_ROOT
 
     # In a child process: the app's window context (GLX) cannot be made current in a process that
@@ -81,36 +81,36 @@ def _app() -> str:
 
 
 APP_CHILD = ("import json, contextlib, io, sys\n"
-             "from explorer.cli.bench import run_app_bench\n"
+             "from explorer.bench import run_app_bench\n"
              "with contextlib.redirect_stdout(io.StringIO()):\n"
              "    rows = run_app_bench(as_json=True, size=512, frames={frames})\n"
              "print(json.dumps({{'rows': rows}}))\n")
 
 
 def _accuracy() -> str:
-    from explorer.cli.bench import FIGURE4_DELTAS, FIGURE4_LAMBDAS, figure4_accuracy
-    from explorer.cli.markdown_tables import accuracy_markdown
+    from explorer.bench import FIGURE4_DELTAS, FIGURE4_LAMBDAS, figure4_accuracy
+    from explorer.bench.markdown_tables import accuracy_markdown
 
     return accuracy_markdown(figure4_accuracy(), FIGURE4_LAMBDAS, FIGURE4_DELTAS)
 
 
 def _bench() -> str:
-    from explorer.cli.bench import run_bench
-    from explorer.cli.markdown_tables import bench_markdown
+    from explorer.bench import run_bench
+    from explorer.bench.markdown_tables import bench_markdown
 
     return bench_markdown(_quiet(run_bench, as_json=True, size=BENCH_SIZE, repeats=BENCH_REPEATS))
 
 
 def _thin_film() -> str:
-    from explorer.cli.bench import run_thin_film_bench
-    from explorer.cli.markdown_tables import thin_film_markdown
+    from explorer.bench import run_thin_film_bench
+    from explorer.bench.markdown_tables import thin_film_markdown
 
     return thin_film_markdown(_quiet(run_thin_film_bench, as_json=True, size=BENCH_SIZE, repeats=BENCH_REPEATS))
 
 
 def _layers() -> str:
-    from explorer.cli.bench import run_layers_bench
-    from explorer.cli.markdown_tables import layers_markdown
+    from explorer.bench import run_layers_bench
+    from explorer.bench.markdown_tables import layers_markdown
 
     return layers_markdown(_quiet(run_layers_bench, as_json=True, repeats=LAYERS_REPEATS))
 

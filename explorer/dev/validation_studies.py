@@ -33,8 +33,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from explorer.cli.bench import FIGURE4_DELTAS, FIGURE4_LAMBDAS, THETA_DEGREES
-from explorer.cli.markdown_tables import markdown_table
+from explorer.bench import FIGURE4_DELTAS, FIGURE4_LAMBDAS, THETA_DEGREES
+from explorer.bench.markdown_tables import markdown_table
 from explorer.physics import bragg, colorimetry, inverse, lobes, microfacet
 from explorer.physics.inverse import Lobe
 

@@ -26,7 +26,7 @@ from explorer.physics import microfacet
 
 COLUMNS = 64
 ROWS = 32
-STRATA = 24
+STRATA = 16
 #: The cosine lobe's share of the samples (the base's diffuse light).
 COSINE_SHARE = 0.25
 
@@ -39,31 +39,39 @@ def roughness_names(material) -> list[str]:
     return [p.name for p in material.parameters if p.name == "alpha" or p.name.startswith("alpha_")]
 
 
+#: Texels (columns) whose samples go to the material's BRDF in one call: the per-call cost (a lobe sum's
+#: setup) is paid 16 times per row, not 64; more columns a call slow a spectral stack down (its arrays outgrow the caches).
+COLUMNS_PER_CALL = 4
+
+
 def _albedo(model, cos_v: np.ndarray, alpha: float) -> np.ndarray:
     """Directional albedo (RGB) at each ``cos_v``, by a stratified MIS estimate."""
     alpha_s = max(alpha, 1e-3)
     k = np.arange(STRATA)
     u1, u2 = np.meshgrid((k + 0.5) / STRATA, (k + 0.5) / STRATA)
     u1, u2 = u1.ravel(), u2.ravel()
+    samples = u1.size
     e = np.eye(3)
     out = np.zeros((cos_v.size, 3))
-    for c, cos in enumerate(cos_v):
-        cos = min(max(cos, 1e-3), 1.0)
-        v = np.array([np.sqrt(1.0 - cos * cos), 0.0, cos])
-        vv = np.broadcast_to(v, (u1.size, 3))
-        m = microfacet.sample_ggx_visible_normal(vv, alpha_s, u1, u2)
+    r, phi = np.sqrt(u1), 2.0 * np.pi * u2
+    l_cos_one = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - u1))], axis=-1)
+    for first in range(0, cos_v.size, COLUMNS_PER_CALL):
+        cos = np.clip(cos_v[first:first + COLUMNS_PER_CALL], 1e-3, 1.0)
+        count = cos.size
+        v = np.stack([np.sqrt(1.0 - cos * cos), np.zeros_like(cos), cos], axis=-1)
+        vv = np.repeat(v, samples, axis=0)  # (count * samples, 3): texel c's samples in rows c S .. (c + 1) S
+        m = microfacet.sample_ggx_visible_normal(vv, alpha_s, np.tile(u1, count), np.tile(u2, count))
         l_ggx = 2.0 * np.sum(vv * m, axis=-1, keepdims=True) * m - vv
-        r, phi = np.sqrt(u1), 2.0 * np.pi * u2
-        l_cos = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - u1))], axis=-1)
-        total = np.zeros(3)
+        l_cos = np.tile(l_cos_one, (count, 1))
+        texel = np.repeat(np.arange(count), samples)
         for l, share in ((l_ggx, 1.0 - COSINE_SHARE), (l_cos, COSINE_SHARE)):
             pdf = (1.0 - COSINE_SHARE) * microfacet.ggx_reflection_pdf(l, vv, alpha_s) + COSINE_SHARE * np.maximum(l[:, 2], 0.0) / np.pi
             ok = (l[:, 2] > 0.0) & (pdf > 0.0)
             with np.errstate(all="ignore"):
                 f = model.brdf(l[ok], vv[ok], e[2], e[0], e[1])
             f = np.where(np.isfinite(f), f, 0.0)
-            total += share * np.sum(f * (l[ok, 2] / pdf[ok])[:, None], axis=0) / u1.size
-        out[c] = total
+            contribution = share * f * (l[ok, 2] / pdf[ok])[:, None] / samples
+            np.add.at(out, first + texel[ok], contribution)
     return out
 
 

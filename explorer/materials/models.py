@@ -317,11 +317,17 @@ def _layer_tables(layer: layered.RoughBraggLayer, n1: float) -> layered.LayerTab
     return layered.layer_tables(layer, n1)
 
 
-@functools.lru_cache(maxsize=32)
-def _layer_compensation(layer: layered.RoughBraggLayer, n1: float):
-    """A layer's multiple-scattering compensation from its cached tables, cached likewise."""
-    table = _layer_tables(layer, n1)
-    return multiscatter.compensation_tables(table.reflectance, table.transmissivity, table.theta, layer.alpha)
+_COMPENSATION_CACHE: dict = {}
+
+
+def _layer_compensation(table: layered.LayerTables):
+    """A layer's multiple-scattering compensation from its (cached) tables, cached per layer and host (32 of them)."""
+    key = (table.layer, table.n1)
+    if key not in _COMPENSATION_CACHE:
+        if len(_COMPENSATION_CACHE) >= 32:
+            _COMPENSATION_CACHE.pop(next(iter(_COMPENSATION_CACHE)))
+        _COMPENSATION_CACHE[key] = multiscatter.compensation_tables(table.reflectance, table.transmissivity, table.theta, table.layer.alpha)
+    return _COMPENSATION_CACHE[key]
 
 
 def _flat_tables(table: layered.LayerTables, R: float) -> layered.LayerTables:
@@ -358,7 +364,7 @@ class BraggStackModel:
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.stack = self.stack_of(values)
-        self.multiple_scattering = bool(values.get("multiple_scattering", True))
+        self.multiple_scattering = bool(values.get("multiple_scattering", False))
         self._tables: tuple | None = None
         self._compensation: tuple | None = None
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
@@ -399,7 +405,7 @@ class BraggStackModel:
             return None
         if self._compensation is None:
             if self.facet_reflectance_override is None:
-                self._compensation = tuple(_layer_compensation(layer, self.stack.n1) for layer in self.stack.layers)
+                self._compensation = tuple(_layer_compensation(table) for table in self.tables)
             else:
                 self._compensation = layered.stack_compensation(self.stack, self.tables)
         return self._compensation

@@ -394,17 +394,23 @@ def converged_spectra(
     return result[0][:, 1:] + result[1][:, :-1], substeps
 
 
-def delta_E_2000(rgb_a: np.ndarray, rgb_b: np.ndarray) -> np.ndarray:
+def rgb_to_lab(rgb: ArrayLike) -> np.ndarray:
     """
-    CIE ΔE2000 between linear RGB colours of this convention.
+    CIELAB of linear RGB colours of this convention: back to XYZ (E white, Y = 1), then CIELAB relative to
+    that white, through colour-science. Reflectances are relative colours, so the white is the flat
+    reflectance of 1.
+    """
+    return colour.XYZ_to_Lab(rgb_to_xyz(np.asarray(rgb, dtype=np.float64)), colour.XYZ_to_xy(white_xyz()))
 
-    Colours go back to XYZ (E white, Y = 1) and to CIELAB relative to that white, through
-    colour-science. Reflectances are relative colours, so the white is the flat reflectance of 1.
-    """
-    white_xy = colour.XYZ_to_xy(white_xyz())
-    lab_a = colour.XYZ_to_Lab(rgb_to_xyz(rgb_a), white_xy)
-    lab_b = colour.XYZ_to_Lab(rgb_to_xyz(rgb_b), white_xy)
+
+def delta_E_2000_lab(lab_a: ArrayLike, lab_b: ArrayLike) -> np.ndarray:
+    """CIE ΔE2000 between CIELAB colours (colour-science)."""
     return np.asarray(colour.delta_E(lab_a, lab_b, method="CIE 2000"))
+
+
+def delta_E_2000(rgb_a: np.ndarray, rgb_b: np.ndarray) -> np.ndarray:
+    """CIE ΔE2000 between linear RGB colours of this convention, in CIELAB (:func:`rgb_to_lab`)."""
+    return delta_E_2000_lab(rgb_to_lab(rgb_a), rgb_to_lab(rgb_b))
 
 
 def encode_srgb8(rgb: np.ndarray) -> np.ndarray:

@@ -153,3 +153,59 @@ def mean_optics(polarisation: str, n0: ArrayLike, indices: list, thicknesses: np
         R += optics.R.sum(axis=0)
         T += optics.T.sum(axis=0)
     return R / rows, T / rows
+
+
+# --------------------------------------------------------------------------------------------------
+# Periodic stacks: N identical cells by repeated squaring (Redheffer's star product)
+
+
+def _star(a: tuple, b: tuple) -> tuple:
+    """Two-port ``(r_top, t_down, r_bottom, t_up)`` of ``a`` above ``b`` (Redheffer's star product), same medium between."""
+    ra, ta, rb_a, tu_a = a
+    rb, tb, rbb, tu_b = b
+    D = 1.0 / (1.0 - rb_a * rb)
+    return (ra + ta * rb * tu_a * D, ta * tb * D, rbb + tu_b * rb_a * tb * D, tu_b * tu_a * D)
+
+
+def periodic_optics(polarisation: str, n0, n1, n2, d1: float, d2: float, N: int, wavelength_nm, sin_theta0) -> StackOptics:
+    """
+    ``r, t, R, T`` of ``N`` cells of ``n2`` (``d2``) over ``n1`` (``d1``) between a lossless ``n0`` and an ``n1``
+    base, as :func:`stack_optics` of ``[n2, n1] * N`` (to rounding), in ``O(log N)`` star products: a cell is the
+    Airy slab of ``n2`` in ``n1`` followed by ``d1`` of ``n1``; its two-port is squared, and the host interface
+    added on top. Broadcast over ``wavelength_nm`` and ``sin_theta0``.
+    """
+    wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
+    shape = np.broadcast_shapes(wavelength_nm.shape, np.shape(sin_theta0), np.shape(n0), np.shape(n1), np.shape(n2))
+    n0, n1, n2 = (np.broadcast_to(np.asarray(n, dtype=np.complex128), shape) for n in (n0, n1, n2))
+    n_sin = n0 * sin_theta0
+    k0 = 2.0 * np.pi / wavelength_nm
+    kz0, kz1, kz2 = forward_kz(n0, n_sin), forward_kz(n1, n_sin), forward_kz(n2, n_sin)
+    r12, t12 = interface(polarisation, n1, kz1, n2, kz2)
+    r21, t21 = interface(polarisation, n2, kz2, n1, kz1)
+    e2 = np.exp(1j * k0 * kz2 * d2)
+    denominator = 1.0 - r21 * r21 * e2 * e2
+    slab_r = r12 + t12 * t21 * r21 * e2 * e2 / denominator  # the slab seen from n1, either side (symmetric)
+    slab_t = t12 * t21 * e2 / denominator
+    e1 = np.exp(1j * k0 * kz1 * d1)
+    cell = (slab_r, slab_t * e1, slab_r * e1 * e1, slab_t * e1)
+    result, power, count = None, cell, int(N)
+    while count:
+        if count & 1:
+            result = power if result is None else _star(result, power)
+        count >>= 1
+        if count:
+            power = _star(power, power)
+    rN, tN = result[0], result[1]
+    r01, t01 = interface(polarisation, n0, kz0, n1, kz1)
+    r10, t10 = interface(polarisation, n1, kz1, n0, kz0)
+    denominator = 1.0 - r10 * rN
+    r = r01 + t01 * rN * t10 / denominator
+    t = t01 * tN / denominator
+    cos_0, cos_b = kz0 / n0, kz1 / n1
+    incident = (n0 * (cos_0 if polarisation == "s" else np.conj(cos_0))).real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if polarisation == "s":
+            T = np.abs(t) ** 2 * (n1 * cos_b).real / incident
+        else:
+            T = np.abs(t) ** 2 * (n1 * np.conj(cos_b)).real / incident
+    return StackOptics(r=r, t=t, R=np.abs(r) ** 2, T=np.where(incident > 0.0, T, 0.0))

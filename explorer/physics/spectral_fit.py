@@ -24,13 +24,14 @@ from explorer.physics.natural import NaturalMirror, mirror_spectrum
 #: The free parameters' ranges (N apart).
 RANGES = {"Lambda": (80.0, 1000.0), "delta": (0.05, 0.95), "n1": (1.0, 2.0), "n2": (1.2, 2.5), "k1": (0.0, 0.3), "k2": (0.0, 0.3)}
 #: The cell counts the global pass tries when N is free.
-N_CANDIDATES = (1, 2, 3, 4, 5, 6, 8, 10, 12, 15, 20, 25, 30)
+N_CANDIDATES = tuple(range(1, 31))
 N_MAX = 60
 #: Sobol samples of the continuous parameters per cell count, and the wavelengths the global pass uses.
-GLOBAL_SAMPLES = 512
+GLOBAL_SAMPLES = 1024
 COARSE_WAVELENGTHS = 48
-#: Starts refined by least squares.
-REFINED = 6
+#: Starts kept per cell count, and refined by least squares (the best over every count).
+PER_COUNT = 2
+REFINED = 12
 
 
 @dataclass
@@ -114,7 +115,7 @@ def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float
         host, n1, n2, d1, d2 = _model(free, fixed, sample, w_coarse)
         R = _reflectance_batch(host, n1, n2, d1, d2, N, w_coarse, sin_theta)
         cost = np.sqrt(np.mean((R - measured[coarse]) ** 2, axis=1))
-        for i in np.argsort(cost)[:REFINED]:
+        for i in np.argsort(cost)[:PER_COUNT]:  # the best few of each N: starts from different basins
             candidates.append((float(cost[i]), N, sample[i]))
     candidates.sort(key=lambda c: c[0])
 

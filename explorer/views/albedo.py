@@ -92,7 +92,7 @@ def _dirac(model, cos_theta: np.ndarray) -> np.ndarray:
     return np.asarray(mirror(V, np.broadcast_to([0.0, 0.0, 1.0], V.shape)), dtype=np.float64).reshape(-1, 3)
 
 
-def albedo_numpy(model, theta_deg) -> np.ndarray:
+def albedo_numpy(model, theta_deg, progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """
     The directional albedo of a numpy twin (:mod:`explorer.materials.models`) at ``theta_deg``: (n, 3).
 
@@ -117,6 +117,8 @@ def albedo_numpy(model, theta_deg) -> np.ndarray:
             frame = [np.broadcast_to(a, V.shape) for a in (L, V, N, X, Y)]
             f = view_brdf(model.brdf, *frame)
             result[k] += np.sum(f * (V[:, 2] * w[start:start + BLOCK])[:, None], axis=0)
+        if progress is not None:
+            progress(k + 1, theta.size)
     return result
 
 
@@ -143,7 +145,8 @@ def scatter_solid_angles(width: int, height: int) -> np.ndarray:
     return np.where(r < 1.0, 0.5 * np.pi * sinc * (2.0 / width) * (2.0 / height), 0.0)
 
 
-def albedo_gl(material, values, theta_deg, renderer, size: int = GL_SIZE, model=None) -> np.ndarray:
+def albedo_gl(material, values, theta_deg, renderer, size: int = GL_SIZE, model=None,
+              progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """
     The directional albedo by the GPU: ``BRDF cos theta_o`` in the scatter view (light at ``(theta, 0)``)
     summed with :func:`scatter_solid_angles`; a Dirac reflector (its twin declares ``dirac``) gives its reflectance
@@ -163,6 +166,8 @@ def albedo_gl(material, values, theta_deg, renderer, size: int = GL_SIZE, model=
     for k, t in enumerate(theta):
         image = renderer.render(material, values, "scatter", size, size, light=(float(t), 0.0)).astype(np.float64)
         result[k] = np.einsum("hwc,hw->c", image, weights)
+        if progress is not None:
+            progress(k + 1, theta.size)
     if model is not None:
         result += _dirac(model, np.cos(np.radians(theta)))
     return result

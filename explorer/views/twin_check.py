@@ -44,7 +44,7 @@ COLOUR_VIEWS = ("gradient", "sphere")
 LIGHTS = {"lit": (30.0, 120.0), "slice": None, "scatter": (50.0, 200.0)}
 #: The views ``check`` compares, and their sizes there: small (the spectral references run per pixel).
 CHECK_SIZES = {"gradient": (180, 1), "sphere": (32, 32), "lit": (32, 32), "slice": (32, 32), "scatter": (32, 32),
-               "theta_h": (64, 1), "theta_d": (64, 1)}
+               "theta_v": (64, 1), "theta_h": (64, 1), "theta_d": (64, 1), "lobe3d": (32, 8)}
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """
 The Design window: colours wanted at chosen angles (picked, or read from a strip image) to the structure
-of the open mirror, rough layer or film (:func:`explorer.physics.design.design`), found on a worker
+of the open mirror, rough layer or film (:func:`explorer.design.design`), found on a worker
 thread with its progress shown, so the window keeps drawing; the result becomes the material's values and
 its θ strip is drawn under the target strip. Below, the chromaticities a Bragg mirror can reach at one
 angle for the current index bounds (Sobol samples of the box), with the spectral locus and the sRGB
@@ -16,7 +16,7 @@ import numpy as np
 
 from explorer.app.panels.base import Panel, checkbox_width, flow, record
 from explorer.physics import colorimetry
-from explorer.physics import design as inverse_design
+from explorer import design as inverse_design
 from explorer.materials.models import BraggMirrorModel
 from explorer.materials.twins import capabilities_of, supporting
 from explorer.resources import DEFAULT_MATERIAL
@@ -92,7 +92,7 @@ class DesignPanel(Panel):
 
     def target_list(self) -> list:
         """
-        The targets as :class:`explorer.physics.design.Target`: a colour read from a strip (or the default
+        The targets as :class:`explorer.design.Target`: a colour read from a strip (or the default
         gradient) as its linear RGB, which may lie outside sRGB; one picked, as its picker's sRGB.
         """
         import colour

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from explorer.physics import colorimetry
 from explorer.physics.bragg.mirror import POLARISATIONS, BraggMirror, cell_geometry
-from explorer.physics.bragg.reflectance import _one_minus_exp_minus_2x, chebyshev_U
+from explorer.physics.bragg.reflectance import chebyshev_U, one_minus_exp_minus_2x
 
 # --------------------------------------------------------------------------------------------------
 # The converged colour by Gauss quadrature over band pieces (ours)
@@ -510,7 +510,7 @@ def _line_reflectance_block(lines: _Lines, omega, line, kind) -> np.ndarray:
         deficit_band = t_sin / (r1_2[band] * sin_Nu * sin_Nu + t_sin)
         # Gap: Q = (sinh Im[K] Lambda / sinh N Im[K] Lambda)^2, scaled as chebyshev_U.
         xg = np.maximum(np.arccosh(np.abs(a[gap])), 1e-12)
-        Q = (np.exp(-(N - 1.0) * xg) * _one_minus_exp_minus_2x(xg) / _one_minus_exp_minus_2x(N * xg)) ** 2
+        Q = (np.exp(-(N - 1.0) * xg) * one_minus_exp_minus_2x(xg) / one_minus_exp_minus_2x(N * xg)) ** 2
         deficit_gap = t1_2[gap] * Q / (r1_2[gap] + t1_2[gap] * Q)
         for where, deficit in ((band, deficit_band), (gap, deficit_gap)):
             value[where] = np.where(kind[where] == 3, -deficit, 1.0 - deficit)

@@ -36,8 +36,8 @@ def cos_K_Lambda(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
 
     Real for real indices, also when a layer is evanescent; ``|cos K Lambda| > 1`` in band gaps.
     """
-    psi = _clamp_decay(omega * geometry.p1)
-    phi = _clamp_decay(omega * geometry.p2)
+    psi = clamp_decay(omega * geometry.p1)
+    phi = clamp_decay(omega * geometry.p2)
     value = np.cos(psi) * np.cos(phi) - 0.5 * geometry.Omega * np.sin(psi) * np.sin(phi)
     return np.real(value)
 
@@ -47,11 +47,12 @@ def cos_K_Lambda(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
 MAX_DECAY = 40.0
 
 
-def _clamp_decay(phase):
+def clamp_decay(phase: ArrayLike) -> np.ndarray:
+    """A complex phase with its decay (imaginary part) capped at :data:`MAX_DECAY`: evanescent layers stay finite."""
     return np.real(phase) + 1j * np.minimum(np.imag(phase), MAX_DECAY)
 
 
-def _one_minus_exp_minus_2x(x):
+def one_minus_exp_minus_2x(x: ArrayLike) -> np.ndarray:
     """``1 - exp(-2x)`` without cancellation near band edges (small ``x``)."""
     return -np.expm1(-2.0 * x)
 
@@ -81,8 +82,8 @@ def chebyshev_U(cos_K_Lambda: ArrayLike, N: int) -> tuple[np.ndarray, np.ndarray
     U_N2_band = np.sin((N - 1.0) * t) / safe_sin_t
     # Band gap (Eq. 9): K Lambda = m pi + i x with x = Im[K] Lambda = acosh|a|; U_n(-b) = (-1)^n U_n(b).
     x = np.maximum(np.arccosh(np.maximum(np.abs(a), 1.0)), 1e-12)
-    ratio_N2 = np.exp(-x) * _one_minus_exp_minus_2x((N - 1.0) * x) / _one_minus_exp_minus_2x(N * x)
-    scale_gap = np.exp(-(N - 1.0) * x) * _one_minus_exp_minus_2x(x) / _one_minus_exp_minus_2x(N * x)
+    ratio_N2 = np.exp(-x) * one_minus_exp_minus_2x((N - 1.0) * x) / one_minus_exp_minus_2x(N * x)
+    scale_gap = np.exp(-(N - 1.0) * x) * one_minus_exp_minus_2x(x) / one_minus_exp_minus_2x(N * x)
     U_N1 = np.where(in_band, U_N1_band, 1.0)
     U_N2 = np.where(in_band, U_N2_band, np.sign(a) * ratio_N2)
     scale = np.where(in_band, 1.0, scale_gap)

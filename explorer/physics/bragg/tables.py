@@ -42,7 +42,7 @@ TABLE_MAX_REFINED = 2 * (TABLE_SIZE - 1)
 TABLE_MAX_SUBSTEPS = 1024
 
 
-def _converged_rgb(cos_theta, mirror: BraggMirror) -> np.ndarray:
+def converged_rgb(cos_theta: ArrayLike, mirror: BraggMirror) -> np.ndarray:
     """
     The converged reference's colours (:func:`reference_rgb`) at a cost that does not grow with ``N``: by Gauss
     quadrature over band pieces (:func:`band_pieces_rgb`) where every wave propagates, from :data:`PIECES_MIN_N` cells
@@ -124,7 +124,7 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
     within :data:`TABLE_MAX_REFINED` computed midpoints. Cached per mirror (32 of them).
     """
     cos_theta = np.linspace(0.0, 1.0, min(TABLE_FIRST_SIZE, size))
-    table = _converged_rgb(cos_theta, mirror)
+    table = converged_rgb(cos_theta, mirror)
     budget = TABLE_MAX_REFINED
     while 2 * table.shape[0] - 1 <= max_size:
         refine = _interpolation_error_estimate(table) > TABLE_TOLERANCE
@@ -139,7 +139,7 @@ def tabulated_rgb_table(mirror: BraggMirror, size: int = TABLE_SIZE, max_size: i
             values[refine & trusted] = cubic[refine & trusted]
             computed = refine & ~trusted
             if computed.any():
-                values[computed] = _converged_rgb(midpoints[computed], mirror)
+                values[computed] = converged_rgb(midpoints[computed], mirror)
         finer = np.empty((2 * table.shape[0] - 1, 3))
         finer[0::2], finer[1::2] = table, values
         table = finer

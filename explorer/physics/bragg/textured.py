@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from explorer.physics import colorimetry
 from explorer.physics.bragg.mirror import BraggMirror
 from explorer.physics.bragg.reference import _spectra
-from explorer.physics.bragg.tables import TABLE_TOLERANCE, _converged_rgb, _interpolation_error_estimate
+from explorer.physics.bragg.tables import TABLE_TOLERANCE, _interpolation_error_estimate, converged_rgb
 
 # --------------------------------------------------------------------------------------------------
 # Spatially varying mirrors (supplemental Figure 7): Lambda and delta from a texture value T in [0, 1]
@@ -65,9 +65,9 @@ TEXTURE_TABLE_BUDGET = 2 * TEXTURE_TABLE_COLUMNS * 33
 
 
 def _textured_row(mirror: BraggMirror, T: float, mapping: str, cos_theta: np.ndarray) -> np.ndarray:
-    """The converged colours (:func:`_converged_rgb`) of the mirror at texture value ``T``, at ``cos_theta``."""
+    """The converged colours (:func:`converged_rgb`) of the mirror at texture value ``T``, at ``cos_theta``."""
     m = textured_mirror(mirror, T, mapping)
-    return _converged_rgb(cos_theta, BraggMirror(mirror.n1, mirror.n2, float(m.Lambda), float(m.delta), mirror.N, mirror.nh))
+    return converged_rgb(cos_theta, BraggMirror(mirror.n1, mirror.n2, float(m.Lambda), float(m.delta), mirror.N, mirror.nh))
 
 
 @functools.lru_cache(maxsize=8)
@@ -76,7 +76,7 @@ def textured_rgb_table(mirror: BraggMirror, mapping: str, rows: int = TEXTURE_TA
                        budget: int = TEXTURE_TABLE_BUDGET) -> np.ndarray:
     """
     The tabulated method's table of a textured mirror, ``(R, columns, 3)`` float32: the converged reference
-    (:func:`_converged_rgb`, as :func:`tabulated_rgb_table`) at ``T = k / (R - 1)`` and ``cos theta = i /
+    (:func:`converged_rgb`, as :func:`tabulated_rgb_table`) at ``T = k / (R - 1)`` and ``cos theta = i /
     (columns - 1)``. Every mapping makes ``Lambda`` and ``delta`` functions of the one value ``T``, so the colour
     is a function of ``(cos theta, T)`` alone: one bilinear lookup a pixel (:func:`textured_tabulated_rgb`),
     built once per mirror and mapping.
@@ -90,7 +90,7 @@ def textured_rgb_table(mirror: BraggMirror, mapping: str, rows: int = TEXTURE_TA
     """
     cos_theta = np.linspace(0.0, 1.0, columns)
     if TEXTURE_MAPPINGS[mapping] == 0:
-        table = np.broadcast_to(_converged_rgb(cos_theta, mirror)[None], (2, columns, 3))
+        table = np.broadcast_to(converged_rgb(cos_theta, mirror)[None], (2, columns, 3))
     else:
         count = min(TEXTURE_TABLE_FIRST_ROWS, rows)
         table = np.stack([_textured_row(mirror, t, mapping, cos_theta) for t in np.linspace(0.0, 1.0, count)])

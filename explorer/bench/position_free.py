@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from explorer.cli.bench.common import _progress
+from explorer.bench.common import _progress
 from explorer.materials.brd import load_material
 from explorer.resources import SHADER_DIR
 from explorer.materials.models import BraggStackModel

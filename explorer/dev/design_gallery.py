@@ -1,8 +1,8 @@
 """
 The gallery of docs/design.md: five beetle- and butterfly-like colour gradients, each designed back by
-``bragg-explorer design`` (explorer.physics.design), printed as the Markdown table the docs show.
+``bragg-explorer design`` (explorer.design), printed as the Markdown table the docs show.
 
-    .venv/bin/python docs/design_gallery.py
+    .venv/bin/python -m explorer.dev.design_gallery
 
 Each target is the converged colour, at 0, 15, 30, 45 and 60 degrees, of a structure: 1-3 the jewel-beetle
 cuticle areas of Fourneau et al. (2024) Table 3 (smooth, in air), 4 and 5 illustrative structures of the
@@ -12,8 +12,10 @@ to the design; it does not see the structure.
 
 from __future__ import annotations
 
-from explorer.cli.design import load, ranges_of
-from explorer.physics import design
+from explorer import design
+from explorer.design import ranges_of
+from explorer.materials.brd import load_material
+from explorer.resources import material_path
 
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)
 
@@ -43,7 +45,7 @@ def main() -> None:
     print("| target | designed structure | ΔE2000 at 0, 15, 30, 45, 60° | time |")
     print("|---|---|---|---|")
     for title, material, targets, fixed in GALLERY:
-        result = design.design(material, targets, ranges_of(load(material)), fixed)
+        result = design.design(material, targets, ranges_of(load_material(material_path(material))), fixed)
         values = ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.values.items())
         errors = ", ".join(f"{d:.2f}" for d in result.delta_e2000)
         flag = "" if result.reachable.all() else " (not reachable)"

@@ -9,9 +9,10 @@ inverse_compare.png: two members of one class, as the Inverse window's "compare 
 in the env view (the shipped default sky, SPP samples per pixel): A | A left, B right | B. Same lobe at
 normal incidence (R = [0.1, 0.2, 0.1], sigma = 0.03); they part at grazing angles.
 inverse_app.png: the Inverse window on that lobe, in a scripted session under Xvfb.
-Run: .venv/bin/python .github/readme/inverse_figure.py   (about a minute on llvmpipe)
+Run: .venv/bin/python -m explorer.dev.readme_inverse_figure   (about a minute on llvmpipe)
 """
 
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -20,7 +21,6 @@ import numpy as np
 from PIL import Image
 
 from explorer.app.panels.inverse import LobeEdit, material_values, solve
-from explorer.cli.inverse import figure_command
 from explorer.gpu import Renderer
 from explorer.gpu.env import render_env
 from explorer.materials.brd import load_material
@@ -34,12 +34,13 @@ CLASSES = ["R=0.6,0.45,0.3 sigma=0.01 base=conductor", "R=0.1,0.2,0.1 sigma=0.03
 LOBE = LobeEdit([0.1, 0.2, 0.1], 0.03, 2)
 POINTS = {"A": (0.05, 0.1), "B": (0.95, 0.9)}
 
-# The class plots, through the figure command itself.
+# The class plots, through the figure command itself (in a child process: the scripts stand beside the command line).
 with tempfile.TemporaryDirectory() as tmp:
     panels = []
     for i, spec in enumerate(CLASSES):
         path = Path(tmp) / f"class{i}.png"
-        figure_command.main(["--lobe", spec, "--out", str(path), "--samples", "96"], standalone_mode=False)
+        subprocess.run([sys.executable, "-m", "explorer.cli.commands", "figure", "--lobe", spec, "--out", str(path), "--samples", "96"],
+                       cwd=ROOT, check=True)
         panels.append(np.asarray(Image.open(path).convert("RGB")))
 height = min(p.shape[0] for p in panels)
 Image.fromarray(np.concatenate([p[:height] for p in panels], axis=1)).save(OUT / "inverse_classes.png", optimize=True)
@@ -64,7 +65,6 @@ print("wrote .github/readme/inverse_compare.png")
 # The Inverse window itself: the Figure-12 lobe typed in, its point walked, under a virtual display.
 import json
 import os
-import subprocess
 
 from explorer.app.xvfb import virtual_display
 

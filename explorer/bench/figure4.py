@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.cli.bench.common import FIGURE4_DELTAS, FIGURE4_LAMBDAS, STRIP_SUFFIXES, THETA_DEGREES, _progress, save_figure
+from explorer.bench.common import FIGURE4_DELTAS, FIGURE4_LAMBDAS, STRIP_SUFFIXES, THETA_DEGREES, _progress, save_figure
 from explorer.files import atomic_output
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
@@ -87,7 +87,7 @@ def run_accuracy(as_json: bool = False, plot: Path | None = None, markdown: bool
     if as_json:
         print(json.dumps({"rows": rows}, indent=2))
     else:  # the text output is the Markdown tables (--markdown says so explicitly)
-        from explorer.cli.markdown_tables import accuracy_markdown
+        from explorer.bench.markdown_tables import accuracy_markdown
 
         print(accuracy_markdown(rows, FIGURE4_LAMBDAS, FIGURE4_DELTAS))
     return rows

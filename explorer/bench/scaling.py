@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.cli.bench.common import _progress
-from explorer.cli.bench.tables import TABLES_LAMBDA_STEP, TABLES_MIRROR, _medians, _timed_frame, _timed_ms
+from explorer.bench.common import _progress
+from explorer.bench.tables import TABLES_LAMBDA_STEP, TABLES_MIRROR, _medians, _timed_frame, _timed_ms
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
@@ -51,7 +51,7 @@ def scaling_study(repeats: int = 3, renderer=None) -> dict:
         for N in SCALING_N:
             mirror = bragg.BraggMirror(**{**TABLES_MIRROR, "Lambda": Lambda}, N=N)
             measured = [_timed_ms(lambda: bragg.tabulated_rgb_table(mirror)), _timed_ms(lambda: _converged_rule_rgb(first, mirror)),
-                        _timed_ms(lambda: bragg._converged_rgb(first, mirror))]
+                        _timed_ms(lambda: bragg.converged_rgb(first, mirror))]
             if round_:
                 for key, value in zip(("table", "rule", "nodes"), measured):
                     times.setdefault((key, N), []).append(value)
@@ -59,7 +59,7 @@ def scaling_study(repeats: int = 3, renderer=None) -> dict:
     for round_ in range(repeats + 1):
         for N in (20, 1000):
             for n in SCALING_ANGLES:
-                measured = _timed_ms(lambda: bragg._converged_rgb(np.linspace(0.0, 1.0, n), bragg.BraggMirror(**TABLES_MIRROR, N=N)))
+                measured = _timed_ms(lambda: bragg.converged_rgb(np.linspace(0.0, 1.0, n), bragg.BraggMirror(**TABLES_MIRROR, N=N)))
                 if round_:
                     times.setdefault(("angles", N, n), []).append(measured)
         _progress(f"bench --scaling: table against its size, round {round_}/{repeats}")

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from explorer.cli.bench.common import _progress
+from explorer.bench.common import _progress
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import colorimetry
@@ -87,7 +87,7 @@ def run_layers_bench(as_json: bool = False, repeats: int = 5, size: int = 64, ma
         "stack": stack_study(repeats=max(repeats // 2, 1)),
     }
     if markdown and not as_json:
-        from explorer.cli.markdown_tables import layers_markdown
+        from explorer.bench.markdown_tables import layers_markdown
 
         print(layers_markdown(document))
         return document

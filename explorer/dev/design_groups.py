@@ -3,10 +3,14 @@ The round trip's groups (docs/design.md): the median of the per-mirror median CI
 within 1, per kind of mirror, from the per-mirror list that ``python3 -m explorer bench --design 50``
 prints (docs/design_round_trip.txt).
 
-Usage: python3 docs/design_groups.py docs/design_round_trip.txt
+Usage: python3 -m explorer.dev.design_groups docs/design_round_trip.txt
 """
 
-import re, sys, numpy as np
+import re
+import sys
+
+import numpy as np
+
 rows = []
 for line in open(sys.argv[1]):
     m = re.match(r"\s*(\d+)\s+(.*?)\s+->\s+median ΔE2000 ([\d.]+)", line)

@@ -5,7 +5,7 @@ true shape (the sum over the 5 targets of CIEDE2000², at the best period of the
 own sampling and fringe averaging, and with finer ones. A score of a few means the search could find the
 truth; hundreds mean the screening model hides it, whatever the search does.
 
-    .venv/bin/python docs/design_fidelity.py       # prints the Markdown table
+    .venv/bin/python -m explorer.dev.design_fidelity       # prints the Markdown table
 """
 
 from __future__ import annotations
@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.cli.design import load, ranges_of
-from explorer.physics import design
+from explorer import design
+from explorer.design import ranges_of
+from explorer.materials.brd import load_material
+from explorer.resources import SOURCE_ROOT, material_path
 
 #: (relative step of the scan's log grid, fringes averaged below this fraction of lambda).
 SETTINGS = ((design.SCAN_RELATIVE_STEP, design.SCAN_SMOOTH), (0.005, 0.003), (0.002, 0.003), (0.001, 0.001))
@@ -34,7 +36,7 @@ def misses(path: Path) -> list[int]:
 
 def round_trip_truths(count: int) -> tuple[dict, design.DesignModel, list[dict]]:
     """The mirror's ranges and model, and the round trip's first ``count`` true structures (seed 0)."""
-    ranges = ranges_of(load("bragg_mirror"))
+    ranges = ranges_of(load_material(material_path("bragg_mirror")))
     rng = np.random.default_rng(0)
     truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(count)]
     return ranges, design.design_model("bragg_mirror"), truths
@@ -42,7 +44,7 @@ def round_trip_truths(count: int) -> tuple[dict, design.DesignModel, list[dict]]
 
 def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]]:
     """The mirror's ranges and model, the round trip's misses, and its true structures (seed 0) up to the last."""
-    indices = misses(Path(__file__).with_name("design_round_trip.txt"))
+    indices = misses(SOURCE_ROOT / "docs" / "design_round_trip.txt")
     ranges, model, truths = round_trip_truths(max(indices) + 1)
     return ranges, model, indices, truths
 

@@ -3,7 +3,7 @@
 Left to right: Figure 1's left mirror (d1 = 125 nm, d2 = 375 nm) at alpha = 0.025, 0.1, 0.4; its right
 mirror (d1 = 101 nm, d2 = 143 nm) likewise; the stacked pair; Table 3's three jewel-beetle areas. The
 shipped default sky (shaders/environments/default.hdr), progressive Monte Carlo, SPP samples per pixel.
-Run: .venv/bin/python .github/readme/stack_figure.py   (a few minutes on llvmpipe)
+Run: .venv/bin/python -m explorer.dev.readme_stack_figure   (a few minutes on llvmpipe)
 """
 
 import sys
@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from explorer.physics.colorimetry import encode_srgb8
-from explorer.gpu.env import render_env
 from explorer.gpu import Renderer
+from explorer.gpu.env import render_env
 from explorer.materials.presets import load_presets
+from explorer.physics.colorimetry import encode_srgb8
 
 ROOT = Path(__file__).resolve().parents[2]
 SIZE, SPP = 144, 96

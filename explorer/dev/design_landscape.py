@@ -4,17 +4,16 @@ over the targets of CIEDE2000², each shape at its best optical period) along ea
 unit box, through the true shape of three round-trip mirrors, with the descent's first and last spreads
 marked. The basins are some 0.01 of the box wide; a random shape scores hundreds.
 
-    .venv/bin/python docs/design_landscape.py      # writes docs/figures/design_landscape.png
+    .venv/bin/python -m explorer.dev.design_landscape      # writes docs/figures/design_landscape.png
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from design_fidelity import round_trip_truths, truth_problem
-from explorer.physics import design
+from explorer import design
+from explorer.dev.design_fidelity import round_trip_truths, truth_problem
+from explorer.resources import SOURCE_ROOT
 
 #: Round-trip mirrors (seed 0): a thin stack, a vivid first-order stack under a host, a high-order mirror.
 MIRRORS = (31, 10, 40)
@@ -53,7 +52,7 @@ def main() -> None:
     figure.suptitle("The design landscape through the true structure, each shape at its best period "
                     "(shaded: the descent's first and last spreads, 0.08 and 0.01)", fontsize=10)
     figure.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
-    out = Path(__file__).parent / "figures" / "design_landscape.png"
+    out = SOURCE_ROOT / "docs" / "figures" / "design_landscape.png"
     figure.savefig(out, dpi=110)
     print(out)
 

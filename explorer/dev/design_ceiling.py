@@ -4,22 +4,24 @@ the round trip's 50 mirrors (seed 0, as ``bench --design 50``), each designed wi
 among the first pass's shapes (``design(..., guesses=[truth])``). The share within ΔE2000 1 is the ceiling
 of everything after the first pass: the descent, the refinements, the choice of candidates, the polish.
 
-    .venv/bin/python docs/design_ceiling.py       # ~4 minutes; prints a line per mirror, then the summary
+    .venv/bin/python -m explorer.dev.design_ceiling       # ~4 minutes; prints a line per mirror, then the summary
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from design_fidelity import truth_targets
-from explorer.cli.design import load, ranges_of
-from explorer.physics import design
+from explorer import design
+from explorer.design import ranges_of
+from explorer.dev.design_fidelity import truth_targets
+from explorer.materials.brd import load_material
+from explorer.resources import material_path
 
 COUNT, SEED = 50, 0
 
 
 def main() -> None:
-    ranges = ranges_of(load("bragg_mirror"))
+    ranges = ranges_of(load_material(material_path("bragg_mirror")))
     rng = np.random.default_rng(SEED)
     medians = []
     for index in range(COUNT):

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from explorer.cli.bench.common import BENCH_LAMBDAS, _progress
+from explorer.bench.common import BENCH_LAMBDAS, _progress
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg

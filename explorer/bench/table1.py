@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from explorer.cli.bench.common import BENCH_LAMBDAS, THETA_DEGREES, _progress
+from explorer.bench.common import BENCH_LAMBDAS, THETA_DEGREES, _progress
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.physics import bragg, colorimetry
@@ -110,7 +110,7 @@ def run_bench(as_json: bool = False, size: int = 512, repeats: int = 3, markdown
     if as_json:
         print(json.dumps(document, indent=2))
     elif markdown:
-        from explorer.cli.markdown_tables import bench_markdown
+        from explorer.bench.markdown_tables import bench_markdown
 
         print(bench_markdown(document))
     else:

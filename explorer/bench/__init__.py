@@ -2,21 +2,26 @@
 Benchmarks and accuracy studies, one module per study; every name is re-exported here, so ``bench.NAME`` reads the
 same:
 
-- :mod:`~explorer.cli.bench.common`: what the studies share (figure output, the grids, progress lines);
-- :mod:`~explorer.cli.bench.table1`: ``bench``, the paper's Table 1 on this machine;
-- :mod:`~explorer.cli.bench.figure4`: ``accuracy``, the Figure 4 grid and its strips;
-- :mod:`~explorer.cli.bench.thin_film`: ``bench --thin-film``;
-- :mod:`~explorer.cli.bench.layers`: ``bench --layers``, rough layers and layered stacks;
-- :mod:`~explorer.cli.bench.app`: ``bench --app``, the explorer's frame times;
-- :mod:`~explorer.cli.bench.position_free`: ``bench --position-free``;
-- :mod:`~explorer.cli.bench.tables`: ``bench --tables``, host table rebuilds and the tabulated method's cost;
-- :mod:`~explorer.cli.bench.scaling`: ``bench --scaling``, how the table and the shading cost grow with ``N``.
+- :mod:`~explorer.bench.common`: what the studies share (figure output, the grids, progress lines);
+- :mod:`~explorer.bench.table1`: ``bench``, the paper's Table 1 on this machine;
+- :mod:`~explorer.bench.figure4`: ``accuracy``, the Figure 4 grid and its strips;
+- :mod:`~explorer.bench.thin_film`: ``bench --thin-film``;
+- :mod:`~explorer.bench.layers`: ``bench --layers``, rough layers and layered stacks;
+- :mod:`~explorer.bench.app`: ``bench --app``, the explorer's frame times;
+- :mod:`~explorer.bench.position_free`: ``bench --position-free``;
+- :mod:`~explorer.bench.tables`: ``bench --tables``, host table rebuilds and the tabulated method's cost;
+- :mod:`~explorer.bench.scaling`: ``bench --scaling``, how the table and the shading cost grow with ``N``;
+- :mod:`~explorer.bench.markdown_tables`: their documents as the Markdown tables of ``--markdown`` and
+  ``docs/validation.md``.
+
+The commands (``bench``, ``accuracy``: :mod:`explorer.cli.commands`) parse their options and call these; the
+checkout's scripts (:mod:`explorer.dev.validation_doc`) call them without the command line.
 
 ``bench --design`` lives with the design command (:mod:`explorer.cli.design`), ``bench --mitsuba`` with the plugins
 (:mod:`explorer.mitsuba.bench`).
 """
 
-from explorer.cli.bench.app import (  # noqa: F401
+from explorer.bench.app import (  # noqa: F401
     APP_ENV_MATERIAL,
     APP_ENV_SLIDER,
     APP_ENV_VALUES,
@@ -40,7 +45,7 @@ from explorer.cli.bench.app import (  # noqa: F401
     summarise_mesh_frames,
     summarise_view_frames,
 )
-from explorer.cli.bench.common import (  # noqa: F401
+from explorer.bench.common import (  # noqa: F401
     BENCH_LAMBDAS,
     FIGURE4_DELTAS,
     FIGURE4_LAMBDAS,
@@ -50,13 +55,13 @@ from explorer.cli.bench.common import (  # noqa: F401
     _progress,
     save_figure,
 )
-from explorer.cli.bench.figure4 import (  # noqa: F401
+from explorer.bench.figure4 import (  # noqa: F401
     figure4_accuracy,
     figure4_strips,
     plot_accuracy,
     run_accuracy,
 )
-from explorer.cli.bench.layers import (  # noqa: F401
+from explorer.bench.layers import (  # noqa: F401
     FIGURE8_LAYER,
     LAYER_ALPHAS,
     LAYER_GOALS,
@@ -70,7 +75,7 @@ from explorer.cli.bench.layers import (  # noqa: F401
     slice_accuracy,
     stack_study,
 )
-from explorer.cli.bench.position_free import (  # noqa: F401
+from explorer.bench.position_free import (  # noqa: F401
     POSITION_FREE_CASES,
     POSITION_FREE_GOAL_S,
     POSITION_FREE_TARGET,
@@ -78,7 +83,7 @@ from explorer.cli.bench.position_free import (  # noqa: F401
     _cpu_seconds,
     run_position_free_bench,
 )
-from explorer.cli.bench.scaling import (  # noqa: F401
+from explorer.bench.scaling import (  # noqa: F401
     SCALING_ANGLES,
     SCALING_N,
     SCALING_SPHERES,
@@ -87,7 +92,7 @@ from explorer.cli.bench.scaling import (  # noqa: F401
     run_scaling_bench,
     scaling_study,
 )
-from explorer.cli.bench.table1 import (  # noqa: F401
+from explorer.bench.table1 import (  # noqa: F401
     _accuracy,
     _methods,
     delta_E_over_theta,
@@ -95,7 +100,7 @@ from explorer.cli.bench.table1 import (  # noqa: F401
     run_bench,
     table_rebuild_ms,
 )
-from explorer.cli.bench.tables import (  # noqa: F401
+from explorer.bench.tables import (  # noqa: F401
     TABLES_LAMBDA_STEP,
     TABLES_MIRROR,
     TABLES_N,
@@ -106,7 +111,7 @@ from explorer.cli.bench.tables import (  # noqa: F401
     table_timings,
     tabulated_over_schlick,
 )
-from explorer.cli.bench.thin_film import (  # noqa: F401
+from explorer.bench.thin_film import (  # noqa: F401
     THIN_FILM_METHODS,
     format_thin_film,
     run_thin_film_bench,

@@ -4,15 +4,15 @@ How far the polish reaches (docs/design.md, "Where it fails"): for the round tri
 box in every free coordinate but N, then polished on the converged model (``design._polish``, no time
 limit). Prints the RMS CIEDE2000 per target before and after, four steps per mirror and spread.
 
-    .venv/bin/python docs/design_polish.py       # ~2 minutes
+    .venv/bin/python -m explorer.dev.design_polish       # ~2 minutes
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from design_fidelity import round_trip_misses, truth_problem
-from explorer.physics import design
+from explorer import design
+from explorer.dev.design_fidelity import round_trip_misses, truth_problem
 
 SIGMAS = (0.003, 0.01, 0.03)
 TRIES = 4

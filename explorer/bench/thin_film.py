@@ -9,7 +9,7 @@ import json
 
 import numpy as np
 
-from explorer.cli.bench.common import THETA_DEGREES, _progress
+from explorer.bench.common import THETA_DEGREES, _progress
 from explorer.materials.brd import load_material
 from explorer.materials.methods import ThinFilmMethod
 from explorer.physics import colorimetry
@@ -84,7 +84,7 @@ def run_thin_film_bench(as_json: bool = False, size: int = 512, repeats: int = 3
                 "theta_degrees": [float(THETA_DEGREES[0]), float(THETA_DEGREES[-1]), len(THETA_DEGREES)],
                 "accuracy": accuracy, "timing": timing}
     if markdown and not as_json:
-        from explorer.cli.markdown_tables import thin_film_markdown
+        from explorer.bench.markdown_tables import thin_film_markdown
 
         print(thin_film_markdown(document))
         return document

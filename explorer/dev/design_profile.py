@@ -2,7 +2,7 @@
 How narrow the misses' basins are once one coordinate is searched exhaustively (docs/design.md, "Where it
 fails"): for the round trip's mirrors that miss (median ΔE2000 above 1 in docs/design_round_trip.txt), the
 true shape's other coordinates moved by ``DISTANCES`` of the box in random directions, each scored by the
-scan at its best period within :data:`explorer.physics.design.DESCENT_SPAN` of the truth's and at its best
+scan at its best period within :data:`explorer.design.DESCENT_SPAN` of the truth's and at its best
 value of the profiled coordinate:
 
 - the optical share f (``F_VALUES`` shares over [0, 1]), moving n1, n2, N and the host;
@@ -14,15 +14,15 @@ value of the profiled coordinate:
 Prints the median score (sum over the 5 targets of ΔE2000², ~5 = 1 per target) per distance, and that of
 random shapes.
 
-    .venv/bin/python docs/design_profile.py       # ~2 minutes
+    .venv/bin/python -m explorer.dev.design_profile       # ~2 minutes
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from design_fidelity import round_trip_misses, truth_problem
-from explorer.physics import design
+from explorer import design
+from explorer.dev.design_fidelity import round_trip_misses, truth_problem
 
 DISTANCES = (0.0, 0.005, 0.01, 0.02, 0.05)
 DIRECTIONS = 4

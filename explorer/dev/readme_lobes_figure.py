@@ -4,7 +4,7 @@ Top: Figure 18's Queen, Rook and Knight (colour saturation of a 2-layer dielectr
 conductor and the same lobe kept under a clear coat. Bottom: Figure 19's haze (sigma_2 = 0.01, 0.04, 0.1),
 Figure 20's coloured highlight and coloured halo. Stacks retrieved by explorer.physics.inverse from the figures'
 lobes (shaders/presets/layered_lobes.toml). The shipped default sky, SPP samples per pixel.
-Run: .venv/bin/python .github/readme/lobes_figure.py   (about a minute on llvmpipe)
+Run: .venv/bin/python -m explorer.dev.readme_lobes_figure   (about a minute on llvmpipe)
 """
 
 import sys
@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from explorer.physics.colorimetry import encode_srgb8
 from explorer.gpu.env import render_env
 from explorer.gpu.renderer import Renderer
 from explorer.materials.presets import load_presets
+from explorer.physics.colorimetry import encode_srgb8
 
 ROOT = Path(__file__).resolve().parents[2]
 SIZE, SPP = 144, 96

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.cli.bench.common import _progress
+from explorer.bench.common import _progress
 from explorer.materials.methods import BraggMethod
 from explorer.resources import SHADER_DIR
 from explorer.materials.models import BraggStackModel

@@ -5,16 +5,15 @@ period) over the first layer's optical share f against each other free coordinat
 around the truth, for round-trip mirrors the search misses. The basin is a few thousandths of the box
 wide in f, a few hundredths in nh and n2; along n1 (and N for thick stacks) it is a long valley.
 
-    .venv/bin/python docs/design_slices.py      # writes docs/figures/design_slices.png (~2 min)
+    .venv/bin/python -m explorer.dev.design_slices      # writes docs/figures/design_slices.png (~2 min)
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from design_fidelity import round_trip_truths, truth_problem
+from explorer.dev.design_fidelity import round_trip_truths, truth_problem
+from explorer.resources import SOURCE_ROOT
 
 #: Round-trip mirrors (seed 0) the search misses: a high-order stack under a dense host (13), a thin
 #: stack (31), a thick high-order stack under a dense host (2).
@@ -69,7 +68,7 @@ def main() -> None:
     figure.colorbar(image, ax=axes, shrink=0.6, label="scan score: Σ ΔE2000² over 5 targets")
     figure.suptitle("The landscape through the truth of three missed round-trip mirrors, each shape at its best period "
                     "(white: ~2.2 ΔE2000 per target)", fontsize=10)
-    out = Path(__file__).parent / "figures" / "design_slices.png"
+    out = SOURCE_ROOT / "docs" / "figures" / "design_slices.png"
     figure.savefig(out, dpi=90)
     print(f"wrote {out}")
 
