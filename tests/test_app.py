@@ -99,6 +99,7 @@ def test_f12_saves_the_active_view_with_the_exposure(x_display, tmp_path, gl_ren
     """F12 writes screenshots/<material>_<view>_1.png (8-bit sRGB with the exposure) and its linear .npy."""
     actions = [
         {"wait": 2}, {"wait_complete": True},
+        {"wheel": "param:n1", "y": -30}, {"wait": 2},  # the exposure below the material's many parameters: scrolled into view
         {"drag": "exposure", "from": 0.5, "to": 0.75, "frames": 4}, {"wait": 2},
         {"wait_complete": True}, {"key": "F12"}, {"quit": True},
     ]

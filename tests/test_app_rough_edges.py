@@ -33,6 +33,7 @@ def test_app_first_screen_method_combo_help_and_saved_view(x_display, tmp_path):
         {"click": "menu_help"}, {"wait": 1}, {"click": "menu_controls"}, {"wait": 2},
         {"view_size": 128}, {"click": "mode:lit"}, {"wait": 2},
         {"drag": "sphere_image", "from": 0.5, "to": 0.6, "frames": 4}, {"wait": 1},
+        {"wheel": "param:n1", "y": -30}, {"wait": 2},  # the exposure below the material's many parameters: scrolled into view
         {"drag": "exposure", "from": 0.5, "to": 0.7, "frames": 3}, {"wait": 2},
         {"focus": "Files"}, {"wait": 2}, {"file_path": str(saved)}, {"click": "save_parameters"}, {"wait": 1},
         {"wait_complete": True}, {"screenshot": str(shot)}, {"quit": True},

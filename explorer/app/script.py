@@ -46,7 +46,8 @@ class ScriptRobot:
     sphere's resolution (the combo's values); ``{"key": "F12"}`` presses and releases a key (ImGui's
     name), then waits for a screenshot it asked for; ``{"focus": TITLE}`` brings a docked window to the
     front; ``{"write": PATH, "text": TEXT}`` writes a file (a user's editor between two reloads);
-    ``{"dialog": [PATH, ...]}`` answers the next File > Open... (:mod:`explorer.app.dialogs`);
+    ``{"wheel": LABEL, "y": Y}`` turns the mouse wheel Y notches over an item (scrolls its window: an item below
+    the window's edge comes into view); ``{"dialog": [PATH, ...]}`` answers the next File > Open... (:mod:`explorer.app.dialogs`);
     ``{"save_slice": PATH}`` saves the Slice window's linear image once complete; ``{"quit": true}``.
     """
 
@@ -274,6 +275,20 @@ def _write(robot, app, io, action, step):  # what a user's editor does to the ma
     return True
 
 
+def _wheel(robot, app, io, action, step):  # the mouse over an item, its wheel turned: scrolls the window under it
+    if step == 0:
+        point = robot._target_point(app.state, action["wheel"])
+        if point is None:
+            return robot._missing("wheel", action["wheel"])
+        robot._mouse(io, point)
+    elif step == 1:
+        io.add_mouse_wheel_event(0.0, float(action.get("y", -10)))
+    elif step >= 3:
+        robot.script.log.append(f"wheel over {action['wheel']}")
+        return True
+    return False
+
+
 def _quit(robot, app, io, action, step):
     app.state.quit = True
     return True
@@ -300,5 +315,6 @@ ACTIONS = {
     "save_slice": _save_slice,
     "focus": _assign("focus_request", str),  # bring a docked window's tab to the front, as a click on it does
     "write": _write,
+    "wheel": _wheel,
     "quit": _quit,
 }
