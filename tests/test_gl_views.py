@@ -81,10 +81,12 @@ def test_tabulated_gl_equals_spectral_reference_on_a_smooth_mirror(gl_renderer, 
 def random_parameters(material, rng) -> dict:
     """Uniform values inside each float or int parameter's declared range (ints: any float, rounded by resolve;
     method 0's wavelength step left at the paper's 1 nm: finer steps cost proportionally more, and
-    tests/test_converged.py checks one)."""
+    tests/test_converged.py checks one; the media, which pick a dispersion by index, are swept in
+    tests/test_natural_render.py)."""
     values = {}
     for parameter in material.parameters:
-        if parameter.type in ("float", "int") and parameter.name not in ("method", "wavelength_step"):
+        if parameter.type in ("float", "int") and parameter.name not in ("method", "wavelength_step") \
+                and not parameter.name.startswith("medium_"):
             values[parameter.name] = float(rng.uniform(parameter.min, parameter.max))
     return values
 

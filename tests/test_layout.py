@@ -52,3 +52,13 @@ def test_the_root_holds_only_its_entries():
 def test_docs_hold_no_python():
     scripts = [str(p.relative_to(REPO_ROOT)) for p in (REPO_ROOT / "docs").rglob("*.py") if DOCS_PYTHON not in p.parts]
     assert not scripts, f"study scripts belong in explorer/dev/: {scripts}"
+
+
+def test_the_wheel_lists_every_package():
+    """pyproject's explicit package list names every package of explorer/ but dev/ (the checkout's scripts)."""
+    import tomllib
+
+    listed = set(tomllib.loads((REPO_ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    packages = {".".join(init.parent.relative_to(REPO_ROOT).parts) for init in (REPO_ROOT / "explorer").rglob("__init__.py")}
+    missing = sorted(p for p in packages - listed if p != "explorer.dev" and not p.startswith("explorer.dev."))
+    assert not missing, f"pyproject.toml's [tool.setuptools] packages lacks {missing}"

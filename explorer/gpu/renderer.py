@@ -381,9 +381,10 @@ class Renderer:
         :meth:`explorer.views.thickness.ThicknessTexture.gl_inputs`). ``environment``: what a smooth mirror reflects
         in the ``lit`` view (an :class:`explorer.views.env.EnvironmentMap`; default the env view's).
         """
-        from explorer.views.geometry import view_named
+        from explorer.views.geometry import VIEW_REGISTRY
 
-        if view_named(view).summed:
+        registered = VIEW_REGISTRY.get(view)  # None for a mesh's templates (mesh/lit, mesh/env)
+        if registered is not None and registered.summed:
             return self._render_summed(material, values, view, width, height, uniforms)
         return self._render_image(material, values, view, width, height, light, inputs, uniforms, environment)
 
