@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from conftest import REPO_ROOT
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display fixture)
+from test_app import lit_fill, run_session, x_display  # noqa: F401  (the session's virtual display fixture)
 
 from explorer.materials.brd import load_material
 
@@ -64,7 +64,7 @@ def test_lit_mesh_and_a_merl_file_in_the_app(x_display, tmp_path, gl_renderer): 
     _, report = run_session(x_display, merl, actions, tmp_path)
     assert report["error"] == "" and report["env"]["model"] == "teapot", report["script_log"]
     material = load_material(merl)
-    headless = render_mesh(gl_renderer, material, {}, "lit", teapot(), SIZE, SIZE)
+    headless = render_mesh(gl_renderer, material, {}, "lit", teapot(), SIZE, SIZE, uniforms=lit_fill(material))
     image = np.load(shot.with_suffix(".npy"))
     np.testing.assert_allclose(image, headless, rtol=1e-4, atol=1e-5)
     assert image.max() > 0.1 and (image == 0).all(axis=-1).mean() > 0.3  # a lit teapot on black
