@@ -64,9 +64,12 @@ def test_texture_window_shows_drafts_while_dragging(x_display, tmp_path, gl_rend
     actions = [{"view_size": 128}, {"set": {"method": 3}}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3},
                {"wait_for": "texture_view"}, {"mark": "drag"}, {"drag": "param:Lambda", "from": 0.3, "to": 0.6, "frames": 40},
                {"mark": None}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
-    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    for attempt in range(2):  # a drag whose press landed before the panel settled moves nothing: once more
+        _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+        drag = [f["main"]["views"]["textured"] for f in report["frames"] if f["mark"] == "drag" and f["dragging"]]
+        if len({v["generation"] for v in drag}) >= 2:
+            break
     assert not [line for line in report["script_log"] if "timed out" in line], report["script_log"]
-    drag = [f["main"]["views"]["textured"] for f in report["frames"] if f["mark"] == "drag" and f["dragging"]]
     assert len(drag) >= 20 and any(v["draft"] for v in drag), drag[-3:]
     assert len({v["generation"] for v in drag}) >= 2, drag[-3:]  # the view followed the slider
     assert not report["frames"][-1]["main"]["views"]["textured"]["draft"]
