@@ -62,7 +62,8 @@ def test_texture_window_shows_drafts_while_dragging(x_display, tmp_path, gl_rend
     from explorer.views.surface_texture import BraggTexture
 
     actions = [{"view_size": 128}, {"set": {"method": 3}}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3},
-               {"wait_for": "texture_view"}, {"mark": "drag"}, {"drag": "param:Lambda", "from": 0.3, "to": 0.6, "frames": 40},
+               {"wait_for": "texture_view"}, {"mark": "drag"}, {"drag": "param:Lambda", "from": 0.3, "to": 0.6, "frames": 40,
+                                                                 "hold": 600, "hold_until_draft": "textured"},
                {"mark": None}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
     for attempt in range(2):  # a drag whose press landed before the panel settled moves nothing: once more
         _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)

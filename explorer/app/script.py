@@ -35,7 +35,8 @@ class ScriptRobot:
     Design window's worker); ``{"wait_accuracy": true}`` until the accuracy badge shows the current values; ``{"wait_converged": true}``
     until the env mode holds its target samples per pixel;
     ``{"drag": LABEL, "from": F0, "to": F1, "frames": N}`` press at fraction F0 of the item's
-    width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); ``{"click": LABEL}``
+    width, move to F1 over N frames, release (sliders are labelled ``param:NAME``); with ``"hold": M,
+    "hold_until_draft": VIEW`` it holds still at F1 for up to M frames until VIEW shows a draft table; ``{"click": LABEL}``
     (``preset_combo``, ``preset:NAME``, ``mode:lit``, ``param:method`` then ``method:N``, ``menu_file`` then
     ``menu_open``, ``menu_help`` then ``menu_about``, the Materials list's ``material:I``,
     ``material:I:visible``, ``material:I:solo``, ``material:I:close``, ...); ``{"set": {NAME: VALUE}}`` (bench only: no
@@ -107,9 +108,15 @@ class ScriptRobot:
             return True
         return False
 
-    def _drag(self, state, io, action: dict, step: int) -> bool:
+    def _drag(self, app, io, action: dict, step: int) -> bool:
+        state = app.state
         frames = int(action.get("frames", 10))
         f0, f1 = float(action.get("from", 0.5)), float(action.get("to", 0.5))
+        held = step - frames - 2  # frames held still at F1 before the release
+        until = action.get("hold_until_draft")  # a view shown from a draft table ends the hold (a loaded machine's
+        # worker thread may need longer than the drag itself)
+        if held >= 0 and until is not None and held < int(action.get("hold", 0)) and until not in app.scheduler.drafts:
+            return False
         if step == 0:
             point = self._target_point(state, action["drag"], f0)
             if point is None:
@@ -303,7 +310,7 @@ ACTIONS = {
     "wait_converged": _wait_converged,
     "mark": _mark,
     "set": _set,
-    "drag": lambda robot, app, io, action, step: robot._drag(app.state, io, action, step),
+    "drag": lambda robot, app, io, action, step: robot._drag(app, io, action, step),
     "click": lambda robot, app, io, action, step: robot._click(app.state, io, action, step),
     "type": lambda robot, app, io, action, step: robot._type(app.state, io, action, step),
     "screenshot": _screenshot,
