@@ -127,7 +127,7 @@ def study(name: str, alpha: float, paths: int) -> list[dict]:
 
 BEGIN, END = "<!-- multiscatter-orders:begin -->", "<!-- multiscatter-orders:end -->"
 STRUCTURE_BEGIN, STRUCTURE_END = "<!-- multiscatter-structure:begin -->", "<!-- multiscatter-structure:end -->"
-STRUCTURE_PRESETS = ("figure7_A", "figure1_right_alpha04", "figure1_stacked_pair")
+STRUCTURE_PRESETS = ("figure7_A", "figure1_right_alpha04", "figure1_stacked_pair", "figure7_A_on_base")
 
 
 def structure_rows(presets, alphas, samples: int = 8192) -> list[dict]:
