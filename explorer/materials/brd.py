@@ -483,6 +483,12 @@ class Material:
             except ValueError as exc:
                 # Name the line that declares the parameter: that is where its range is.
                 raise MaterialError(self.path, p.line, f"parameter {name!r}: {exc}") from None
+        if "medium_nh" in values:  # a host naming a medium must be lossless (explorer.materials.media)
+            from explorer.materials.media import host_problem
+
+            problem = host_problem(values)
+            if problem:
+                raise MaterialError(self.path, self.parameter("medium_nh").line, problem)
         return Values(values)
 
     def typed_values(self, values: Mapping[str, object]) -> Values:

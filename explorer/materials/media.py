@@ -39,6 +39,19 @@ def index_value(values: Mapping[str, object], name: str) -> float | dispersion.D
     return float(values[name])
 
 
+def host_problem(values: Mapping[str, object]) -> str | None:
+    """
+    Why the host ``medium_nh`` selects cannot be one (an absorbing medium: light comes from a lossless,
+    semi-infinite host, where an absorbing one would leave no wave to reflect), or None.
+    """
+    value = index_value(values, "nh")
+    if isinstance(value, dispersion.Dispersion) and value.absorbing:
+        lossless = [name for name in MEDIA if not dispersion.LIBRARY[name].absorbing]
+        return (f"parameter 'nh': {value.name} absorbs (k > 0) and the host must be lossless; "
+                f"a number or one of {', '.join(lossless)}")
+    return None
+
+
 def medium_name(values: Mapping[str, object], name: str) -> str | None:
     """The medium ``medium_NAME`` selects, or None."""
     value = index_value(values, name)

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import multilayer
+from explorer.physics.bragg.mirror import BraggMirror
 from explorer.physics.dispersion import RANGE_NM, Dispersion, complex_index
 
 IndexValue = float | Dispersion
@@ -30,9 +31,11 @@ MIN_STEP_NM = 0.01
 
 
 @dataclass(frozen=True)
-class NaturalMirror:
+class NaturalMirror(BraggMirror):
     """
-    A Bragg mirror with complex, dispersive indices and thickness disorder.
+    A Bragg mirror with complex, dispersive indices and thickness disorder: the paper's mirror
+    (:class:`explorer.physics.bragg.BraggMirror`, whose cell geometry ``Lambda``, ``delta``, ``N``, ``d1``, ``d2``
+    it keeps) with three more things.
 
     Parameters
     ----------
@@ -50,9 +53,6 @@ class NaturalMirror:
 
     n1: IndexValue = 1.0
     n2: IndexValue = 1.5
-    Lambda: float = 500.0
-    delta: float = 0.5
-    N: int = 20
     nh: IndexValue | None = None
     k1: float = 0.0
     k2: float = 0.0
@@ -65,14 +65,6 @@ class NaturalMirror:
             raise ValueError(f"sigma must be in [0, {1.0 / multilayer.TRUNCATION:g}] (a thickness stays >= 0)")
         if isinstance(self.nh, Dispersion) and self.nh.absorbing:
             raise ValueError(f"the host {self.nh.name} absorbs: light comes from a lossless host")
-
-    @property
-    def d1(self) -> float:
-        return self.delta * self.Lambda
-
-    @property
-    def d2(self) -> float:
-        return (1.0 - self.delta) * self.Lambda
 
     def index_1(self, wavelength_nm: ArrayLike) -> np.ndarray:
         return complex_index(self.n1, self.k1, wavelength_nm)
