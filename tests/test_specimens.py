@@ -84,3 +84,23 @@ def test_absorbing_host_is_one_line_naming_nh(args):
         assert "'nh'" in line and "melanin absorbs" in line and "bragg_mirror.brd" in line
     assert host_problem({"nh": 1.0, "medium_nh": 0}) is None
     assert host_problem({"nh": 1.0, "medium_nh": 2}) is None  # chitin: lossless
+
+
+def test_brdf_export_inlines_the_specimens_exact_table():
+    """The .brdf file bakes the natural table (dispersion and absorption inlined as colours) for its values."""
+    from explorer.materials.export_brdf import brdf_text, material_tables
+    from explorer.physics.natural import natural_rgb_table
+
+    preset = SPECIMENS["parotia_lawesii_occipital"]
+    values = preset.resolve()
+    tables = material_tables(preset.material, values)
+    mirror = natural_mirror(dict(values), {})
+    np.testing.assert_array_equal(tables["bragg_table"].reshape(-1, 3), natural_rgb_table(mirror))
+    text = brdf_text(preset.material, values)
+    assert "medium_n1 = 3, medium_n2 = 4" in text and "k1 = 0, k2 = 0, sigma = 0" in text
+
+
+def test_textured_view_refuses_natural_layers_in_one_line():
+    line = one_line_error(run_cli("render", "bragg_mirror", "--view", "textured", "--set", "n2=chitin", "--engine", "numpy",
+                                  "--out", "unused.png", cwd=REPO_ROOT))
+    assert "textured view" in line and "sigma" in line

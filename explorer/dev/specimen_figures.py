@@ -18,6 +18,7 @@ from PIL import Image
 
 from explorer.views.spectrum_plot import describe, natural_mirror, spectrum_document, write_plot
 from explorer.files import atomic_output
+from explorer.materials.methods import BraggMethod
 from explorer.materials.presets import load_presets
 from explorer.physics.colorimetry import encode_srgb8
 from explorer.physics.natural import mirror_spectrum
@@ -37,7 +38,7 @@ def specimens():
 
 def views_image(preset) -> np.ndarray:
     """The colour strip over the sphere, one 8-bit image (the strip stretched to the sphere's width)."""
-    values = preset.resolve({"method": 3})
+    values = preset.resolve({"method": int(BraggMethod.TABULATED)})
     strip = encode_srgb8(render_material(preset.material, values, "gradient", STRIP[0], STRIP[1], "numpy"))
     sphere = encode_srgb8(render_material(preset.material, values, "sphere", SPHERE, SPHERE, "numpy"))
     strip = np.asarray(Image.fromarray(strip).resize((SPHERE, STRIP[1]), Image.Resampling.BILINEAR))

@@ -473,6 +473,8 @@ class Material:
                 try:
                     values.update(medium_values(self, name, value))
                 except LocatedError as exc:
+                    if exc.path != "--set":  # a medium's file is wrong: its own file and line
+                        raise
                     raise MaterialError(self.path, self.parameter(name).line, f"parameter {name!r}: {exc.message}") from None
                 continue
             if f"medium_{name}" in values and f"medium_{name}" not in overrides:
