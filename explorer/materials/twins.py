@@ -172,3 +172,13 @@ def names_with(predicate: Callable[[Capabilities], bool]) -> tuple[str, ...]:
 def supporting(what: str) -> tuple[str, ...]:
     """The registered twins that support ``what`` (:meth:`Capabilities.supports`), sorted: for messages."""
     return names_with(lambda c: c.supports(what))
+
+
+def shipped_file(cls: type):
+    """
+    The shipped material file (``shaders/NAME.brd``) of a built-in twin class: how a study script names the
+    material it studies, by the plugin's own declaration rather than by a string.
+    """
+    from explorer.resources import material_path
+
+    return material_path(cls.name)
