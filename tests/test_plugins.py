@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from twins import Twins, assert_twins_equal
 from explorer.materials.brd import load_material
 from explorer.materials.methods import Method
@@ -57,6 +57,22 @@ def test_every_shipped_material_declares_every_capability(path):
         assert len(alphas) == len(weights) >= 1 and np.all(np.asarray(cosine) >= 0.0)
     if declared.supports("position-free"):
         assert model.stack.layers
+
+
+def test_info_json_lists_each_materials_capabilities_from_the_registry(tmp_path):
+    """``info --json`` carries the twin's declaration: a built-in's, and a plugin's loaded from another folder."""
+    import json
+
+    for path in SHIPPED + [_example(tmp_path)]:
+        run = run_cli("info", path, "--json")
+        assert run.returncode == 0, run.stderr
+        listed = json.loads(run.stdout)["capabilities"]
+        declared = registry()[load_material(path).model].capabilities
+        assert set(listed) == set(CAPABILITY_FIELDS)
+        assert listed["albedo"] == list(declared.albedo) and listed["exports"] == list(declared.exports)
+        assert (listed["dirac"], listed["bragg_spectrum"], listed["numpy"], listed["design"]) == \
+            (declared.dirac, declared.bragg_spectrum, declared.numpy, declared.design)
+        assert listed["methods"] == (None if declared.methods is None else [m.name for m in declared.methods])
 
 
 def test_design_models_are_the_twins_that_declare_design():

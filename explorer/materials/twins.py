@@ -66,6 +66,13 @@ class Capabilities:
                  f"design {'yes' if self.design else 'no'}"]
         return "; ".join(parts + kinds)
 
+    def as_json(self) -> dict:
+        """The declaration as JSON (``info --json``): ``methods`` as the enumeration's member names."""
+        document = {f.name: getattr(self, f.name) for f in fields(self)}
+        document["methods"] = None if self.methods is None else [m.name for m in self.methods]
+        document.update(albedo=list(self.albedo), exports=list(self.exports))
+        return document
+
     def supports(self, what: str) -> bool:
         """Whether ``what`` (an albedo engine, an export target, ``numpy`` or ``design``) is declared."""
         if what in ("numpy", "design"):
