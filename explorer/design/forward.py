@@ -19,6 +19,11 @@ from explorer.materials.twins import capabilities_of
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["coarse_nodes", "log_nodes", "chebyshev_U_real_N", "bragg_reflectance_batch", "bragg_rgb_batch",
+           "thin_film_rgb_batch", "bragg_spectra_batch", "thin_film_spectra_batch", "mirror_of", "bragg_converged_rgb",
+           "thin_film_converged_rgb", "DESIGN_MODELS", "DESIGNABLE", "design_model"]
+
 # --------------------------------------------------------------------------------------------------
 # Forward models
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from explorer import design
+from explorer.design import search
 from explorer.design import ranges_of
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggMirrorModel
@@ -58,9 +59,9 @@ def truth_targets(truth: dict) -> list[design.Target]:
     return [design.Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(design.ROUND_TRIP_ANGLES, colours)]
 
 
-def truth_problem(model: design.DesignModel, ranges: dict, truth: dict) -> design._Problem:
+def truth_problem(model: design.DesignModel, ranges: dict, truth: dict) -> search._Problem:
     """The design problem (every parameter free over ``ranges``) whose targets are ``truth``'s colours."""
-    return design._Problem(model, design.parameter_box(model, ranges), {}, truth_targets(truth), None)
+    return search._Problem(model, design.parameter_box(model, ranges), {}, truth_targets(truth), None)
 
 
 def main() -> None:
