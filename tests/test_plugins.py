@@ -241,3 +241,57 @@ def test_the_recipe_the_plugin_example_works_outside_the_repository(tmp_path):
     twins = Twins.of(np.load(folder / "gl.npy"), np.load(folder / "numpy.npy"), "lit")
     assert twins.gl.max() > 0.0
     assert_twins_equal(twins, "the example's lit view, GL against numpy")
+
+
+#: Run in a subprocess (Mitsuba's scalar variant, no LLVM in this process): a plugin loaded after register() gets its
+#: BSDF, evaluated as its twin's brdf x cos; an edit to its file replaces the BSDF.
+MITSUBA_LATE = r"""
+import json, math, sys
+import numpy as np
+from explorer.mitsuba import register
+from explorer.materials.brd import load_material
+from explorer.materials.models import model_for
+from explorer.mitsuba.bsdfs import plugin_names
+
+mi = register("scalar_rgb")
+before = "tinted_phong" in plugin_names()
+material = load_material(sys.argv[1])
+bsdf = mi.load_dict({"type": "tinted_phong", "exponent": 20.0})
+si = mi.SurfaceInteraction3f()
+si.wi = mi.Vector3f(math.sin(0.4), 0.0, math.cos(0.4))
+wo = [math.sin(0.5) * math.cos(2.8), math.sin(0.5) * math.sin(2.8), math.cos(0.5)]
+value = np.ravel(np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(*wo)), np.float64))
+twin = model_for(material, material.resolve({"exponent": 20.0}))
+expected = twin.brdf(np.array(wo), np.array([math.sin(0.4), 0.0, math.cos(0.4)]), np.array([0.0, 0.0, 1.0]),
+                     np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])) * wo[2]
+print(json.dumps({"before": before, "variant": mi.variant(), "value": value.tolist(), "expected": np.ravel(expected).tolist()}))
+"""
+
+#: What the example's twin adds to declare a Mitsuba export: its spectral BRDF and its sampling lobes (cosine only).
+MITSUBA_HOOKS = '''
+    def spectral_brdf(self, i, o, wavelengths, rgb_upsample):
+        n = np.zeros_like(i); n[:, 2] = 1.0
+        x = np.zeros_like(i); x[:, 0] = 1.0
+        return rgb_upsample(self.brdf(i, o, n, x, np.cross(n, x)), wavelengths)
+
+    def sampling_lobes(self, cos_o):
+        return [], [], np.ones_like(np.asarray(cos_o, dtype=np.float64))
+'''
+
+
+def test_a_plugin_loaded_after_mitsuba_register_gets_its_bsdf(tmp_path):
+    """Plugin registration reaches Mitsuba whenever it happens: here after ``register()`` set the variant."""
+    import json
+
+    pytest.importorskip("mitsuba")
+    path = _example(tmp_path)
+    source = path.with_suffix(".py")
+    text = source.read_text().replace('exports=("brdf", "table")', 'exports=("brdf", "table", "mitsuba")')
+    source.write_text(text + MITSUBA_HOOKS)
+    env = {**os.environ, "PYTHONWARNINGS": "ignore", "PYTHONPATH": str(REPO_ROOT)}
+    run = subprocess.run([sys.executable, "-c", MITSUBA_LATE, str(path)], capture_output=True, text=True, timeout=600, env=env)
+    assert run.returncode == 0, run.stderr[-2000:]
+    result = json.loads(run.stdout.strip().splitlines()[-1])
+    assert result["before"] is False and result["variant"] == "scalar_rgb"
+    assert max(result["expected"]) > 0.01
+    np.testing.assert_allclose(result["value"], result["expected"], rtol=1e-5, atol=1e-7)

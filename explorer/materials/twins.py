@@ -136,7 +136,20 @@ def twin(cls: type) -> type:
         if lacking:
             raise TypeError(f"{cls.__name__}: a Mitsuba export needs {', '.join(lacking)}")
     TWINS[name] = cls
+    for listener in tuple(_LISTENERS):
+        listener(cls)
     return cls
+
+
+#: What runs on each registration (:func:`on_register`): a consumer above the registry that keeps its own table of
+#: plugins (Mitsuba's BSDFs, once :func:`explorer.mitsuba.register` has run) hears of a twin registered later.
+_LISTENERS: list[Callable[[type], None]] = []
+
+
+def on_register(listener: Callable[[type], None]) -> None:
+    """Call ``listener(cls)`` for every twin registered from now on (once per listener)."""
+    if listener not in _LISTENERS:
+        _LISTENERS.append(listener)
 
 
 def registry() -> dict[str, type]:
