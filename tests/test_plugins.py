@@ -194,11 +194,27 @@ def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, 
     from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
 
     material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
-    assert check_views(material) == tuple(CHECK_SIZES)
-    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}))
-    assert [r.view for r in results] == list(CHECK_SIZES)
+    images = [v for v in CHECK_SIZES if v not in ("textured", "env", "albedo")]
+    assert check_views(material) == tuple(images) + ("env", "albedo")  # no '# texture:' line
+    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}), images)
+    assert [r.view for r in results] == images
     for result in results:
         assert result.passed and 0.0 < result.max_difference, result.message()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name, view", [("ggx_schlick", "env"), ("ggx_schlick", "albedo"), ("thin_film", "textured")])
+def test_check_compares_the_env_textured_and_albedo_views(gl_renderer, name, view):
+    """The env view (Monte Carlo against the twin's exact integral), the albedo and the textured view, each within its tolerance."""
+    from explorer.views.twin_check import CHECK_SIZES, ENV_PIXELS, check_material, check_views, tolerance_for
+
+    material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
+    assert view in check_views(material)
+    (result,) = check_material(gl_renderer, material, material.resolve({}), [view])
+    assert result.view == view and result.tolerance == tolerance_for(view)
+    assert result.passed and 0.0 < result.max_difference, result.message()
+    if view == "env":
+        assert result.tolerance.standard_errors > 0.0 and CHECK_SIZES["env"][0] ** 2 > ENV_PIXELS
 
 
 @pytest.mark.gl
@@ -208,9 +224,9 @@ def test_check_fails_a_plugin_whose_twin_disagrees_with_its_shader(tmp_path):
     # The twin's Fresnel off by 1 %: beyond the colour views' 2e-3 absolute.
     source.write_text(source.read_text().replace("return self.F0 + (1.0 - self.F0) * m**5",
                                                  "return 1.01 * (self.F0 + (1.0 - self.F0) * m**5)"))
-    run = _cli("check", path.name, "--views", "gradient,lit", cwd=path.parent)
+    run = _cli("check", path.name, "--views", "gradient,lit,albedo", cwd=path.parent)
     assert run.returncode == 1, run.stdout + run.stderr
-    assert "OVER" in run.stdout and "over: gradient, lit" in run.stdout, run.stdout
+    assert "OVER" in run.stdout and "over: gradient, lit, albedo" in run.stdout, run.stdout
 
 
 @pytest.mark.gl
@@ -223,7 +239,7 @@ def test_the_recipe_the_plugin_example_works_outside_the_repository(tmp_path):
     run = _cli("check", path.name, "--json", cwd=folder)
     assert run.returncode == 0, run.stdout + run.stderr
     report = json.loads(run.stdout)
-    assert report["passed"] and {v["view"] for v in report["views"]} >= {"gradient", "sphere", "lit", "slice", "scatter"}
+    assert report["passed"] and {v["view"] for v in report["views"]} >= {"gradient", "sphere", "lit", "slice", "scatter", "env", "albedo"}
     run = _cli("info", path.name, cwd=folder)
     assert run.returncode == 0 and "model tinted_phong" in run.stdout, run.stderr
     run = _cli("albedo", path.name, "--theta", "0,60", "--json", cwd=folder)
