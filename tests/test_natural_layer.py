@@ -110,3 +110,18 @@ def test_spectral_reflectance_is_the_exact_multilayer(layer_material):
 
     lobe = microfacet.microfacet_lobe(i, i, np.array([0.0, 0.0, 1.0]), layer.alpha)[0]
     np.testing.assert_allclose(value, lobe[:, None] * expected[0], rtol=1e-9)
+
+
+def test_the_mitsuba_plugin_reads_the_natural_layers():
+    """The RGB plugin's model is the numpy twin with k, the medium and sigma (its Dirac's colours are the twin's)."""
+    pytest.importorskip("mitsuba")
+    from explorer.mitsuba import register
+    from explorer.mitsuba.scene import bsdf_properties
+
+    mi = register("scalar_rgb")
+    material = load_material(material_path("bragg_mirror"))
+    values = material.resolve({**{k: v for k, v in ABSORBING.items() if k not in ("alpha", "rho_d")}, "sigma": "0.05"})
+    bsdf = mi.load_dict(bsdf_properties(material, values, "scalar_rgb"))
+    assert bsdf.model.natural == model_for(material, values).natural and bsdf.model.natural.sigma == 0.05
+    cos_theta = np.array([1.0, 0.7, 0.3])
+    np.testing.assert_array_equal(bsdf.model.reflectance(cos_theta), model_for(material, values).reflectance(cos_theta))
