@@ -104,3 +104,12 @@ def test_textured_view_refuses_natural_layers_in_one_line():
     line = one_line_error(run_cli("render", "bragg_mirror", "--view", "textured", "--set", "n2=chitin", "--engine", "numpy",
                                   "--out", "unused.png", cwd=REPO_ROOT))
     assert "textured view" in line and "sigma" in line
+
+
+def test_accuracy_presets_leave_out_natural_mirrors():
+    """The approximations' table measures the paper's mirrors; a specimen with media shows the exact table anyway."""
+    from explorer.cli.accuracy import preset_mirrors
+
+    sources = {source for entry in preset_mirrors([PRESETS]) for source in entry.sources}
+    assert "chrysochroa_fulgidissima_green" in sources and "figure3" in sources
+    assert not {"parotia_lawesii_occipital", "glossy_black_barbule"} & sources
