@@ -142,3 +142,24 @@ def test_every_built_in_material_maps():
         assert len(principled) == 1, name
         inputs = principled[0].inputs
         assert inputs["Thin Film Thickness"].default_value > 0.0 or inputs["Coat Weight"].default_value == 1.0, name
+
+
+def test_script_in_a_fresh_bpy_rebuilds_a_rough_material(tmp_path):
+    """FILE.py of the thin film's default export, run by a fresh Python with bpy (its start-up cube active): the
+    cube's material becomes the converged table driving a GGX Glossy, the same tree as the .blend's."""
+    import subprocess
+    import sys
+
+    from conftest import run_cli
+
+    out = tmp_path / "film.blend"
+    run = run_cli("export", "thin_film", "--to", "blender", out)
+    assert run.returncode == 0, run.stderr
+    probe = ("import bpy, runpy, sys; runpy.run_path(sys.argv[1]); m = bpy.context.object.active_material; "
+             "print(sorted(n.bl_idname for n in m.node_tree.nodes))")
+    fresh = subprocess.run([sys.executable, "-c", probe, str(tmp_path / "film.py")], capture_output=True, text=True, timeout=300)
+    assert fresh.returncode == 0, fresh.stderr[-2000:]
+    rebuilt = [line for line in fresh.stdout.splitlines() if line.startswith("[")][-1]
+    bpy.ops.wm.open_mainfile(filepath=str(out))
+    exported = sorted(n.bl_idname for n in bpy.data.objects["sphere"].active_material.node_tree.nodes)
+    assert rebuilt == str(exported) and "ShaderNodeTexImage" in rebuilt, (rebuilt, exported)  # Glossy: ShaderNodeBsdfAnisotropic in 5.0
