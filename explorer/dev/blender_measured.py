@@ -2,8 +2,9 @@
 The measurements of docs/blender.md: every built-in material exported to Blender, rendered headless with
 Cycles (CPU) and compared with the GL env view of the same scene under the default sky, median and p95
 ΔE2000 over the pixels wholly inside the disc, at three roughnesses (every roughness parameter set to it;
-a smooth material once). ``python -m explorer.dev.blender_measured [--write]`` prints the Markdown table
-(``--write`` puts it in docs/blender.md between its markers). Tens of minutes on two cores.
+a smooth material once). ``python -m explorer.dev.blender_measured [--write] [--cache FILE]`` prints the
+Markdown table (``--write`` puts it in docs/blender.md between its markers; ``--cache`` keeps the rows
+measured, for a rerun). Tens of minutes on two cores.
 
 Both sides carry noise: the GL view at :data:`GL_SPP` samples a pixel, Cycles at :data:`CYCLES_SAMPLES`;
 a smooth mirror against the view's exact value (a Dirac: no samples); the table's last column is the ΔE2000 between two Cycles renders of different seeds (median), which bounds
@@ -12,6 +13,7 @@ the part of the numbers that is noise.
 
 from __future__ import annotations
 
+import json
 import sys
 import tempfile
 from pathlib import Path
@@ -89,12 +91,14 @@ def cases():
                 yield name, alpha, overrides, "principled"
 
 
-def table(echo=print) -> str:
+def table(echo=print, cache_file: Path | None = None) -> str:
+    """The Markdown table; ``cache_file`` (JSON) keeps each row measured, so that a rerun measures only the rest."""
     from explorer.blender import mapping_of
     from explorer.materials.brd import load_material
     from explorer.resources import builtin_materials
 
     paths = builtin_materials()
+    cache = json.loads(cache_file.read_text()) if cache_file is not None and cache_file.is_file() else {}
     lines = [f"{SIZE} x {SIZE}, the default sky, GL at {GL_SPP} samples a pixel, Cycles (CPU) at {CYCLES_SAMPLES}; "
              "pixels wholly inside the disc, ΔE2000 of linear sRGB clamped at 0 "
              "(`python -m explorer.dev.blender_measured`).", "",
@@ -104,10 +108,14 @@ def table(echo=print) -> str:
         values = material.resolve(overrides)
         kind = mapping_of(material, values)
         how = {"table": "reflectance table, Glossy at 0", "converged": "converged table, GGX Glossy",
-               "lobes": "Principled coat + specular"}[kind]
+               "diffuse": "albedo table, Diffuse"}[kind]
         if kind == "converged" and film == "principled":
             how = "Principled Thin Film"
-        row = measure(material, values, film)
+        key = f"{name} {alpha} {film}"
+        row = cache.get(key) or measure(material, values, film)
+        cache[key] = row
+        if cache_file is not None:
+            cache_file.write_text(json.dumps(cache))
         line = (f"| {name} | {'smooth' if alpha is None else f'{alpha:g}'} | {how} | {row['median']:.2f} | {row['p95']:.2f} | "
                 f"{row['noise']:.2f} |")
         echo(line)
@@ -117,7 +125,8 @@ def table(echo=print) -> str:
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    text = table(echo=lambda line: print(line, file=sys.stderr, flush=True))
+    cache = Path(argv[argv.index("--cache") + 1]) if "--cache" in argv else None
+    text = table(echo=lambda line: print(line, file=sys.stderr, flush=True), cache_file=cache)
     print(text)
     if "--write" in argv:
         from explorer.files import write_text_atomic
