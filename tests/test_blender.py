@@ -40,14 +40,19 @@ def reference(material, values, environment, size: int = SIZE) -> np.ndarray:
     return exact.reshape(size, 4, size, 4, 3).mean(axis=(1, 3))
 
 
-@pytest.mark.parametrize("overrides", [{}, {"Lambda": 400.0, "N": 20}, {"nh": 1.0, "n1": 1.5, "n2": 1.8}],
-                         ids=["defaults", "Lambda400_N20", "host_of_air"])
+@pytest.mark.parametrize("overrides", [{}, {"Lambda": 400.0, "N": 20}, {"nh": 1.0, "n1": 1.5, "n2": 1.8}, "table3_red"],
+                         ids=["defaults", "Lambda400_N20", "host_of_air", "preset_table3_red"])
 def test_cycles_render_of_the_mirror_is_the_env_view(tmp_path, overrides):
+    """The last: a preset whose mirror lies in a host (a jewel beetle's cuticle in air, nh = 1)."""
     from explorer.blender import preview_scene, render
+    from explorer.materials.presets import presets_for
     from explorer.mitsuba.bench import median_delta_e
     from explorer.views.env import EnvironmentMap
 
     material = load_material(material_path("bragg_mirror"))
+    if isinstance(overrides, str):
+        overrides = presets_for(material.path).get(overrides).values
+        assert float(overrides["nh"]) >= 1.0
     values = material.resolve({"method": 3, **overrides})
     image = render(preview_scene(material, values, EnvironmentMap.default(), SIZE, 16), tmp_path / "m.exr")
     expected = reference(material, values, EnvironmentMap.default())
