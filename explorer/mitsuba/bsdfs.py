@@ -130,8 +130,8 @@ def _float_property(props, name: str, default):
         return tuple(float(c) for c in np.ravel(np.asarray(value)))[:3]
 
 
-def define_bsdfs(mi, dr) -> dict[str, type]:
-    """The plugin classes (:func:`plugin_names`) for the active variant ``mi.variant()``."""
+def define_bsdfs(mi, dr, names=None) -> dict[str, type]:
+    """The plugin classes of ``names`` (default :func:`plugin_names`) for the active variant ``mi.variant()``."""
     spectral = "spectral" in mi.variant()
     jit = dr.is_jit_v(mi.Float)
 
@@ -226,7 +226,8 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
 
         def _rebuild(self):
             self.model = model_for(self.material, self.values)
-            if not spectral and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
+            natural = getattr(self.model, "natural", None) is not None  # already the exact table, whatever the method
+            if not spectral and not natural and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
                 # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
                 # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
                 self.model.reflectance = functools.partial(bragg.tabulated_rgb, reference_table(self.model))
@@ -341,6 +342,6 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return bs, dr.select(active, spectrum_from_numpy(weight), 0.0)
 
     classes = {}
-    for name in plugin_names():
+    for name in plugin_names() if names is None else names:
         classes[name] = type(name, (ExplorerBSDF,), {"material_name": name, "dirac": twin_class(name).capabilities.dirac})
     return classes
