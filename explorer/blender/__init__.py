@@ -6,9 +6,12 @@ The materials in Blender (Cycles): ``export MATERIAL --to blender FILE.blend`` a
   float image over ``cos theta`` (:data:`TABLE_SIZE` columns, ``cos theta = j / (size - 1)``, texel centres
   as GL's), looked up per shading point from the Geometry node's Normal and Incoming, driving a Glossy
   BSDF at roughness 0: exact for a smooth mirror up to the table's linear interpolation.
-- A single film (the thin film) maps onto the Principled BSDF's own Thin Film inputs (thickness, IOR) over
-  a dielectric base (black base colour, IOR ``eta3``) or a metallic one (base colour its normal-incidence
-  reflectance), roughness ``sqrt(alpha)``: editable in Blender, close but not exact (docs/blender.md).
+- A rough material (a GGX roughness parameter) is its converged table (:func:`converged_tables`: its
+  directional albedo over the Glossy's own at colour 1) colouring a GGX Glossy of its roughness, plus a
+  Diffuse BSDF of its base's share where it has one (``rho_d``): exact under uniform light. ``film="principled"``
+  maps a thin film onto Principled's Thin Film instead, and a stack of rough interfaces onto its coat and
+  specular (the model's ``principled_layers``): editable in Blender, further off (docs/blender.md).
+- Any other material is its directional albedo colouring a Diffuse BSDF.
 
 The preview scene is the env view's: a unit sphere (smooth-shaded UV sphere), an orthographic camera
 spanning ``[-1, 1]^2``, the environment as the world's Environment Texture in the same orientation, linear
