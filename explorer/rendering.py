@@ -51,10 +51,11 @@ def gl_inputs(view: str, *, light=None, plot=None, fill: float | None = None, su
     from explorer.views.geometry import VIEW_REGISTRY
 
     bound = dict(uniforms or {})
-    tables = dict(inputs or {})
+    tables = inputs or None
     if surface is not None:
         bound.update(surface.get("uniforms") or {})
-        tables.update(surface.get("inputs") or {})
+        # The surface's own mapping, not a copy: a progressive job without an inputs_key knows its tables by identity.
+        tables = surface.get("inputs") if not tables else {**tables, **(surface.get("inputs") or {})}
     if view in VIEW_REGISTRY and VIEW_REGISTRY[view].plot is not None:
         from explorer.views.plots import gl_uniforms
 
