@@ -179,7 +179,9 @@ def _write_plot(loaded, view: str, image, plot, out: Path, light, engine: str) -
     height, width = image.shape[:2]
     values = plotted(image, plot, cos_light(view, width, height, light_direction(light), plot))
     shown_light = (light or DEFAULT_LIGHT) if view_named(view).takes_light else None
-    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light)
+    from explorer.views.mirror import is_mirror_only
+
+    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light, is_mirror_only(loaded))
     click.echo(f"wrote {out} ({view} plot, {width}x{height} samples, {engine})")
 
 
