@@ -438,12 +438,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         from explorer.views.fill import DEFAULT_FILL, has_fill
 
         fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
-    from explorer.cli.albedo import progress_printer
+    from explorer.cli.albedo import progress_printer, progress_while
     from explorer.rendering import render_material
 
-    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
-                            variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
-                            progress_printer=progress_printer, warn=warn)
+    with progress_while(f"render {view} ({engine})"):
+        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
+                                variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
+                                progress_printer=progress_printer, warn=warn)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
         return
