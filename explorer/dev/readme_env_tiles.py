@@ -12,7 +12,6 @@ from PIL import Image
 
 from explorer.gpu import Renderer
 from explorer.gpu.env import render_env
-from explorer.materials.presets import load_presets
 from explorer.views.tonemap import default_tonemap, display_srgb8
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -21,9 +20,8 @@ SIZE, SPP = 144, 96
 EXPOSURE = 1.0
 
 
-def write_env_tiles(material: str, names: list[str], out: str, size: int = SIZE, spp: int = SPP) -> None:
-    """Render ``names`` (presets of ``shaders/presets/<material>.toml``) and write them in two rows to ``.github/readme/<out>``."""
-    presets = load_presets(ROOT / "shaders" / "presets" / f"{material}.toml")
+def write_env_tiles(presets, names: list[str], out: str, size: int = SIZE, spp: int = SPP) -> None:
+    """Render ``names`` of ``presets`` (a :class:`explorer.materials.presets.PresetFile`) and write them in two rows to ``.github/readme/<out>``."""
     renderer = Renderer()
     tiles = []
     for name in names:

@@ -8,8 +8,10 @@ Run: .venv/bin/python -m explorer.dev.readme_lobes_figure   (about a minute on l
 """
 
 from explorer.dev.readme_env_tiles import write_env_tiles
+from explorer.materials.lobes_presets import PRESET_FILE
+from explorer.materials.presets import load_presets
 
 NAMES = ["figure18_queen", "figure18a_rook", "figure18a_knight", "figure14a_conductor", "figure14a_coated",
          "figure19a_subtle_haze", "figure19b_haze", "figure19c_strong_haze", "figure20_coloured_highlight", "figure20_coloured_halo"]
 
-write_env_tiles('layered_lobes', NAMES, 'lobes.png')
+write_env_tiles(load_presets(PRESET_FILE), NAMES, 'lobes.png')

@@ -8,9 +8,12 @@ Run: .venv/bin/python -m explorer.dev.readme_stack_figure   (a few minutes on ll
 """
 
 from explorer.dev.readme_env_tiles import write_env_tiles
+from explorer.materials.models import BraggStackModel
+from explorer.materials.presets import presets_for
+from explorer.materials.twins import shipped_file
 
 NAMES = ["figure1_left_alpha0025", "figure1_left_alpha01", "figure1_left_alpha04",
          "figure1_right_alpha0025", "figure1_right_alpha01", "figure1_right_alpha04", "figure1_stacked_pair",
          "table3_green_blue", "table3_red", "table3_purple"]
 
-write_env_tiles('bragg_stack', NAMES, 'stack.png')
+write_env_tiles(presets_for(shipped_file(BraggStackModel)), NAMES, 'stack.png')
