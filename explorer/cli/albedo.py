@@ -55,27 +55,41 @@ def progress_printer(label: str, unit: str):
 
 
 @contextlib.contextmanager
-def progress_while(label: str):
+def progress_while(label: str, started: bool = True):
     """
     For work that cannot count its steps (a GL render, an export): a line to stderr every 2 s while the block
-    runs, unless a :func:`progress_printer` inside it spoke in the meantime.
+    runs, unless a :func:`progress_printer` inside it spoke in the meantime. Yields ``start()``: with
+    ``started=False`` the lines begin only once the block calls it, after its checks of the input, so that bad
+    input found late on a loaded machine is still one line.
     """
     start = time.perf_counter()
-    stop = threading.Event()
+    stop, go = threading.Event(), threading.Event()
+
+    def begin() -> None:
+        nonlocal start
+        if not go.is_set():
+            start = time.perf_counter()
+            go.set()
 
     def beat() -> None:
+        while not go.wait(0.05):
+            if stop.is_set():
+                return
         while not stop.wait(PROGRESS_INTERVAL):
             now = time.perf_counter()
             if now - _last_line[0] >= PROGRESS_INTERVAL:
                 _last_line[0] = now
                 click.echo(f"{PROG}: {label}: working ({now - start:.0f} s)", err=True)
 
+    if started:
+        begin()
     thread = threading.Thread(target=beat, name="progress", daemon=True)
     thread.start()
     try:
-        yield
+        yield begin
     finally:
         stop.set()
+        go.set()
         thread.join()
 
 

@@ -441,10 +441,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     from explorer.cli.albedo import progress_printer, progress_while
     from explorer.rendering import render_material
 
-    with progress_while(f"render {view} ({engine})"):
+    with progress_while(f"render {view} ({engine})", started=False) as checked:
         image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
                                 variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
-                                progress_printer=progress_printer, warn=warn)
+                                progress_printer=progress_printer, warn=warn, checked=checked)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
         return
