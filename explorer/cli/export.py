@@ -42,16 +42,19 @@ def export_command(material, target, preset, params_file, assignments, env_file,
     from explorer.errors import LocatedError
     from explorer.views.images import OutputError
 
+    from explorer.cli.albedo import progress_while
+
     try:
         if texture_table and target != "gltf":
             raise click.BadParameter("--texture-table is for --to gltf", param_hint="--texture-table")
-        if target == "blender":
-            _export_blender(material, preset, params_file, assignments, env_file, out, load(material), blender_film)
-            return
-        if target == "gltf":
-            _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, load(material))
-            return
-        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load(material))
+        loaded = load(material)
+        with progress_while(f"export --to {target}"):
+            if target == "blender":
+                _export_blender(material, preset, params_file, assignments, env_file, out, loaded, blender_film)
+            elif target == "gltf":
+                _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, loaded)
+            else:
+                _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded)
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
