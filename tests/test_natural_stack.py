@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from explorer.errors import LocatedError
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggStackModel, model_for
 from explorer.physics import colorimetry, dispersion, layered, position_free
@@ -107,3 +108,16 @@ def test_position_free_reads_the_natural_layers(stack_material):
 def test_a_layers_natural_checks_are_one_line():
     with pytest.raises(ValueError, match="k1 and k2"):
         layered.RoughBraggLayer(k1=-0.1)
+
+
+def test_a_file_medium_names_a_layers_index(stack_material, tmp_path):
+    """``--set n2_2=my_layer.csv``: the second layer's n2 is the file's medium; a bad file is refused naming its line."""
+    (tmp_path / "layer.csv").write_text("wavelength_nm,n,k\n360,1.9,0.02\n600,1.8,0.01\n830,1.75,0.0\n")
+    values = stack_material.resolve({"layers": "2", "n2_2": str(tmp_path / "layer.csv")})
+    layer = BraggStackModel.stack_of(values).layers[1]
+    assert layer.natural and layer.medium_n2.name == str(tmp_path / "layer.csv") and layer.medium_n1 is None
+    np.testing.assert_allclose(layer.natural_mirror(1.0).index_2([600.0]), [1.8 + 0.01j])
+    (tmp_path / "bad.csv").write_text("wavelength_nm,n,k\n360,1.9,0.02\n600,x,0.01\n")
+    with pytest.raises(LocatedError) as error:
+        stack_material.resolve({"layers": "2", "n2_2": str(tmp_path / "bad.csv")})
+    assert str(error.value).startswith(f"{tmp_path / 'bad.csv'}:3:") and "\n" not in str(error.value)
