@@ -121,3 +121,26 @@ def test_a_file_medium_names_a_layers_index(stack_material, tmp_path):
     with pytest.raises(LocatedError) as error:
         stack_material.resolve({"layers": "2", "n2_2": str(tmp_path / "bad.csv")})
     assert str(error.value).startswith(f"{tmp_path / 'bad.csv'}:3:") and "\n" not in str(error.value)
+
+
+def test_two_smooth_absorbing_layers_bounce_incoherently():
+    """
+    Two smooth natural layers in air over black: the position-free walk is the incoherent pair
+    ``R1 + T1^2 R2 / (1 - R1 R2)`` per wavelength with each layer's exact T (< 1 - R: they absorb), within 3
+    standard errors; with 1 - R in place of T it would be brighter by many. (A layer reflects its table's R from
+    below as from above: exact for lossless layers, the model's choice for absorbing ones.)
+    """
+    chitin = dispersion.LIBRARY["chitin"]
+    top = layered.RoughBraggLayer(n2=1.55, Lambda=330.0, delta=0.5, N=6, alpha=0.0, k2=0.05, medium_n2=chitin)
+    bottom = layered.RoughBraggLayer(n2=1.7, Lambda=420.0, delta=0.5, N=5, alpha=0.0, k1=0.03)
+    stack = layered.LayeredBragg(layers=(top, bottom), n1=1.0, rho_d=0.0)
+    theta = np.array([0.0, 30.0, 60.0])
+    result = position_free.directional_albedo(stack, theta, samples=4096, seed=20261129)
+    tables = layered.stack_tables(stack)
+    R1, R2 = (layered.lookup(t.reflectance.astype(np.float64), np.radians(theta)) for t in tables)
+    T1 = layered.lookup(tables[0].transmittance.astype(np.float64), np.radians(theta))
+    pair = colorimetry.spectrum_to_rgb(R1 + T1**2 * R2 / (1.0 - R1 * R2))
+    error = np.abs(result.value - pair)
+    assert np.all(error <= 3.0 * result.stderr + 1e-4), (error, result.stderr)
+    lossless = colorimetry.spectrum_to_rgb(R1 + (1.0 - R1) ** 2 * R2 / (1.0 - R1 * R2))
+    assert (lossless - pair).max() > 10 * result.stderr.max()
