@@ -144,3 +144,19 @@ def test_two_smooth_absorbing_layers_bounce_incoherently():
     assert np.all(error <= 3.0 * result.stderr + 1e-4), (error, result.stderr)
     lossless = colorimetry.spectrum_to_rgb(R1 + (1.0 - R1) ** 2 * R2 / (1.0 - R1 * R2))
     assert (lossless - pair).max() > 10 * result.stderr.max()
+
+
+def test_mitsubas_spectral_hook_reads_the_natural_tables(stack_material):
+    """The spectral BRDF Mitsuba evaluates (one natural layer, over black, at normal incidence both ways) is
+    Eq. 17's lobe times the layer's exact R at the path's wavelengths (the table's 1-nm samples interpolated)."""
+    from explorer.physics import microfacet
+
+    model = model_for(stack_material, stack_material.resolve({**ABSORBING, "layers": "1", "rho_d": "0", "nh": "1",
+                                                              "n1_1": "1", "coating": "0"}))
+    wavelengths = np.array([[420.0, 510.0, 600.0, 700.0]])
+    i = np.array([[0.0, 0.0, 1.0]])
+    value = model.spectral_brdf(i, i, wavelengths, lambda rgb, w: np.zeros(w.shape))  # a black base
+    mirror = NaturalMirror(n1=1.0, n2=dispersion.LIBRARY["chitin"], Lambda=320.0, delta=0.5, N=6, nh=1.0, k2=0.05)
+    exact = mirror_spectrum(mirror, wavelengths[0], [0.0])["R"][0]
+    lobe = microfacet.microfacet_lobe(i, i, np.array([0.0, 0.0, 1.0]), 0.2)[0]
+    np.testing.assert_allclose(value[0], lobe[0] * exact, rtol=1e-5)
