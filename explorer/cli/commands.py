@@ -327,10 +327,13 @@ def _errors(function):
 @click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
+@click.option("--maps", "maps_dir", metavar="DIR", help="textured view, --engine numpy: the structure maps design --target-image wrote; "
+              "one pixel a texel, its colour at --theta.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the viewing angle in degrees (default 0).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
-           ndotl, mapping):
+           ndotl, mapping, maps_dir, maps_theta):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr. Without MATERIAL, the one --params names.
 
@@ -344,6 +347,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
     as a chart (.png) or their values (.npy); --size W sets their samples.
     """
+    if maps_dir is not None:
+        from explorer.cli.paint import render_maps_command
+
+        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
+        return
+    if maps_theta is not None:
+        raise click.UsageError("--theta goes with --maps")
     from explorer.views.geometry import scatter_circles, view_named
 
     if material is None:

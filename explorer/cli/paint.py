@@ -135,3 +135,42 @@ def paint_command(material: str, image: str, image_2: str | None, angles_text: s
                f"{report['unreachable_pixels']} unreachable (flagged in unreachable.png)")
     click.echo("time: " + ", ".join(f"{k} {v:.1f} s" for k, v in result.stages.items()) + f"; total {time.perf_counter() - start:.1f} s")
     click.echo(f"maps: {out}/ ({', '.join(f'{n}.exr' for n in result.maps)}, params.json, report.json)")
+
+
+def render_maps_command(material: str | None, maps: str, view: str, theta: float | None, out: str, engine: str, exposure: str | None) -> None:
+    """``render MATERIAL --maps DIR --view textured [--theta DEG]``: the maps' colours at one angle, one pixel a texel."""
+    from explorer.cli.design import load
+    from explorer.design import DesignError, design_model
+    from explorer.design.paint import read_maps
+    from explorer.errors import LocatedError, OutputError
+    from explorer.views.images import write_image
+    from explorer.views.maps import map_colours
+
+    if view != "textured":
+        raise click.UsageError(f"--maps renders the textured view (the maps' colours at --theta), not {view}")
+    if engine != "numpy":
+        raise click.UsageError("--maps renders with --engine numpy (each texel's converged spectral colour)")
+    try:
+        exposure_factor = 1.0 if exposure is None else float(exposure)
+    except ValueError:
+        raise click.UsageError(f"--exposure {exposure!r}: with --maps, a number") from None
+    theta = 0.0 if theta is None else theta
+    if not (np.isfinite(theta) and 0.0 <= theta < 90.0):
+        raise click.UsageError(f"--theta {theta:g}: degrees in [0, 90)")
+    try:
+        params, arrays = read_maps(maps)
+    except ValueError as error:
+        _fail(str(error))
+    try:
+        loaded = load(material or params.get("material", ""))
+        model = design_model(loaded.model)
+    except (LocatedError, DesignError) as error:
+        _fail(str(error))
+    if model.name != params.get("model"):
+        _fail(f"--maps {maps}: maps of a {params.get('model')}, not of {model.name} ({material})")
+    image = map_colours(model.name, params.get("fixed", {}), arrays, theta)
+    try:
+        write_image(image, Path(out), exposure=exposure_factor)
+    except OutputError as error:
+        _fail(str(error))
+    click.echo(f"wrote {out} ({image.shape[1]}x{image.shape[0]}, the maps' colours at {theta:g} degrees)")
