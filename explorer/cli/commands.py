@@ -583,9 +583,13 @@ def presets(material, as_json):
 @click.option("--mitsuba", "mitsuba", is_flag=True,
               help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
 @click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
+@click.option("--paint", "paint", is_flag=True,
+              help="Instead: painting with structural colour on a local Dask cluster (--workers): a 64x64 round trip and a 256x256 "
+                   "image of 8 regions, their ΔE2000 and times.")
+@click.option("--workers", "paint_workers", type=click.IntRange(min=1), default=2, show_default=True, help="--paint: local Dask workers.")
 @_errors
 def bench(as_json, size, repeats, film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
-          plot, markdown, mitsuba, spp):
+          plot, markdown, mitsuba, spp, paint, paint_workers):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -599,6 +603,11 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
         raise click.UsageError("--seed goes with --design")
     if design_tries is not None and design_count is None:
         raise click.UsageError("--tries goes with --design")
+    if paint:
+        from explorer.bench.paint import run_paint_bench
+
+        run_paint_bench(workers=paint_workers, as_json=as_json)
+        return
     if position_free:
         from explorer.bench import run_position_free_bench
 
