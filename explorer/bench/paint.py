@@ -71,7 +71,8 @@ def _run(name, model_name, ranges, fixed, maps, client, seed, rows):
     targets = _targets(model_name, fixed, maps)
     rendered = time.perf_counter() - start
     start = time.perf_counter()
-    result = paint(model_name, ranges, fixed, targets, seed=seed, client=client)
+    result = paint(model_name, ranges, fixed, targets, seed=seed, client=client,
+                   progress=lambda message: click.echo(f"bench --paint: {name}: {message}", err=True))
     painted = time.perf_counter() - start
     start = time.perf_counter()
     again = np.stack([map_colours(model_name, result.fixed, result.maps, a) for a in ANGLES]).astype(np.float64)

@@ -43,7 +43,7 @@ from explorer.physics import colorimetry
 #: A cluster holds colours within this many CIELAB units of its centroid at every angle.
 CLUSTER_RADIUS = 12.0
 #: At most this many clusters (designs).
-MAX_CLUSTERS = 32
+MAX_CLUSTERS = 16
 #: Colours polished per task.
 CHUNK = 256
 #: A colour whose coarse RMS CIEDE2000 stays above this tries its neighbours' structures.
@@ -51,8 +51,8 @@ POLISHED_DELTA_E = 0.5
 #: Rounds of neighbours' starts.
 NEIGHBOUR_ROUNDS = 3
 #: Converged-model polish: evaluations and CPU seconds per colour.
-CONVERGED_NFEV = 6
-CONVERGED_SECONDS = 0.5
+CONVERGED_NFEV = 4
+CONVERGED_SECONDS = 0.25
 #: At most this many colours get a full design when still unreachable after the polish.
 RESCUE_LIMIT = 16
 #: Searches per cluster design (:func:`explorer.design.design`'s ``tries``).
@@ -321,18 +321,25 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
     centre_U = np.array([rows_of.unit({k: np.array([v]) for k, v in d["values"].items()})[0] for d in designs]).reshape(len(centres), len(free))
     lap("designs")
 
-    # 4. Every colour from its cluster's structure.
+    # 4. Seed colours (on a coarse grid of the image) from their cluster's structure, then every other colour from
+    # its nearest seed's: neighbouring pixels start in the same basin, and a start that close needs few steps.
     U = np.zeros((C, len(free)))
     cost = np.full(C, np.inf)
-    if live.size:
-        starts = centre_U[labels[live]]
-        U[live], cost[live] = _polish_many(runner, "polish", model_name, ranges, fixed, angles, colour_rgb[live], colour_bounds[live], starts)
-    lap("polish")
-
-    # 5. Neighbours' structures for colours left above POLISHED_DELTA_E.
     pixel_colour = np.full(H * W, -1)
     pixel_colour[pixels] = inverse
     pixel_colour = pixel_colour.reshape(H, W)
+    if live.size:
+        seeds, nearest_seed = _seed_colours(pixel_colour, colour_possible)
+        seed_starts = centre_U[labels[seeds]]
+        U[seeds], cost[seeds] = _polish_many(runner, "polish seeds", model_name, ranges, fixed, angles, colour_rgb[seeds],
+                                             colour_bounds[seeds], seed_starts)
+        rest = np.setdiff1d(live, seeds)
+        if rest.size:
+            U[rest], cost[rest] = _polish_many(runner, "polish", model_name, ranges, fixed, angles, colour_rgb[rest],
+                                               colour_bounds[rest], U[nearest_seed[rest]])
+    lap("polish")
+
+    # 5. Neighbours' structures for colours left above POLISHED_DELTA_E.
     neighbour_pairs = _neighbour_colours(pixel_colour)
     for round_ in range(NEIGHBOUR_ROUNDS):
         poor = live[np.sqrt(cost[live] / len(angles)) > POLISHED_DELTA_E]
@@ -402,6 +409,40 @@ def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, 
     return np.concatenate([r["U"] for r in results]), np.concatenate([r["cost"] for r in results])
 
 
+#: Seed colours lie on a grid of about this many pixels a side.
+SEED_GRID = 16
+
+
+def _seed_colours(pixel_colour: np.ndarray, possible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The colours of the pixels on a grid of about :data:`SEED_GRID` a side (possible colours only; every colour
+    when the image has few), and per colour the seed colour nearest its first pixel.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    H, W = pixel_colour.shape
+    C = possible.size
+    if C <= SEED_GRID * SEED_GRID:
+        return np.flatnonzero(possible), np.arange(C)
+    stride = max(1, int(round(max(H, W) / SEED_GRID)))
+    grid = np.zeros((H, W), bool)
+    grid[stride // 2 :: stride, stride // 2 :: stride] = True
+    grid &= pixel_colour >= 0
+    grid[pixel_colour >= 0] &= possible[pixel_colour[pixel_colour >= 0]]
+    seeds = np.unique(pixel_colour[grid])
+    if seeds.size == 0:
+        return np.flatnonzero(possible), np.arange(C)
+    # The nearest grid pixel of every pixel (a distance transform's indices), then per colour its first pixel's.
+    _, (iy, ix) = distance_transform_edt(~grid, return_indices=True)
+    nearest_pixel_colour = pixel_colour[iy, ix]
+    nearest = np.arange(C)
+    flat = pixel_colour.ravel()
+    order = np.flatnonzero(flat >= 0)
+    colours, first = np.unique(flat[order], return_index=True)
+    nearest[colours] = nearest_pixel_colour.ravel()[order[first]]
+    return seeds, nearest
+
+
 def _neighbour_colours(pixel_colour: np.ndarray) -> dict[int, set[int]]:
     """Per colour, the colours of its pixels' 4-neighbours (masked pixels have none)."""
     pairs: dict[int, set[int]] = {}
@@ -416,7 +457,7 @@ def _neighbour_colours(pixel_colour: np.ndarray) -> dict[int, set[int]]:
 
 #: Starts tried per poor colour and round: its best neighbours' structures, then the nearest other clusters'.
 NEIGHBOUR_STARTS = 3
-OTHER_CLUSTERS = 2
+OTHER_CLUSTERS = 2  # (besides its own cluster's, when it started elsewhere)
 
 
 def _candidates(poor, cost, pairs, labels, centre_U, colour_lab, centres, U, angles) -> dict[int, list[np.ndarray]]:
@@ -427,10 +468,12 @@ def _candidates(poor, cost, pairs, labels, centre_U, colour_lab, centres, U, ang
         neighbours = sorted((n for n in pairs.get(int(c), ()) if cost[n] < cost[c]), key=lambda n: (cost[n], n))
         for n in neighbours[:NEIGHBOUR_STARTS]:
             starts.append(U[n])
+        if labels[c] >= 0:
+            starts.append(centre_U[labels[c]])
         if centres.size > 1:
             distance = np.sum((colour_lab[centres] - colour_lab[c]) ** 2, axis=(1, 2))
             for k in np.argsort(distance, kind="stable"):
-                if k != labels[c] and len(starts) < NEIGHBOUR_STARTS + OTHER_CLUSTERS:
+                if k != labels[c] and len(starts) < NEIGHBOUR_STARTS + OTHER_CLUSTERS + 1:
                     starts.append(centre_U[k])
         distinct = []
         for s in starts:
