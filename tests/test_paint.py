@@ -46,7 +46,7 @@ def test_a_two_worker_cluster_paints_a_16_pixel_image_that_renders_back(tmp_path
     image, (first, second) = _two_regions(tmp_path)
     out = tmp_path / "maps"
     args = ("design", "bragg_mirror", "--target-image", first, "--target-image-2", second, "--free", "Lambda",
-            "--out-maps", out, "--workers", "2", "--seed", "3")
+            "--out-maps", out, "--workers", "2", "--seed", "3", "--tries", "1")
     run = run_cli(*args)
     assert run.returncode == 0, run.stderr
     assert "2 Dask workers (local)" in run.stderr

@@ -259,7 +259,9 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
             raise click.UsageError("--target-image paints alone: no --target, --target-strip, --target-spectrum, --guess or --save")
         if out_maps is None:
             raise click.UsageError("--target-image needs --out-maps DIR (where the maps go)")
-        paint_command(material, target_image, target_image_2, angles_text, fixes, free, out_maps, workers, scheduler, seed, as_json)
+        given = click.get_current_context().get_parameter_source("tries") == click.core.ParameterSource.COMMANDLINE
+        paint_command(material, target_image, target_image_2, angles_text, fixes, free, out_maps, workers, scheduler, seed, as_json,
+                      tries if given else None)
         return
     if any(option is not None for option in paint_options):
         raise click.UsageError("--target-image-2, --angles, --out-maps, --workers and --scheduler go with --target-image")

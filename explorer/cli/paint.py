@@ -79,11 +79,11 @@ def start_client(workers: int | None, scheduler: str | None):
 
 
 def paint_command(material: str, image: str, image_2: str | None, angles_text: str | None, fixes, free, out_maps: str,
-                  workers: int | None, scheduler: str | None, seed: int, as_json: bool) -> None:
-    """What ``design --target-image`` runs."""
+                  workers: int | None, scheduler: str | None, seed: int, as_json: bool, tries: int | None = None) -> None:
+    """What ``design --target-image`` runs; ``tries``: each cluster's searches (default :data:`explorer.design.paint.CLUSTER_TRIES`)."""
     from explorer.cli.design import load, parse_fixes
     from explorer.design import DesignError, design_model, ranges_of
-    from explorer.design.paint import paint, write_maps
+    from explorer.design.paint import CLUSTER_TRIES, paint, write_maps
     from explorer.errors import LocatedError, OutputError
     from explorer.resources import display_path
 
@@ -111,7 +111,8 @@ def paint_command(material: str, image: str, image_2: str | None, angles_text: s
         link = getattr(client, "dashboard_link", None) if (cluster is None or cluster.dashboard_link) else None
         say(f"{workers_up} Dask workers ({'at ' + scheduler if scheduler else 'local'}) up in {started:.1f} s"
             + (f"; dashboard {link}" if link else "; no dashboard (install bokeh for one)"))
-        result = paint(loaded.model, ranges_of(loaded), fixed, targets, seed=seed, client=client, cache=out / "cache", progress=say)
+        result = paint(loaded.model, ranges_of(loaded), fixed, targets, seed=seed, client=client, cache=out / "cache", progress=say,
+                       tries=tries or CLUSTER_TRIES)
     except DesignError as error:
         _fail(str(error))
     finally:
