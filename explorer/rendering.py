@@ -1,6 +1,9 @@
 """
-Any view of a material by any engine, headless: the render service that ``bragg-explorer render``, the app and
-``explorer/dev`` call (:func:`render_material`).
+Any view of a material by any engine: the render service that ``bragg-explorer render``, the app and ``explorer/dev``
+call. :func:`render_material` draws a view headless; :func:`gl_inputs` says what the GL engine binds for a view (its
+light, uniforms, tables, environment), and :func:`request_view` hands that to one of the app's progressive jobs
+(:class:`explorer.gpu.progressive.ProgressiveView`, drawn in row bands within a frame's budget), so that the app's
+images and the command's are one description of the view.
 
 It only dispatches: the GL engine draws with :class:`explorer.gpu.Renderer` (meshes: :mod:`explorer.gpu.mesh`; the env
 view: :mod:`explorer.gpu.env`), the numpy engine with the material's twin (:func:`explorer.views.render.render_numpy`),
@@ -10,7 +13,7 @@ the position-free engine by :mod:`explorer.views.position_free`, and Mitsuba's e
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -32,6 +35,44 @@ def check_numpy_size(width: int, height: int) -> None:
     if width * height > pixels:
         raise LocatedError("--size", None, f"{width}x{height} is more than the {pixels} pixels of an image "
                                            f"(a float image under {MAX_IMAGE_BYTES >> 20} MiB)")
+
+
+def gl_inputs(view: str, *, light=None, plot=None, fill: float | None = None, surface: Mapping | None = None,
+              inputs: Mapping | None = None, environment=None, uniforms: Mapping | None = None) -> dict:
+    """
+    What the GL engine binds to draw ``view``: the keyword arguments ``light``, ``uniforms``, ``inputs`` and
+    ``environment`` of :meth:`explorer.gpu.Renderer.render` and of
+    :meth:`explorer.gpu.progressive.ProgressiveView.request`. ``plot``: a plot view's settings
+    (:func:`explorer.views.plots.gl_uniforms`); ``fill``: the lit view's environment fill (:mod:`explorer.views.fill`,
+    None: not bound); ``surface``: the textured view's tables and uniforms (a surface texture's ``gl_arguments``);
+    ``inputs``: other tables (a mesh's normals); ``uniforms``: a view's own (the slice's ``slice_phi_d``). ``light`` is
+    passed as given (``(theta, phi)`` degrees to ``render``, a direction to a progressive job).
+    """
+    from explorer.views.geometry import VIEW_REGISTRY
+
+    bound = dict(uniforms or {})
+    tables = dict(inputs or {})
+    if surface is not None:
+        bound.update(surface.get("uniforms") or {})
+        tables.update(surface.get("inputs") or {})
+    if view in VIEW_REGISTRY and VIEW_REGISTRY[view].plot is not None:
+        from explorer.views.plots import gl_uniforms
+
+        bound.update(gl_uniforms(view, plot))
+    elif fill is not None:
+        bound["fill"] = float(fill)
+    return {"light": light, "uniforms": bound, "inputs": tables or None, "environment": environment}
+
+
+def request_view(job, material: Material, values, view: str, size: tuple[int, int], *, dragging: bool = False,
+                 inputs_key=None, **described) -> None:
+    """
+    Ask the app's progressive ``job`` (a :class:`explorer.gpu.progressive.ProgressiveView`) for ``view`` of ``material``
+    at ``values`` and ``size``, bound as :func:`gl_inputs` describes it (``described``: its keywords). The job draws
+    it in row bands over the frames (a preview while ``dragging``); ``inputs_key`` names the tables (arrays are not
+    compared).
+    """
+    job.request(material, values, view, size, dragging=dragging, inputs_key=inputs_key, **gl_inputs(view, **described))
 
 
 def render_material(
@@ -99,18 +140,16 @@ def render_material(
     renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
-        return renderer.render(material, values, view, width, height, light=light,
-                               **thickness.gl_arguments(material, values, width, height))
+        return renderer.render(material, values, view, width, height,
+                               **gl_inputs(view, light=light, surface=thickness.gl_arguments(material, values, width, height)))
+    view_named(view)  # an unknown view: one line listing them
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 
         return render_mesh(renderer, material, values, view, mesh, width, height, light=light, environment=environment,
-                           uniforms={"fill": float(fill)})
-    if view_named(view).plot is not None:
-        from explorer.views.plots import gl_uniforms
-
-        return renderer.render(material, values, view, width, height, light=light, uniforms=gl_uniforms(view, plot))
-    return renderer.render(material, values, view, width, height, light=light, environment=environment, uniforms={"fill": float(fill)})
+                           uniforms=gl_inputs(view, fill=fill)["uniforms"])
+    return renderer.render(material, values, view, width, height,
+                           **gl_inputs(view, light=light, plot=plot, fill=fill, environment=environment))
 
 
 def _render_env(material: Material, values: dict, width: int, height: int, engine: str, environment, spp: int, mesh,

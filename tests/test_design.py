@@ -14,6 +14,7 @@ import pytest
 from conftest import one_line_error, run_cli
 
 from explorer import design
+from explorer.design import search, solve
 from explorer.physics import bragg, thinfilm
 
 
@@ -112,7 +113,7 @@ def test_colours_invariant_under_index_scaling():
 def _scan_problem(fixed):
     model = design.design_model("bragg_mirror")
     targets = [design.Target(a, c) for a, c in [(0.0, (0.1, 0.3, 0.05)), (35.0, (0.05, 0.1, 0.3)), (70.0, (0.2, 0.2, 0.2))]]
-    return design._Problem(model, design.parameter_box(model, RANGES), fixed, targets, None)
+    return search._Problem(model, design.parameter_box(model, RANGES), fixed, targets, None)
 
 
 @pytest.mark.parametrize("fixed, window", [({}, False), ({}, True), ({"delta": 0.3, "nh": 0.0}, False)])
@@ -163,12 +164,12 @@ def test_scan_descent_walks_into_a_basin_the_first_pass_missed():
     colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
     model = design.design_model("bragg_mirror")
     targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
-    problem = design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
+    problem = search._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
     u = problem.unit_row(truth)
     np.testing.assert_allclose([problem.fine_values(u[None])[k] for k in truth], list(truth.values()), rtol=1e-12)
     starts = np.clip(u + np.random.default_rng(2).normal(0.0, 0.04, (4, u.size)), 0.0, 1.0)
-    starts, before = design._scan_best(problem, starts)
-    after_rows, after = design._scan_descent(problem, starts, before, np.random.default_rng(0))
+    starts, before = search._scan_best(problem, starts)
+    after_rows, after = search._scan_descent(problem, starts, before, np.random.default_rng(0))
     # From an RMS CIEDE2000 per target above 5 to below 2.5: where the local refinement takes over.
     assert np.all(after <= before)
     assert np.sqrt(before.min() / len(targets)) > 5.0 and np.sqrt(after.min() / len(targets)) < 2.5, (before, after)
@@ -179,7 +180,7 @@ def _problem_of(truth):
     colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
     targets = [design.Target(a, tuple(c)) for a, c in zip(design.ROUND_TRIP_ANGLES, colours)]
     model = design.design_model("bragg_mirror")
-    return design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None), targets
+    return search._Problem(model, design.parameter_box(model, RANGES), {}, targets, None), targets
 
 
 def test_polish_reaches_a_thick_stack_from_a_hundredth_of_the_box():
@@ -191,7 +192,7 @@ def test_polish_reaches_a_thick_stack_from_a_hundredth_of_the_box():
     step[[k for k, p in enumerate(problem.free) if p.integer]] = 0.0
     start = np.clip(u + step, 0.0, 1.0)
     assert np.sqrt(problem.fine_cost(start) / len(targets)) > 5.0
-    values, cost = design._polish(problem, start, max_nfev=20, deadline=float("inf"))
+    values, cost = search._polish(problem, start, max_nfev=20, deadline=float("inf"))
     assert np.sqrt(cost / len(targets)) < 0.05, values
 
 
@@ -388,14 +389,14 @@ def test_a_host_below_its_threshold_is_reported_as_no_host():
     model = design.design_model("bragg_mirror")
     targets = [design.Target(0.0, (0.1, 0.2, 0.3))]
     found = dict(n1=1.4, n2=1.9, Lambda=300.0, delta=0.4, N=12.0, nh=0.37)
-    problem = design._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
-    reported = design._reported_values(problem, found)
+    problem = search._Problem(model, design.parameter_box(model, RANGES), {}, targets, None)
+    reported = solve._reported_values(problem, found)
     assert reported["nh"] == RANGES["nh"][0] and reported["N"] == 12 and isinstance(reported["N"], int)
     np.testing.assert_array_equal(design.forward_rgb("bragg_mirror", reported, [0.0, 50.0]),
                                   design.forward_rgb("bragg_mirror", found, [0.0, 50.0]))
-    assert design._reported_values(problem, {**found, "nh": 1.3})["nh"] == 1.3
-    fixed = design._Problem(model, design.parameter_box(model, RANGES), {"nh": 0.37}, targets, None)
-    assert design._reported_values(fixed, found)["nh"] == 0.37
+    assert solve._reported_values(problem, {**found, "nh": 1.3})["nh"] == 1.3
+    fixed = search._Problem(model, design.parameter_box(model, RANGES), {"nh": 0.37}, targets, None)
+    assert solve._reported_values(fixed, found)["nh"] == 0.37
 
 
 def test_design_bench_draws_its_mirrors_from_the_seed():
@@ -451,7 +452,7 @@ def test_a_bounded_channel_costs_only_on_the_wrong_side():
 
     model = design.design_model("bragg_mirror")
     box = design.parameter_box(model, ranges_of(load_material(material_path("bragg_mirror"))))
-    problem = design._Problem(model, box, {}, [design.Target(30.0, (1.0, 0.2, 0.0), (1, 0, -1))], None)
+    problem = search._Problem(model, box, {}, [design.Target(30.0, (1.0, 0.2, 0.0), (1, 0, -1))], None)
     beyond = np.array([[[1.3, 0.2, -0.1]]])
     short = np.array([[[0.8, 0.2, 0.1]]])
     assert problem.delta_e(beyond[0])[0] < 1e-6

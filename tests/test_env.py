@@ -26,6 +26,7 @@ from explorer.views.env import (
 )
 from explorer.gpu.env import ProgressiveEnvRender
 from explorer.views.geometry import brdf_view_geometry, rim_distance
+from explorer.views.twin_check import smooth_environment  # the env comparisons' sky, shared with check
 
 GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
@@ -51,17 +52,6 @@ DEFAULT_MAX_BYTES = 300_000
 #: float32 GLSL against float64 numpy: sampled directions (absolute), densities (relative above 1e-3).
 SAMPLE_ATOL = 2e-3
 PDF_RTOL = 2e-3
-
-
-def smooth_environment(width: int = 64, height: int = 32) -> EnvironmentMap:
-    """A sky gradient, a tint along x and a broad glow toward (0.5, 0.6, 0.62): smooth at every scale."""
-    u = (np.arange(width) + 0.5) / width
-    v = (np.arange(height) + 0.5) / height
-    d = uv_to_direction(u[None, :], v[:, None])
-    image = 0.5 + 0.3 * d[..., 1:2] * np.array([0.5, 1.0, 1.5]) + 0.2 * d[..., 0:1] * np.array([1.0, 0.5, 0.0])
-    glow = np.array([0.5, 0.6, 0.62]) / np.linalg.norm([0.5, 0.6, 0.62])
-    image = image + 2.0 * np.exp(-(1.0 - d @ glow) / 0.06)[..., None] * np.array([1.0, 0.9, 0.7])
-    return EnvironmentMap(image.astype(np.float32), "<smooth>")
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error
+from conftest import REPO_ROOT, one_line_error, run_cli
 from twins import Twins, assert_twins_equal
 from explorer.materials.brd import load_material
 from explorer.materials.methods import Method
@@ -57,6 +57,22 @@ def test_every_shipped_material_declares_every_capability(path):
         assert len(alphas) == len(weights) >= 1 and np.all(np.asarray(cosine) >= 0.0)
     if declared.supports("position-free"):
         assert model.stack.layers
+
+
+def test_info_json_lists_each_materials_capabilities_from_the_registry(tmp_path):
+    """``info --json`` carries the twin's declaration: a built-in's, and a plugin's loaded from another folder."""
+    import json
+
+    for path in SHIPPED + [_example(tmp_path)]:
+        run = run_cli("info", path, "--json")
+        assert run.returncode == 0, run.stderr
+        listed = json.loads(run.stdout)["capabilities"]
+        declared = registry()[load_material(path).model].capabilities
+        assert set(listed) == set(CAPABILITY_FIELDS)
+        assert listed["albedo"] == list(declared.albedo) and listed["exports"] == list(declared.exports)
+        assert (listed["dirac"], listed["bragg_spectrum"], listed["numpy"], listed["design"]) == \
+            (declared.dirac, declared.bragg_spectrum, declared.numpy, declared.design)
+        assert listed["methods"] == (None if declared.methods is None else [m.name for m in declared.methods])
 
 
 def test_design_models_are_the_twins_that_declare_design():
@@ -106,8 +122,7 @@ def test_no_builtin_material_name_outside_its_plugin_files():
     found = builtin_name_literals(REPO_ROOT)
     default = found.pop(DEFAULT_FILE, [])
     assert len(default) == 1, f"{DEFAULT_FILE}: one default material, found {default}"
-    stray = {path: hits for path, hits in found.items()
-             if path not in PLUGIN_FILES and not path.startswith("explorer/dev/")}
+    stray = {path: hits for path, hits in found.items() if path not in PLUGIN_FILES}  # study scripts included
     assert not stray, "built-in material names as string literals: " + "; ".join(
         f"{path}:{line} {text[:50]!r}" for path, hits in stray.items() for line, text in hits)
 
@@ -179,11 +194,27 @@ def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, 
     from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
 
     material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
-    assert check_views(material) == tuple(CHECK_SIZES)
-    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}))
-    assert [r.view for r in results] == list(CHECK_SIZES)
+    images = [v for v in CHECK_SIZES if v not in ("textured", "env", "albedo")]
+    assert check_views(material) == tuple(images) + ("env", "albedo")  # no '# texture:' line
+    results = check_material(gl_renderer, material, material.resolve({"method": 3} if name == "bragg_layer" else {}), images)
+    assert [r.view for r in results] == images
     for result in results:
         assert result.passed and 0.0 < result.max_difference, result.message()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name, view", [("ggx_schlick", "env"), ("ggx_schlick", "albedo"), ("thin_film", "textured")])
+def test_check_compares_the_env_textured_and_albedo_views(gl_renderer, name, view):
+    """The env view (Monte Carlo against the twin's exact integral), the albedo and the textured view, each within its tolerance."""
+    from explorer.views.twin_check import CHECK_SIZES, ENV_PIXELS, check_material, check_views, tolerance_for
+
+    material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
+    assert view in check_views(material)
+    (result,) = check_material(gl_renderer, material, material.resolve({}), [view])
+    assert result.view == view and result.tolerance == tolerance_for(view)
+    assert result.passed and 0.0 < result.max_difference, result.message()
+    if view == "env":
+        assert result.tolerance.standard_errors > 0.0 and CHECK_SIZES["env"][0] ** 2 > ENV_PIXELS
 
 
 @pytest.mark.gl
@@ -193,9 +224,9 @@ def test_check_fails_a_plugin_whose_twin_disagrees_with_its_shader(tmp_path):
     # The twin's Fresnel off by 1 %: beyond the colour views' 2e-3 absolute.
     source.write_text(source.read_text().replace("return self.F0 + (1.0 - self.F0) * m**5",
                                                  "return 1.01 * (self.F0 + (1.0 - self.F0) * m**5)"))
-    run = _cli("check", path.name, "--views", "gradient,lit", cwd=path.parent)
+    run = _cli("check", path.name, "--views", "gradient,lit,albedo", cwd=path.parent)
     assert run.returncode == 1, run.stdout + run.stderr
-    assert "OVER" in run.stdout and "over: gradient, lit" in run.stdout, run.stdout
+    assert "OVER" in run.stdout and "over: gradient, lit, albedo" in run.stdout, run.stdout
 
 
 @pytest.mark.gl
@@ -208,7 +239,7 @@ def test_the_recipe_the_plugin_example_works_outside_the_repository(tmp_path):
     run = _cli("check", path.name, "--json", cwd=folder)
     assert run.returncode == 0, run.stdout + run.stderr
     report = json.loads(run.stdout)
-    assert report["passed"] and {v["view"] for v in report["views"]} >= {"gradient", "sphere", "lit", "slice", "scatter"}
+    assert report["passed"] and {v["view"] for v in report["views"]} >= {"gradient", "sphere", "lit", "slice", "scatter", "env", "albedo"}
     run = _cli("info", path.name, cwd=folder)
     assert run.returncode == 0 and "model tinted_phong" in run.stdout, run.stderr
     run = _cli("albedo", path.name, "--theta", "0,60", "--json", cwd=folder)
@@ -226,3 +257,57 @@ def test_the_recipe_the_plugin_example_works_outside_the_repository(tmp_path):
     twins = Twins.of(np.load(folder / "gl.npy"), np.load(folder / "numpy.npy"), "lit")
     assert twins.gl.max() > 0.0
     assert_twins_equal(twins, "the example's lit view, GL against numpy")
+
+
+#: Run in a subprocess (Mitsuba's scalar variant, no LLVM in this process): a plugin loaded after register() gets its
+#: BSDF, evaluated as its twin's brdf x cos; an edit to its file replaces the BSDF.
+MITSUBA_LATE = r"""
+import json, math, sys
+import numpy as np
+from explorer.mitsuba import register
+from explorer.materials.brd import load_material
+from explorer.materials.models import model_for
+from explorer.mitsuba.bsdfs import plugin_names
+
+mi = register("scalar_rgb")
+before = "tinted_phong" in plugin_names()
+material = load_material(sys.argv[1])
+bsdf = mi.load_dict({"type": "tinted_phong", "exponent": 20.0})
+si = mi.SurfaceInteraction3f()
+si.wi = mi.Vector3f(math.sin(0.4), 0.0, math.cos(0.4))
+wo = [math.sin(0.5) * math.cos(2.8), math.sin(0.5) * math.sin(2.8), math.cos(0.5)]
+value = np.ravel(np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(*wo)), np.float64))
+twin = model_for(material, material.resolve({"exponent": 20.0}))
+expected = twin.brdf(np.array(wo), np.array([math.sin(0.4), 0.0, math.cos(0.4)]), np.array([0.0, 0.0, 1.0]),
+                     np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])) * wo[2]
+print(json.dumps({"before": before, "variant": mi.variant(), "value": value.tolist(), "expected": np.ravel(expected).tolist()}))
+"""
+
+#: What the example's twin adds to declare a Mitsuba export: its spectral BRDF and its sampling lobes (cosine only).
+MITSUBA_HOOKS = '''
+    def spectral_brdf(self, i, o, wavelengths, rgb_upsample):
+        n = np.zeros_like(i); n[:, 2] = 1.0
+        x = np.zeros_like(i); x[:, 0] = 1.0
+        return rgb_upsample(self.brdf(i, o, n, x, np.cross(n, x)), wavelengths)
+
+    def sampling_lobes(self, cos_o):
+        return [], [], np.ones_like(np.asarray(cos_o, dtype=np.float64))
+'''
+
+
+def test_a_plugin_loaded_after_mitsuba_register_gets_its_bsdf(tmp_path):
+    """Plugin registration reaches Mitsuba whenever it happens: here after ``register()`` set the variant."""
+    import json
+
+    pytest.importorskip("mitsuba")
+    path = _example(tmp_path)
+    source = path.with_suffix(".py")
+    text = source.read_text().replace('exports=("brdf", "table")', 'exports=("brdf", "table", "mitsuba")')
+    source.write_text(text + MITSUBA_HOOKS)
+    env = {**os.environ, "PYTHONWARNINGS": "ignore", "PYTHONPATH": str(REPO_ROOT)}
+    run = subprocess.run([sys.executable, "-c", MITSUBA_LATE, str(path)], capture_output=True, text=True, timeout=600, env=env)
+    assert run.returncode == 0, run.stderr[-2000:]
+    result = json.loads(run.stdout.strip().splitlines()[-1])
+    assert result["before"] is False and result["variant"] == "scalar_rgb"
+    assert max(result["expected"]) > 0.01
+    np.testing.assert_allclose(result["value"], result["expected"], rtol=1e-5, atol=1e-7)

@@ -29,14 +29,14 @@ APP_MODES = ("sphere", "lit")
 APP_ENV_MATERIAL = f"{BraggStackModel.name}.brd"
 APP_ENV_VALUES = {"layers": 2}
 APP_ENV_SLIDER = "param:Lambda_1"
-#: The goals of issue 22: frames while a slider moves, and the env view's first pass.
+#: The goals: frames while a slider moves, and the env view's first pass.
 APP_GOAL_FPS = 30.0
 APP_GOAL_FIRST_PASS_MS = 33.0
 
 
-def _drag(mark: str, slider: str, frames: int) -> list:
+def _drag(mark: str, slider: str, frames: int, **hold) -> list:
     # About 2 px a frame: an integer slider (1 nm steps, ~8 nm a pixel) changes on every frame.
-    return [{"mark": mark}, {"drag": slider, "from": 0.15, "to": 0.85, "frames": frames}, {"mark": None}, {"wait": 3}]
+    return [{"mark": mark}, {"drag": slider, "from": 0.15, "to": 0.85, "frames": frames, **hold}, {"mark": None}, {"wait": 3}]
 
 
 def app_bench_script(frames: int = 60) -> list:
@@ -169,7 +169,7 @@ def print_view_frames(views: list[dict], size: int) -> None:
     print("view/s: frames that show new parameter values in the view's window; draft: drag frames showing a draft table")
 
 
-#: ``bench --app``'s new views (issue 18): the Plots window's plots (:data:`explorer.views.geometry.PLOT_VIEWS`),
+#: ``bench --app``'s views: the Plots window's plots (:data:`explorer.views.geometry.PLOT_VIEWS`),
 #: then the Texture window's textured mirror, as (mark, window, the scheduler's job, plot to choose or None).
 def app_view_cases() -> tuple[tuple[str, str, str, str | None], ...]:
     from explorer.views.geometry import PLOT_VIEWS
@@ -180,12 +180,15 @@ def app_view_cases() -> tuple[tuple[str, str, str, str | None], ...]:
 def app_view_steps(frames: int) -> list:
     """Drag Lambda (tabulated method, sphere mode) with each plot shown in the Plots window, then the Texture window."""
     steps: list = [{"click": "mode:sphere"}, {"set": {"method": int(BraggMethod.TABULATED)}}, {"wait": 3}]
-    for mark, window, _job, plot in app_view_cases():
+    for mark, window, job, plot in app_view_cases():
         steps += [{"focus": window}, {"wait": 3}]
         if plot is not None:
             steps += [{"click": "plot_combo"}, {"wait": 2}, {"click": f"plot:{plot}"}, {"wait": 3}]
         report = "plots" if window == "Plots" else "texture_view"
-        steps += [{"wait_for": report}] + _drag(f"view {mark}", "param:Lambda", frames) + [{"wait_for": report}]
+        # The textured view's drafts come from a worker thread: on a loaded machine the press is held still
+        # until one is shown, so the row measures drafts rather than the machine's load.
+        hold = {"hold": 600, "hold_until_draft": job} if job == "textured" else {}
+        steps += [{"wait_for": report}] + _drag(f"view {mark}", "param:Lambda", frames, **hold) + [{"wait_for": report}]
     return steps
 
 
@@ -207,7 +210,7 @@ def summarise_view_frames(frames: list[dict]) -> list[dict]:
     return rows
 
 
-#: ``bench --app``'s mesh cases (issue 18): the Sphere window's teapot, lit and under the environment (tabulated method).
+#: ``bench --app``'s mesh cases: the Sphere window's teapot, lit and under the environment (tabulated method).
 APP_MESH_CASES = (("teapot lit", "mode:lit"), ("teapot env", "mode:env"))
 
 

@@ -18,7 +18,7 @@ from explorer.resources import SHADER_DIR
 from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 # --------------------------------------------------------------------------------------------------
-# bench --scaling: how the table and the shading cost grow (issue 22)
+# bench --scaling: how the table and the shading cost grow
 
 SCALING_N = (1, 2, 5, 10, 20, 50, 100, 200, 300, 500, 1000)
 #: Entries (angles) of the converged table computed at once: its first size is 65.

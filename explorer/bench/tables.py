@@ -17,7 +17,7 @@ from explorer.resources import SHADER_DIR
 from explorer.materials.models import BraggMirrorModel, SchlickFresnelModel
 
 # --------------------------------------------------------------------------------------------------
-# bench --tables: host table rebuilds and the tabulated method's per-pixel cost (issue 22)
+# bench --tables: host table rebuilds and the tabulated method's per-pixel cost
 
 #: The mirror of the table timings (n1 = 1, n2 = 1.5, delta = 0.5) at Lambda = 500 nm, and its N values.
 TABLES_MIRROR = {"n1": 1.0, "n2": 1.5, "Lambda": 500.0, "delta": 0.5}

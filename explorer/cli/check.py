@@ -1,7 +1,9 @@
 """
 ``bragg-explorer check MATERIAL [--views …] [--json]``: a material's GLSL against its numpy twin, view by
 view, under the test suite's named tolerances (:mod:`explorer.views.twin_check`). For anyone writing a
-material (docs/plugins.md): the exit status is non-zero when one view is over its tolerance.
+material (docs/plugins.md): the exit status is non-zero when one view is over its tolerance. The sizes are small
+(:data:`explorer.views.twin_check.CHECK_SIZES`): measured on a loaded 2-core llvmpipe machine, 9 s (GGX) to 70 s (a
+spectral stack, whose env integral costs most) a material.
 """
 
 from __future__ import annotations

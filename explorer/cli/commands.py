@@ -481,6 +481,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
 def info(material, as_json, dispersions):
     """Print the parameters of MATERIAL (a file, or a built-in's name such as thin_film), or --dispersions."""
     from explorer.materials.methods import method_labels, opening_values
+    from explorer.materials.twins import capabilities_of
 
     if dispersions:
         from explorer.cli.spectrum import dispersions_listing
@@ -499,6 +500,7 @@ def info(material, as_json, dispersions):
                 shown.update({key: round_integer(shown[key]) for key in ("min", "max", "default")})
         if labels:
             document["methods"] = {str(value): label.partition(" ")[2] for value, label in labels.items()}
+        document["capabilities"] = capabilities_of(loaded).as_json()  # the twin's declaration, from the registry
         click.echo(json.dumps(document, indent=2))
         return
     click.echo(f"{display_path(loaded.path)}: model {loaded.model or '(none)'}, {len(loaded.parameters)} parameters")
@@ -517,8 +519,6 @@ def info(material, as_json, dispersions):
             click.echo(f"  {'':5} {'':{width}} {p.doc}")
         if p.name == "method" and labels:
             click.echo(f"  {'':5} {'':{width}} methods: {', '.join(labels.values())}")
-    from explorer.materials.twins import capabilities_of
-
     click.echo(f"  supports: {capabilities_of(loaded).summary()}")
 
 

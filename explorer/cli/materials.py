@@ -52,6 +52,22 @@ def load(path: str | Path) -> Material:
     return material
 
 
+def load_mirror(path: str | Path, command: str) -> Material:
+    """
+    :func:`load`, for a command that takes a Bragg mirror (``spectrum``, ``design --target-spectrum``): a material whose
+    twin declares ``bragg_spectrum`` (a rough layer's spectrum is its smooth mirror's), else one line that starts with
+    ``command`` (``"spectrum takes"``) and names the materials that do.
+    """
+    from explorer.errors import LocatedError
+    from explorer.materials.twins import capabilities_of, names_with
+
+    loaded = load(path)
+    if not capabilities_of(loaded).bragg_spectrum:
+        mirrors = ", ".join(names_with(lambda c: c.bragg_spectrum))
+        raise LocatedError(loaded.path, None, f"{command} a Bragg mirror ({mirrors}), not model {loaded.model}")
+    return loaded
+
+
 def resolve_values(loaded: Material, preset: str | None, params_file: str | None, assignments, opening: dict | None = None) -> dict:
     """
     The material's values: its defaults, under ``opening`` (default: the app's opening values,

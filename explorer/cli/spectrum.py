@@ -17,27 +17,13 @@ import json
 import click
 import numpy as np
 
-from explorer.cli.materials import load, resolve_values
+from explorer.cli.materials import load_mirror, resolve_values
 from explorer.errors import LocatedError
 from explorer.files import atomic_output, check_output, write_text_atomic
 from explorer.physics import dispersion
 from explorer.physics.natural import NaturalMirror, band_gaps, mirror_spectrum, wavelength_grid
 
 
-
-def is_mirror_material(loaded) -> bool:
-    """Whether the material's structure is a Bragg mirror (its twin declares ``bragg_spectrum``; a rough layer's
-    spectrum is its smooth mirror's)."""
-    from explorer.materials.twins import capabilities_of
-
-    return capabilities_of(loaded).bragg_spectrum
-
-
-def mirror_models() -> str:
-    """The registered materials whose structure is a Bragg mirror, for messages."""
-    from explorer.materials.twins import names_with
-
-    return ", ".join(names_with(lambda c: c.bragg_spectrum))
 
 #: Index parameters that may name a medium.
 INDEX_PARAMETERS = ("n1", "n2", "nh")
@@ -189,9 +175,7 @@ def spectrum_command(material, preset, params_file, assignments, theta_text, as_
     for out, suffixes in ((csv_out, (".csv",)), (plot_out, (".png",))):
         if out is not None:
             check_output(out, suffixes)
-    loaded = load(material)
-    if not is_mirror_material(loaded):
-        raise LocatedError(loaded.path, None, f"spectrum takes a Bragg mirror ({mirror_models()}), not model {loaded.model}")
+    loaded = load_mirror(material, "spectrum takes")
     passed, natural = split_natural(loaded, assignments)
     values = resolve_values(loaded, preset, params_file, passed)
     mirror = natural_mirror(values, natural)

@@ -15,8 +15,8 @@ import math
 import click
 import numpy as np
 
-from explorer.cli.materials import load, warn
-from explorer.cli.spectrum import INDEX_PARAMETERS, NATURAL_PARAMETERS, describe, is_mirror_material, mirror_models
+from explorer.cli.materials import load_mirror, warn
+from explorer.cli.spectrum import INDEX_PARAMETERS, NATURAL_PARAMETERS, describe
 from explorer.errors import LocatedError
 from explorer.files import atomic_output, check_output
 from explorer.physics import dispersion
@@ -130,9 +130,7 @@ def fit_command(material: str, path: str, theta: float, fixes, as_json: bool, pl
     """What ``design --target-spectrum`` prints: the structure as ``--set`` values, the RMS residual; ``--plot``."""
     if plot_out is not None:
         check_output(plot_out, (".png",))
-    loaded = load(material)
-    if not is_mirror_material(loaded):
-        raise LocatedError(loaded.path, None, f"--target-spectrum fits a Bragg mirror ({mirror_models()}), not model {loaded.model}")
+    load_mirror(material, "--target-spectrum fits")
     wavelengths, measured, note = read_measured(path)
     fixed = parse_fixed(fixes)
     fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed)

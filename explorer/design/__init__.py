@@ -33,7 +33,7 @@ Belcour & Barla (2017). A Practical Extension to Microfacet Theory for the Model
 Iridescence. ACM TOG 36(4): Eqs. 2-3 (the film's Airy reflectance).
 Sharma, Wu, Dalal (2005). The CIEDE2000 colour-difference formula. Color Res. Appl. 30(1).
 
-The package by subject (every name is re-exported here, so ``design.NAME`` reads the same):
+The package by subject (every public name is re-exported here, so ``design.NAME`` reads the same):
 
 - :mod:`~explorer.design.base`: the search's settings, its errors, a design parameter and a design model;
 - :mod:`~explorer.design.forward`: the forward models (the coarse batch models, the converged colours) and the
@@ -47,104 +47,10 @@ Colours are compared in CIELAB with CIEDE2000 (:func:`explorer.physics.colorimet
 :func:`explorer.physics.colorimetry.delta_E_2000_lab`).
 """
 
-from explorer.design.base import (  # noqa: F401
-    BATCH,
-    COARSE_DIFF_STEP,
-    COARSE_STEP,
-    DESCENT_SAMPLES,
-    DESCENT_SIGMAS,
-    DESCENT_SPAN,
-    DESCENT_STARTS,
-    DISTINCT_STARTS,
-    FINE_DIFF_STEP,
-    FIRST_PASS_SAMPLES,
-    GOOD_ENOUGH,
-    LOCAL_STARTS,
-    POLISH_DISTINCT,
-    POLISH_SECONDS,
-    POLISHED,
-    POLISHED_ENOUGH,
-    REACHABLE_DELTA_E,
-    REACHED_DELTA_E,
-    REFINE_NFEV,
-    SCAN_BATCH,
-    SCAN_BATCH_SAMPLES,
-    SCAN_KEPT,
-    SCAN_RELATIVE_STEP,
-    SCAN_SHAPES,
-    SCAN_SMOOTH,
-    SCAN_THREADS,
-    SCREEN_SMOOTH,
-    SCREEN_STEP,
-    SECOND_COUNTS,
-    SECOND_PERTURBED,
-    SECOND_SPREAD,
-    SECOND_STARTS,
-    TRY_SEED_STRIDE,
-    DesignCancelled,
-    DesignError,
-    DesignModel,
-    DesignParameter,
-)
-from explorer.design.forward import (  # noqa: F401
-    _BRAGG,
-    _LOG_WEIGHTS,
-    _WEIGHTS,
-    DESIGN_MODELS,
-    DESIGNABLE,
-    _averaged_reflectance,
-    _Geometry,
-    _interpolation_weights,
-    _interpolation_weights_at,
-    _point_reflectance,
-    _where_needed,
-    bragg_converged_rgb,
-    bragg_reflectance_batch,
-    bragg_rgb_batch,
-    bragg_spectra_batch,
-    chebyshev_U_real_N,
-    coarse_nodes,
-    design_model,
-    log_nodes,
-    mirror_of,
-    thin_film_converged_rgb,
-    thin_film_rgb_batch,
-    thin_film_spectra_batch,
-)
-from explorer.design.search import (  # noqa: F401
-    _distinct,
-    _distinct_indices,
-    _host_bounds,
-    _least_squares,
-    _polish,
-    _Problem,
-    _refine_coarse,
-    _refine_level,
-    _scan_best,
-    _scan_descent,
-    _threaded_scan,
-    _variants,
-)
-from explorer.design.solve import (  # noqa: F401
-    _design_once,
-    _guess_values,
-    _reported_values,
-    design,
-)
-from explorer.design.studies import (  # noqa: F401
-    ROUND_TRIP_ANGLES,
-    _reachable,
-    forward_rgb,
-    random_structure,
-    reachable_chromaticities,
-    reachable_structures,
-    round_trip,
-)
-from explorer.design.targets import (  # noqa: F401
-    DesignResult,
-    Target,
-    check_target_rgb,
-    parameter_box,
-    ranges_of,
-    targets_from_strip,
-)
+# Each subject declares its public names (its __all__); the package only re-exports them. The search's stages are
+# private to explorer.design.search (a test or a study imports them from there).
+from explorer.design.base import *  # noqa: F401,F403
+from explorer.design.forward import *  # noqa: F401,F403
+from explorer.design.solve import *  # noqa: F401,F403
+from explorer.design.studies import *  # noqa: F401,F403
+from explorer.design.targets import *  # noqa: F401,F403

@@ -12,6 +12,14 @@ from typing import Callable
 
 import numpy as np
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["REACHABLE_DELTA_E", "REACHED_DELTA_E", "TRY_SEED_STRIDE", "COARSE_STEP", "SCREEN_STEP", "SCREEN_SMOOTH",
+           "FIRST_PASS_SAMPLES", "SCAN_SHAPES", "SCAN_RELATIVE_STEP", "SCAN_SMOOTH", "SCAN_KEPT", "SCAN_BATCH",
+           "SCAN_BATCH_SAMPLES", "POLISH_SECONDS", "POLISHED_ENOUGH", "LOCAL_STARTS", "REFINE_NFEV", "POLISHED",
+           "DISTINCT_STARTS", "POLISH_DISTINCT", "COARSE_DIFF_STEP", "FINE_DIFF_STEP", "SECOND_COUNTS", "SECOND_PERTURBED",
+           "SECOND_SPREAD", "SECOND_STARTS", "GOOD_ENOUGH", "SCAN_THREADS", "DESCENT_STARTS", "DESCENT_SAMPLES",
+           "DESCENT_SIGMAS", "DESCENT_SPAN", "BATCH", "DesignError", "DesignCancelled", "DesignParameter", "DesignModel"]
+
 #: A target whose CIEDE2000 stays above this is reported as not reachable (about twice a just
 #: noticeable difference).
 REACHABLE_DELTA_E = 2.0

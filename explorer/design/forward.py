@@ -19,6 +19,11 @@ from explorer.materials.twins import capabilities_of
 from explorer.physics import bragg, colorimetry, thinfilm
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["coarse_nodes", "log_nodes", "chebyshev_U_real_N", "bragg_reflectance_batch", "bragg_rgb_batch",
+           "thin_film_rgb_batch", "bragg_spectra_batch", "thin_film_spectra_batch", "mirror_of", "bragg_converged_rgb",
+           "thin_film_converged_rgb", "DESIGN_MODELS", "DESIGNABLE", "design_model"]
+
 # --------------------------------------------------------------------------------------------------
 # Forward models
 
@@ -79,23 +84,16 @@ def log_nodes(ratio: float) -> tuple[np.ndarray, np.ndarray]:
 
 def chebyshev_U_real_N(a: ArrayLike, N: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
-    :func:`explorer.physics.bragg.chebyshev_U` for a real (array) ``N``: ``sin(N t) / sin t`` continues the
-    polynomials to non-integer cell counts, which lets the coarse search treat ``N`` as continuous.
+    :func:`explorer.physics.bragg.chebyshev_U` for a real (array) ``N``, with the band edges' limits ``N`` and
+    ``N - 1`` where ``|sin t| < 1e-9`` (the coarse search's continuous ``N`` lands there at any value).
     """
+    U_N1, U_N2, scale = bragg.chebyshev_U(a, N)
     in_band = np.abs(a) < 1.0
-    t = np.arccos(np.clip(a, -1.0, 1.0))
-    safe_sin_t = np.where(in_band, np.sin(t), 1.0)
-    U_N1_band = np.sin(N * t) / safe_sin_t
-    U_N2_band = np.sin((N - 1.0) * t) / safe_sin_t
-    x = np.maximum(np.arccosh(np.maximum(np.abs(a), 1.0)), 1e-12)
-    h = bragg.one_minus_exp_minus_2x
-    ratio_N2 = np.exp(-x) * h((N - 1.0) * x) / h(N * x)
-    scale_gap = np.exp(-(N - 1.0) * x) * h(x) / h(N * x)
-    # Band edges: the limits N and N - 1 (sin t -> 0) without 0/0.
-    edge = in_band & (np.abs(np.sin(t)) < 1e-9)
-    U_N1 = np.where(in_band, np.where(edge, N, U_N1_band), 1.0)
-    U_N2 = np.where(in_band, np.where(edge, N - 1.0, U_N2_band), np.sign(a) * ratio_N2)
-    return U_N1, U_N2, np.where(in_band, 1.0, scale_gap)
+    edge = in_band & (np.abs(np.sin(np.arccos(np.clip(a, -1.0, 1.0)))) < 1e-9)
+    if edge.any():
+        N = np.broadcast_to(np.asarray(N, dtype=np.float64), U_N1.shape)
+        U_N1, U_N2 = np.where(edge, N, U_N1), np.where(edge, N - 1.0, U_N2)
+    return U_N1, U_N2, scale
 
 
 def bragg_reflectance_batch(
@@ -168,7 +166,7 @@ def _point_reflectance(a, N, r1, t1, e_psi, r_h1) -> np.ndarray:
     """``|r_hN|^2`` of :func:`bragg_reflectance_batch` at its samples (Appendix D, ``N`` real)."""
     U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
     r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
-    return np.abs((r_N + r_h1) / (1.0 + r_h1 * r_N)) ** 2
+    return np.abs(bragg.reflection_coefficient_host(r_N, r_h1)) ** 2
 
 
 def _averaged_reflectance(r1, t1, omega, p1, r_h1, a) -> np.ndarray:

@@ -31,6 +31,9 @@ from explorer.design.forward import design_model
 from explorer.design.search import _distinct, _distinct_indices, _polish, _Problem, _refine_coarse, _scan_best, _scan_descent, _variants
 from explorer.design.targets import DesignResult, Target, check_target_rgb, parameter_box
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["design"]
+
 
 def design(
     model_name: str,

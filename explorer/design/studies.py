@@ -16,6 +16,10 @@ from explorer.design.solve import design
 from explorer.design.targets import DesignResult, Target, parameter_box
 from explorer.physics import colorimetry
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["forward_rgb", "reachable_structures", "reachable_chromaticities", "ROUND_TRIP_ANGLES", "random_structure",
+           "round_trip"]
+
 
 def forward_rgb(model_name: str, values: Mapping[str, float], theta_deg: ArrayLike) -> np.ndarray:
     """The converged colours of a structure at angles (degrees): what :func:`design` reports as achieved."""

@@ -14,6 +14,9 @@ from numpy.typing import ArrayLike
 from explorer.design.base import REACHABLE_DELTA_E, DesignError, DesignModel, DesignParameter
 from explorer.physics import colorimetry
 
+#: The public names (re-exported by :mod:`explorer.design`).
+__all__ = ["check_target_rgb", "targets_from_strip", "Target", "DesignResult", "ranges_of", "parameter_box"]
+
 
 def check_target_rgb(rgb: ArrayLike, what: str = "colour") -> np.ndarray:
     """

@@ -15,18 +15,20 @@ from explorer import design
 from explorer.design import ranges_of
 from explorer.dev.design_fidelity import truth_targets
 from explorer.materials.brd import load_material
+from explorer.materials.models import BraggMirrorModel
 from explorer.resources import material_path
 
 COUNT, SEED = 50, 0
+MIRROR = BraggMirrorModel.name
 
 
 def main() -> None:
-    ranges = ranges_of(load_material(material_path("bragg_mirror")))
+    ranges = ranges_of(load_material(material_path(MIRROR)))
     rng = np.random.default_rng(SEED)
     medians = []
     for index in range(COUNT):
-        truth = design.random_structure("bragg_mirror", ranges, rng)
-        result = design.design("bragg_mirror", truth_targets(truth), ranges, seed=SEED + index, guesses=[truth])
+        truth = design.random_structure(MIRROR, ranges, rng)
+        result = design.design(MIRROR, truth_targets(truth), ranges, seed=SEED + index, guesses=[truth])
         medians.append(result.median_delta_e2000)
         print(f"{index:3d}  median ΔE2000 {result.median_delta_e2000:.3f}, {result.seconds:.2f} s", flush=True)
     medians = np.array(medians)

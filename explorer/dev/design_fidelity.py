@@ -16,10 +16,14 @@ from pathlib import Path
 import numpy as np
 
 from explorer import design
+from explorer.design import search
 from explorer.design import ranges_of
 from explorer.materials.brd import load_material
+from explorer.materials.models import BraggMirrorModel
 from explorer.resources import SOURCE_ROOT, material_path
 
+#: The material the round trip designs (its twin's name).
+MIRROR = BraggMirrorModel.name
 #: (relative step of the scan's log grid, fringes averaged below this fraction of lambda).
 SETTINGS = ((design.SCAN_RELATIVE_STEP, design.SCAN_SMOOTH), (0.005, 0.003), (0.002, 0.003), (0.001, 0.001))
 
@@ -36,10 +40,10 @@ def misses(path: Path) -> list[int]:
 
 def round_trip_truths(count: int) -> tuple[dict, design.DesignModel, list[dict]]:
     """The mirror's ranges and model, and the round trip's first ``count`` true structures (seed 0)."""
-    ranges = ranges_of(load_material(material_path("bragg_mirror")))
+    ranges = ranges_of(load_material(material_path(MIRROR)))
     rng = np.random.default_rng(0)
-    truths = [design.random_structure("bragg_mirror", ranges, rng) for _ in range(count)]
-    return ranges, design.design_model("bragg_mirror"), truths
+    truths = [design.random_structure(MIRROR, ranges, rng) for _ in range(count)]
+    return ranges, design.design_model(MIRROR), truths
 
 
 def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]]:
@@ -51,13 +55,13 @@ def round_trip_misses() -> tuple[dict, design.DesignModel, list[int], list[dict]
 
 def truth_targets(truth: dict) -> list[design.Target]:
     """A true structure's converged colours at the round trip's angles, as targets."""
-    colours = design.forward_rgb("bragg_mirror", truth, design.ROUND_TRIP_ANGLES)
+    colours = design.forward_rgb(MIRROR, truth, design.ROUND_TRIP_ANGLES)
     return [design.Target(float(a), tuple(float(c) for c in rgb)) for a, rgb in zip(design.ROUND_TRIP_ANGLES, colours)]
 
 
-def truth_problem(model: design.DesignModel, ranges: dict, truth: dict) -> design._Problem:
+def truth_problem(model: design.DesignModel, ranges: dict, truth: dict) -> search._Problem:
     """The design problem (every parameter free over ``ranges``) whose targets are ``truth``'s colours."""
-    return design._Problem(model, design.parameter_box(model, ranges), {}, truth_targets(truth), None)
+    return search._Problem(model, design.parameter_box(model, ranges), {}, truth_targets(truth), None)
 
 
 def main() -> None:

@@ -15,14 +15,17 @@ from __future__ import annotations
 from explorer import design
 from explorer.design import ranges_of
 from explorer.materials.brd import load_material
+from explorer.materials.models import BraggMirrorModel
+from explorer.materials.thinfilm_model import ThinFilmModel
 from explorer.resources import material_path
 
+MIRROR, FILM = BraggMirrorModel.name, ThinFilmModel.name
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0)
 
 
 def table3(n1, n2, Lambda, delta, N):
     structure = dict(n1=n1, n2=n2, Lambda=Lambda, delta=delta, N=N, nh=1.0)
-    return [design.Target(a, tuple(c)) for a, c in zip(ANGLES, design.forward_rgb("bragg_mirror", structure, ANGLES))]
+    return [design.Target(a, tuple(c)) for a, c in zip(ANGLES, design.forward_rgb(MIRROR, structure, ANGLES))]
 
 
 def of_structure(material, structure):
@@ -30,14 +33,14 @@ def of_structure(material, structure):
 
 
 GALLERY = [
-    ("Jewel beetle (Chrysochroa), green/blue area: Table 3 (a) in air", "bragg_mirror",
+    ("Jewel beetle (Chrysochroa), green/blue area: Table 3 (a) in air", MIRROR,
      table3(1.59, 1.67, 160.0, 0.51, 8), {"nh": 1.0}),
-    ("Jewel beetle, red area: Table 3 (b) in air", "bragg_mirror", table3(1.60, 1.68, 190.0, 0.51, 8), {"nh": 1.0}),
-    ("Jewel beetle, purple area: Table 3 (c) in air", "bragg_mirror", table3(1.60, 1.68, 205.0, 0.51, 6), {"nh": 1.0}),
-    ("Morpho-like lamellae: chitin (1.56) 80 nm, air 110 nm, N = 8 (illustrative values)", "bragg_mirror",
-     of_structure("bragg_mirror", dict(n1=1.0, n2=1.56, Lambda=190.0, delta=110.0 / 190.0, N=8, nh=0.0)), {"n1": 1.0, "nh": 0.0}),
-    ("Insect-wing membrane: chitin (1.57) film of 350 nm in air (illustrative values)", "thin_film",
-     of_structure("thin_film", dict(d=350.0, eta1=1.0, eta2=1.57, eta3=1.0, kappa3=0.0)), {"eta1": 1.0, "eta3": 1.0, "kappa3": 0.0}),
+    ("Jewel beetle, red area: Table 3 (b) in air", MIRROR, table3(1.60, 1.68, 190.0, 0.51, 8), {"nh": 1.0}),
+    ("Jewel beetle, purple area: Table 3 (c) in air", MIRROR, table3(1.60, 1.68, 205.0, 0.51, 6), {"nh": 1.0}),
+    ("Morpho-like lamellae: chitin (1.56) 80 nm, air 110 nm, N = 8 (illustrative values)", MIRROR,
+     of_structure(MIRROR, dict(n1=1.0, n2=1.56, Lambda=190.0, delta=110.0 / 190.0, N=8, nh=0.0)), {"n1": 1.0, "nh": 0.0}),
+    ("Insect-wing membrane: chitin (1.57) film of 350 nm in air (illustrative values)", FILM,
+     of_structure(FILM, dict(d=350.0, eta1=1.0, eta2=1.57, eta3=1.0, kappa3=0.0)), {"eta1": 1.0, "eta3": 1.0, "kappa3": 0.0}),
 ]
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer import design
+from explorer.design import search
 from explorer.dev.design_fidelity import round_trip_misses, truth_problem
 
 DISTANCES = (0.0, 0.005, 0.01, 0.02, 0.05)
@@ -32,11 +33,11 @@ HOST_WINDOW = 0.15
 COUNT_VALUES = 48
 
 
-def profiled(problem: design._Problem, u: np.ndarray, period: float, coordinate: int, values: np.ndarray) -> float:
+def profiled(problem: search._Problem, u: np.ndarray, period: float, coordinate: int, values: np.ndarray) -> float:
     """The scan's best score of ``u`` over ``values`` of one unit coordinate and the periods near ``period``."""
     shapes = np.repeat(u[None], len(values), axis=0)
     shapes[:, coordinate] = values
-    scores, _ = design._threaded_scan(problem, shapes, around=np.full(len(values), period), span=design.DESCENT_SPAN)
+    scores, _ = search._threaded_scan(problem, shapes, around=np.full(len(values), period), span=design.DESCENT_SPAN)
     return float(scores.min())
 
 

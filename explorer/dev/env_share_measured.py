@@ -18,17 +18,18 @@ from explorer.gpu import Renderer
 from explorer.gpu.env import ENVIRONMENT_SAMPLING_WEIGHT, ProgressiveEnvRender
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
-from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggLayerModel, GGXSchlickModel
+from explorer.materials.twins import shipped_file
 from explorer.views.env import ENVIRONMENTS, environment_solid_angle
 from explorer.views.geometry import brdf_view_geometry
 
 SIZE, SPP, SEEDS, CONVERGED_SPP = 32, 64, (1, 2, 3, 4), 16384
-#: (label, material file, overrides): a sharp, a medium and a rough GGX lobe, and a Bragg layer over a base.
+#: (label, twin class of the shipped material, overrides): a sharp, a medium and a rough GGX lobe, and a Bragg layer over a base.
 CASES = (
-    ("ggx alpha 0.05 (sharp)", "ggx_schlick.brd", {"alpha": 0.05, "F0": 0.9}),
-    ("ggx alpha 0.2 (medium)", "ggx_schlick.brd", {"alpha": 0.2, "F0": 0.9}),
-    ("ggx alpha 0.6 (rough)", "ggx_schlick.brd", {"alpha": 0.6, "F0": 0.9}),
-    ("bragg_layer alpha 0.1, rho_d 0.5", "bragg_layer.brd", {"alpha": 0.1, "method": int(BraggMethod.TABULATED), "rho_d": 0.5}),
+    ("ggx alpha 0.05 (sharp)", GGXSchlickModel, {"alpha": 0.05, "F0": 0.9}),
+    ("ggx alpha 0.2 (medium)", GGXSchlickModel, {"alpha": 0.2, "F0": 0.9}),
+    ("ggx alpha 0.6 (rough)", GGXSchlickModel, {"alpha": 0.6, "F0": 0.9}),
+    (f"{BraggLayerModel.name} alpha 0.1, rho_d 0.5", BraggLayerModel, {"alpha": 0.1, "method": int(BraggMethod.TABULATED), "rho_d": 0.5}),
 )
 #: The shares compared: fixed at one half (before), the material's sampling alone, per pixel (after).
 SHARES = {"0.5 fixed": ENVIRONMENT_SAMPLING_WEIGHT, "0 (BRDF only)": 0.0, "per pixel": None}
@@ -50,7 +51,7 @@ def rows(renderer: Renderer) -> list[str]:
     for env_name in ("sky", "studio"):
         environment = ENVIRONMENTS[env_name]()
         for label, path, overrides in CASES:
-            material = load_material(SHADER_DIR / path)
+            material = load_material(shipped_file(path))
             values = material.resolve(overrides)
             converged = _render(renderer, material, values, environment, CONVERGED_SPP, None, seed=99)
             errors = {}
@@ -72,7 +73,7 @@ def sweep_rows(renderer: Renderer) -> list[str]:
     """Per GGX lobe and environment: the best fixed share and the per-pixel share's error relative to it."""
     size, spp = 24, 512
     inside = brdf_view_geometry("lit", size, size)[5]
-    material = load_material(SHADER_DIR / "ggx_schlick.brd")
+    material = load_material(shipped_file(GGXSchlickModel))
 
     def rms(values, environment, share) -> float:
         render = ProgressiveEnvRender(renderer, material, values, environment, size, size, environment_sampling=share, seed=3)

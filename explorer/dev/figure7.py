@@ -30,7 +30,9 @@ def main(argv=None) -> None:
     from explorer.files import atomic_output
     from explorer.materials.brd import load_material
     from explorer.physics.colorimetry import encode_srgb8
-    from explorer.resources import DEFAULT_TEXTURE, SHADER_DIR
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
+    from explorer.resources import DEFAULT_TEXTURE
     from explorer.views.surface_texture import BraggTexture
     from explorer.views.thickness import load_grey
 
@@ -43,7 +45,7 @@ def main(argv=None) -> None:
     if args.accuracy:
         accuracy()
         return
-    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    material = load_material(shipped_file(BraggMirrorModel))
     values = material.resolve({**FIGURE7, "method": args.method})
     size, label = args.size, 24
     texture = np.round(255 * load_grey(DEFAULT_TEXTURE)).astype(np.uint8)
@@ -57,7 +59,7 @@ def main(argv=None) -> None:
             light = LIGHT if view == "textured" else None
             image = render_material(material, values, view, size, size, "gl", light, surface, spp=1)
             options = "--light 0,0" if view == "textured" else "--texture shaders/textures/thickness_noise.png --spp 1"
-            print(f"python3 -m explorer render bragg_mirror --view {view} --mapping {mapping} {sets} {options} "
+            print(f"python3 -m explorer render {material.model} --view {view} --mapping {mapping} {sets} {options} "
                   f"--size {size} --out {mapping}_{view}.png  # {time.perf_counter() - start:.2f} s")
             row.append((caption if view == "textured" else "", Image.fromarray(encode_srgb8(image), "RGB")))
     sheet = Image.new("RGB", (len(panels) * size, 2 * (size + label)), "white")
@@ -81,11 +83,13 @@ def accuracy(size: int = 128) -> None:
     from explorer.materials.brd import load_material
     from explorer.physics import bragg
     from explorer.physics.colorimetry import delta_E_2000
-    from explorer.resources import DEFAULT_TEXTURE, SHADER_DIR
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
+    from explorer.resources import DEFAULT_TEXTURE
     from explorer.views.geometry import disc
     from explorer.views.surface_texture import BraggTexture
 
-    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    material = load_material(shipped_file(BraggMirrorModel))
     _, _, r2 = disc(size, size)
     inside = r2 < 0.98
     start = time.perf_counter()

@@ -75,10 +75,11 @@ def compare_preset(name: str, samples: int = ALBEDO_SAMPLES, spp: int = MAP_SPP,
     from explorer.materials.presets import presets_for
     from explorer.physics import colorimetry, layered
     from explorer.physics.position_free import PositionFree
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
     from explorer.views.albedo import albedo_numpy
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     preset = presets_for(material.path).get(name)
     model = model_for(material, material.resolve(preset.values))
     walker = PositionFree(model.stack, model.tables)
@@ -156,9 +157,10 @@ def plot_preset(row: dict, path: Path) -> None:
 
 def preset_names(prefixes=PREFIXES) -> list[str]:
     from explorer.materials.presets import presets_for
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
 
-    return [name for name in presets_for(material_path("bragg_stack")).presets if name.startswith(tuple(prefixes))]
+    return [name for name in presets_for(shipped_file(BraggStackModel)).presets if name.startswith(tuple(prefixes))]
 
 
 def summary(row: dict) -> dict:

@@ -20,8 +20,8 @@ from explorer.gpu.mesh import MESH_TEMPLATES, mesh_normals, render_mesh
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
 from explorer.materials.merl import tabulate, write_merl
-from explorer.materials.models import model_for
-from explorer.resources import SHADER_DIR
+from explorer.materials.models import BraggMirrorModel, GGXSchlickModel, model_for
+from explorer.materials.twins import shipped_file
 from explorer.views.env import ENVIRONMENTS
 from explorer.views.geometry import brdf_view_geometry
 from explorer.views.mesh import SHAPES, rasterise
@@ -41,7 +41,7 @@ def _median_ms(function) -> float:
 
 
 def mesh_rows(renderer: Renderer) -> list[str]:
-    material = load_material(SHADER_DIR / "bragg_mirror.brd")
+    material = load_material(shipped_file(BraggMirrorModel))
     values = material.resolve({"method": int(BraggMethod.TABULATED)})
     lines = ["| model | triangles | normals pass (ms) | lit frame (ms) | numpy rasteriser (s) | GL vs numpy: pixels compared, max rel. error |",
              "|---|---|---|---|---|---|"]
@@ -93,8 +93,8 @@ def env_rows(renderer: Renderer) -> list[str]:
     inside = brdf_view_geometry("lit", size, size)[5]
     for env_name in ("sky", "studio"):
         environment = ENVIRONMENTS[env_name]()
-        for path, overrides in (("ggx_schlick.brd", {"alpha": 0.6, "F0": 0.9}), ("ggx_schlick.brd", {"alpha": 0.1, "F0": 0.9})):
-            material = load_material(SHADER_DIR / path)
+        for path, overrides in ((GGXSchlickModel, {"alpha": 0.6, "F0": 0.9}), (GGXSchlickModel, {"alpha": 0.1, "F0": 0.9})):
+            material = load_material(shipped_file(path))
             values = material.resolve(overrides)
             errors = []
             for weight in (0.5, 0.0):
@@ -112,7 +112,7 @@ def env_rows(renderer: Renderer) -> list[str]:
 
 def main() -> None:
     renderer = Renderer()
-    print("### Meshes (lit view, bragg_mirror tabulated)\n")
+    print(f"### Meshes (lit view, {BraggMirrorModel.name} tabulated)\n")
     print("\n".join(mesh_rows(renderer)))
     print("\n### MERL tables (an analytic BRDF written as a MERL file)\n")
     print("\n".join(merl_rows(renderer)))

@@ -51,10 +51,11 @@ def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0) -> d
     from explorer.materials.presets import presets_for
     from explorer.physics import colorimetry
     from explorer.physics.position_free import PositionFree
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
     from explorer.views.albedo import albedo_numpy
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     values = dict(material.resolve(presets_for(material.path).get(name).values))
     for k in range(1, 4):
         values[f"alpha_{k}"] = float(alpha)
@@ -135,9 +136,10 @@ def shader_cost(size: int = 256, repeats: int = 7, layers: int = 2) -> dict:
     """
     from explorer.gpu import Renderer
     from explorer.materials.brd import load_material
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     renderer = Renderer()
     cases = {on: material.resolve({"layers": layers, "alpha_1": 0.7, "alpha_2": 0.5, "alpha_3": 0.9, "rho_d": 0.3,
                                    "multiple_scattering": on}) for on in (0, 1)}
@@ -161,9 +163,11 @@ def main(argv=None) -> int:
     parser.add_argument("--cost", action="store_true", help="instead: the shader's cost with and without multiple scattering")
     args = parser.parse_args(argv)
     if args.cost:
+        from explorer.materials.models import BraggStackModel
+
         for layers in (1, 3):
             cost = shader_cost(layers=layers)
-            print(f"bragg_stack lit view {cost['size']}^2, {layers} layer(s), median of {cost['repeats']} interleaved rounds: "
+            print(f"{BraggStackModel.name} lit view {cost['size']}^2, {layers} layer(s), median of {cost['repeats']} interleaved rounds: "
                   f"single scattering {cost['single_ms']:.1f} ms, compensated {cost['compensated_ms']:.1f} ms, "
                   f"ratio {cost['ratio']:.2f}")
         return 0

@@ -24,6 +24,8 @@ from explorer.app.panels.inverse import LobeEdit, material_values, solve
 from explorer.gpu import Renderer
 from explorer.gpu.env import render_env
 from explorer.materials.brd import load_material
+from explorer.materials.lobes_model import LayeredLobesModel
+from explorer.materials.twins import shipped_file
 from explorer.physics.colorimetry import encode_srgb8
 from explorer.physics.inverse import forward_lobes
 
@@ -47,7 +49,7 @@ Image.fromarray(np.concatenate([p[:height] for p in panels], axis=1)).save(OUT /
 print("wrote .github/readme/inverse_classes.png")
 
 # Two members of one class, rendered.
-material = load_material(ROOT / "shaders" / "layered_lobes.brd")
+material = load_material(shipped_file(LayeredLobesModel))
 renderer = Renderer()
 images = {}
 for name, point in POINTS.items():
@@ -76,7 +78,7 @@ with tempfile.TemporaryDirectory() as tmp, virtual_display() as display:
                {"window_screenshot": str(shot)}, {"quit": True}]
     (Path(tmp) / "script.json").write_text(json.dumps(actions))
     env = {**os.environ, "DISPLAY": display, "BRAGG_EXPLORER_NO_SETUP": "1", "PYTHONPATH": str(ROOT)}
-    subprocess.run([sys.executable, "-m", "explorer.cli.commands", "open", str(ROOT / "shaders" / "layered_lobes.brd"),
+    subprocess.run([sys.executable, "-m", "explorer.cli.commands", "open", str(shipped_file(LayeredLobesModel)),
                     "--script", str(Path(tmp) / "script.json"), "--window-size", "1280x1000"], cwd=tmp, env=env, check=True)
     window = Image.open(shot).convert("RGB")
     window.crop((window.width * 26 // 100, 0, window.width, 640)).save(OUT / "inverse_app.png", optimize=True)

@@ -15,6 +15,7 @@ from PIL import Image
 
 from explorer.gpu.env import render_env
 from explorer.gpu.renderer import Renderer
+from explorer.materials.lobes_presets import PRESET_FILE
 from explorer.materials.presets import load_presets
 from explorer.physics.colorimetry import encode_srgb8
 
@@ -23,7 +24,7 @@ SIZE, SPP = 144, 96
 NAMES = ["figure18_queen", "figure18a_rook", "figure18a_knight", "figure14a_conductor", "figure14a_coated",
          "figure19a_subtle_haze", "figure19b_haze", "figure19c_strong_haze", "figure20_coloured_highlight", "figure20_coloured_halo"]
 
-presets = load_presets(ROOT / "shaders" / "presets" / "layered_lobes.toml")
+presets = load_presets(PRESET_FILE)
 renderer = Renderer()
 tiles = []
 for name in NAMES:

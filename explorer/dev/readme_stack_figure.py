@@ -14,7 +14,9 @@ from PIL import Image
 
 from explorer.gpu import Renderer
 from explorer.gpu.env import render_env
-from explorer.materials.presets import load_presets
+from explorer.materials.models import BraggStackModel
+from explorer.materials.presets import presets_for
+from explorer.materials.twins import shipped_file
 from explorer.physics.colorimetry import encode_srgb8
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -23,7 +25,7 @@ NAMES = ["figure1_left_alpha0025", "figure1_left_alpha01", "figure1_left_alpha04
          "figure1_right_alpha0025", "figure1_right_alpha01", "figure1_right_alpha04", "figure1_stacked_pair",
          "table3_green_blue", "table3_red", "table3_purple"]
 
-presets = load_presets(ROOT / "shaders" / "presets" / "bragg_stack.toml")
+presets = presets_for(shipped_file(BraggStackModel))
 renderer = Renderer()
 tiles = []
 for name in NAMES:

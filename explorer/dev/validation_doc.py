@@ -32,6 +32,8 @@ from pathlib import Path
 from explorer import resources
 from explorer.errors import OutputError
 from explorer.files import write_text_atomic
+from explorer.materials.models import BraggStackModel
+from explorer.materials.thinfilm_model import ThinFilmModel
 
 DEFAULT_OUT = Path("docs/validation.md")
 
@@ -181,7 +183,7 @@ SECTIONS: tuple[Section, ...] = (
               "between successive K (Simpson's rule), K doubling until one comparison changes the cell's share of the "
               "colour by less than 2e-4 of the row's brightest channel divided among the 472 cells; only the cells beside "
               "band edges and under narrow resonances refine further (to 1/1024 nm). Thin films "
-              "(`thinfilm.reference_rgb`) and the layer tables of `bragg_stack.brd` (Eq. 28) use the same hat averages.",
+              f"(`thinfilm.reference_rgb`) and the layer tables of `{BraggStackModel.name}.brd` (Eq. 28) use the same hat averages.",
         after="*The table* (method 3) refines where the second differences of its 256 entries say that linear "
               "interpolation may miss by more than 5e-4, up to 4081 entries (the colour turns fastest near Brewster's "
               "angle, where the p band gap closes). *GL, method 0*: `wavelength_step = 1` is the paper's sum; at 1/32 nm "
@@ -191,7 +193,7 @@ SECTIONS: tuple[Section, ...] = (
               "columns, and so does θ = 89.75°, beyond the 89.5° in scope."),
     Section(
         "thin-film", "Thin films (Belcour & Barla 2017)", "python3 -m explorer bench --thin-film --markdown", _thin_film,
-        prose="ΔE2000 of the thin-film methods of `thin_film.brd` on Figure 7's film and every thin-film preset, and "
+        prose=f"ΔE2000 of the thin-film methods of `{ThinFilmModel.name}.brd` on Figure 7's film and every thin-film preset, and "
               "their frame time on a lit sphere relative to plain GGX with Schlick's Fresnel.",
         reduction=f"a {BENCH_SIZE}² sphere (the command's default: 512²)"),
     Section(
@@ -201,7 +203,7 @@ SECTIONS: tuple[Section, ...] = (
               "Slice view (θh across, θd down, φd = 90°) of the Figure 8 layer (Λ = 500 nm, δ = 0.5, N = 20) with "
               "ρd = 0: each approximation against the converged reference per pixel, over pixels with Y > 0.01; where "
               "the lobe is brighter than white (grazing rows) L* exceeds 100 and the maxima come from there. Stacks "
-              "(`bragg_stack.brd`): the tables' rebuild after a parameter change, the GL time of a `lit` frame, and "
+              f"(`{BraggStackModel.name}.brd`): the tables' rebuild after a parameter change, the GL time of a `lit` frame, and "
               "how far the tabulated R_λ (Table 2's Model-LUT) moves Eq. 34 from Yeh's R_λ at the exact angle (Model).",
         after="With ρd = 0 every method shares the lobe D G1 G1 / (4 cos θi cos θo) and differs only in R_rgb(θd). "
               "Tables under Appendix D's host take the complex float64 path of Yeh's reflectance, hence their cost.",

@@ -359,9 +359,10 @@ def lobes_rows(tmm_stacks: int = 20, fgd_samples: int = 150, fgd_count: int = 40
                seed: int = 0, progress: Progress = None) -> dict:
     """Every check of :func:`lobes_markdown`, as a JSON-able document (GL parts need an EGL context)."""
     from explorer.materials.brd import load_material
+    from explorer.materials.lobes_model import LayeredLobesModel
     from explorer.materials.models import model_for
+    from explorer.materials.twins import shipped_file
     from explorer.physics import lobes_fgd
-    from explorer.resources import SHADER_DIR
 
     rng = np.random.default_rng(seed)
     document: dict = {}
@@ -394,7 +395,7 @@ def lobes_rows(tmm_stacks: int = 20, fgd_samples: int = 150, fgd_count: int = 40
         errors.append(abs(ours - float(brute_force_fgd(cos_theta, alpha, eta, count=fgd_count).mean(axis=0))))
     document["fgd"] = {"samples": fgd_samples, "median": float(np.median(errors)), "p95": float(np.percentile(errors, 95))}
     _say(progress, f"lobes: white furnace, {len(FURNACE_STACKS)} stacks")
-    material = load_material(SHADER_DIR / "layered_lobes.brd")
+    material = load_material(shipped_file(LayeredLobesModel))
     o, d_omega = hemisphere(furnace_count)
     albedo = 0.0
     for overrides in FURNACE_STACKS:
@@ -411,8 +412,8 @@ def lobes_rows(tmm_stacks: int = 20, fgd_samples: int = 150, fgd_count: int = 40
 def _lobes_gl(material, gl_size, lit_size: int, repeats: int, progress: Progress) -> dict:
     from explorer.gpu import Renderer
     from explorer.materials.brd import load_material
-    from explorer.materials.models import model_for
-    from explorer.resources import SHADER_DIR
+    from explorer.materials.models import GGXSchlickModel, model_for
+    from explorer.materials.twins import shipped_file
     from explorer.views.geometry import rim_distance
     from explorer.views.render import render_numpy
 
@@ -430,7 +431,7 @@ def _lobes_gl(material, gl_size, lit_size: int, repeats: int, progress: Progress
             scale = np.maximum(np.abs(reference).max(axis=-1), GL_FLOOR)
             worst = max(worst, float((np.abs(gl - reference).max(axis=-1) / scale)[compared].max()))
     _say(progress, f"lobes: a {lit_size}² lit frame, 1-4 interfaces and GGX + Schlick, {repeats} repeats")
-    cases = [("GGX + Schlick", load_material(SHADER_DIR / "ggx_schlick.brd"), {})]
+    cases = [("GGX + Schlick", load_material(shipped_file(GGXSchlickModel)), {})]
     cases += [(f"{n} interface{'s' * (n > 1)}", material, {"layers": n}) for n in (1, 2, 3, 4)]
     resolved = [(name, m, m.resolve(o)) for name, m, o in cases]
     for _, m, values in resolved:  # compile and warm every program first

@@ -1,5 +1,5 @@
 """
-A 1D RGB table over cos theta packed for one texel fetch a lookup (issue 22 item 3): texel ``i`` of an
+A 1D RGB table over cos theta packed for one texel fetch a lookup: texel ``i`` of an
 RGBA32UI buffer texture holds the interval between entries ``i`` and ``i + 1``, both entries' channels as
 signed 16-bit codes and the interval's own scale. GLSL twin: ``shaders/lib/bragg.glsl``'s
 ``packed_tabulated_rgb`` (the tabulated method's ``tabulated_rgb`` on a ``usamplerBuffer``).

@@ -41,7 +41,7 @@ class BufferTexture:
     ``components``, ``dtype``, ``use``, ``write`` and ``release`` of a moderngl texture, which is all
     :class:`GLResources` and the renderer's draw ask of one.
 
-    Why (issue 22, docs/performance.md *Tabulated shading*): on Mesa's llvmpipe its ``texelFetch`` skips
+    Why (docs/performance.md *Tabulated shading*): on Mesa's llvmpipe its ``texelFetch`` skips
     the 2D path's wrap and coordinate work (two float fetches and a ``mix``: ~13% less CPU than from a 2D
     texture), and a packed table (:mod:`explorer.gpu.packed_tables`) needs one fetch a lookup.
     """

@@ -66,6 +66,13 @@ class Capabilities:
                  f"design {'yes' if self.design else 'no'}"]
         return "; ".join(parts + kinds)
 
+    def as_json(self) -> dict:
+        """The declaration as JSON (``info --json``): ``methods`` as the enumeration's member names."""
+        document = {f.name: getattr(self, f.name) for f in fields(self)}
+        document["methods"] = None if self.methods is None else [m.name for m in self.methods]
+        document.update(albedo=list(self.albedo), exports=list(self.exports))
+        return document
+
     def supports(self, what: str) -> bool:
         """Whether ``what`` (an albedo engine, an export target, ``numpy`` or ``design``) is declared."""
         if what in ("numpy", "design"):
@@ -129,7 +136,20 @@ def twin(cls: type) -> type:
         if lacking:
             raise TypeError(f"{cls.__name__}: a Mitsuba export needs {', '.join(lacking)}")
     TWINS[name] = cls
+    for listener in tuple(_LISTENERS):
+        listener(cls)
     return cls
+
+
+#: What runs on each registration (:func:`on_register`): a consumer above the registry that keeps its own table of
+#: plugins (Mitsuba's BSDFs, once :func:`explorer.mitsuba.register` has run) hears of a twin registered later.
+_LISTENERS: list[Callable[[type], None]] = []
+
+
+def on_register(listener: Callable[[type], None]) -> None:
+    """Call ``listener(cls)`` for every twin registered from now on (once per listener)."""
+    if listener not in _LISTENERS:
+        _LISTENERS.append(listener)
 
 
 def registry() -> dict[str, type]:
@@ -172,3 +192,13 @@ def names_with(predicate: Callable[[Capabilities], bool]) -> tuple[str, ...]:
 def supporting(what: str) -> tuple[str, ...]:
     """The registered twins that support ``what`` (:meth:`Capabilities.supports`), sorted: for messages."""
     return names_with(lambda c: c.supports(what))
+
+
+def shipped_file(cls: type):
+    """
+    The shipped material file (``shaders/NAME.brd``) of a built-in twin class: how a study script names the
+    material it studies, by the plugin's own declaration rather than by a string.
+    """
+    from explorer.resources import material_path
+
+    return material_path(cls.name)

@@ -23,7 +23,7 @@ from explorer.mitsuba.bsdfs import plugin_names
 from explorer.mitsuba.variants import llvm_works
 
 
-#: The agreement issue 19 asks of Mitsuba against GL: median per-pixel ΔE2000 (at 64x64, 1024 spp).
+#: The agreement asked of Mitsuba against GL: median per-pixel ΔE2000 (at 64x64, 1024 spp).
 ACCEPTED_DELTA_E = 1.0
 
 
@@ -75,7 +75,7 @@ def run_mitsuba_bench(as_json: bool = False, size: int = 64, spp: int = 64, vari
         echo(json.dumps({"size": size, "spp": spp, "rows": rows}, indent=2))
     else:
         echo(f"env view, {size}x{size}, {spp} spp: seconds per frame; median per-pixel ΔE2000 against GL "
-             f"(issue 19's acceptance: <= {ACCEPTED_DELTA_E:g} at 64x64, 1024 spp)")
+             f"(accepted: <= {ACCEPTED_DELTA_E:g} at 64x64, 1024 spp)")
         for row in rows:
             verdict = "" if row["engine"] == "gl" else "  ok" if row["delta_e_vs_gl"] <= ACCEPTED_DELTA_E else "  above"
             echo(f"  {row['material']:<14} {row['engine']:<26} {row['seconds']:8.3f} s   ΔE {row['delta_e_vs_gl']:.2f}{verdict}")

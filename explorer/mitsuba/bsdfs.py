@@ -130,8 +130,8 @@ def _float_property(props, name: str, default):
         return tuple(float(c) for c in np.ravel(np.asarray(value)))[:3]
 
 
-def define_bsdfs(mi, dr) -> dict[str, type]:
-    """The plugin classes (:func:`plugin_names`) for the active variant ``mi.variant()``."""
+def define_bsdfs(mi, dr, names=None) -> dict[str, type]:
+    """The plugin classes of ``names`` (default :func:`plugin_names`) for the active variant ``mi.variant()``."""
     spectral = "spectral" in mi.variant()
     jit = dr.is_jit_v(mi.Float)
 
@@ -341,6 +341,6 @@ def define_bsdfs(mi, dr) -> dict[str, type]:
             return bs, dr.select(active, spectrum_from_numpy(weight), 0.0)
 
     classes = {}
-    for name in plugin_names():
+    for name in plugin_names() if names is None else names:
         classes[name] = type(name, (ExplorerBSDF,), {"material_name": name, "dirac": twin_class(name).capabilities.dirac})
     return classes

@@ -15,6 +15,11 @@ pixel under a :class:`Tolerance`:
   mirror (method 1) misses 2e-3 at isolated near-zero channels (1e-4 on a channel of 0.017 in a pixel
   of 0.665).
 
+- :data:`ENV_TOLERANCE`, the env view's: the GPU's Monte Carlo mean against the twin's exact integral, within
+  :data:`ENV_STANDARD_ERRORS` of the pixel's standard error plus the quadrature's own :data:`ENV_QUADRATURE_RTOL`;
+- :data:`ALBEDO_TOLERANCE`, the directional albedo's (the gl engine's scatter sum against the numpy quadrature):
+  :data:`ALBEDO_ATOL` absolute per channel.
+
 :func:`tolerance_for` picks one by view. The test suite (``tests/twins.py``) and ``bragg-explorer check``
 (:func:`check_material`, for anyone writing a material) share all of it.
 """
@@ -42,9 +47,23 @@ RIM_EXCLUSION = 1e-4
 COLOUR_VIEWS = ("gradient", "sphere")
 #: The light of each BRDF view in the comparisons: off the x axis, so that phi matters.
 LIGHTS = {"lit": (30.0, 120.0), "slice": None, "scatter": (50.0, 200.0)}
-#: The views ``check`` compares, and their sizes there: small (the spectral references run per pixel).
+#: The env view: a pixel within this many standard errors of its Monte Carlo mean (P(|z| > 5.5) ~ 4e-8 a value) ...
+ENV_STANDARD_ERRORS = 5.5
+#: ... plus the twin's quadrature's own error, relative (measured: < 2e-4 against twice the subdivisions).
+ENV_QUADRATURE_RTOL = 1e-3
+#: The directional albedo: the gl engine's scatter sum against the numpy quadrature, absolute per channel.
+ALBEDO_ATOL = 1e-3
+#: The angles of incidence (degrees) of ``check``'s albedo comparison.
+ALBEDO_THETA = (20.0, 70.0)
+#: The views ``check`` compares, and their sizes there: small (the spectral references run per pixel). The env view
+#: is 12^2 at :data:`ENV_SPP` samples per pixel, compared at :data:`ENV_PIXELS` of them (the twin's exact integral costs
+#: up to ~0.5 s a pixel); the albedo is
+#: one row of :data:`ALBEDO_THETA`'s angles (the gl engine's scatter view at its own size, 512^2 or more).
 CHECK_SIZES = {"gradient": (180, 1), "sphere": (32, 32), "lit": (32, 32), "slice": (32, 32), "scatter": (32, 32),
-               "theta_v": (64, 1), "theta_h": (64, 1), "theta_d": (64, 1), "lobe3d": (32, 8)}
+               "theta_v": (64, 1), "theta_h": (64, 1), "theta_d": (64, 1), "lobe3d": (32, 8),
+               "textured": (32, 32), "env": (12, 12), "albedo": (len(ALBEDO_THETA), 1)}
+#: Samples per pixel of ``check``'s env view, and the pixels across its disc where the twin's integral is compared.
+ENV_SPP, ENV_PIXELS = 1024, 16
 
 
 @dataclass(frozen=True)
@@ -54,18 +73,43 @@ class Tolerance:
     name: str
     atol: float
     rtol: float = 0.0
+    #: Monte Carlo images: this many of the pixel's standard error (its largest channel's) on top.
+    standard_errors: float = 0.0
 
-    def allowed(self, reference: np.ndarray) -> np.ndarray:
-        return np.maximum(self.atol, self.rtol * np.abs(reference).max(axis=-1))
+    def allowed(self, reference: np.ndarray, standard_error: np.ndarray | None = None) -> np.ndarray:
+        allowed = np.maximum(self.atol, self.rtol * np.abs(reference).max(axis=-1))
+        if self.standard_errors and standard_error is not None:
+            allowed = allowed + self.standard_errors * np.asarray(standard_error, np.float64).max(axis=-1)
+        return allowed
 
 
 COLOUR_TOLERANCE = Tolerance(f"{GL_ATOL:g} absolute per channel", atol=GL_ATOL)
 BRDF_TOLERANCE = Tolerance(f"{RTOL:g} x max(value, {FLOOR:g})", atol=RTOL * FLOOR, rtol=RTOL)
+ENV_TOLERANCE = Tolerance(f"{ENV_STANDARD_ERRORS:g} standard errors + {ENV_QUADRATURE_RTOL:g} x value", atol=RTOL * FLOOR,
+                          rtol=ENV_QUADRATURE_RTOL, standard_errors=ENV_STANDARD_ERRORS)
+ALBEDO_TOLERANCE = Tolerance(f"{ALBEDO_ATOL:g} absolute per channel", atol=ALBEDO_ATOL)
 
 
 def tolerance_for(view: str) -> Tolerance:
-    """The colour views' absolute tolerance, or the BRDF views' relative one."""
-    return COLOUR_TOLERANCE if view in COLOUR_VIEWS else BRDF_TOLERANCE
+    """The colour views' absolute tolerance, the env view's statistical one, the albedo's, or the BRDF views' relative one."""
+    return {"env": ENV_TOLERANCE, "albedo": ALBEDO_TOLERANCE}.get(view, COLOUR_TOLERANCE if view in COLOUR_VIEWS else BRDF_TOLERANCE)
+
+
+def smooth_environment(width: int = 64, height: int = 32):
+    """
+    The env comparisons' environment (an :class:`explorer.views.env.EnvironmentMap`): a sky gradient, a tint
+    along x and a broad glow toward (0.5, 0.6, 0.62), smooth at every scale, so that the twin's quadrature is
+    converged and the Monte Carlo error is the only one.
+    """
+    from explorer.views.env import EnvironmentMap, uv_to_direction
+
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    d = uv_to_direction(u[None, :], v[:, None])
+    image = 0.5 + 0.3 * d[..., 1:2] * np.array([0.5, 1.0, 1.5]) + 0.2 * d[..., 0:1] * np.array([1.0, 0.5, 0.0])
+    glow = np.array([0.5, 0.6, 0.62]) / np.linalg.norm([0.5, 0.6, 0.62])
+    image = image + 2.0 * np.exp(-(1.0 - d @ glow) / 0.06)[..., None] * np.array([1.0, 0.9, 0.7])
+    return EnvironmentMap(image.astype(np.float32), "<smooth>")
 
 
 def compared_pixels(view: str, width: int, height: int) -> np.ndarray:
@@ -82,6 +126,8 @@ class Twins:
     compared: np.ndarray
     view: str = ""
     light: tuple[float, float] | None = None
+    #: A Monte Carlo GL image's standard error per pixel and channel (the env view), else None.
+    standard_error: np.ndarray | None = None
 
     def __iter__(self):
         return iter((self.gl, self.reference, self.compared))
@@ -179,7 +225,7 @@ def compare(twins: Twins, tolerance: Tolerance | None = None) -> Comparison:
     non_finite = ("numpy twin" if not np.isfinite(reference[compared]).all()
                   else "GLSL" if not np.isfinite(gl[compared]).all() else "")
     error = np.abs(gl.astype(np.float64) - reference).max(axis=-1)
-    allowed = tolerance.allowed(reference)
+    allowed = tolerance.allowed(reference, twins.standard_error)
     ratio = np.where(compared, error / allowed, 0.0)
     ratio = np.where(np.isfinite(ratio), ratio, np.inf)
     worst = np.unravel_index(ratio.argmax(), ratio.shape)
@@ -192,12 +238,93 @@ def compare(twins: Twins, tolerance: Tolerance | None = None) -> Comparison:
 def check_views(material) -> tuple[str, ...]:
     """
     The views of :data:`CHECK_SIZES` that ``material`` supports: the colour views when its shader defines
-    ``reflectance(cos_theta)``, the BRDF views and BRDF plots always.
+    ``reflectance(cos_theta)``, the textured view when it declares ``# texture:``, the albedo when its twin
+    declares both the ``numpy`` and ``gl`` albedo engines, the BRDF views, plots and env view always.
     """
     import re
 
+    from explorer.materials.twins import capabilities_of
+
     has_reflectance = re.search(r"\bvec3\s+reflectance\s*\(", material.shader) is not None
-    return tuple(view for view in CHECK_SIZES if has_reflectance or view not in COLOUR_VIEWS)
+    albedo = {"numpy", "gl"} <= set(capabilities_of(material).albedo)
+    supported = {"textured": getattr(material, "texture", None) is not None, "albedo": albedo}
+    return tuple(view for view in CHECK_SIZES
+                 if supported.get(view, True) and (has_reflectance or view not in COLOUR_VIEWS))
+
+
+def render_env_both(renderer, material, values, size, spp: int = ENV_SPP, environment=None, seed: int = 0,
+                    pixels: int | None = ENV_PIXELS) -> Twins:
+    """
+    The env view on the GPU (its Monte Carlo mean after ``spp`` samples a pixel, and its standard error) and the
+    twin's exact integral (:func:`explorer.views.env.env_integral_numpy`) at :func:`env_pixels`, under ``environment``
+    (default :func:`smooth_environment`).
+    """
+    from explorer.gpu.env import ProgressiveEnvRender
+    from explorer.views.env import env_integral_numpy
+
+    width, height = size
+    environment = smooth_environment() if environment is None else environment
+    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
+    try:
+        while render.samples < spp:
+            render.step(min(spp - render.samples, max(1, render.samples_per_pass)))
+        gl, error = render.image(), render.standard_error()
+        dropped = render.dropped_samples()
+    finally:
+        render.release()
+    if dropped:
+        gl = np.full_like(gl, np.nan)  # samples dropped: the GLSL BRDF returned NaN or infinity somewhere
+    compared = env_pixels(width, height, pixels)
+    rows, columns = np.nonzero(compared)
+    reference = np.zeros((height, width, 3))
+    reference[rows, columns] = env_integral_numpy(model_for(material, values), environment, width, height,
+                                                  np.stack([rows, columns], axis=-1))
+    return Twins(gl, reference, compared, "env", None, error)
+
+
+def env_pixels(width: int, height: int, count: int | None = ENV_PIXELS) -> np.ndarray:
+    """
+    The env view's compared pixels: ``count`` spread evenly over the disc (its float32 rim left out), or every
+    one of them (``count`` None). The twin's exact integral costs up to ~0.5 s a pixel for a spectral stack.
+    """
+    from explorer.views.geometry import brdf_view_geometry
+
+    inside = brdf_view_geometry("lit", width, height)[5] & compared_pixels("env", width, height)  # the same sphere
+    if count is None:
+        return inside
+    chosen = np.flatnonzero(inside)
+    chosen = chosen[np.round(np.linspace(0, chosen.size - 1, min(count, chosen.size))).astype(int)]
+    mask = np.zeros(inside.size, bool)
+    mask[chosen] = True
+    return mask.reshape(inside.shape)
+
+
+def render_albedo_both(renderer, material, values, theta_deg=ALBEDO_THETA) -> Twins:
+    """
+    The directional albedo at ``theta_deg`` by the gl engine (:func:`explorer.views.albedo.albedo_gl`, at the size
+    its twin's lobes need) and by the numpy quadrature (:func:`explorer.views.albedo.albedo_numpy`), as one row.
+    """
+    from explorer.views.albedo import albedo_gl, albedo_numpy, gl_size_for
+
+    model = model_for(material, values)
+    gl = albedo_gl(material, values, theta_deg, renderer=renderer, size=gl_size_for(model), model=model)
+    reference = albedo_numpy(model, theta_deg)
+    return Twins(np.asarray(gl, np.float64)[None], np.asarray(reference, np.float64)[None],
+                 np.ones((1, len(theta_deg)), bool), "albedo")
+
+
+def render_view_both(renderer, material, values, view: str) -> Twins:
+    """``check``'s pair of images of ``view`` at :data:`CHECK_SIZES` (the textured view on the material's default texture)."""
+    if view == "env":
+        return render_env_both(renderer, material, values, CHECK_SIZES["env"])
+    if view == "albedo":
+        return render_albedo_both(renderer, material, values)
+    thickness = None
+    if view == "textured":
+        from explorer.views.surface_texture import default_texture
+
+        thickness = default_texture(material)
+    return render_both(renderer, material, values, view, CHECK_SIZES[view], thickness=thickness)
 
 
 def check_material(renderer, material, values, views=None) -> list[Comparison]:
@@ -207,4 +334,4 @@ def check_material(renderer, material, values, views=None) -> list[Comparison]:
     the view's named tolerance (:func:`tolerance_for`).
     """
     views = check_views(material) if views is None else tuple(views)
-    return [compare(render_both(renderer, material, values, view, CHECK_SIZES[view])) for view in views]
+    return [compare(render_view_both(renderer, material, values, view)) for view in views]

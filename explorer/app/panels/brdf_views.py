@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from explorer.rendering import request_view
 from explorer.app import data
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, record, show_image
@@ -18,12 +19,12 @@ class BrdfViewPanel(Panel):
     caption = ""
     dock = "centre"
 
-    def request(self, uniforms=None, size=(SIDE_VIEW_SIZE, SIDE_VIEW_SIZE)):
+    def requested(self, uniforms=None, size=(SIDE_VIEW_SIZE, SIDE_VIEW_SIZE)):
         state = self.state
         size = tuple(size)
         job = self.scheduler.job(self.view)
-        job.request(state.material, state.values, self.view, size, light=light_vector(state.light, state.camera),
-                    dragging=self.app.dragging, uniforms=uniforms)
+        request_view(job, state.material, state.values, self.view, size, light=light_vector(state.light, state.camera),
+                     dragging=self.app.dragging, uniforms=uniforms)
         return job, size
 
     def progress(self, imgui, job) -> None:
@@ -35,7 +36,7 @@ class BrdfViewPanel(Panel):
         imgui.text_wrapped(self.caption)
         avail = imgui.get_content_region_avail()  # the image fills the window, less its progress line
         side = auto_view_size(avail.x, avail.y - 2.0 * imgui.get_text_line_height_with_spacing())
-        job, size = self.request(size=(side, side))
+        job, size = self.requested(size=(side, side))
         show_image(self.state, self.scheduler.show(self.view, size, job), size, f"{self.view}_image")
         self.progress(imgui, job)
 
@@ -84,7 +85,7 @@ class SlicePanel(BrdfViewPanel):
         imgui.same_line()
         _, state.slice_chroma = imgui.checkbox("chroma", state.slice_chroma)
         record(state, "slice_chroma")
-        job, size = self.request({"slice_phi_d": float(np.radians(state.slice_phi_d))})
+        job, size = self.requested({"slice_phi_d": float(np.radians(state.slice_phi_d))})
         if job.complete and job.error is None:
             key = (job.generation, state.exposure, state.slice_gamma, state.slice_chroma)
             if key != self._shown or state.pending_slice_save:

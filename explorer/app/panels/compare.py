@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from explorer.rendering import request_view
 from explorer.app import data
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
@@ -98,10 +99,10 @@ class ComparePanel(Panel):
         a, b = self.scheduler.job("compare_a"), self.scheduler.job("compare_b")
         # What a smooth mirror reflects in the lit view: the Sphere window's environment and probe turn.
         environment = self.scheduler.env.environment(state.environment).rotated(state.env_rotation)
-        a.request(state.material, values_a, view, size, light=light, dragging=dragging, environment=environment,
-                  uniforms=state.lit_uniforms(state.material, view))
-        b.request(material_b, values_b, view, size, light=light, dragging=dragging, environment=environment,
-                  uniforms=state.lit_uniforms(material_b, view))
+        request_view(a, state.material, values_a, view, size, light=light, dragging=dragging, environment=environment,
+                     uniforms=state.lit_uniforms(state.material, view))
+        request_view(b, material_b, values_b, view, size, light=light, dragging=dragging, environment=environment,
+                     uniforms=state.lit_uniforms(material_b, view))
         if c.heat and self._heat_texture is not None:
             show_image(state, self._heat_texture, size, "compare_image", side=COLOUR_BAR_WIDTH + 8)
             imgui.same_line()

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from explorer.rendering import request_view
 from explorer.app.panels.base import Panel, combo
 from explorer.views.geometry import PLOT_VIEWS, light_direction, view_named
-from explorer.views.plots import CHANNELS, PLOT_SETTINGS, PlotSettings, abscissa, cos_light, gl_uniforms, plotted
+from explorer.views.plots import CHANNELS, PLOT_SETTINGS, PlotSettings, abscissa, cos_light, plotted
 
 #: Samples of a curve, and of the lobe (phi_o x theta_o), in the window; the albedo's (each costs a quadrature).
 CURVE_SAMPLES = 256
@@ -66,8 +67,8 @@ class PlotsPanel(Panel):
         size = plot_size(self.view)
         # The values whose tables are ready (draft ones while dragging), as the sphere's: none built on the spot.
         values = self.scheduler.prefetcher.values(self.state.material, self.state.values, self.app.dragging)
-        job.request(self.state.material, values, self.view, size, light=tuple(float(c) for c in light_direction(light)),
-                    uniforms=gl_uniforms(self.view, settings), dragging=self.app.dragging)
+        request_view(job, self.state.material, values, self.view, size, light=tuple(float(c) for c in light_direction(light)),
+                     plot=settings, dragging=self.app.dragging)
         key = (self.view, settings, light)
         if not job.complete:  # a new curve on its way (scripts wait_for it)
             self.state.plots = {"running": True}

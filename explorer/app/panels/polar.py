@@ -6,6 +6,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from explorer.rendering import request_view
 from explorer.app import data
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel
@@ -42,7 +43,7 @@ class PolarPanel(Panel):
             name = self._job_name(entry)
             material, values = (state.material, state.values) if entry is None else (entry.material, entry.values)
             job = self.scheduler.job(name)
-            job.request(material, values, "scatter", (POLAR_SAMPLES, 1), light=light, dragging=False)
+            request_view(job, material, values, "scatter", (POLAR_SAMPLES, 1), light=light, dragging=False)
             self._jobs.append(name)
             cached = self._curves.get(name)
             if job.complete and (cached is None or cached[0] != job.generation):

@@ -6,6 +6,7 @@ from explorer.app.camera import light_vector
 from explorer.app.scheduler import model_mesh
 from explorer.app.state import ENV_TARGETS, MODES, SPHERE_MODELS, auto_view_size, has_reflectance
 from explorer.app.panels.base import Panel, combo, record, show_image
+from explorer.rendering import request_view
 
 
 class SpherePanel(Panel):
@@ -51,9 +52,9 @@ class SpherePanel(Panel):
                     self._normals = mesh_normals(scheduler.renderer, mesh, *size)
                     self._normals_key = (state.model, size)
                 view, inputs = MESH_TEMPLATES["lit"], {"mesh_normals": self._normals}
-            job.request(state.material, values, view, size, light=light_vector(state.light, state.camera), dragging=dragging,
-                        inputs=inputs, inputs_key=state.model, environment=self._mirror_environment(),
-                        uniforms=state.lit_uniforms(state.material, view))
+            request_view(job, state.material, values, view, size, light=light_vector(state.light, state.camera), dragging=dragging,
+                         inputs=inputs, inputs_key=state.model, environment=self._mirror_environment(),
+                         uniforms=state.lit_uniforms(state.material, view))
             texture = scheduler.show("main", size, job)
         show_image(state, texture, size, "sphere_image", interactive=True)
         if state.mode == "env":  # the env mode's own progress: samples per pixel, converged at the target

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from explorer.rendering import request_view
 from explorer.app import data
 from explorer.app.state import has_reflectance
 from explorer.app.panels.base import Panel
@@ -50,7 +51,7 @@ class StripsPanel(Panel):
         if name not in self._methods:
             self._methods.append(name)
         job = self.scheduler.job(name)
-        job.request(material, values, "gradient", (STRIP_WIDTH, 1), dragging=self.app.dragging)
+        request_view(job, material, values, "gradient", (STRIP_WIDTH, 1), dragging=self.app.dragging)
         texture = self.scheduler.show(name, (STRIP_WIDTH, 1), job)
         avail = imgui.get_content_region_avail().x
         imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(max(avail - 110, 32), 22), imgui.ImVec2(0, 1), imgui.ImVec2(1, 0))

@@ -10,6 +10,7 @@ import functools
 
 import numpy as np
 
+from explorer.rendering import request_view
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.errors import LocatedError
@@ -134,8 +135,8 @@ class TexturePanel(Panel):
             done = "done" if source.render.samples >= self._env_samples else "refining"
             imgui.text(f"env: {source.render.samples} samples per pixel ({done})")
             return
-        job.request(state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
-                    uniforms=self._arguments["uniforms"], inputs=self._arguments["inputs"], dragging=self.app.dragging)
+        request_view(job, state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
+                     surface=self._arguments, dragging=self.app.dragging)
         show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
         imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + ("  (draft table)" if self._draft else "")
                    + (f"  {job.error}" if job.error else ""))

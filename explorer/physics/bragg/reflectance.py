@@ -57,14 +57,16 @@ def one_minus_exp_minus_2x(x: ArrayLike) -> np.ndarray:
     return -np.expm1(-2.0 * x)
 
 
-def chebyshev_U(cos_K_Lambda: ArrayLike, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def chebyshev_U(cos_K_Lambda: ArrayLike, N: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Chebyshev polynomials ``(U_{N-1}, U_{N-2})`` of ``cos K Lambda``, scaled to stay finite.
 
     ``U_{N-1}(cos K Lambda) = sin(N K Lambda) / sin(K Lambda)``: Yeh's ``[M]^N = U_{N-1} M - U_{N-2} I``
     (Appendix D). In a band gap they grow like ``exp(N Im[K] Lambda)`` and overflow for large ``N``, so
     both are returned divided by ``U_{N-1}`` there, with that scale; elsewhere the scale is 1. Band
-    edges (``sin K Lambda -> 0``) take the limits ``U_{N-1} -> N``, ``U_{N-2} -> N - 1`` without 0/0.
+    edges (``sin K Lambda -> 0``) take the limits ``U_{N-1} -> N``, ``U_{N-2} -> N - 1`` without 0/0. ``N`` may be
+    an array broadcast against ``cos_K_Lambda``, and real: ``sin(N t) / sin t`` continues the polynomials to
+    non-integer cell counts (the design's continuous search).
 
     Returns
     -------
@@ -72,7 +74,7 @@ def chebyshev_U(cos_K_Lambda: ArrayLike, N: int) -> tuple[np.ndarray, np.ndarray
         ``scale * U_{N-1}(a) == U_N1`` and ``scale * U_{N-2}(a) == U_N2``.
     """
     a = np.asarray(cos_K_Lambda, dtype=np.float64)
-    N = float(N)
+    N = np.asarray(N, dtype=np.float64)
     in_band = np.abs(a) < 1.0
     # Pass band: K Lambda = t real in (0, pi).
     t = np.arccos(np.clip(a, -1.0, 1.0))
