@@ -58,7 +58,7 @@ def test_a_two_worker_cluster_paints_a_16_pixel_image_that_renders_back(tmp_path
     report = json.loads((out / "report.json").read_text())
     assert report["pixels"] == 256 and report["colours"] == 2 and report["within_1_at_every_angle"] == 1.0
     assert not np.asarray(Image.open(out / "unreachable.png")).any()
-    from explorer.design.paint import read_maps
+    from explorer.views.maps import read_maps
 
     _, maps = read_maps(out)
     assert maps["Lambda"].shape == (16, 16)

@@ -104,9 +104,10 @@ def run_paint_bench(workers: int = 2, seed: int = 0, size: int = 64, as_json: bo
 
     from explorer.design import ranges_of
     from explorer.design.forward import design_model
-    from explorer.cli.design import load
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
 
-    material = load("bragg_mirror")
+    material = load_material(material_path("bragg_mirror"))
     model = design_model(material.model)
     defaults = material.resolve({})
     fixed = {name: float(defaults[name]) for name in model.parameters if name not in ROUND_TRIP_BOX}

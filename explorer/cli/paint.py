@@ -40,7 +40,8 @@ def parse_angles(text: str, images: int) -> tuple[float, ...]:
 
 def read_targets(image: str, image_2: str | None, angles: tuple[float, ...]):
     """The :class:`explorer.design.paint.PaintTargets` of one or two images; a one-line error for a bad file or sizes."""
-    from explorer.design.paint import PaintTargets, read_target_image
+    from explorer.design.paint import PaintTargets
+    from explorer.views.maps import read_target_image
 
     paths = [image] + ([image_2] if image_2 else [])
     read = []
@@ -78,24 +79,18 @@ def start_client(workers: int | None, scheduler: str | None):
     return Client(cluster), cluster
 
 
-def paint_command(material: str, image: str, image_2: str | None, angles_text: str | None, fixes, free, out_maps: str,
+def paint_command(loaded, fixed: dict, image: str, image_2: str | None, angles_text: str | None, out_maps: str,
                   workers: int | None, scheduler: str | None, seed: int, as_json: bool, tries: int | None = None) -> None:
-    """What ``design --target-image`` runs; ``tries``: each cluster's searches (default :data:`explorer.design.paint.CLUSTER_TRIES`)."""
-    from explorer.cli.design import load, parse_fixes
-    from explorer.design import DesignError, design_model, ranges_of
-    from explorer.design.paint import CLUSTER_TRIES, paint, write_maps
-    from explorer.errors import LocatedError, OutputError
+    """What ``design --target-image`` runs for a loaded material and its fixed values; ``tries``: each cluster's searches (default :data:`explorer.design.paint.CLUSTER_TRIES`)."""
+    from explorer.design import DesignError, ranges_of
+    from explorer.design.paint import CLUSTER_TRIES, paint
+    from explorer.views.maps import write_maps
+    from explorer.errors import OutputError
     from explorer.resources import display_path
 
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers starts a local cluster; --scheduler uses an existing one: give one of them")
     angles = parse_angles(angles_text or ("0,45" if image_2 else "0"), 2 if image_2 else 1)
-    try:
-        loaded = load(material)
-        model = design_model(loaded.model)
-        fixed = parse_fixes(fixes, free or DEFAULT_FREE.get(model.name), loaded)
-    except (LocatedError, DesignError) as error:
-        _fail(str(error))
     targets = read_targets(image, image_2, angles)
     out = Path(out_maps)
     try:
@@ -140,9 +135,10 @@ def paint_command(material: str, image: str, image_2: str | None, angles_text: s
 
 def render_maps_command(material: str | None, maps: str, view: str, theta: float | None, out: str, engine: str, exposure: str | None) -> None:
     """``render MATERIAL --maps DIR --view textured [--theta DEG]``: the maps' colours at one angle, one pixel a texel."""
-    from explorer.cli.design import load
     from explorer.design import DesignError, design_model
-    from explorer.design.paint import read_maps
+    from explorer.views.maps import read_maps
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
     from explorer.errors import LocatedError, OutputError
     from explorer.views.images import write_image
     from explorer.views.maps import map_colours
@@ -163,7 +159,7 @@ def render_maps_command(material: str | None, maps: str, view: str, theta: float
     except ValueError as error:
         _fail(str(error))
     try:
-        loaded = load(material or params.get("material", ""))
+        loaded = load_material(material_path(material or params.get("material", "")))
         model = design_model(loaded.model)
     except (LocatedError, DesignError) as error:
         _fail(str(error))

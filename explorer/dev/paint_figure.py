@@ -32,13 +32,15 @@ def main() -> None:
     from distributed import Client, LocalCluster
 
     from explorer.bench.paint import ANGLES, ROUND_TRIP_BOX, _targets, region_maps
-    from explorer.cli.design import load
     from explorer.design import ranges_of
     from explorer.design.paint import paint
     from explorer.views.maps import map_colours
     from explorer.views.tonemap import display_srgb8
 
-    material = load("bragg_mirror")
+    from explorer.materials.brd import load_material
+    from explorer.resources import material_path
+
+    material = load_material(material_path("bragg_mirror"))
     defaults = material.resolve({})
     fixed = {name: float(defaults[name]) for name in ("n1", "n2", "nh")}
     maps = region_maps(args.size, 8, args.seed, ROUND_TRIP_BOX)
