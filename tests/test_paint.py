@@ -23,6 +23,9 @@ ANGLES = (0.0, 45.0)
 #: The material's defaults (n1 = 1, n2 = 1.5, delta = 0.5, N = 20, no host): only Lambda is designed, which keeps the
 #: searches to a second or two each.
 DEFAULTS = dict(n1=1.0, n2=1.5, nh=0.0, delta=0.5, N=20)
+#: A painted structure's colour against tmm's and colour-science's (tests/test_design_independent.py's integral,
+#: 0.5 nm trapezoids): its 20 cells' fringes are narrower than that design test's stacks (measured 0.022).
+INDEPENDENT_DELTA_E = 0.05
 
 
 def _colours(Lambda: float) -> np.ndarray:
@@ -100,6 +103,17 @@ def test_unreachable_colours_are_flagged_and_masked_pixels_skipped():
     assert np.all(np.isnan(result.maps["Lambda"][0])) and np.all(np.isnan(result.delta_e[:, 0]))
     assert np.all(result.delta_e[:, 1:, 2:] < 1.0)
     assert np.all(np.max(result.delta_e[:, 1:, :2], axis=0) > 2.0)
+    # An independent check of a written structure: tmm's spectrum and colour-science's colour (tests/test_design_independent.py)
+    # against the colour the result reports and the target.
+    import colour
+    from test_design_independent import XY_E, lab_of_rgb, mirror_layers, tmm_unpolarised, xyz_of
+
+    structure = {**DEFAULTS, "Lambda": float(result.maps["Lambda"][1, 2])}
+    indices, thicknesses = mirror_layers(structure)
+    for k, theta in enumerate(ANGLES):
+        lab = colour.XYZ_to_Lab(xyz_of(tmm_unpolarised(indices, thicknesses, theta)), XY_E)
+        assert colour.delta_E(lab, lab_of_rgb(result.achieved[k, 1, 2]), method="CIE 2000") <= INDEPENDENT_DELTA_E
+        assert colour.delta_E(lab, lab_of_rgb(reachable[k]), method="CIE 2000") < 1.0
 
 
 def test_a_file_that_is_not_an_image_is_one_line(tmp_path):

@@ -8,8 +8,9 @@ The stages (each timed; each a set of tasks whose results are cached in the outp
 2. their clusters in CIELAB (:func:`explorer.design.pixels.cluster_colours`: k-means, k doubling until every colour
    lies within :data:`CLUSTER_RADIUS` of its centroid);
 3. one design per cluster centre (:func:`explorer.design.design`, the search with its tries);
-4. every colour polished from its cluster's structure (:func:`explorer.design.pixels.polish_whole`, least squares
-   on the coarse model, many colours per task);
+4. the colours on a coarse grid of the image polished from their cluster's structure
+   (:func:`explorer.design.pixels.polish_whole`, least squares on the coarse model, many colours per task), then
+   every other colour from its nearest grid colour's structure;
 5. rounds in which a colour left above :data:`POLISHED_DELTA_E` starts again from its image neighbours' structures
    (and the nearest other clusters'): neighbouring pixels stay in one basin, so the maps stay smooth;
 6. the converged colours (:func:`explorer.design.forward.bragg_converged_rgb`'s reference), with a polish on the
@@ -42,8 +43,8 @@ from explorer.physics import colorimetry
 CLUSTER_RADIUS = 12.0
 #: At most this many clusters (designs).
 MAX_CLUSTERS = 16
-#: Colours polished per task.
-CHUNK = 256
+#: Colours polished per task (small enough that a stage's tasks spread over the workers).
+CHUNK = 64
 #: A colour whose coarse RMS CIEDE2000 stays above this tries its neighbours' structures.
 POLISHED_DELTA_E = 0.5
 #: Rounds of neighbours' starts.
