@@ -135,3 +135,8 @@ def test_targets_of_different_sizes_are_one_line(tmp_path):
 def test_paint_options_need_a_target_image(tmp_path):
     run = run_cli("design", "bragg_mirror", "--target", "0:#3f9f4f", "--out-maps", tmp_path / "maps")
     assert "--target-image" in one_line_error(run)
+
+
+def test_render_maps_of_a_folder_without_maps_is_one_line(tmp_path):
+    run = run_cli("render", "bragg_mirror", "--maps", tmp_path, "--view", "textured", "--engine", "numpy", "--out", tmp_path / "x.npy")
+    assert "params.json" in one_line_error(run)
