@@ -118,6 +118,12 @@ def render_material(
 
         # What the texture varies is the material's declaration ('# texture:'), not its name.
         check_texture_kind(material)
+        if "medium_n2" in values:  # a Bragg mirror's natural layers have no texture mapping (explorer.physics.natural)
+            from explorer.materials.models import natural_mirror_of
+
+            if natural_mirror_of(values) is not None:
+                raise MaterialError(material.path, None, "the textured view varies the paper's mirror only: without k1, k2, "
+                                                         "sigma and media (the sphere, lit and env views show them)")
         thickness = default_texture(material) if thickness is None else thickness
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
     if engine == "numpy":

@@ -161,7 +161,7 @@ def test_cli_set_and_engines_agree_on_a_half(gl_renderer, tmp_path):
 #: Every integer parameter of the shipped materials: declared ``int``.
 SHIPPED_INTEGERS = {
     "bragg_mirror.brd": {"N", "method", "s", "medium_n1", "medium_n2", "medium_nh"},
-    "bragg_layer.brd": {"N", "method", "s"},
+    "bragg_layer.brd": {"N", "method", "s", "medium_n1", "medium_n2", "medium_nh"},
     "bragg_stack.brd": {"layers", "N_1", "N_2", "N_3"},
     "thin_film.brd": {"method"},
     "layered_lobes.brd": {"layers"},

@@ -68,8 +68,9 @@ def test_first_event_is_height_correlated_smith():
     rng = np.random.default_rng(SEED)
     d = np.tile([-np.sin(theta), 0.0, -np.cos(theta)], (n, 1))
     ones = np.ones((n, 1))
-    _, _, _, up, alive, events = microsurface.walk(d, ones, ones.copy(), alpha, lambda c, rows: np.ones((rows.size, 1)), rng)
+    _, _, _, up, alive, events, reflections = microsurface.walk(d, ones, ones.copy(), alpha, lambda c, rows: np.ones((rows.size, 1)), rng)
     assert alive.all() and up.all()
+    np.testing.assert_array_equal(reflections, events)  # white facets: every event is a reflection
     once = np.mean(events == 1)
     # Quadrature over the visible normals (midpoints of the sampler's unit square).
     k = 400
@@ -93,7 +94,8 @@ def test_transparent_layer_is_ballistic():
     d = rng.normal(size=(n, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     ones = np.ones((n, 2))
-    out, beta, _, up, alive, events = microsurface.walk(d, ones, ones.copy(), 1.0, lambda c, rows: np.zeros((rows.size, 2)), rng)
+    out, beta, _, up, alive, events, reflections = microsurface.walk(d, ones, ones.copy(), 1.0, lambda c, rows: np.zeros((rows.size, 2)), rng)
+    assert not reflections.any()
     # Grazing rays zigzag through many facets: a few reach the walk's limit (near the horizon only).
     assert np.mean(alive) > 0.99 and np.all(np.abs(d[~alive, 2]) < 0.05)
     assert not up[alive & (d[:, 2] < 0)].any() and up[alive & (d[:, 2] > 0)].all()
@@ -111,3 +113,20 @@ def test_walk_seeded_and_albedo_only():
         position_free.PositionFree(stack, microsurface="walk").brdf([[0, 0, 1]], [[0, 0, 1]], samples=4)
     with pytest.raises(ValueError, match="microsurface"):
         position_free.PositionFree(stack, microsurface="double")
+
+
+def test_orders_split_the_walk_and_first_order_is_eq17_for_white_facets():
+    """The per-order study's parts add up to what left the layer; with white facets nothing goes down and
+    its first order is the height-correlated Smith term, above Eq. 17's separable one (quadrature)."""
+    from explorer.dev import multiscatter_orders as orders
+
+    half = np.full((361, 471), 0.5, np.float32)
+    parts = orders.walk_orders(half, 0.8, 40.0, (100, 200), 2000, seed=SEED)
+    total = parts["up1"] + parts["up2"] + parts["down0"] + parts["down1"]
+    assert np.all(total > 0.995) and np.all(total <= 1.0)
+    np.testing.assert_allclose(parts["up"], parts["up1"] + parts["up2"])
+    white = np.ones((361, 471), np.float32)
+    parts = orders.walk_orders(white, 0.8, 40.0, (100,), 4000, seed=SEED)
+    assert parts["down0"][0] == 0.0 and parts["down1"][0] == 0.0
+    eq17 = orders.eq17_albedo(white, 0.8, 40.0, (100,))[0]
+    assert eq17 < parts["up1"][0] < eq17 + 0.1, (eq17, parts["up1"])

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, one_line_error, run_cli
+from explorer.materials.media import medium_name
 from explorer.materials.models import GGXSchlickModel
 from explorer.materials.presets import PRESET_DIR, PresetError, all_preset_files, load_presets
 
@@ -41,6 +42,9 @@ def test_preset_resolves_within_range(stem, preset):
             assert values[name] == parameter.coerce(value)
             continue
         assert parameter.min <= float(values[name]) <= parameter.max
+        if isinstance(value, str):  # an index naming a medium: its medium_NAME selects it
+            assert medium_name(values, name) == value
+            continue
         assert float(values[name]) == pytest.approx(float(value))
 
 

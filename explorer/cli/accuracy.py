@@ -71,7 +71,10 @@ def preset_mirrors(preset_files=None) -> list[PresetMirror]:
         capabilities = capabilities_of(preset_file.material)
         for name, preset in preset_file.presets.items():
             if capabilities.bragg_spectrum:  # one Bragg mirror
-                add(model_for(preset_file.material, preset.resolve()).mirror, name, kind)
+                model = model_for(preset_file.material, preset.resolve())
+                if getattr(model, "natural", None) is not None:
+                    continue  # absorbing, dispersive or disordered layers: every method shows the exact table
+                add(model.mirror, name, kind)
             elif capabilities.supports("position-free"):  # a layered Bragg structure: each layer's mirror
                 stack = twin_class(preset_file.material).stack_of(preset_file.material.typed_values(preset.resolve()))
                 for k, layer in enumerate(stack.layers, start=1):

@@ -541,7 +541,7 @@ def presets(material, as_json):
         none = "no presets installed"
     rows = [
         {"name": p.name, "material": display_path(p.material.path), "figure": p.figure,
-         "description": p.description, "values": p.values}
+         "description": p.description, "values": p.values, **({"citation": p.citation} if p.citation else {})}
         for f in files for p in f.presets.values()
     ]
     if as_json:

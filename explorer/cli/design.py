@@ -152,6 +152,10 @@ def _named_values(option: str, items, model, material_model: str, expected: str 
             value = float(value_text)
         except ValueError:
             value = float("nan")
+        if not np.isfinite(value) and option == "--fix" and name in ("n1", "n2", "nh") and value_text.strip() \
+                and not value_text.strip().lower().startswith(("nan", "inf", "-inf", "+inf")):
+            raise click.UsageError(f"{option} {item!r}: the colour design takes an index as a number; a medium is held by "
+                                   f"the spectral fit (design {material_model} --target-spectrum FILE.csv --fix {name}=MEDIUM)")
         if not np.isfinite(value):
             raise click.UsageError(f"{option} {item!r}: the value must be a finite number")
         if name in values:

@@ -473,6 +473,8 @@ class Material:
                 try:
                     values.update(medium_values(self, name, value))
                 except LocatedError as exc:
+                    if exc.path != "--set":  # a medium's file is wrong: its own file and line
+                        raise
                     raise MaterialError(self.path, self.parameter(name).line, f"parameter {name!r}: {exc.message}") from None
                 continue
             if f"medium_{name}" in values and f"medium_{name}" not in overrides:
@@ -483,6 +485,12 @@ class Material:
             except ValueError as exc:
                 # Name the line that declares the parameter: that is where its range is.
                 raise MaterialError(self.path, p.line, f"parameter {name!r}: {exc}") from None
+        if "medium_nh" in values:  # a host naming a medium must be lossless (explorer.materials.media)
+            from explorer.materials.media import host_problem
+
+            problem = host_problem(values)
+            if problem:
+                raise MaterialError(self.path, self.parameter("medium_nh").line, problem)
         return Values(values)
 
     def typed_values(self, values: Mapping[str, object]) -> Values:

@@ -270,6 +270,7 @@ def _parameter_lines(material, values: Mapping[str, object]) -> list[str]:
 def material_tables(material, values: Mapping[str, object], model=None) -> dict[str, np.ndarray]:
     """The library's tables and the material's own (its twin's ``textures()`` for its values), as (height, width, 3) arrays."""
     from explorer.materials.models import model_for
+    from explorer.physics.thinfilm import fourier  # noqa: F401  (registers sensitivity_fourier)
     from explorer.tables import luts
 
     tables = {
@@ -291,6 +292,12 @@ def brdf_text(material, values: Mapping[str, object]) -> str:
 
     if not capabilities_of(material).supports("brdf"):
         raise BrdfExportError(material.path, None, f"no self-contained .brdf export for this material (exports: {', '.join(supporting('brdf'))})")
+    from explorer.materials.media import file_media_in
+
+    files = file_media_in(values)
+    if files:  # the file's sliders hold the shipped media's numbers only
+        raise BrdfExportError(material.path, None, f"{files[0]} is a medium from a file: a .brdf carries the shipped media "
+                                                   "only (give that index as a number)")
     ints = [p.name for p in material.parameters if p.type == "int"]
     shader = round_int_parameters(material.shader, ints)
     model = model_for(material, values)

@@ -53,6 +53,22 @@ def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray
     return layered.integrated_transmissivity(F, 1.0 - R)
 
 
+@functools.lru_cache(maxsize=8)
+def _natural_layer_transmissivity(mirror: "natural.NaturalMirror", alpha: float) -> np.ndarray:
+    """A natural mirror's rough layer: Eq. 28 over its exact transmittance (absorbing layers: ``T < 1 - R``), ``(361, 471)``."""
+    F = layered.transmission_filter_for(alpha)
+    return layered.integrated_transmissivity(F, natural.transmittance_table(mirror, F.theta))
+
+
+@functools.lru_cache(maxsize=16)
+def _natural_transmission_rgb_table(mirror: "natural.NaturalMirror", alpha: float, size: int) -> np.ndarray:
+    """:func:`_transmission_rgb_table` of a natural mirror (its exact transmittance)."""
+    T_rgb = colorimetry.spectrum_to_rgb(_natural_layer_transmissivity(mirror, alpha))
+    table = layered.lookup(T_rgb, np.arccos(np.linspace(0.0, 1.0, size))).astype(np.float32)
+    table.setflags(write=False)
+    return table
+
+
 def host_index(nh):
     """
     The host a mirror's ``nh`` value stands for: a number below 1 means the host is ``n1`` (None), as the shaders
@@ -121,6 +137,8 @@ class BraggMirrorModel:
 
     def spectral_reflectance(self, cos_theta, wavelengths) -> np.ndarray:
         """The smooth mirror's ``R_lambda(theta)`` (Eqs. 2, 9, 10) at ``cos_theta`` ``(n,)`` and wavelengths ``(n, W)`` (Mitsuba's Dirac)."""
+        if self.natural is not None:  # absorbing, dispersive or disordered layers: the exact multilayer
+            return natural.unpolarised_reflectance(self.natural, wavelengths, np.asarray(cos_theta, dtype=np.float64))
         return bragg.bragg_reflectance(np.clip(cos_theta, microfacet.COS_THETA_MIN, 1.0)[:, None], wavelengths, self.mirror)
 
     def texture_table(self, mapping: str) -> np.ndarray:
@@ -265,7 +283,10 @@ class BraggLayerModel(BraggMirrorModel):
     @property
     def transmission_table(self) -> np.ndarray:
         """``T_rgb`` at ``cos theta = k / 255`` (Eq. 28 in RGB), ``(256, 3)`` float32."""
-        return _transmission_rgb_table(self.mirror, float(microfacet.check_alpha(self.alpha)), bragg.TABLE_SIZE)
+        alpha = float(microfacet.check_alpha(self.alpha))
+        if self.natural is not None:
+            return _natural_transmission_rgb_table(self.natural, alpha, bragg.TABLE_SIZE)
+        return _transmission_rgb_table(self.mirror, alpha, bragg.TABLE_SIZE)
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         """The shader's ``BRDF`` for unit vectors ``(..., 3)``; 0 where ``L`` or ``V`` is at or below the surface."""
@@ -290,10 +311,14 @@ class BraggLayerModel(BraggMirrorModel):
         the layer twice, at local directions ``(n, 3)`` above the surface and wavelengths ``(n, W)``.
         """
         lobe, cos_d, _ = microfacet.microfacet_lobe(i, o, np.array([0.0, 0.0, 1.0]), self.alpha)
-        R = bragg.bragg_reflectance(np.maximum(cos_d, microfacet.COS_THETA_MIN)[:, None], wavelengths, self.mirror)
+        if self.natural is not None:  # absorbing, dispersive or disordered layers: the exact multilayer
+            R = natural.unpolarised_reflectance(self.natural, wavelengths, np.maximum(cos_d, microfacet.COS_THETA_MIN))
+        else:
+            R = bragg.bragg_reflectance(np.maximum(cos_d, microfacet.COS_THETA_MIN)[:, None], wavelengths, self.mirror)
         value = lobe[:, None] * R
         if self.rho_d.any():
-            T = _layer_transmissivity(self.mirror, float(self.alpha))
+            T = (_natural_layer_transmissivity(self.natural, float(self.alpha)) if self.natural is not None
+                 else _layer_transmissivity(self.mirror, float(self.alpha)))
             Ti = _interp_wavelength(layered.lookup(T, _theta(i)), wavelengths)
             To = _interp_wavelength(layered.lookup(T, _theta(o)), wavelengths)
             value = value + rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths) / np.pi * Ti * To

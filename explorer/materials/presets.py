@@ -31,6 +31,8 @@ from explorer.resources import MATERIAL_SUFFIXES, PRESET_DIR
 
 #: Keys of a preset table that are not parameter values.
 META_KEYS = ("figure", "description")
+#: Optional keys of a preset table that are not parameter values: a specimen's published source.
+OPTIONAL_META_KEYS = ("citation",)
 _TOML_LINE = re.compile(r"\(at line (\d+), column \d+\)")
 
 
@@ -47,6 +49,8 @@ class Preset:
     #: The preset's own values (as written), in file order.
     values: dict[str, object]
     line: int | None = None
+    #: Where a specimen's numbers come from (None for the papers' figures).
+    citation: str | None = None
 
     def resolve(self, overrides=None) -> dict:
         """The material's values: defaults, then this preset, then ``overrides`` (e.g. ``--set``)."""
@@ -152,7 +156,10 @@ def load_presets(path: str | os.PathLike[str]) -> PresetFile:
         for key in META_KEYS:
             if not isinstance(table.get(key), str) or not table[key].strip():
                 raise PresetError(where, line, f"preset {name!r} needs a {key} = \"...\" line")
-        values = {k: v for k, v in table.items() if k not in META_KEYS}
+        for key in OPTIONAL_META_KEYS:
+            if key in table and (not isinstance(table[key], str) or not table[key].strip()):
+                raise PresetError(where, _find_line(lines, name, key) or line, f"preset {name!r}: {key} must be a non-empty string")
+        values = {k: v for k, v in table.items() if k not in META_KEYS + OPTIONAL_META_KEYS}
         for key, value in values.items():
             key_line = _find_line(lines, name, key) or line
             if isinstance(value, (dict, list)) and not (isinstance(value, list) and len(value) == 3):
@@ -161,7 +168,8 @@ def load_presets(path: str | os.PathLike[str]) -> PresetFile:
                 material.resolve({key: value})
             except MaterialError as error:
                 raise PresetError(where, key_line, f"preset {name!r}: {error.message}") from None
-        result.presets[name] = Preset(name, material, table["figure"], table["description"], values, line)
+        result.presets[name] = Preset(name, material, table["figure"], table["description"], values, line,
+                                      table.get("citation"))
     if not result.presets:
         raise PresetError(where, None, "defines no presets")
     return result

@@ -226,7 +226,8 @@ def define_bsdfs(mi, dr, names=None) -> dict[str, type]:
 
         def _rebuild(self):
             self.model = model_for(self.material, self.values)
-            if not spectral and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
+            natural = getattr(self.model, "natural", None) is not None  # already the exact table, whatever the method
+            if not spectral and not natural and round_integer(self.values.get("method", -1)) == int(BraggMethod.REFERENCE):
                 # The reference method in RGB: its colours over cos(theta) tabulated once (the Bragg
                 # materials' converged table, the film's 1-nm sum at REFERENCE_NODES), looked up per sample.
                 self.model.reflectance = functools.partial(bragg.tabulated_rgb, reference_table(self.model))

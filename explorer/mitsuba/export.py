@@ -110,6 +110,12 @@ def export_scene(material, values: Mapping[str, object], directory: str | os.Pat
 
     if material.model is None or material.model not in _plugin_names():
         raise ExportError(material.path, None, f"no Mitsuba plugin for this material (plugins: {', '.join(_plugin_names())})")
+    from explorer.materials.media import file_media_in
+
+    files = file_media_in(values)
+    if files:  # a scene file is read by another process, which knows the shipped media only
+        raise ExportError(material.path, None, f"{files[0]} is a medium from a file: a Mitsuba scene carries the shipped "
+                                               "media only (give that index as a number, or render with --engine mitsuba)")
     directory = Path(directory)
     if directory.exists() and not directory.is_dir():
         raise ExportError(directory, None, "exists and is not a directory")

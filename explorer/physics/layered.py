@@ -516,10 +516,10 @@ def _compensated_layer(layer, table, compensation, h, theta_d, theta_i, theta_o,
     t_i, t_o = lookup(table.transmissivity, theta_i), lookup(table.transmissivity, theta_o)
     rho_i = multiscatter.occluder_reflectance(t_i, cos_i, alpha)
     rho_o = multiscatter.occluder_reflectance(t_o, cos_o, alpha)
-    # Eq. 17 with G_eff for G1: D(h) G_eff(i) G_eff(o) R(i.h) / (4 cos_i cos_o).
+    # Eq. 17 with the occluders' height-correlated masking-shadowing for G1 G1: D(h) G2 R(i.h) / (4 cos_i cos_o).
     lobe = 0.25 * microfacet.ggx_D(h[..., 2], alpha)[..., None]
-    reflection = (lobe * multiscatter.masking_over_cos(cos_i, alpha, rho_i) * multiscatter.masking_over_cos(cos_o, alpha, rho_o)
-                  * lookup(table.reflectance, theta_d))
+    masking = multiscatter.correlated_masking_over_cos(cos_i, cos_o, alpha, multiscatter.occluder_stop(rho_i), multiscatter.occluder_stop(rho_o))
+    reflection = lobe * masking * lookup(table.reflectance, theta_d)
     m_i, m_o = multiscatter.missing_energy(compensation, theta_i), multiscatter.missing_energy(compensation, theta_o)
     through_i = multiscatter.compensated_transmissivity(
         multiscatter.ballistic_transmissivity(rho_i, multiscatter.effective_masking(cos_i, alpha, rho_i)), m_i, compensation)

@@ -64,7 +64,7 @@ def walk(
     direction: np.ndarray, beta: np.ndarray, pi: np.ndarray, alpha: float,
     reflectance: Callable[[np.ndarray, np.ndarray], np.ndarray], rng: np.random.Generator,
     max_events: int = MAX_WALK_EVENTS,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """
     Walk ``n`` paths through one rough Bragg layer until they leave it.
 
@@ -95,7 +95,10 @@ def walk(
     alive : ndarray of bool, shape (n,)
         ``False`` for paths dropped at ``max_events``.
     events : ndarray of int, shape (n,)
-        Facet events per path (1: single scattering).
+        Facet events per path, reflections and crossings (1: single scattering).
+    reflections : ndarray of int, shape (n,)
+        Of them, reflections: the scattering order (a path reflected once that crossed occluders on its way
+        out is still first order).
     """
     alpha = float(microfacet.check_alpha(alpha))
     d = np.array(direction, dtype=np.float64)
@@ -107,6 +110,7 @@ def walk(
     up = np.zeros(n, dtype=bool)
     alive = np.ones(n, dtype=bool)
     events = np.zeros(n, dtype=np.int64)
+    reflections = np.zeros(n, dtype=np.int64)
     active = np.arange(n)
     for _ in range(max_events + 1):
         if active.size == 0:
@@ -138,6 +142,7 @@ def walk(
         cos_d = np.clip(np.sum(wi * m, axis=-1), 0.0, 1.0)
         R = np.clip(reflectance(cos_d, rows), 0.0, 1.0)
         reflect = rng.random(rows.size) < R[:, 0]
+        reflections[rows] += reflect
         # Reflection: about m, on the same side; crossing: the same direction, on the other side.
         beta[rows] *= np.where(reflect[:, None], R, 1.0 - R)
         pi[rows] *= np.where(reflect[:, None], R, 1.0 - R)
@@ -146,4 +151,4 @@ def walk(
         d[rows] = w_new * np.stack([np.ones_like(side), np.ones_like(side), side], axis=-1)
         u[rows] = np.where(above[rows], ul, 1.0 - ul)
         above[rows] = np.where(reflect, above[rows], ~above[rows])
-    return d, beta, pi, up, alive, events
+    return d, beta, pi, up, alive, events, reflections

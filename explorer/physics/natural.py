@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import multilayer
+from explorer.physics.bragg.mirror import BraggMirror
 from explorer.physics.dispersion import RANGE_NM, Dispersion, complex_index
 
 IndexValue = float | Dispersion
@@ -30,9 +31,11 @@ MIN_STEP_NM = 0.01
 
 
 @dataclass(frozen=True)
-class NaturalMirror:
+class NaturalMirror(BraggMirror):
     """
-    A Bragg mirror with complex, dispersive indices and thickness disorder.
+    A Bragg mirror with complex, dispersive indices and thickness disorder: the paper's mirror
+    (:class:`explorer.physics.bragg.BraggMirror`, whose cell geometry ``Lambda``, ``delta``, ``N``, ``d1``, ``d2``
+    it keeps) with three more things.
 
     Parameters
     ----------
@@ -50,9 +53,6 @@ class NaturalMirror:
 
     n1: IndexValue = 1.0
     n2: IndexValue = 1.5
-    Lambda: float = 500.0
-    delta: float = 0.5
-    N: int = 20
     nh: IndexValue | None = None
     k1: float = 0.0
     k2: float = 0.0
@@ -65,14 +65,6 @@ class NaturalMirror:
             raise ValueError(f"sigma must be in [0, {1.0 / multilayer.TRUNCATION:g}] (a thickness stays >= 0)")
         if isinstance(self.nh, Dispersion) and self.nh.absorbing:
             raise ValueError(f"the host {self.nh.name} absorbs: light comes from a lossless host")
-
-    @property
-    def d1(self) -> float:
-        return self.delta * self.Lambda
-
-    @property
-    def d2(self) -> float:
-        return (1.0 - self.delta) * self.Lambda
 
     def index_1(self, wavelength_nm: ArrayLike) -> np.ndarray:
         return complex_index(self.n1, self.k1, wavelength_nm)
@@ -186,20 +178,78 @@ NATURAL_MAX_SUBSTEPS = 64
 
 def _unpolarised(mirror: NaturalMirror, wavelength_nm: np.ndarray, cos_theta: ArrayLike, realised: np.ndarray) -> np.ndarray:
     """Mean unpolarised R at ``wavelength_nm`` (broadcast against ``cos_theta``), over the rows of ``realised``."""
+    return _unpolarised_rt(mirror, wavelength_nm, cos_theta, realised)[0]
+
+
+def _unpolarised_rt(mirror: NaturalMirror, wavelength_nm: np.ndarray, cos_theta: ArrayLike,
+                    realised: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean unpolarised ``(R, T)`` at ``wavelength_nm`` (broadcast against ``cos_theta``), over the rows of ``realised``."""
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     shape = np.broadcast_shapes(wavelength_nm.shape, cos_theta.shape)
     wavelength_nm = np.broadcast_to(wavelength_nm, shape)
     host, indices, _, base = mirror.layer_stack(wavelength_nm)
     sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
-    R = 0.0
+    R = T = 0.0
     with np.errstate(divide="ignore", invalid="ignore"):  # exact grazing: 0/0 at index-matched interfaces
         for pol in ("s", "p"):
             if realised.shape[0] == 1:  # ordered: N cells by repeated squaring, O(log N)
-                R = R + 0.5 * multilayer.periodic_optics(pol, host, base, indices[0], mirror.d1, mirror.d2, mirror.N,
-                                                         wavelength_nm, sin_theta).R
+                optics = multilayer.periodic_optics(pol, host, base, indices[0], mirror.d1, mirror.d2, mirror.N,
+                                                    wavelength_nm, sin_theta)
+                R_pol, T_pol = optics.R, optics.T
             else:
-                R = R + 0.5 * multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)[0]
-    return np.where(cos_theta <= 0.0, 1.0, R)  # exact grazing: total reflection
+                R_pol, T_pol = multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)
+            R, T = R + 0.5 * R_pol, T + 0.5 * T_pol
+    grazing = cos_theta <= 0.0  # exact grazing: total reflection
+    return np.where(grazing, 1.0, R), np.where(grazing, 0.0, np.nan_to_num(T))
+
+
+#: Angular step (degrees) of a disordered mirror's transmittance table, interpolated linearly in theta
+#: between (disorder smooths the spectra; every 0.25 degree would cost 8 times as many realisations).
+DISORDERED_ANGLE_STEP_DEG = 2.0
+
+
+def transmittance_table(mirror: NaturalMirror, theta: ArrayLike) -> np.ndarray:
+    """
+    The mean unpolarised transmittance into the base at angles ``theta`` (radians, in the host) and the CMFs'
+    wavelengths, ``(n_angles, 471)``: what a rough layer's transmission filter integrates (Eq. 28) where the
+    layers absorb (``T < 1 - R``). Ordered: at every angle, 1-nm samples. Disordered: every
+    :data:`DISORDERED_STEP_NM` nm and :data:`DISORDERED_ANGLE_STEP_DEG` degrees over :func:`colour_realisations`
+    realisations, interpolated linearly.
+    """
+    from explorer.physics import colorimetry
+
+    theta = np.asarray(theta, dtype=np.float64)
+    wavelengths = colorimetry.WAVELENGTHS
+    thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
+    if mirror.sigma == 0.0:
+        return _unpolarised_rt(mirror, wavelengths[np.newaxis, :], np.cos(theta)[:, np.newaxis], thicknesses[np.newaxis, :])[1]
+    realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, colour_realisations(mirror))
+    nodes = np.radians(np.append(np.arange(0.0, 90.0, DISORDERED_ANGLE_STEP_DEG), 90.0))
+    # Only the nodes that bracket the angles asked for.
+    index = np.searchsorted(nodes, np.clip(theta.ravel(), 0.0, nodes[-1]))
+    nodes = nodes[np.unique(np.clip(np.concatenate([index - 1, index]), 0, nodes.size - 1))]
+    coarse = np.append(np.arange(RANGE_NM[0], RANGE_NM[1], DISORDERED_STEP_NM), RANGE_NM[1])
+    T = _unpolarised_rt(mirror, coarse[np.newaxis, :], np.cos(nodes)[:, np.newaxis], realised)[1]
+    T = np.array([np.interp(wavelengths, coarse, row) for row in T])
+    return np.array([np.interp(theta, nodes, column) for column in T.T]).T
+
+
+def colour_realisations(mirror: NaturalMirror) -> int:
+    """Realisations of a disordered mirror's colours: :data:`COLOUR_REALISATIONS`, fewer for thick stacks."""
+    return int(min(COLOUR_REALISATIONS, max(MIN_COLOUR_REALISATIONS, DISORDER_LAYER_BUDGET // (2 * int(mirror.N)))))
+
+
+def unpolarised_reflectance(mirror: NaturalMirror, wavelength_nm: ArrayLike, cos_theta: ArrayLike) -> np.ndarray:
+    """
+    The exact unpolarised ``R_lambda`` at ``cos_theta`` ``(n,)`` (in the host) and ``wavelength_nm`` ``(n, W)``: a
+    spectral renderer's (Mitsuba's) reflectance. With ``sigma > 0`` the mean over :func:`colour_realisations`
+    seeded realisations, the colours' own.
+    """
+    thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
+    realised = (multilayer.disordered_thicknesses(thicknesses, mirror.sigma, colour_realisations(mirror))
+                if mirror.sigma > 0.0 else thicknesses[np.newaxis, :])
+    cos_theta = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    return _unpolarised(mirror, np.asarray(wavelength_nm, dtype=np.float64), cos_theta[:, np.newaxis], realised)
 
 
 def natural_rgb(cos_theta: ArrayLike, mirror: NaturalMirror) -> np.ndarray:
@@ -216,8 +266,7 @@ def natural_rgb(cos_theta: ArrayLike, mirror: NaturalMirror) -> np.ndarray:
     angles, inverse = flat
     thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
     if mirror.sigma > 0.0:
-        realisations = int(min(COLOUR_REALISATIONS, max(MIN_COLOUR_REALISATIONS, DISORDER_LAYER_BUDGET // thicknesses.size)))
-        realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, realisations)
+        realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, colour_realisations(mirror))
         # Disorder smooths the fringes: every DISORDERED_STEP_NM, interpolated linearly to the CMFs' nm.
         coarse = np.append(np.arange(RANGE_NM[0], RANGE_NM[1], DISORDERED_STEP_NM), RANGE_NM[1])
         samples = _unpolarised(mirror, coarse[np.newaxis, :], angles[:, np.newaxis], realised)

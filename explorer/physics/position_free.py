@@ -212,7 +212,7 @@ class PositionFree:
         (transmitted, ballistically after every crossing), its facets reflecting with the layer's ``R_lambda``.
         """
         table = self.reflectance[l]
-        d[at], beta[at], pi[at], up, kept, _ = microsurface.walk(
+        d[at], beta[at], pi[at], up, kept, _, _ = microsurface.walk(
             d[at], beta[at], pi[at], self.alphas[l], lambda cos_d, rows: self._lookup(table, cos_d, wavelength[rows]), rng)
         alive[at[~kept]] = False
         gap[at] = np.where(up, l, l + 1)

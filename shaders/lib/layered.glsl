@@ -90,7 +90,7 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
 // Multiple scattering among a layer's facets (twin of explorer/physics/multiscatter.py and of
 // explorer.physics.layered.single_reflection_spectra with its compensation): per wavelength and layer, the
 // occluders' reflectance rho = 1 - f_t cos / G1 (Eqs. 28, 30), their masking G_eff = 1 / (1 + Lambda rho), Eq. 17
-// with G_eff for G1, the ballistic transmission (1 - rho) G_eff^2 plus the downward share (1 - r) m(theta) of
+// with the height-correlated masking-shadowing of occluders that stop rho (2 - rho) for G1 G1, the ballistic transmission (1 - rho) G_eff^2 plus the downward share (1 - r) m(theta) of
 // the missing light m, and Kulla & Conty's lobe r m(i) m(o) / (pi m_avg) for its upward share.
 // missing_table: rows theta = k 2 deg (k = 0..45) of m, row 46 r, row 47 r / (pi m_avg); channel l layer l.
 float smith_lambda(float c, float alpha) {
@@ -98,8 +98,10 @@ float smith_lambda(float c, float alpha) {
     return (sqrt(c * c + alpha * alpha * (1.0 - c * c)) - c) / (2.0 * c);
 }
 
-vec3 masking_over_cos(float c, vec3 root_minus_c, vec3 rho) {
-    return c > 0.0 ? 2.0 / max(2.0 * c + rho * root_minus_c, vec3(1e-6)) : vec3(0.0);
+// correlated_masking_over_cos of multiscatter.py: G2 / (cos_i cos_o), G2 = 1 / (1 + Lambda_i s_i + Lambda_o s_o),
+// s = rho (2 - rho) the chance an occluder stops the ray (it is passed by crossing the heightfield twice).
+vec3 correlated_masking_over_cos(float ci, float co, vec3 root_i, vec3 root_o, vec3 stop_i, vec3 stop_o) {
+    return (ci > 0.0 && co > 0.0) ? 2.0 / max(2.0 * ci * co + co * stop_i * root_i + ci * stop_o * root_o, vec3(1e-12)) : vec3(0.0);
 }
 
 void compensation_row(float theta, out int k, out float f) {
@@ -153,7 +155,8 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
         vec3 scale = texelFetch(missing_table, ivec2(j, COMPENSATION_ROWS + 1), 0).rgb;
         vec3 rho_i = clamp(1.0 - t_i / max(G1_i, vec3(1e-12)), 0.0, 1.0), rho_o = clamp(1.0 - t_o / max(G1_o, vec3(1e-12)), 0.0, 1.0);
         vec3 Ge_i = 1.0 / (1.0 + lambda_i * rho_i), Ge_o = 1.0 / (1.0 + lambda_o * rho_o);
-        vec3 layer = lobe * masking_over_cos(ci, root_i, rho_i) * masking_over_cos(co, root_o, rho_o) * R + scale * m_i * m_o;
+        vec3 masking = correlated_masking_over_cos(ci, co, root_i, root_o, rho_i * (2.0 - rho_i), rho_o * (2.0 - rho_o));
+        vec3 layer = lobe * masking * R + scale * m_i * m_o;
         vec3 t = mix(vec3(1.0), ((1.0 - rho_i) * Ge_i * Ge_i + (1.0 - up) * m_i) * ((1.0 - rho_o) * Ge_o * Ge_o + (1.0 - up) * m_o), used);
         float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
         float layers_term = used.x * layer.x * path + used.y * layer.y * p2 + used.z * layer.z * p3;

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from explorer.errors import LocatedError
 from explorer.materials.brd import round_integer
+from explorer.materials.media import MEDIA, medium_labels
 from explorer.materials.methods import method_labels
 from explorer.app.parameter_files import inactive_parameters, slider_format, widget_kind
 from explorer.app.state import VIEW_SIZES
@@ -139,6 +140,32 @@ class ParametersPanel(Panel):
         imgui.push_id(name)
         no_ctrl_input = imgui.SliderFlags_.no_input  # Ctrl-click resets instead of typing; the field types
         labels = method_labels(state.material) if name == "method" else {}
+        if name.startswith("medium_") and kind == "int":  # the media by name beside the index's slider
+            index = name[len("medium_"):]
+            media = medium_labels(state.values, name)
+            imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.75)
+            current = round_integer(value)
+            chosen = None
+            if imgui.begin_combo(f"{index} medium", media.get(current, str(current))):
+                for key, label in media.items():
+                    clicked, _ = imgui.selectable(label, key == current)
+                    record(state, f"{name}:{key}")
+                    if clicked:
+                        chosen = key
+                imgui.end_combo()
+            record(state, f"param:{name}")
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(parameter_tooltip(parameter))
+            imgui.pop_id()
+            if chosen is not None and chosen != current:
+                # A library medium sets the index's slider to its n at 550 nm too (Material.resolve, n2=chitin).
+                update = {index: media[chosen], name: float(chosen)} if 1 <= chosen <= len(MEDIA) else {name: float(chosen)}
+                try:
+                    state.values = state.material.resolve({**state.values, **update})
+                    state.preset = None
+                except LocatedError as error:  # an absorbing host: the one-line reason
+                    state.status = str(error)
+            return
         if labels:  # the methods by name (explorer.materials.methods), not a bare integer slider
             imgui.set_next_item_width(imgui.get_content_region_avail().x * 0.75)
             current = round_integer(value)
