@@ -105,9 +105,10 @@ def run_paint_bench(workers: int = 2, seed: int = 0, size: int = 64, as_json: bo
     from explorer.design import ranges_of
     from explorer.design.forward import design_model
     from explorer.materials.brd import load_material
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
 
-    material = load_material(material_path("bragg_mirror"))
+    material = load_material(shipped_file(BraggMirrorModel))
     model = design_model(material.model)
     defaults = material.resolve({})
     fixed = {name: float(defaults[name]) for name in model.parameters if name not in ROUND_TRIP_BOX}

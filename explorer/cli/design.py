@@ -263,14 +263,13 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
             raise click.UsageError("--target-image paints alone: no --target, --target-strip, --target-spectrum, --guess or --save")
         if out_maps is None:
             raise click.UsageError("--target-image needs --out-maps DIR (where the maps go)")
-        from explorer.cli.paint import DEFAULT_FREE
         from explorer.errors import LocatedError
         from explorer.design import DesignError, design_model
 
         given = click.get_current_context().get_parameter_source("tries") == click.core.ParameterSource.COMMANDLINE
         try:
             loaded = load(material)
-            fixed = parse_fixes(fixes, free or DEFAULT_FREE.get(design_model(loaded.model).name), loaded)
+            fixed = parse_fixes(fixes, free or ",".join(design_model(loaded.model).paint_free) or None, loaded)
         except (LocatedError, DesignError) as error:
             _fail(str(error))
         paint_command(loaded, fixed, target_image, target_image_2, angles_text, out_maps, workers, scheduler, seed, as_json,

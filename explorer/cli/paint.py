@@ -15,9 +15,6 @@ import click
 import numpy as np
 
 PROG = "bragg-explorer"
-#: The free parameters by default, per design model: the structure's lengths and count (the indices are
-#: materials, fixed at the file's defaults unless ``--free`` names them).
-DEFAULT_FREE = {"bragg_mirror": "Lambda,delta,N", "bragg_layer": "Lambda,delta,N", "thin_film": "d"}
 
 
 def _fail(message: str) -> None:

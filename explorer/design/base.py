@@ -163,3 +163,6 @@ class DesignModel:
     optical: bool = False
     #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
     spectra: Callable | None = None
+    #: Free by default when painting an image: the structure's lengths and count (its indices are materials,
+    #: fixed at the file's values unless named free).
+    paint_free: tuple[str, ...] = ()

@@ -38,23 +38,24 @@ def main() -> None:
     from explorer.views.tonemap import display_srgb8
 
     from explorer.materials.brd import load_material
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
 
-    material = load_material(material_path("bragg_mirror"))
+    material = load_material(shipped_file(BraggMirrorModel))
     defaults = material.resolve({})
     fixed = {name: float(defaults[name]) for name in ("n1", "n2", "nh")}
     maps = region_maps(args.size, 8, args.seed, ROUND_TRIP_BOX)
-    targets = _targets("bragg_mirror", fixed, maps)
+    targets = _targets(material.model, fixed, maps)
     start = time.perf_counter()
     cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None, silence_logs=logging.ERROR)
     client = Client(cluster)
     up = time.perf_counter() - start
     try:
-        result = paint("bragg_mirror", ranges_of(material), fixed, targets, seed=args.seed, client=client, progress=print)
+        result = paint(material.model, ranges_of(material), fixed, targets, seed=args.seed, client=client, progress=print)
     finally:
         client.close()
         cluster.close()
-    again = [map_colours("bragg_mirror", result.fixed, result.maps, a) for a in ANGLES]
+    again = [map_colours(material.model, result.fixed, result.maps, a) for a in ANGLES]
     figure, axes = plt.subplots(2, 5, figsize=(15, 6.4))
     for row, theta in enumerate(ANGLES):
         axes[row, 0].imshow(display_srgb8(targets.rgb[row], 1.0, "none"))
