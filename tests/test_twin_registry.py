@@ -33,3 +33,12 @@ def test_registration_refuses_a_second_class_and_a_nameless_one():
     with pytest.raises(TypeError, match="brdf"):
         twin(type("Partial", (), {"name": "partial_twin", "reflectance": lambda self, c: c, "textures": lambda self: {}}))
     assert "partial_twin" not in TWINS
+
+
+@pytest.mark.parametrize("path", sorted((REPO_ROOT / "shaders").glob("*.brd")), ids=lambda p: p.stem)
+def test_a_twins_sampling_lobes_are_the_shaders(path):
+    """A twin that declares ``sampling_lobes`` (the env view's numpy twin and Mitsuba sample by them) has the shader's
+    hook too, and the other way round: otherwise the GL env view samples another density than its twins."""
+    material = load_material(path)
+    model = model_for(material, material.resolve())
+    assert callable(getattr(model, "sampling_lobes", None)) == ("HAS_SAMPLING_LOBES" in material.shader), material.model

@@ -574,6 +574,11 @@ class GGXSchlickModel:
         result[above] = lobe[above, None] * self.reflectance(cos_theta_d[above])
         return result
 
+    def sampling_lobes(self, cos_o):
+        """``(alphas, weights, cosine_weight)`` at view cosines ``(n,)``: one GGX lobe (the shader's ``sampling_lobes``)."""
+        ones = np.ones_like(cos_o)
+        return [max(self.alpha, 1e-4)], [ones], 0.0 * ones
+
     def textures(self) -> dict[str, np.ndarray]:
         return {}
 
