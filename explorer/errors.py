@@ -13,6 +13,16 @@ def did_you_mean(word: str, choices) -> str:
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
+#: Files the user named otherwise, by resolved path: a built-in material typed by name is reported by that name
+#: (:func:`explorer.resources.material_path` records it), not by the absolute path of its installed file.
+_SHOWN_AS: dict[str, str] = {}
+
+
+def show_path_as(path: str | os.PathLike[str], typed: str) -> None:
+    """Report errors located in ``path`` under ``typed``, the text the user named it by."""
+    _SHOWN_AS[os.fspath(path)] = typed
+
+
 class LocatedError(Exception):
     """
     Something is wrong at a place in a file.
@@ -40,7 +50,8 @@ class LocatedError(Exception):
         self.message: str = message
 
     def __str__(self) -> str:
-        where = self.path if self.line is None else f"{self.path}:{self.line}"
+        path = _SHOWN_AS.get(self.path, self.path)
+        where = path if self.line is None else f"{path}:{self.line}"
         return " ".join(f"{where}: {self.message}".splitlines())
 
 

@@ -51,10 +51,11 @@ def gl_inputs(view: str, *, light=None, plot=None, fill: float | None = None, su
     from explorer.views.geometry import VIEW_REGISTRY
 
     bound = dict(uniforms or {})
-    tables = dict(inputs or {})
+    tables = inputs or None
     if surface is not None:
         bound.update(surface.get("uniforms") or {})
-        tables.update(surface.get("inputs") or {})
+        # The surface's own mapping, not a copy: a progressive job without an inputs_key knows its tables by identity.
+        tables = surface.get("inputs") if not tables else {**tables, **(surface.get("inputs") or {})}
     if view in VIEW_REGISTRY and VIEW_REGISTRY[view].plot is not None:
         from explorer.views.plots import gl_uniforms
 
@@ -80,6 +81,7 @@ def render_material(
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int | None = None,
     variant: str | None = None, mesh=None, background: bool = False, plot=None, fill: float = 0.0,
     progress_printer: ProgressPrinter | None = None, warn: Callable[[str], None] | None = None,
+    checked: Callable[[], None] = lambda: None,
 ) -> np.ndarray:
     """
     One view of a material as a linear float RGB image ``(height, width, 3)``, by ``engine`` (:data:`ENGINES`): on the
@@ -91,7 +93,8 @@ def render_material(
     :class:`explorer.views.mesh.Mesh`) drawn instead of the sphere in the ``lit`` and ``env`` views; ``plot`` (an
     :class:`explorer.views.plots.PlotSettings`) for the plot views; ``fill``, the ``lit`` view's environment fill
     (:mod:`explorer.views.fill`), 0 without. ``progress_printer(label, unit)`` reports long renders; ``warn(message)``
-    is told of samples dropped.
+    is told of samples dropped; ``checked()`` once the input has passed its checks (sizes against this GL's
+    limits), where the work that cannot count its steps begins.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -108,6 +111,7 @@ def render_material(
     if view == "env" and engine == "mitsuba":
         if thickness is not None:
             raise LocatedError("--engine", None, "the Mitsuba plugins have no surface texture: --engine gl or numpy")
+        checked()
         return _render_env_mitsuba(material, values, width, height, environment, spp, variant, warn)
     if view == "env":
         return _render_env(material, values, width, height, engine, environment, spp, mesh, background, thickness,
@@ -137,6 +141,7 @@ def render_material(
         if view in BRDF_VIEWS and not callable(getattr(model, "brdf", None)):
             raise MaterialError(material.path, None, f"its numpy twin has no brdf(): no {view} view with --engine numpy")
         check_numpy_size(width, height)
+        checked()
         return render_numpy(model, view, width, height, light=light, thickness=thickness, mesh=mesh, plot=plot, environment=environment,
                             fill=fill)
     from explorer.gpu import Renderer
@@ -146,9 +151,12 @@ def render_material(
     renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
+        checked()
         return renderer.render(material, values, view, width, height,
                                **gl_inputs(view, light=light, surface=thickness.gl_arguments(material, values, width, height)))
     view_named(view)  # an unknown view: one line listing them
+    if view != "textured":
+        checked()
     if mesh is not None:
         from explorer.gpu.mesh import render_mesh
 

@@ -110,11 +110,15 @@ def material_path(text: str | os.PathLike[str]) -> Path:
     """
     text = os.fspath(text)
     path = Path(text)
+    from explorer.errors import show_path_as
+
     if path.exists() or not is_bare_name(text):
+        show_path_as(path, text)  # as typed, even where a built-in was named by name before
         return path  # an unreadable or malformed file is the material loader's error, with its line
     builtins = builtin_materials()
     stem = path.stem if path.suffix in MATERIAL_SUFFIXES else path.name
     if stem in builtins and path.suffix in ("", ".brd"):
+        show_path_as(builtins[stem], text)  # its errors name it as typed, not by its installed path
         return builtins[stem]
     from explorer.errors import did_you_mean
 

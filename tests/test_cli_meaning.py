@@ -91,6 +91,21 @@ def test_params_alone_names_its_material_and_paths_are_reported_as_typed(tmp_pat
     assert "MATERIAL" in line
 
 
+def test_a_built_in_named_by_name_is_reported_by_name(tmp_path):
+    """Errors about a built-in typed as a name name it so, not by its installed file's absolute path; a file stays as typed."""
+    from explorer.resources import SHADER_DIR
+
+    out = tmp_path / "x.npy"
+    for cwd in (REPO_ROOT, tmp_path):
+        line = one_line_error(run_cli("render", "bragg_layer", "--set", "Lambda=9999", "--out", out, cwd=cwd))
+        assert "error: bragg_layer:" in line and str(SHADER_DIR) not in line, line
+        line = one_line_error(run_cli("export", "bragg_mirror.brd", "--to", "materialx", tmp_path / "x.mtlx", cwd=cwd))
+        assert "error: bragg_mirror.brd:" in line and str(SHADER_DIR) not in line, line
+    typed = SHADER_DIR / "bragg_mirror.brd"  # a file named by its path keeps it
+    line = one_line_error(run_cli("render", typed, "--set", "Lamda=400", "--out", out, cwd=tmp_path))
+    assert f"error: {typed}:" in line, line
+
+
 def test_open_documents_its_options_and_opens_the_default_material_without_one(monkeypatch):
     text = run_cli("open", "--help").stdout
     for option in ("--script", "--window-size", "--report"):

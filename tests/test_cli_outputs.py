@@ -197,3 +197,29 @@ def test_presets_of_a_material_without_presets_says_so(tmp_path):
     everything = cli("presets", "--json")
     assert {row["material"] for row in json.loads(everything.stdout)} == {
         f"shaders/{path.stem}.brd" for path in (REPO_ROOT / "shaders" / "presets").glob("*.toml")}
+
+
+def test_slow_commands_show_progress_and_quick_ones_stay_quiet(tmp_path, monkeypatch):
+    """Work that cannot count its steps (a render, an export) says it is working every interval; a quick command prints nothing."""
+    import re
+
+    from explorer.cli import albedo
+
+    run = cli("render", "ggx_schlick", "--view", "gradient", "--engine", "numpy", "--size", "8x1", "--out", tmp_path / "g.npy")
+    assert run.returncode == 0 and "working" not in run.stderr, run.stderr
+    monkeypatch.setattr(albedo, "PROGRESS_INTERVAL", 0.01)  # every command is slow at this scale
+    run = cli("render", "bragg_layer", "--view", "slice", "--engine", "numpy", "--size", "48", "--out", tmp_path / "s.npy")
+    assert run.returncode == 0 and re.search(r"^bragg-explorer: render slice \(numpy\): working \(\d+ s\)$", run.stderr, re.M), run.stderr
+    for target, out in (("brdf", "m.brdf"), ("materialx", "f.mtlx")):
+        material = "bragg_mirror" if target == "brdf" else "thin_film"
+        run = cli("export", material, "--to", target, tmp_path / out)
+        assert run.returncode == 0 and f"export --to {target}: working" in run.stderr, run.stderr
+    lines = []
+    monkeypatch.setattr(albedo.click, "echo", lambda text, err=False: lines.append((text, err)))
+    progress = albedo.progress_printer("table", "rows")
+    import time
+
+    for done in range(1, 4):
+        time.sleep(0.02)
+        progress(done, 3)
+    assert lines and all(err for _, err in lines) and lines[-1][0].startswith("bragg-explorer: table: 3/3 rows ("), lines

@@ -190,3 +190,27 @@ def test_polar_window_draws_the_light_where_the_curve_puts_its_angle():
         assert xs[0] == ys[0] == 0.0
         assert np.hypot(xs[1], ys[1]) == pytest.approx(2.0)
         assert np.degrees(np.arctan2(xs[1], ys[1])) == pytest.approx(signed, abs=1e-4)
+
+
+def test_cli_chart_names_a_smooth_mirrors_curve_as_the_app_does(tmp_path, monkeypatch):
+    """A smooth mirror's plotted value is its reflectance R(theta_d), not a BRDF: the CLI's chart says it in the app's words."""
+    from explorer.app.panels.brdf_views import slice_quantity
+    from explorer.views import plot_images
+    from explorer.views.mirror import BRDF_QUANTITY, MIRROR_QUANTITY, plotted_quantity
+
+    labels = {}
+    drawn = plot_images.chart
+
+    def recording(*args, **kwargs):
+        figure = drawn(*args, **kwargs)
+        labels[args[3]] = figure.axes[0].get_ylabel()
+        return figure
+
+    monkeypatch.setattr(plot_images, "chart", recording)
+    for name in ("bragg_mirror", "ggx_schlick"):
+        run = run_cli("render", name, "--view", "theta_d", "--engine", "numpy", "--size", "16", "--out", tmp_path / f"{name}.png")
+        assert run.returncode == 0, run.stderr
+    (mirror,), (rough,) = ([label for title, label in labels.items() if name in title] for name in ("bragg_mirror", "ggx_schlick"))
+    assert mirror == MIRROR_QUANTITY == plotted_quantity([True]) and rough == BRDF_QUANTITY, labels
+    loaded, _ = material("bragg_mirror")
+    assert slice_quantity(loaded).startswith(MIRROR_QUANTITY) and slice_quantity(material("ggx_schlick")[0]) == BRDF_QUANTITY

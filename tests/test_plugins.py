@@ -25,6 +25,20 @@ from explorer.materials.models import model_for
 from explorer.materials.plugins import PluginError
 from explorer.materials.twins import CAPABILITY_FIELDS, Capabilities, registry, supporting
 
+@pytest.fixture(autouse=True)
+def _plugins_unloaded_afterwards():
+    """A plugin a test loads in this process leaves the registry with it (another test loads its own copy)."""
+    from explorer.materials import plugins, twins as registered
+
+    registry()
+    before, loaded = dict(registered.TWINS), dict(plugins._LOADED)
+    yield
+    registered.TWINS.clear()
+    registered.TWINS.update(before)
+    plugins._LOADED.clear()
+    plugins._LOADED.update(loaded)
+
+
 SHIPPED = sorted((REPO_ROOT / "shaders").glob("*.brd"))
 EXAMPLE = REPO_ROOT / "docs" / "plugin_example"
 #: The built-in materials' names: their files' stems and their twins' names.
@@ -191,7 +205,8 @@ def test_the_broken_plugin_error_reaches_the_cli_as_one_line(tmp_path):
 @pytest.mark.parametrize("name", ["ggx_schlick", "bragg_layer"])
 def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, name):
     """``check``'s comparisons are the harness's: a built-in twin is within the named tolerance in each view."""
-    from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
+    from explorer.gpu.twin_check import check_material
+    from explorer.views.twin_check import CHECK_SIZES, check_views
 
     material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
     images = [v for v in CHECK_SIZES if v not in ("textured", "env", "albedo")]
@@ -206,7 +221,8 @@ def test_check_passes_a_builtin_material_in_every_view_it_supports(gl_renderer, 
 @pytest.mark.parametrize("name, view", [("ggx_schlick", "env"), ("ggx_schlick", "albedo"), ("thin_film", "textured")])
 def test_check_compares_the_env_textured_and_albedo_views(gl_renderer, name, view):
     """The env view (Monte Carlo against the twin's exact integral), the albedo and the textured view, each within its tolerance."""
-    from explorer.views.twin_check import CHECK_SIZES, ENV_PIXELS, check_material, check_views, tolerance_for
+    from explorer.gpu.twin_check import check_material
+    from explorer.views.twin_check import CHECK_SIZES, ENV_PIXELS, check_views, tolerance_for
 
     material = load_material(REPO_ROOT / "shaders" / f"{name}.brd")
     assert view in check_views(material)

@@ -74,3 +74,15 @@ def test_a_progressive_job_requested_through_the_service_is_the_render_command(g
     expected = render_material(material, values, view, *size, "gl", **headless)
     assert np.abs(expected).max() > 0.01
     np.testing.assert_array_equal(job.read(), expected)
+
+
+def test_a_views_tables_keep_their_identity():
+    """A progressive job without an inputs_key knows its tables by identity: a copy per frame would restart it each frame."""
+    from explorer.rendering import gl_inputs
+
+    surface = {"inputs": {"thickness": np.zeros((2, 2))}, "uniforms": {"prefilter": False}}
+    bound = gl_inputs("textured", surface=surface, uniforms={"a": 1.0})
+    assert bound["inputs"] is surface["inputs"] and bound["uniforms"] == {"a": 1.0, "prefilter": False}
+    normals = {"mesh_normals": np.zeros((2, 2, 3))}
+    assert gl_inputs("lit", inputs=normals, fill=0.5)["inputs"] is normals
+    assert gl_inputs("lit", fill=0.5)["uniforms"] == {"fill": 0.5} and gl_inputs("lit")["inputs"] is None

@@ -6,7 +6,7 @@ import pytest
 
 from conftest import REPO_ROOT
 from explorer.materials.brd import load_material
-from explorer.views.twin_check import check_material
+from explorer.gpu.twin_check import check_material
 
 
 @pytest.mark.parametrize("multiple_scattering", [0, 1])

@@ -5,8 +5,10 @@ the progress lines of the long renders. Registered by :mod:`explorer.cli.command
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
+import threading
 import time
 
 import click
@@ -32,6 +34,12 @@ def parse_theta(text: str) -> np.ndarray:
     return theta
 
 
+#: Seconds between progress lines (and before the first: a command quicker than this prints none).
+PROGRESS_INTERVAL = 2.0
+#: When the last progress line was written (either kind below), so that the two never speak at once.
+_last_line = [0.0]
+
+
 def progress_printer(label: str, unit: str):
     """A ``progress(done, total)`` that writes a line to stderr every 2 s (and at the end after 2 s)."""
     start = last = time.perf_counter()
@@ -39,11 +47,50 @@ def progress_printer(label: str, unit: str):
     def progress(done: int, total: int) -> None:
         nonlocal last
         now = time.perf_counter()
-        if now - last >= 2.0 or (done == total and now - start >= 2.0):
-            last = now
+        if now - last >= PROGRESS_INTERVAL or (done == total and now - start >= PROGRESS_INTERVAL):
+            last = _last_line[0] = now
             click.echo(f"{PROG}: {label}: {done}/{total} {unit} ({now - start:.0f} s)", err=True)
 
     return progress
+
+
+@contextlib.contextmanager
+def progress_while(label: str, started: bool = True):
+    """
+    For work that cannot count its steps (a GL render, an export): a line to stderr every 2 s while the block
+    runs, unless a :func:`progress_printer` inside it spoke in the meantime. Yields ``start()``: with
+    ``started=False`` the lines begin only once the block calls it, after its checks of the input, so that bad
+    input found late on a loaded machine is still one line.
+    """
+    start = time.perf_counter()
+    stop, go = threading.Event(), threading.Event()
+
+    def begin() -> None:
+        nonlocal start
+        if not go.is_set():
+            start = time.perf_counter()
+            go.set()
+
+    def beat() -> None:
+        while not go.wait(0.05):
+            if stop.is_set():
+                return
+        while not stop.wait(PROGRESS_INTERVAL):
+            now = time.perf_counter()
+            if now - _last_line[0] >= PROGRESS_INTERVAL:
+                _last_line[0] = now
+                click.echo(f"{PROG}: {label}: working ({now - start:.0f} s)", err=True)
+
+    if started:
+        begin()
+    thread = threading.Thread(target=beat, name="progress", daemon=True)
+    thread.start()
+    try:
+        yield begin
+    finally:
+        stop.set()
+        go.set()
+        thread.join()
 
 
 def _fail(message: str) -> None:

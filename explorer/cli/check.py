@@ -36,7 +36,8 @@ def check_command(material, views, preset, params_file, assignments, as_json):
     from explorer.materials.methods import opening_values
     from explorer.materials.twins import capabilities_of
     from explorer.resources import display_path
-    from explorer.views.twin_check import CHECK_SIZES, check_material, check_views
+    from explorer.gpu.twin_check import check_material
+    from explorer.views.twin_check import CHECK_SIZES, check_views
 
     try:
         loaded = load(material)

@@ -179,7 +179,9 @@ def _write_plot(loaded, view: str, image, plot, out: Path, light, engine: str) -
     height, width = image.shape[:2]
     values = plotted(image, plot, cos_light(view, width, height, light_direction(light), plot))
     shown_light = (light or DEFAULT_LIGHT) if view_named(view).takes_light else None
-    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light)
+    from explorer.views.mirror import is_mirror_only
+
+    write_plot(view, values, plot, out, f"{display_path(loaded.path)}: {view} ({engine})", shown_light, is_mirror_only(loaded))
     click.echo(f"wrote {out} ({view} plot, {width}x{height} samples, {engine})")
 
 
@@ -436,12 +438,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         from explorer.views.fill import DEFAULT_FILL, has_fill
 
         fill = (DEFAULT_FILL if fill is None else fill) if view == "lit" and has_fill(loaded) else 0.0
-    from explorer.cli.albedo import progress_printer
+    from explorer.cli.albedo import progress_printer, progress_while
     from explorer.rendering import render_material
 
-    image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
-                            variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
-                            progress_printer=progress_printer, warn=warn)
+    with progress_while(f"render {view} ({engine})", started=False) as checked:
+        image = render_material(loaded, values, view, width, height, engine, light_angles, thickness, environment, spp,
+                                variant=variant, mesh=mesh_shape, background=background, plot=plot, fill=fill,
+                                progress_printer=progress_printer, warn=warn, checked=checked)
     if plot is not None:
         _write_plot(loaded, view, image, plot, Path(out), light_angles, engine)
         return

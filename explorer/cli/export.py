@@ -33,29 +33,34 @@ def check_mitsuba_render(view: str, engine: str, variant: str | None) -> None:
 @click.option("--env", "env_file", metavar="FILE", help="mitsuba: the environment (.hdr or .exr; default the env view's).")
 @click.option("--mesh", metavar="FILE", help="mitsuba: an .obj or .ply in place of the unit sphere; gltf: an .obj or teapot, cube, torus.")
 @click.option("--texture-table", is_flag=True, help="gltf: embed the exact reflectance table too (extras; docs/export.md).")
+@click.option("--blender-film", type=click.Choice(("table", "principled")), default="table", show_default=True,
+              help="blender: a thin film or a stack of interfaces as its converged table, or Principled's own inputs (docs/blender.md).")
 @click.option("--spp", type=click.IntRange(min=1), default=256, show_default=True, help="mitsuba: samples per pixel.")
 @click.argument("out", type=click.Path())
-def export_command(material, target, preset, params_file, assignments, env_file, mesh, texture_table, spp, out):
+def export_command(material, target, preset, params_file, assignments, env_file, mesh, texture_table, blender_film, spp, out):
     """Write MATERIAL (a file or a built-in's name) for use elsewhere, to OUT (a directory for --to mitsuba)."""
     from explorer.errors import LocatedError
     from explorer.views.images import OutputError
 
+    from explorer.cli.albedo import progress_while
+
     try:
         if texture_table and target != "gltf":
             raise click.BadParameter("--texture-table is for --to gltf", param_hint="--texture-table")
-        if target == "blender":
-            _export_blender(material, preset, params_file, assignments, env_file, out, load(material))
-            return
-        if target == "gltf":
-            _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, load(material))
-            return
-        _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, load(material))
+        loaded = load(material)
+        with progress_while(f"export --to {target}"):
+            if target == "blender":
+                _export_blender(material, preset, params_file, assignments, env_file, out, loaded, blender_film)
+            elif target == "gltf":
+                _export_gltf(material, preset, params_file, assignments, env_file, mesh, texture_table, out, loaded)
+            else:
+                _export(material, target, preset, params_file, assignments, env_file, mesh, spp, out, loaded)
     except (LocatedError, OutputError) as error:  # bad input: one line (as commands._errors)
         click.echo(f"{PROG}: error: {error}", err=True)
         raise SystemExit(1) from None
 
 
-def _export_blender(material, preset, params_file, assignments, env_file, out, loaded):
+def _export_blender(material, preset, params_file, assignments, env_file, out, loaded, film="table"):
     """``--to blender``: the preview scene (.blend) and the script that rebuilds the material (.py)."""
     from explorer.blender import export_blender
     from explorer.views.env import DEFAULT_ENVIRONMENT, EnvironmentMap
@@ -64,7 +69,7 @@ def _export_blender(material, preset, params_file, assignments, env_file, out, l
         warn(warning)
     values = resolve_values(loaded, preset, params_file, assignments)
     environment = EnvironmentMap.load(env_file if env_file is not None else DEFAULT_ENVIRONMENT)
-    blend, script = export_blender(loaded, values, Path(out), environment)
+    blend, script = export_blender(loaded, values, Path(out), environment, film=film)
     click.echo(f"wrote {blend} (Cycles preview: the env view's scene) and {script} (rebuilds the material on yours)")
 
 

@@ -42,6 +42,8 @@ _XYZ_TO_REC709 = np.array([
 #: and an index >= 1).
 THICKNESS_RANGE = (0.0, 1500.0)
 IOR_RANGE = (1.0, 3.0)
+#: The largest specularColorFactor the dielectric's fit may write (the extension allows any >= 0; F0 is clamped to 1).
+SPECULAR_COLOR_MAX = 4.0
 
 
 def _schlick(f0, cos):
@@ -110,6 +112,8 @@ class Film:
     metallic: float  # metallicFactor: 0 or 1
     base_color: tuple[float, float, float] = (0.0, 0.0, 0.0)  # baseColorFactor's RGB (the metal's F0)
     base_ior: float = 1.5  # KHR_materials_ior (the dielectric's)
+    specular_color: tuple[float, float, float] = (1.0, 1.0, 1.0)  # KHR_materials_specular's specularColorFactor
+    specular: float = 1.0  # KHR_materials_specular's specularFactor
     mapping: str = "direct"  # "direct" (a thin film), "refined" (from the direct one) or "fit" (the nearest film)
     delta_e: np.ndarray = field(default_factory=lambda: np.zeros(0))  # ΔE2000 at THETA_DEG
     direct: "Film | None" = None  # a refined film's direct mapping
@@ -122,8 +126,11 @@ def specular_reflectance(film: Film, cos_theta) -> np.ndarray:
         f0 = np.asarray(film.base_color, np.float64)
         plain = _schlick(f0, cos[..., None])  # conductor_fresnel
     else:
-        f0 = np.full(3, _ior_to_f0(film.base_ior, 1.0))
-        plain = _schlick(f0, cos[..., None])  # fresnel_mix over a black base: the specular share
+        # iridescent_dielectric_layer with KHR_materials_specular over a black base: F0 its colour times the
+        # index's, Schlick's plain Fresnel weighted by the specular factor, the film on weight * F0.
+        f0 = np.minimum(_ior_to_f0(film.base_ior, 1.0) * np.asarray(film.specular_color, np.float64), 1.0)
+        plain = film.specular * _schlick(f0, cos[..., None])
+        f0 = film.specular * f0
     iridescent = iridescent_fresnel(1.0, film.ior, f0, film.thickness, cos)
     return (1.0 - film.factor) * plain + film.factor * iridescent
 
@@ -160,13 +167,17 @@ def direct_film(model) -> Film | None:
 
 def _films_rgb(params: np.ndarray, metallic: bool, cos: np.ndarray) -> np.ndarray:
     """:func:`specular_reflectance` of many films at once: ``params`` ``(K, 6)`` (thickness, ior, factor, then
-    the base colour for a metal, or the base's index for a dielectric) -> ``(K, len(cos), 3)``."""
+    the base colour for a metal) or ``(K, 8)`` (then the base's index, the specular colour and factor for a
+    dielectric) -> ``(K, len(cos), 3)``."""
     thickness, ior, factor = params[:, 0:1], params[:, 1:2], params[:, 2:3, None]
     if metallic:
         f0 = params[:, None, 3:6]
+        plain = _schlick(f0, cos[None, :, None])
     else:
-        f0 = np.repeat(_ior_to_f0(params[:, None, 3:4], 1.0), 3, axis=-1)
-    plain = _schlick(f0, cos[None, :, None])
+        weight = params[:, None, 7:8]
+        f0 = np.minimum(_ior_to_f0(params[:, None, 3:4], 1.0) * params[:, None, 4:7], 1.0)
+        plain = weight * _schlick(f0, cos[None, :, None])
+        f0 = weight * f0
     iridescent = iridescent_fresnel(1.0, ior, f0, thickness, cos[None, :])
     return (1.0 - factor) * plain + factor * iridescent
 
@@ -184,11 +195,11 @@ def _films_delta_e(params: np.ndarray, metallic: bool, target_lab: np.ndarray, c
     return np.asarray(colour.delta_E(_lab(_films_rgb(params, metallic, cos)), target_lab[None], method="CIE 2000"))
 
 
-def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: bool, target_lab, cos):
+def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: bool, target_lab, cos, loss: str = "linear"):
     """Bounded least squares on the ΔE2000 per angle from ``start`` (scipy), the Jacobian's differences in one batch."""
     from scipy.optimize import least_squares
 
-    steps = np.array([0.05, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4])[: len(start)]
+    steps = np.array([0.05] + [1e-4] * 7)[: len(start)]
 
     def jacobian(p):
         sign = np.where(p + steps <= upper, 1.0, -1.0)
@@ -197,7 +208,7 @@ def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: b
         return ((e[1:] - e[0]) / (steps * sign)[:, None]).T
 
     result = least_squares(lambda p: _films_delta_e(p[None], metallic, target_lab, cos)[0], np.clip(start, lower, upper),
-                           jac=jacobian, bounds=(lower, upper), max_nfev=100)
+                           jac=jacobian, bounds=(lower, upper), max_nfev=100, loss=loss)
     return result.x, result.cost
 
 
@@ -205,7 +216,8 @@ def _film_of(params: np.ndarray, metallic: bool, mapping: str, target: np.ndarra
     if metallic:
         film = Film(float(params[0]), float(params[1]), float(params[2]), 1.0, tuple(float(c) for c in params[3:6]), mapping=mapping)
     else:
-        film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping)
+        film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping,
+                    specular_color=tuple(float(c) for c in params[4:7]), specular=float(params[7]))
     film.delta_e = delta_e(film, target)
     return film
 
@@ -234,16 +246,22 @@ def fit_film(target: np.ndarray, starts: int = 3) -> Film:
 
 def refine_film(film: Film, target: np.ndarray) -> Film:
     """
-    ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour, the
-    dielectric's index) moved to the nearest minimum of the ΔE2000 to ``target``; ``film`` itself where
-    that is no closer.
+    ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour; the
+    dielectric's index, specular colour and factor: KHR_materials_specular) moved to a nearby minimum of the
+    ΔE2000 to ``target``, by plain and by robust (soft L1) least squares: the spec's Schlick Fresnel cannot
+    follow the polarised film at oblique angles, and the robust fit keeps those few angles from pulling the
+    rest. Of ``film`` and the two, the one of least median ΔE2000 is kept.
     """
     cos = np.cos(np.radians(THETA_DEG))
     target = np.asarray(target, np.float64)
     metallic = film.metallic >= 0.5
-    start = np.array([film.thickness, film.ior, film.factor, *(film.base_color if metallic else (film.base_ior,))])
-    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0,))])
-    upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0, *((1.0,) * 3 if metallic else (3.0,))])
-    params, _ = _refine(start, lower, upper, metallic, _lab(target), cos)
-    refined = _film_of(params, metallic, "refined", target)
-    return refined if np.sum(refined.delta_e**2) < np.sum(film.delta_e**2) else film
+    base = film.base_color if metallic else (film.base_ior, *film.specular_color, film.specular)
+    start = np.array([film.thickness, film.ior, film.factor, *base])
+    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0, 0.0, 0.0, 0.0, 0.0))])
+    upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0,
+                      *((1.0,) * 3 if metallic else (3.0, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, 1.0))])
+    candidates = [film]
+    for loss in ("linear", "soft_l1"):
+        params, _ = _refine(start, lower, upper, metallic, _lab(target), cos, loss)
+        candidates.append(_film_of(params, metallic, "refined", target))
+    return min(candidates, key=lambda f: (float(np.median(f.delta_e)), float(np.sum(f.delta_e**2))))

@@ -75,6 +75,32 @@ class LayeredLobesModel:
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         return lobes.brdf(self.stack, L, V, N)
 
+    def principled_layers(self) -> dict[str, object]:
+        """
+        Blender's Principled BSDF inputs nearest the stack (docs/blender.md): interface 1 its coat (IOR, roughness
+        ``sqrt(alpha)``, tint the round trip's transmittance ``exp(-2 tau_1)`` at normal incidence: Cycles
+        raises it to ``1 / cos theta_t``), interface 2 its specular base (a dielectric of the medium's
+        absolute index, black, or the conductor of F0 from ``eta_base + i kappa_base``); a one-interface stack
+        is the base alone. Interfaces 3 and 4 have no place in Principled: they are left out.
+        """
+        v, count = self.values, int(np.clip(round_integer(self.values["layers"]), 1, lobes.MAX_INTERFACES))
+        conductor = bool(v.get("conductor", False))
+        base = 1 if count == 1 else 2
+        layers: dict[str, object] = {"Base Color": (0.0, 0.0, 0.0, 1.0), "Metallic": 0.0,
+                                     "Roughness": float(np.sqrt(float(v[f"alpha_{base}"])))}
+        if conductor and count <= 2:
+            n = np.asarray(v["eta_base"], np.float64) + 1j * np.asarray(v["kappa_base"], np.float64)
+            outside = float(v["eta_1"]) if count == 2 else 1.0
+            f0 = np.abs((n / outside - 1.0) / (n / outside + 1.0)) ** 2
+            layers.update({"Metallic": 1.0, "Base Color": (*(float(c) for c in f0), 1.0)})
+        else:
+            layers["IOR"] = float(v[f"eta_{base}"])
+        if count >= 2:
+            tint = np.exp(-2.0 * np.asarray(v["tau_1"], np.float64))
+            layers.update({"Coat Weight": 1.0, "Coat IOR": float(v["eta_1"]), "Coat Roughness": float(np.sqrt(float(v["alpha_1"]))),
+                           "Coat Tint": (*(float(c) for c in tint), 1.0)})
+        return layers
+
     def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
         """For Mitsuba's spectral variants: an RGB model (Belcour 2018's lobes), upsampled."""
         rgb = self.brdf(i, o, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))

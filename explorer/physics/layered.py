@@ -373,12 +373,19 @@ def stack_tables(stack: LayeredBragg) -> tuple[LayerTables, ...]:
 def lookup(table: np.ndarray, theta: ArrayLike) -> np.ndarray:
     """
     Linear interpolation of a per-angle table (rows at ``k * 0.25 deg``) at ``theta`` (radians), as a
-    linearly filtered texture fetch does: shape ``theta.shape + table.shape[1:]``.
+    linearly filtered texture fetch does: shape ``theta.shape + table.shape[1:]``, in the table's precision
+    (a float32 table is blended in float32, as the texture unit does: several times faster than promoting
+    its rows to float64, and the hot spot of every spectral BRDF evaluation).
     """
     x = np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi) / microfacet.THETA_STEP
-    k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
-    f = (x - k)[..., None]
-    return table[k] * (1.0 - f) + table[k + 1] * f
+    k = np.minimum(np.floor(x).astype(np.intp), table.shape[0] - 2)
+    f = (x - k).astype(table.dtype, copy=False)[..., None]
+    low = table[k]
+    out = table[k + 1]  # a fresh copy (fancy indexing): blended in place, low + (high - low) f
+    out -= low
+    out *= f
+    out += low
+    return out
 
 
 # --------------------------------------------------------------------------------------------------
@@ -501,8 +508,9 @@ def single_reflection_spectra(
             )
         else:
             R = lookup(table.reflectance, theta_d)
-        layers = layers + lobe[..., None] * R * path
-        path = path * lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o)
+        # The per-direction factors first (cheap), then one product per wavelength.
+        layers = layers + (lobe[..., None] * path) * R
+        path = path * (lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o))
     path = path * gap
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
 

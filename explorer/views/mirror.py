@@ -38,6 +38,22 @@ def is_mirror_only(material) -> bool:
     return bool(_MIRROR_ONLY.search(getattr(material, "shader", "") or ""))
 
 
+#: What a BRDF plot's values are: a density per steradian, or for a smooth mirror (a Dirac, which has none) the
+#: weight of its reflection, its reflectance at the half vector. The app's Polar and Slice and the CLI's charts say so.
+BRDF_QUANTITY = "BRDF (1/sr)"
+MIRROR_QUANTITY = "reflectance R(theta_d)"
+
+
+def plotted_quantity(mirrors) -> str:
+    """The quantity a BRDF plot of some materials shows; ``mirrors``: :func:`is_mirror_only` of each."""
+    mirrors = list(mirrors)
+    if mirrors and all(mirrors):
+        return MIRROR_QUANTITY
+    if not any(mirrors):
+        return BRDF_QUANTITY
+    return f"{BRDF_QUANTITY}; a smooth mirror's {MIRROR_QUANTITY}"
+
+
 def light_glint(reflected, light) -> np.ndarray:
     """
     The directional light seen in a mirror: radiance ``GLINT_PEAK t^3``, ``t = 1 - |r x l|^2 / sin^2 rho``,

@@ -37,8 +37,10 @@ def plot_table(view: str, values: np.ndarray, settings: PlotSettings) -> np.ndar
     return np.concatenate([abscissa(view, width)[:, None], values[0]], axis=1).astype(np.float32)
 
 
-def _ylabel(view: str, settings: PlotSettings) -> str:
-    quantity = "albedo" if view == "albedo" else "BRDF (1/sr)"
+def _ylabel(view: str, settings: PlotSettings, mirror: bool = False) -> str:
+    from explorer.views.mirror import plotted_quantity
+
+    quantity = "albedo" if view == "albedo" else plotted_quantity([mirror])
     if settings.ndotl:
         quantity += " x cos theta_i" if view == "albedo" else " x N.L"
     if settings.channel == "luminance":
@@ -55,11 +57,12 @@ def _settings_note(view: str, settings: PlotSettings, light) -> str:
     return note
 
 
-def write_plot(view: str, values: np.ndarray, settings: PlotSettings, out: Path, title: str = "", light=None) -> None:
+def write_plot(view: str, values: np.ndarray, settings: PlotSettings, out: Path, title: str = "", light=None,
+               mirror: bool = False) -> None:
     """
     Write a plot view: ``values`` are what it plots ``(height, width, k)`` (:func:`explorer.views.plots.plotted`);
     ``.npy`` gets :func:`plot_table`, ``.png`` a matplotlib chart (Agg), ``title`` above it; ``light`` (degrees) is
-    drawn in the lobe and named in the caption.
+    drawn in the lobe and named in the caption; ``mirror``: a smooth mirror's (its values are a reflectance).
     """
     suffix = Path(out).suffix.lower()
     with atomic_output(out, (".png", ".npy")) as temporary:
@@ -67,7 +70,7 @@ def write_plot(view: str, values: np.ndarray, settings: PlotSettings, out: Path,
             with open(temporary, "wb") as stream:
                 np.save(stream, plot_table(view, values, settings))
             return
-        figure = chart(view, values, settings, title, light)
+        figure = chart(view, values, settings, title, light, mirror)
         try:
             with open(temporary, "wb") as stream:
                 figure.savefig(stream, format="png", dpi=DPI)
@@ -77,7 +80,7 @@ def write_plot(view: str, values: np.ndarray, settings: PlotSettings, out: Path,
             plt.close(figure)
 
 
-def chart(view: str, values: np.ndarray, settings: PlotSettings, title: str = "", light=None):
+def chart(view: str, values: np.ndarray, settings: PlotSettings, title: str = "", light=None, mirror: bool = False):
     """The matplotlib figure of a plot view (curves against their angle, or the 3D lobe's surface)."""
     import matplotlib
 
@@ -109,7 +112,7 @@ def chart(view: str, values: np.ndarray, settings: PlotSettings, title: str = ""
         axes.set_zlim(0, extent)
         axes.set_xlabel("x")
         axes.set_ylabel("y")
-        axes.set_zlabel(_ylabel(view, settings), fontsize=8)
+        axes.set_zlabel(_ylabel(view, settings, mirror), fontsize=8)
         return figure
     axes = figure.add_subplot()
     angle = abscissa(view, values.shape[1])
@@ -118,7 +121,7 @@ def chart(view: str, values: np.ndarray, settings: PlotSettings, title: str = ""
     label, first, last = ABSCISSAE[view]
     axes.set_xlim(first, last)
     axes.set_xlabel(label)
-    axes.set_ylabel(_ylabel(view, settings))
+    axes.set_ylabel(_ylabel(view, settings, mirror))
     axes.grid(True, alpha=0.3)
     if len(channels) > 1 or channels[0] == "luminance":
         axes.legend(fontsize=8)

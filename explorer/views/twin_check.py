@@ -21,7 +21,7 @@ pixel under a :class:`Tolerance`:
   :data:`ALBEDO_ATOL` absolute per channel.
 
 :func:`tolerance_for` picks one by view. The test suite (``tests/twins.py``) and ``bragg-explorer check``
-(:func:`check_material`, for anyone writing a material) share all of it.
+(:func:`explorer.gpu.twin_check.check_material`, for anyone writing a material) share all of it.
 """
 
 from __future__ import annotations
@@ -252,36 +252,6 @@ def check_views(material) -> tuple[str, ...]:
                  if supported.get(view, True) and (has_reflectance or view not in COLOUR_VIEWS))
 
 
-def render_env_both(renderer, material, values, size, spp: int = ENV_SPP, environment=None, seed: int = 0,
-                    pixels: int | None = ENV_PIXELS) -> Twins:
-    """
-    The env view on the GPU (its Monte Carlo mean after ``spp`` samples a pixel, and its standard error) and the
-    twin's exact integral (:func:`explorer.views.env.env_integral_numpy`) at :func:`env_pixels`, under ``environment``
-    (default :func:`smooth_environment`).
-    """
-    from explorer.gpu.env import ProgressiveEnvRender
-    from explorer.views.env import env_integral_numpy
-
-    width, height = size
-    environment = smooth_environment() if environment is None else environment
-    render = ProgressiveEnvRender(renderer, material, values, environment, width, height, seed=seed)
-    try:
-        while render.samples < spp:
-            render.step(min(spp - render.samples, max(1, render.samples_per_pass)))
-        gl, error = render.image(), render.standard_error()
-        dropped = render.dropped_samples()
-    finally:
-        render.release()
-    if dropped:
-        gl = np.full_like(gl, np.nan)  # samples dropped: the GLSL BRDF returned NaN or infinity somewhere
-    compared = env_pixels(width, height, pixels)
-    rows, columns = np.nonzero(compared)
-    reference = np.zeros((height, width, 3))
-    reference[rows, columns] = env_integral_numpy(model_for(material, values), environment, width, height,
-                                                  np.stack([rows, columns], axis=-1))
-    return Twins(gl, reference, compared, "env", None, error)
-
-
 def env_pixels(width: int, height: int, count: int | None = ENV_PIXELS) -> np.ndarray:
     """
     The env view's compared pixels: ``count`` spread evenly over the disc (its float32 rim left out), or every
@@ -311,27 +281,3 @@ def render_albedo_both(renderer, material, values, theta_deg=ALBEDO_THETA) -> Tw
     reference = albedo_numpy(model, theta_deg)
     return Twins(np.asarray(gl, np.float64)[None], np.asarray(reference, np.float64)[None],
                  np.ones((1, len(theta_deg)), bool), "albedo")
-
-
-def render_view_both(renderer, material, values, view: str) -> Twins:
-    """``check``'s pair of images of ``view`` at :data:`CHECK_SIZES` (the textured view on the material's default texture)."""
-    if view == "env":
-        return render_env_both(renderer, material, values, CHECK_SIZES["env"])
-    if view == "albedo":
-        return render_albedo_both(renderer, material, values)
-    thickness = None
-    if view == "textured":
-        from explorer.views.surface_texture import default_texture
-
-        thickness = default_texture(material)
-    return render_both(renderer, material, values, view, CHECK_SIZES[view], thickness=thickness)
-
-
-def check_material(renderer, material, values, views=None) -> list[Comparison]:
-    """
-    ``bragg-explorer check``: every view of ``views`` (default :func:`check_views`) of ``material`` at
-    ``values`` rendered by the GPU and by its numpy twin (sizes :data:`CHECK_SIZES`), each compared under
-    the view's named tolerance (:func:`tolerance_for`).
-    """
-    views = check_views(material) if views is None else tuple(views)
-    return [compare(render_view_both(renderer, material, values, view)) for view in views]

@@ -46,11 +46,11 @@ class BrdfViewPanel(Panel):
 
 def slice_quantity(material) -> str:
     """What the Slice window's colours are: a BRDF, or for a smooth mirror (a Dirac) its reflectance R(theta_d)."""
-    from explorer.views.mirror import is_mirror_only
+    from explorer.views.mirror import MIRROR_QUANTITY, is_mirror_only, plotted_quantity
 
     if is_mirror_only(material):
-        return "reflectance R(theta_d) of the smooth mirror (the weight of its mirror reflection, not a density per sr)"
-    return "BRDF (1/sr)"
+        return f"{MIRROR_QUANTITY} of the smooth mirror (the weight of its mirror reflection, not a density per sr)"
+    return plotted_quantity([False])
 
 
 class SlicePanel(BrdfViewPanel):

@@ -33,7 +33,7 @@ class PolarPanel(Panel):
     def draw(self, imgui) -> None:
         from imgui_bundle import implot
 
-        from explorer.views.mirror import is_mirror_only
+        from explorer.views.mirror import is_mirror_only, plotted_quantity
 
         state = self.state
         entries = state.visible_entries() or [None]
@@ -53,8 +53,7 @@ class PolarPanel(Panel):
                 curves.append((entry, material, cached[1]))
         mirrors = [is_mirror_only(material) for _, material, _ in curves]
         # A smooth mirror's "BRDF" is its reflectance R(theta_d) at the half vector: the weight of its Dirac, not a density.
-        quantity = "reflectance R(theta_d)" if mirrors and all(mirrors) else "BRDF (1/sr)" if not any(mirrors) else \
-            "BRDF (1/sr); a smooth mirror's reflectance R(theta_d)"
+        quantity = plotted_quantity(mirrors)
         imgui.text_wrapped(f"plane of incidence (light theta = {state.light[0]:.1f} deg); radius = {quantity}"
                            + ("; luminance per material" if len(curves) > 1 else ""))
         state.plotted["Polar"] = [entry.name if entry is not None else state.material_path.name for entry, _, _ in curves]
