@@ -110,3 +110,19 @@ def test_media_refusals_are_one_line(args, message):
 
 def test_a_thin_film_takes_no_medium():
     assert "not a design parameter" in one_line_error(run_cli("design", "thin_film", "--target", "0:#3f9f4f", "--fix", "n2=chitin"))
+
+
+def test_a_guessed_absorbing_mirror_survives_the_scan():
+    # The scan screens with melanin's real index at 550 nm; the shapes it places are ranked again on the
+    # absorbing model, so a guessed truth is refined rather than lost to a lossless look-alike (N = 6 with a host).
+    from explorer import design
+    from explorer.design.media import reference_value
+
+    media = {"n2": LIBRARY["melanin"]}
+    truth = dict(n1=1.56, n2=reference_value(media["n2"]), Lambda=210.0, delta=0.45, N=5, nh=0.0)
+    angles = [0.0, 20.0, 40.0, 60.0, 75.0]
+    colours = natural_rgb(np.cos(np.radians(angles)), mirror_with_media(truth, media))
+    ranges = dict(n1=(1, 2.5), n2=(1, 2.5), Lambda=(50, 1500), delta=(0, 1), N=(1, 1000), nh=(0, 2.5))
+    result = design.design("bragg_mirror", [design.Target(a, tuple(c)) for a, c in zip(angles, colours)], ranges,
+                           media=media, guesses=[truth])
+    assert result.median_delta_e2000 < 0.05 and result.values["N"] == 5, result

@@ -76,7 +76,10 @@ def absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta: ArrayLi
         denominator = 1.0 - r12 * r12 * phase2
         r1 = r12 * (1.0 - phase2) / denominator
         t1 = (1.0 - r12 * r12) * e_phi / denominator
-        t = np.arccos(a.astype(np.complex128))
+        # Below the gap at K Lambda ~ pi, U_n(-b) = (-1)^n U_n(b): the ratio U_{N-2} / U_{N-1} of -a, negated,
+        # continues the count N as the real model does (chebyshev_U's gap: no phase e^{2 pi i N} between counts).
+        flip = np.real(a) < -1.0
+        t = np.arccos(np.where(flip, -a, a).astype(np.complex128))
         t = np.where(np.imag(t) < 0.0, -t, t)  # U_n(cos t) is even in t: the decaying branch
         z = np.exp(1j * t)
         one_z2 = 1.0 - z * z
@@ -84,6 +87,7 @@ def absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta: ArrayLi
         safe = np.where(edge, 1.0, one_z2)
         W1 = np.where(edge, N, (1.0 - np.exp(2j * N * t)) / safe)
         W2 = np.where(edge, z * (N - 1.0), z * (1.0 - np.exp(2j * (N - 1.0) * t)) / safe)
+        W2 = np.where(flip, -W2, W2)
         r_N = r1 * W1 / (W1 - W2 * t1 * e_psi)
         R = np.abs(bragg.reflection_coefficient_host(r_N, r_h1)) ** 2
         if step is not None and np.any(w_point < 1.0):

@@ -114,4 +114,4 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion]) -> DesignMod
         rows["N"] = np.array([max(1.0, float(np.round(values["N"])))])
         return rgb_at(rows, cos_theta, POLISH_STEP, None)[0]
 
-    return replace(model, batch=batch, spectra=spectra, converged=converged)
+    return replace(model, batch=batch, spectra=spectra, converged=converged, rescreen=True)

@@ -171,6 +171,11 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
             U[tops], scores[tops] = _scan_descent(problem, U[tops], scores[tops], np.random.default_rng(seed),
                                                   lambda f: report(0.5 + 0.1 * f, "descent"))
             stages["descent"] = time.perf_counter() - start_time
+            if model.rescreen:
+                found = np.isfinite(scores)
+                for start in range(0, len(U), chunk):
+                    rows = slice(start, start + chunk)
+                    scores[rows] = np.where(found[rows], problem.screen(U[rows]), np.inf)
         else:
             # 1. Space-filling first pass (Sobol) on the screening model.
             U = np.concatenate([guessed, qmc.Sobol(P, scramble=True, seed=seed).random(samples)])
