@@ -81,7 +81,7 @@ def render_material(
     light: tuple[float, float] | None = None, thickness=None, environment=None, spp: int | None = None,
     variant: str | None = None, mesh=None, background: bool = False, plot=None, fill: float = 0.0,
     progress_printer: ProgressPrinter | None = None, warn: Callable[[str], None] | None = None,
-    checked: Callable[[], None] = lambda: None,
+    checked: Callable[[], None] = lambda: None, renderer=None,
 ) -> np.ndarray:
     """
     One view of a material as a linear float RGB image ``(height, width, 3)``, by ``engine`` (:data:`ENGINES`): on the
@@ -94,7 +94,8 @@ def render_material(
     :class:`explorer.views.plots.PlotSettings`) for the plot views; ``fill``, the ``lit`` view's environment fill
     (:mod:`explorer.views.fill`), 0 without. ``progress_printer(label, unit)`` reports long renders; ``warn(message)``
     is told of samples dropped; ``checked()`` once the input has passed its checks (sizes against this GL's
-    limits), where the work that cannot count its steps begins.
+    limits), where the work that cannot count its steps begins. ``renderer``: an :class:`explorer.gpu.Renderer` to
+    draw the GL views with (a caller that holds one: a second context made current would take its calls), else a new one.
     """
     if material.measured is not None:
         from explorer.views.geometry import VIEW_REGISTRY
@@ -147,7 +148,7 @@ def render_material(
     from explorer.gpu import Renderer
     from explorer.views.geometry import view_named
 
-    renderer = Renderer()
+    renderer = Renderer() if renderer is None else renderer
     renderer.limits.check_target(width, height)  # this GL's limits, before any work at this size
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)

@@ -37,6 +37,14 @@ def test_mitsuba_commands_bring_the_mitsuba_extra():
         assert bs.parse_mode(argv)[2] == (), argv
 
 
+def test_paint_commands_bring_the_paint_extra():
+    for argv in (["design", "m", "--target-image", "a.png", "--out-maps", "d"], ["design", "--target-image=a.png"],
+                 ["bench", "--paint"]):
+        assert bs.parse_mode(argv)[2] == ("paint",), argv
+    for argv in (["design", "m", "--target", "0:#ff0000"], ["render", "m", "--maps", "d"]):
+        assert bs.parse_mode(argv)[2] == (), argv
+
+
 def test_llvm_is_optional_and_only_for_the_mitsuba_extras(monkeypatch, capsys):
     assert bs.optional_packages_for(()) == ()
     assert bs.optional_packages_for(("mitsuba",)) == bs.optional_packages_for(("test",)) == ("libllvm19",)

@@ -126,3 +126,9 @@ def test_a_guessed_absorbing_mirror_survives_the_scan():
     result = design.design("bragg_mirror", [design.Target(a, tuple(c)) for a, c in zip(angles, colours)], ranges,
                            media=media, guesses=[truth])
     assert result.median_delta_e2000 < 0.05 and result.values["N"] == 5, result
+
+
+def test_painting_refuses_a_medium_in_one_line(tmp_path):
+    assert "painting takes an index as a number" in one_line_error(run_cli(
+        "design", "bragg_mirror", "--target-image", str(tmp_path / "a.png"), "--out-maps", str(tmp_path / "maps"),
+        "--fix", "n2=chitin"))

@@ -92,6 +92,12 @@ def _cheap(name: str, values: dict) -> dict:
     if name == "bragg_stack":
         for layer in (1, 2, 3):
             values[f"N_{layer}"] = min(values[f"N_{layer}"], 100.0)
+            # A disordered layer's tables: realisations x cells x 46 angles, seconds per cell. The first layer
+            # keeps its disorder (two cells at most); the others' is left to tests/test_natural_stack.py.
+            if layer == 1 and values.get("sigma_1", 0.0) > 0.0:
+                values["N_1"] = min(values["N_1"], 2.0)
+            elif layer > 1:
+                values[f"sigma_{layer}"] = 0.0
     return values
 
 

@@ -78,6 +78,8 @@ def preset_mirrors(preset_files=None) -> list[PresetMirror]:
             elif capabilities.supports("position-free"):  # a layered Bragg structure: each layer's mirror
                 stack = twin_class(preset_file.material).stack_of(preset_file.material.typed_values(preset.resolve()))
                 for k, layer in enumerate(stack.layers, start=1):
+                    if layer.natural:
+                        continue  # absorbing, dispersive or disordered: its exact tables, no approximation to rate
                     add(layer.mirror(stack.n1), f"{name}/layer {k}", kind)
     return list(found.values())
 

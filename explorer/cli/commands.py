@@ -329,10 +329,13 @@ def _errors(function):
 @click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
+@click.option("--maps", "maps_dir", metavar="DIR", help="textured view, --engine numpy: the structure maps design --target-image wrote; "
+              "one pixel a texel, its colour at --theta.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the viewing angle in degrees (default 0).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
-           ndotl, mapping):
+           ndotl, mapping, maps_dir, maps_theta):
     """Render MATERIAL (.brd, BRDF Explorer .brdf, or a built-in's name such as bragg_mirror) headless
     to a PNG, .npy or .exr. Without MATERIAL, the one --params names.
 
@@ -346,6 +349,13 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
     as a chart (.png) or their values (.npy); --size W sets their samples.
     """
+    if maps_dir is not None:
+        from explorer.cli.paint import render_maps_command
+
+        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
+        return
+    if maps_theta is not None:
+        raise click.UsageError("--theta goes with --maps")
     from explorer.views.geometry import scatter_circles, view_named
 
     if material is None:
@@ -576,9 +586,13 @@ def presets(material, as_json):
 @click.option("--mitsuba", "mitsuba", is_flag=True,
               help="Instead: Mitsuba's env-view frame times per variant beside GL's, and their median ΔE2000 (--size default 64 here; --spp).")
 @click.option("--spp", type=click.IntRange(min=1), default=64, show_default=True, help="--mitsuba: samples per pixel.")
+@click.option("--paint", "paint", is_flag=True,
+              help="Instead: painting with structural colour on a local Dask cluster (--workers): a 64x64 round trip and a 256x256 "
+                   "image of 8 regions, their ΔE2000 and times.")
+@click.option("--workers", "paint_workers", type=click.IntRange(min=1), default=2, show_default=True, help="--paint: local Dask workers.")
 @_errors
 def bench(as_json, size, repeats, film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
-          plot, markdown, mitsuba, spp):
+          plot, markdown, mitsuba, spp, paint, paint_workers):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
     With --thin-film: the thin-film methods of shaders/thin_film.brd (Belcour & Barla 2017).
@@ -592,6 +606,11 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
         raise click.UsageError("--seed goes with --design")
     if design_tries is not None and design_count is None:
         raise click.UsageError("--tries goes with --design")
+    if paint:
+        from explorer.bench.paint import run_paint_bench
+
+        run_paint_bench(workers=paint_workers, as_json=as_json)
+        return
     if position_free:
         from explorer.bench import run_position_free_bench
 

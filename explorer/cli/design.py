@@ -162,8 +162,11 @@ def _named_values(option: str, items, model, material_model: str, expected: str 
             value = float(value_text)
         except ValueError:
             value = float("nan")
-        if not np.isfinite(value) and media is not None and name in MEDIUM_PARAMETERS and value_text.strip() \
+        if not np.isfinite(value) and option == "--fix" and name in MEDIUM_PARAMETERS and value_text.strip() \
                 and not value_text.strip().lower().startswith(("nan", "inf", "-inf", "+inf")):
+            if media is None:
+                raise click.UsageError(f"{option} {item!r}: painting takes an index as a number (the colour design "
+                                       f"and --target-spectrum take media)")
             if not model.optical:
                 raise click.UsageError(f"{option} {item!r}: the colour design takes media for a Bragg mirror's indices only")
             if name in values or name in media:
@@ -190,8 +193,8 @@ def parse_fixes(fixes, free, material, media: dict | None = None):
 
     model = design_model(material.model)
     values = material.resolve({})
-    media = {} if media is None else media
     fixed = _named_values("--fix", fixes, model, material.model, media=media)
+    media = {} if media is None else media
     if free is not None:
         names = [n.strip() for n in free.split(",") if n.strip()]
         if not names:
@@ -254,10 +257,18 @@ def render_command(material_name: str, values: dict, material=None) -> str:
 @click.option("--tries", type=click.IntRange(min=1, max=MAX_TRIES), default=DEFAULT_TRIES, show_default=True, metavar="K",
               help="Search up to K times until every target is within ΔE2000 1, each from fresh samples and the best "
                    "structure so far (~4 s each; 1: one search).")
+@click.option("--target-image", metavar="IMAGE", help="Paint: the colours wanted per pixel at the first angle (.png 8/16 bits sRGB, "
+              ".exr/.npy linear; alpha masks pixels out); writes structure maps to --out-maps.")
+@click.option("--target-image-2", metavar="IMAGE", help="Paint: the colours at the second angle (the same size).")
+@click.option("--angles", "angles_text", metavar="A[,B]", help="Paint: the images' angles in degrees (default 0, or 0,45 with two images).")
+@click.option("--out-maps", metavar="DIR", help="Paint: the folder of the maps (one EXR per free parameter), params.json, ΔE2000 maps, report.")
+@click.option("--workers", type=click.IntRange(min=1), help="Paint: a local Dask cluster of this many workers (default one per core).")
+@click.option("--scheduler", metavar="ADDRESS", help="Paint: an existing Dask cluster's scheduler (tcp://host:8786) instead.")
 @click.option("--save", metavar="FILE", help="Also write the structure as a parameter set (FILE.json, or BRDF Explorer's .bparam) "
               "that render, export and open take with --params.")
 def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
-                   spectrum_theta, spectrum_plot, seed, tries, save):
+                   spectrum_theta, spectrum_plot, seed, tries, target_image, target_image_2, angles_text, out_maps, workers,
+                   scheduler, save):
     """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
     colours at the target angles come closest to the targets (CIEDE2000).
 
@@ -269,6 +280,28 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     from explorer.design import REACHABLE_DELTA_E, DesignError, design, design_model, ranges_of
     from explorer.resources import display_path
 
+    paint_options = (target_image_2, angles_text, out_maps, workers, scheduler)
+    if target_image is not None:
+        from explorer.cli.paint import paint_command
+
+        if target_texts or target_strip or target_spectrum or guess_texts or save:
+            raise click.UsageError("--target-image paints alone: no --target, --target-strip, --target-spectrum, --guess or --save")
+        if out_maps is None:
+            raise click.UsageError("--target-image needs --out-maps DIR (where the maps go)")
+        from explorer.errors import LocatedError
+        from explorer.design import DesignError, design_model
+
+        given = click.get_current_context().get_parameter_source("tries") == click.core.ParameterSource.COMMANDLINE
+        try:
+            loaded = load(material)
+            fixed = parse_fixes(fixes, free or ",".join(design_model(loaded.model).paint_free) or None, loaded)
+        except (LocatedError, DesignError) as error:
+            _fail(str(error))
+        paint_command(loaded, fixed, target_image, target_image_2, angles_text, out_maps, workers, scheduler, seed, as_json,
+                      tries if given else None)
+        return
+    if any(option is not None for option in paint_options):
+        raise click.UsageError("--target-image-2, --angles, --out-maps, --workers and --scheduler go with --target-image")
     if target_spectrum is not None:
         from explorer.cli.spectrum_fit import fit_command
 

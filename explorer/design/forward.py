@@ -264,14 +264,14 @@ def thin_film_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, f
 
 _BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
               integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, host_parameter="nh",
-              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch)
+              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch, paint_free=("Lambda", "delta", "N"))
 #: The forward model of each twin that declares ``design`` (:mod:`explorer.materials.twins`); its specular
 #: colour is what is designed (the rough Bragg layer's: the smooth mirror's colour, which its gradient view shows).
 DESIGN_MODELS: dict[str, DesignModel] = {model.name: model for model in (
     DesignModel(BraggMirrorModel.name, **_BRAGG),
     DesignModel(BraggLayerModel.name, **_BRAGG),
     DesignModel(ThinFilmModel.name, ("d", "eta1", "eta2", "eta3", "kappa3"), (), (), thin_film_rgb_batch, thin_film_converged_rgb,
-                scale_parameter="d", spectra=thin_film_spectra_batch),
+                scale_parameter="d", spectra=thin_film_spectra_batch, paint_free=("d",)),
 )}
 DESIGNABLE = tuple(DESIGN_MODELS)
 

@@ -77,6 +77,7 @@ def cases():
     """``(material name, roughness or None, overrides, film path)`` of the table."""
     from explorer.materials.brd import load_material
     from explorer.materials.export_table import roughness_names
+    from explorer.materials.thinfilm_model import ThinFilmModel
     from explorer.resources import builtin_materials
 
     for name, path in sorted(builtin_materials().items()):
@@ -87,7 +88,7 @@ def cases():
         for alpha in ROUGHNESSES:
             overrides = {n: alpha for n in names}
             yield name, alpha, overrides, "table"
-            if name == "thin_film":
+            if name == ThinFilmModel.name:  # the one with Principled's own film beside the table
                 yield name, alpha, overrides, "principled"
 
 

@@ -113,12 +113,18 @@ def wants_mitsuba(argv: Sequence[str]) -> bool:
     return False
 
 
+def wants_paint(argv: Sequence[str]) -> bool:
+    """Whether a CLI command line paints with Dask (``design --target-image``, ``bench --paint``)."""
+    return any(arg in ("--paint", "--target-image") or arg.startswith("--target-image=") for arg in argv)
+
+
 def parse_mode(argv: Sequence[str]) -> tuple[str, list[str], tuple[str, ...]]:
     """Return (mode, remaining args, pip extras) for ``python3 -m explorer`` argv."""
     argv = list(argv)
     if argv and argv[0] == MODE_TEST:
         return MODE_TEST, argv[1:], ("test",)
-    return MODE_RUN, argv, ("mitsuba",) if wants_mitsuba(argv) else ()
+    extras = (("mitsuba",) if wants_mitsuba(argv) else ()) + (("paint",) if wants_paint(argv) else ())
+    return MODE_RUN, argv, extras
 
 
 def system_packages_for(mode: str) -> tuple[str, ...]:

@@ -108,9 +108,10 @@ def study(name: str, alpha: float, paths: int) -> list[dict]:
     from explorer.materials.brd import load_material
     from explorer.materials.models import model_for
     from explorer.materials.presets import presets_for
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     values = dict(material.resolve(presets_for(material.path).get(name).values))
     for k in range(1, 4):
         values[f"alpha_{k}"] = float(alpha)
@@ -142,10 +143,11 @@ def structure_rows(presets, alphas, samples: int = 8192) -> list[dict]:
     from explorer.materials.models import model_for
     from explorer.materials.presets import presets_for
     from explorer.physics.position_free import PositionFree
-    from explorer.resources import material_path
+    from explorer.materials.models import BraggStackModel
+    from explorer.materials.twins import shipped_file
     from explorer.views.albedo import albedo_numpy
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     rows = []
     for name in presets:
         for alpha in alphas:

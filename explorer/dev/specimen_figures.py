@@ -19,7 +19,9 @@ from PIL import Image
 from explorer.views.spectrum_plot import describe, natural_mirror, spectrum_document, write_plot
 from explorer.files import atomic_output
 from explorer.materials.methods import BraggMethod
-from explorer.materials.presets import load_presets
+from explorer.materials.models import BraggMirrorModel
+from explorer.materials.presets import presets_for
+from explorer.materials.twins import shipped_file
 from explorer.physics.colorimetry import encode_srgb8
 from explorer.physics.natural import mirror_spectrum
 from explorer.rendering import render_material
@@ -32,7 +34,7 @@ THETAS = [0.0, 30.0, 60.0]
 
 def specimens():
     """The bragg_mirror presets that cite a published specimen."""
-    presets = load_presets(ROOT / "shaders" / "presets" / "bragg_mirror.toml")
+    presets = presets_for(shipped_file(BraggMirrorModel))
     return [p for p in presets.presets.values() if p.citation]
 
 

@@ -400,14 +400,22 @@ class BraggStackModel:
         count = round_integer(values["layers"])
         if not 1 <= count <= layered.MAX_LAYERS:
             raise ValueError(f"layers must be 1 to {layered.MAX_LAYERS}, got {values['layers']}")
+        from explorer.materials.media import index_value
+
         nh = _number(values, "nh")
         layers = []
         for k in range(1, count + 1):
             n1_k = _number(values, f"n1_{k}")
+            # Natural layers (explorer.physics.natural): k1_k, k2_k, sigma_k and media medium_n1_k, medium_n2_k.
+            media = {f"medium_{name}": (index_value(values, f"{name}_{k}") if f"medium_{name}_{k}" in values else None)
+                     for name in ("n1", "n2")}
+            media = {key: (None if isinstance(value, float) else value) for key, value in media.items()}
             layers.append(layered.RoughBraggLayer(
                 n2=_number(values, f"n2_{k}"), Lambda=_number(values, f"Lambda_{k}"),
                 delta=_number(values, f"delta_{k}"), N=round_integer(values[f"N_{k}"]),
                 alpha=_number(values, f"alpha_{k}"), n1=None if n1_k == nh else n1_k,
+                k1=float(values.get(f"k1_{k}", 0.0)), k2=float(values.get(f"k2_{k}", 0.0)),
+                sigma=float(values.get(f"sigma_{k}", 0.0)), **media,
             ))
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
@@ -477,7 +485,8 @@ class BraggStackModel:
         """
         ``stack_reflectance`` and ``stack_transmissivity``: ``(361, 471, 3)``, rows theta = k 0.25 deg,
         columns the wavelengths, channel l layer l (zeros beyond the used layers); ``stack_sampling``:
-        ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator).
+        ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator); ``stack_transmittance``
+        as ``stack_reflectance``: each smooth layer's ``T_lambda`` (exact for natural layers, else ``1 - R``).
         """
         return self._textures_of(self.tables, self.compensation)
 
@@ -494,9 +503,12 @@ class BraggStackModel:
         shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
         reflectance = np.zeros(shape, np.float32)
         transmissivity = np.zeros(shape, np.float32)
+        transmittance = np.zeros(shape, np.float32)
         for l, table in enumerate(tables):
             reflectance[..., l] = table.reflectance
             transmissivity[..., l] = table.transmissivity
+            # The smooth limit's T: a natural layer's exact one (absorbing: < 1 - R), else 1 - R.
+            transmittance[..., l] = np.float32(1.0) - table.reflectance if table.transmittance is None else table.transmittance
         # stack_missing: rows theta = k 2 deg (46) of m(theta), then r and r / (pi m_avg) (zeros: no compensation).
         missing = np.zeros((multiscatter.COMPENSATION_ROWS + 2, colorimetry.WAVELENGTHS.size, 3), np.float32)
         for l, c in enumerate(compensation or ()):
@@ -508,6 +520,7 @@ class BraggStackModel:
             "stack_transmissivity": transmissivity,
             "stack_sampling": transmissivity.mean(axis=1, dtype=np.float64).astype(np.float32),
             "stack_missing": missing,
+            "stack_transmittance": transmittance,
         }
 
 

@@ -69,6 +69,14 @@ class RoughBraggLayer:
     n1 : float, optional
         The mirror's low index when it differs from the host (the jewel-beetle cuticles of Table 3:
         Yeh's reflectance then follows Appendix D with ``nh`` the host); ``None``, the host's ``n1``.
+    k1, k2 : float
+        Extinction coefficients of the ``n1`` and ``n2`` layers (>= 0; absorbing layers).
+    sigma : float
+        Thickness disorder (:class:`explorer.physics.natural.NaturalMirror`): the ensemble's mean.
+    medium_n1, medium_n2 : explorer.physics.dispersion.Dispersion, optional
+        Dispersive media instead of the numbers ``n1``, ``n2`` (which then only stand for them on a slider).
+    With any of the last five the layer is natural (:attr:`natural`): its tables are the exact multilayer's
+    (:func:`explorer.physics.natural.spectral_tables`), its facets transmit ``T <= 1 - R``.
     """
 
     n2: float = 1.5
@@ -77,9 +85,16 @@ class RoughBraggLayer:
     N: int = 10
     alpha: float = 0.1
     n1: float | None = None
+    k1: float = 0.0
+    k2: float = 0.0
+    sigma: float = 0.0
+    medium_n1: object = None
+    medium_n2: object = None
 
     def __post_init__(self):
         microfacet.check_alpha(self.alpha)
+        if self.natural or min(self.k1, self.k2, self.sigma) < 0.0:
+            self.natural_mirror(1.0)  # NaturalMirror's own checks (k >= 0, sigma's range)
         if not (float(self.N) >= 1 and float(self.N) == int(self.N)):
             raise ValueError(f"N must be a whole number of cells >= 1, got {self.N}")
         if not (self.Lambda > 0.0):
@@ -100,6 +115,21 @@ class RoughBraggLayer:
             N=int(self.N),
             nh=None if n1 == host_n1 else float(host_n1),
         )
+
+    @property
+    def natural(self) -> bool:
+        """Whether the layer absorbs, disperses or is disordered (its tables are then the exact multilayer's)."""
+        return (self.k1 > 0.0 or self.k2 > 0.0 or self.sigma > 0.0
+                or self.medium_n1 is not None or self.medium_n2 is not None)
+
+    def natural_mirror(self, host_n1: float):
+        """The layer's :class:`explorer.physics.natural.NaturalMirror` in a host of index ``host_n1`` (lossless)."""
+        from explorer.physics import natural
+
+        n1 = self.medium_n1 if self.medium_n1 is not None else (host_n1 if self.n1 is None else float(self.n1))
+        n2 = self.medium_n2 if self.medium_n2 is not None else float(self.n2)
+        return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(self.Lambda), delta=float(self.delta), N=int(self.N),
+                                     nh=float(host_n1), k1=float(self.k1), k2=float(self.k2), sigma=float(self.sigma))
 
 
 @dataclass(frozen=True)
@@ -295,6 +325,9 @@ class LayerTables:
         of Eq. 17, looked up at the half-vector angle.
     transmissivity : ndarray, shape (361, 471), float32
         The integrated transmissivity ``f_t(theta) cos theta`` (Eq. 28): Eq. 34's ``f_t,k``.
+    transmittance : ndarray, shape (361, 471), float32, or None
+        A natural layer's exact smooth transmittance ``T_lambda(theta)`` (``< 1 - R`` where it absorbs); None:
+        ``1 - R`` (lossless layers).
     seconds : float
         Wall-clock build time of both (the filter excluded: it depends on ``alpha`` only).
     """
@@ -305,6 +338,7 @@ class LayerTables:
     reflectance: np.ndarray = field(repr=False)
     transmissivity: np.ndarray = field(repr=False)
     seconds: float = 0.0
+    transmittance: np.ndarray | None = field(default=None, repr=False)
 
 
 @functools.lru_cache(maxsize=32)
@@ -350,6 +384,14 @@ def layer_tables(
         raise ValueError(f"the transmission filter is for alpha={F.alpha:g}, the layer has alpha={layer.alpha:g}")
     start = time.perf_counter()
     theta = F.theta
+    if layer.natural:  # absorbing, dispersive or disordered: the exact multilayer (no draft), Eq. 28 over its T
+        from explorer.physics import natural
+
+        R, T = (np.asarray(a, dtype=np.float32) for a in natural.spectral_tables(layer.natural_mirror(float(n1)), theta))
+        transmissivity = F.weights.astype(np.float32) @ T
+        for a in (R, T, transmissivity):
+            a.setflags(write=False)
+        return LayerTables(layer, float(n1), theta, R, transmissivity, time.perf_counter() - start, transmittance=T)
     mirror = layer.mirror(float(n1))
     if draft:
         reflectance = bragg.reflectance_spectra(np.cos(theta), mirror).astype(np.float32)
@@ -502,7 +544,7 @@ def single_reflection_spectra(
             * microfacet.smith_G1_over_cos(cos_i_host, layer.alpha)
             * microfacet.smith_G1_over_cos(cos_o_host, layer.alpha)
         )
-        if exact_reflectance:
+        if exact_reflectance and not layer.natural:
             R = bragg.bragg_reflectance(
                 np.maximum(cos_theta_d, microfacet.COS_THETA_MIN)[..., None], colorimetry.WAVELENGTHS, layer.mirror(n1)
             )
@@ -610,7 +652,8 @@ def stack_specular_rgb(stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequen
         through = through * gap
         R = lookup(table.reflectance, theta)
         spectrum = spectrum + through * R
-        through = through * (1.0 - R) ** 2
+        T = 1.0 - R if table.transmittance is None else lookup(table.transmittance, theta)  # absorbing: T < 1 - R
+        through = through * T ** 2
     return colorimetry.spectrum_to_rgb(spectrum) + F[..., None]  # F is flat: white is (1, 1, 1)
 
 

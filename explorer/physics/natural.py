@@ -199,7 +199,8 @@ def _unpolarised_rt(mirror: NaturalMirror, wavelength_nm: np.ndarray, cos_theta:
             else:
                 R_pol, T_pol = multilayer.mean_optics(pol, host, indices, realised, base, wavelength_nm, sin_theta)
             R, T = R + 0.5 * R_pol, T + 0.5 * T_pol
-    grazing = cos_theta <= 0.0  # exact grazing: total reflection
+    # Exact grazing (or within rounding of it, cos(pi / 2) = 6e-17: 0/0 there): total reflection.
+    grazing = (cos_theta <= 0.0) | ~np.isfinite(R)
     return np.where(grazing, 1.0, R), np.where(grazing, 0.0, np.nan_to_num(T))
 
 
@@ -216,22 +217,33 @@ def transmittance_table(mirror: NaturalMirror, theta: ArrayLike) -> np.ndarray:
     :data:`DISORDERED_STEP_NM` nm and :data:`DISORDERED_ANGLE_STEP_DEG` degrees over :func:`colour_realisations`
     realisations, interpolated linearly.
     """
+    return spectral_tables(mirror, theta)[1]
+
+
+def spectral_tables(mirror: NaturalMirror, theta: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The mean unpolarised ``(R, T)`` at angles ``theta`` (radians, in the host) and the CMFs' wavelengths, each
+    ``(n_angles, 471)``, sampled as :func:`transmittance_table` says: a rough layer's tables (Eq. 17's facet
+    reflectance, Eq. 28's transmittance) when its layers absorb, disperse or are disordered.
+    """
     from explorer.physics import colorimetry
 
     theta = np.asarray(theta, dtype=np.float64)
     wavelengths = colorimetry.WAVELENGTHS
     thicknesses = np.array([mirror.d2, mirror.d1] * int(mirror.N))
     if mirror.sigma == 0.0:
-        return _unpolarised_rt(mirror, wavelengths[np.newaxis, :], np.cos(theta)[:, np.newaxis], thicknesses[np.newaxis, :])[1]
+        return _unpolarised_rt(mirror, wavelengths[np.newaxis, :], np.cos(theta)[:, np.newaxis], thicknesses[np.newaxis, :])
     realised = multilayer.disordered_thicknesses(thicknesses, mirror.sigma, colour_realisations(mirror))
     nodes = np.radians(np.append(np.arange(0.0, 90.0, DISORDERED_ANGLE_STEP_DEG), 90.0))
     # Only the nodes that bracket the angles asked for.
     index = np.searchsorted(nodes, np.clip(theta.ravel(), 0.0, nodes[-1]))
     nodes = nodes[np.unique(np.clip(np.concatenate([index - 1, index]), 0, nodes.size - 1))]
     coarse = np.append(np.arange(RANGE_NM[0], RANGE_NM[1], DISORDERED_STEP_NM), RANGE_NM[1])
-    T = _unpolarised_rt(mirror, coarse[np.newaxis, :], np.cos(nodes)[:, np.newaxis], realised)[1]
-    T = np.array([np.interp(wavelengths, coarse, row) for row in T])
-    return np.array([np.interp(theta, nodes, column) for column in T.T]).T
+    tables = []
+    for table in _unpolarised_rt(mirror, coarse[np.newaxis, :], np.cos(nodes)[:, np.newaxis], realised):
+        table = np.array([np.interp(wavelengths, coarse, row) for row in table])
+        tables.append(np.array([np.interp(theta, nodes, column) for column in table.T]).T)
+    return tables[0], tables[1]
 
 
 def colour_realisations(mirror: NaturalMirror) -> int:

@@ -148,6 +148,12 @@ class PositionFree:
         # The layers' tables, float32 (the shader's textures): R_lambda(theta) and f_t cos theta (Eq. 28).
         self.reflectance = [np.ascontiguousarray(t.reflectance, dtype=np.float32) for t in tables]
         self.transmissivity = [np.ascontiguousarray(t.transmissivity, dtype=np.float32) for t in tables]
+        # Natural layers' facets transmit their exact T (absorbing: < 1 - R; the rest is absorbed); None: 1 - R.
+        self.transmittance = [None if getattr(t, "transmittance", None) is None
+                              else np.ascontiguousarray(t.transmittance, dtype=np.float32) for t in tables]
+        if self.walk and any(t is not None for t in self.transmittance):
+            raise ValueError("the microsurface walk's facets transmit 1 - R: natural (absorbing, dispersive or "
+                             "disordered) layers take microsurface='single'")
         self.rgb = _rgb_matrix()
         self.pdf = wavelength_pdf()
         self.cdf = np.cumsum(self.pdf)
@@ -333,7 +339,9 @@ class PositionFree:
                 transmit = split | ~chosen
                 beta_r = b * R * G1_o
                 pi_r = pi[at] * np.where(split[:, None], 1.0, R)
-                beta_t = b * np.where(split[:, None], self._lookup(self.transmissivity[l], cos_in, j), (1.0 - R) * G1_i)
+                # A natural layer's facet transmits T (<= 1 - R), chosen with probability 1 - R: the rest is absorbed.
+                T = 1.0 - R if self.transmittance[l] is None else np.clip(self._lookup(self.transmittance[l], cos_d, j), 0.0, 1.0)
+                beta_t = b * np.where(split[:, None], self._lookup(self.transmissivity[l], cos_in, j), T * G1_i)
                 pi_t = pi[at] * np.where(split[:, None], 1.0, 1.0 - R)
                 sign = np.where(from_above, 1.0, -1.0)
                 d_r = np.stack([o[:, 0], o[:, 1], sign * o[:, 2]], axis=-1)

@@ -171,7 +171,9 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
 // F + (1 - F)^2 sum_l R_l(theta') prod_{k<l} (1 - R_k(theta'))^2, theta' the refracted angle (without a
 // coating: theta' = theta, F = 0). Smooth layers transmit 1 - R (the rough layer's integrated
 // transmissivity would exceed it beside band edges: see explorer.physics.layered.stack_specular_rgb).
-vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h) {
+// exact_transmittance: natural (absorbing) layers transmit transmittance_table's T < 1 - R (the host's exact table).
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h,
+                        bool exact_transmittance, sampler2D transmittance_table) {
     float c = clamp(cos_theta, 0.0, 1.0), s = sqrt(max(1.0 - c * c, 0.0));
     float F = 0.0, through = 1.0;
     if (coating) {
@@ -190,7 +192,13 @@ vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count
     vec3 xyz = vec3(0.0);
     for (int j = 0; j < CMF_COUNT; ++j) {
         vec3 R = table_fetch(reflectance_table, j, k, f) * used;
-        vec3 t = (1.0 - R) * (1.0 - R) * g;
+        vec3 t;
+        if (exact_transmittance) {
+            vec3 T = table_fetch(transmittance_table, j, k, f);
+            t = T * T * g;
+        } else {
+            t = (1.0 - R) * (1.0 - R) * g;
+        }
         xyz += colour_matching_functions(j) * (through * (R.x + t.x * (R.y + t.y * R.z)));
     }
     return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)

@@ -1,0 +1,141 @@
+"""
+``bench --paint``: painting with structural colour, timed (:mod:`explorer.design.paint`).
+
+1. The round trip: smooth random maps of ``Lambda``, ``delta`` and ``N`` (:data:`ROUND_TRIP_BOX`) rendered at 0 and
+   45 degrees as ``render --maps --view textured`` renders them (:func:`explorer.views.maps.map_colours`), designed
+   back on a local Dask cluster, the designed maps rendered again: the share of pixels within CIEDE2000 1 of the
+   targets at both angles, and the time.
+2. A 256 x 256 image of 8 painted regions (each the colours of a random mirror in the box at 0 and 45 degrees).
+
+A benchmark prints numbers; the measurements in docs/paint.md come from it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+import click
+import numpy as np
+
+#: The round trip's box (the material's other values at its defaults: n1 = 1, n2 = 1.5, no host).
+ROUND_TRIP_BOX = {"Lambda": (150.0, 320.0), "delta": (0.3, 0.7), "N": (6.0, 30.0)}
+ANGLES = (0.0, 45.0)
+#: The smooth fields' correlation length, as a share of the image's side.
+SMOOTHNESS = 0.15
+
+
+def smooth_random_maps(size: int, seed: int, box=ROUND_TRIP_BOX) -> dict[str, np.ndarray]:
+    """Gaussian-filtered noise per parameter, stretched over its box (``N`` whole): smooth random structure maps."""
+    from scipy.ndimage import gaussian_filter
+
+    rng = np.random.default_rng(seed)
+    maps = {}
+    for name, (low, high) in box.items():
+        field = gaussian_filter(rng.normal(size=(size, size)), SMOOTHNESS * size, mode="wrap")
+        field = (field - field.min()) / max(field.max() - field.min(), 1e-12)
+        value = low + field * (high - low)
+        maps[name] = np.round(value) if name == "N" else value
+    return maps
+
+
+def region_maps(size: int, regions: int, seed: int, box=ROUND_TRIP_BOX) -> dict[str, np.ndarray]:
+    """``regions`` Voronoi regions, each one random structure of the box."""
+    rng = np.random.default_rng(seed)
+    centres = rng.random((regions, 2)) * size
+    y, x = np.mgrid[0:size, 0:size] + 0.5
+    label = np.argmin((x[..., None] - centres[:, 0]) ** 2 + (y[..., None] - centres[:, 1]) ** 2, axis=-1)
+    maps = {}
+    for name, (low, high) in box.items():
+        values = low + rng.random(regions) * (high - low)
+        maps[name] = (np.round(values) if name == "N" else values)[label]
+    return maps
+
+
+def _targets(model_name, fixed, maps):
+    from explorer.design.paint import PaintTargets
+    from explorer.views.maps import map_colours
+
+    rgb = np.stack([map_colours(model_name, fixed, maps, a) for a in ANGLES]).astype(np.float64)
+    shape = rgb.shape[1:3]
+    return PaintTargets(ANGLES, rgb, np.zeros(rgb.shape, np.int8), np.ones(shape, bool))
+
+
+def _run(name, model_name, ranges, fixed, maps, client, seed, rows):
+    from explorer.design.paint import paint
+    from explorer.physics.colorimetry import delta_E_2000
+    from explorer.views.maps import map_colours
+
+    start = time.perf_counter()
+    targets = _targets(model_name, fixed, maps)
+    rendered = time.perf_counter() - start
+    start = time.perf_counter()
+    result = paint(model_name, ranges, fixed, targets, seed=seed, client=client,
+                   progress=lambda message: click.echo(f"bench --paint: {name}: {message}", err=True))
+    painted = time.perf_counter() - start
+    start = time.perf_counter()
+    again = np.stack([map_colours(model_name, result.fixed, result.maps, a) for a in ANGLES]).astype(np.float64)
+    rerendered = time.perf_counter() - start
+    delta = delta_E_2000(again, targets.rgb)  # (A, H, W)
+    within = float(np.mean(np.all(delta <= 1.0, axis=0)))
+    row = {"image": name, "size": list(delta.shape[1:]), "colours": result.colours, "clusters": result.clusters,
+           "within_1_both_angles": within, "median": [float(np.median(d)) for d in delta],
+           "p95": [float(np.percentile(d, 95)) for d in delta], "unreachable_pixels": int(result.unreachable.sum()),
+           "render_seconds": rendered, "paint_seconds": painted, "rerender_seconds": rerendered, "stages": result.stages,
+           "task_seconds": result.task_seconds, "critical_path_seconds": result.critical_path,
+           "total_variation": {k: total_variation(v) for k, v in result.maps.items()}}
+    rows.append(row)
+    return row
+
+
+def total_variation(image: np.ndarray) -> float:
+    """Mean absolute difference between 4-neighbours (finite pixels), relative to the map's range."""
+    finite = np.isfinite(image)
+    span = float(np.nanmax(image) - np.nanmin(image)) if finite.any() else 0.0
+    diffs = [np.abs(np.diff(image, axis=a))[np.isfinite(np.diff(image, axis=a))] for a in (0, 1)]
+    values = np.concatenate(diffs)
+    return float(values.mean() / span) if values.size and span > 0 else 0.0
+
+
+def run_paint_bench(workers: int = 2, seed: int = 0, size: int = 64, as_json: bool = False) -> None:
+    """The round trip at ``size`` and the 256 x 256 8-region image on a local cluster of ``workers``."""
+    from distributed import Client, LocalCluster
+
+    from explorer.design import ranges_of
+    from explorer.design.forward import design_model
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
+
+    material = load_material(shipped_file(BraggMirrorModel))
+    model = design_model(material.model)
+    defaults = material.resolve({})
+    fixed = {name: float(defaults[name]) for name in model.parameters if name not in ROUND_TRIP_BOX}
+    ranges = ranges_of(material)
+    start = time.perf_counter()
+    import logging
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+    client = Client(cluster)
+    up = time.perf_counter() - start
+    rows: list[dict] = []
+    try:
+        for name, maps in ((f"round trip {size}x{size}", smooth_random_maps(size, seed)),
+                           ("8 regions 256x256", region_maps(256, 8, seed))):
+            row = _run(name, model.name, ranges, fixed, maps, client, seed, rows)
+            if not as_json:
+                click.echo(f"{row['image']}: {100 * row['within_1_both_angles']:.1f} % of pixels within ΔE2000 1 at 0 and 45 degrees "
+                           f"(median {row['median'][0]:.2f} / {row['median'][1]:.2f}, p95 {row['p95'][0]:.2f} / {row['p95'][1]:.2f}); "
+                           f"{row['colours']} colours, {row['clusters']} clusters, {row['unreachable_pixels']} unreachable")
+                click.echo(f"  design {row['paint_seconds']:.1f} s on {workers} workers (+ cluster start {up:.1f} s; target render "
+                           f"{row['render_seconds']:.1f} s, re-render {row['rerender_seconds']:.1f} s); stages: "
+                           + ", ".join(f"{k} {v:.1f} s" for k, v in row["stages"].items())
+                           + f"; task time {row['task_seconds']:.1f} s, critical path {row['critical_path_seconds']:.1f} s")
+    finally:
+        client.close()
+        cluster.close()
+    if as_json:
+        click.echo(json.dumps({"workers": workers, "cluster_start_seconds": up, "load_average": list(os.getloadavg()), "runs": rows}, indent=2))
+    else:
+        click.echo(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")

@@ -1,0 +1,144 @@
+"""
+The colours of structure maps (:mod:`explorer.design.paint`'s output): each texel's structure, the fixed values
+and the map's free parameters, seen at one angle. The flat textured view of a painted material: what a target image
+of ``design --target-image`` shows, so that a map folder renders back to the image it was designed from.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from explorer.design.paint import PaintResult
+
+
+def map_structures(fixed: Mapping[str, float], maps: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The texels that hold a structure (every map finite) and their design values (flat arrays, in texel order)."""
+    shape = next(iter(maps.values())).shape
+    inside = np.logical_and.reduce([np.isfinite(m) for m in maps.values()])
+    values = {name: np.full(int(inside.sum()), float(v)) for name, v in fixed.items()}
+    values.update({name: np.asarray(m, dtype=np.float64)[inside] for name, m in maps.items()})
+    return inside.reshape(shape), values
+
+
+def map_colours(model_name: str, fixed: Mapping[str, float], maps: Mapping[str, np.ndarray], theta_deg: float) -> np.ndarray:
+    """
+    ``(H, W, 3)`` linear RGB: each texel's converged spectral colour at ``theta_deg`` (the design's forward model,
+    :attr:`explorer.design.base.DesignModel.converged` with ``final``: the reference); black where a map is NaN.
+    """
+    from explorer.design import design_model
+
+    model = design_model(model_name)
+    inside, values = map_structures(fixed, maps)
+    cos_theta = np.array([np.cos(np.radians(theta_deg))])
+    out = np.zeros(inside.shape + (3,))
+    colours = np.empty((int(inside.sum()), 3))
+    cache: dict[tuple, np.ndarray] = {}
+    for i in range(colours.shape[0]):
+        structure = {name: float(v[i]) for name, v in values.items()}
+        key = tuple(sorted(structure.items()))
+        if key not in cache:  # painted regions repeat one structure
+            cache[key] = model.converged(structure, cos_theta, final=True)[0]
+        colours[i] = cache[key]
+    out[inside] = colours
+    return out.astype(np.float32)
+
+
+# --------------------------------------------------------------------------------------------------
+# Map folders and target images
+
+
+def write_maps(result: PaintResult, out: Path, material: str, model_name: str, angles: Sequence[float], seed: int) -> list[Path]:
+    """
+    The maps as EXR (one per free parameter, the value in every channel; NaN off the mask), ``params.json``
+    (the fixed values, the free ones, the angles), a CIEDE2000 EXR per angle, ``unreachable.png`` (white where no
+    structure reaches) and ``report.json``. Every file written atomically.
+    """
+    from PIL import Image
+
+    from explorer.files import atomic_output, write_text_atomic
+    from explorer.views.images import write_image
+
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, image in result.maps.items():
+        path = out / f"{name}.exr"
+        write_image(np.repeat(image[..., None], 3, axis=-1).astype(np.float32), path)
+        written.append(path)
+    params = {"material": material, "model": model_name, "fixed": result.fixed, "free": list(result.maps),
+              "angles_deg": list(angles), "seed": seed, "shape": list(result.unreachable.shape)}
+    write_text_atomic(out / "params.json", json.dumps(params, indent=2) + "\n")
+    written.append(out / "params.json")
+    for a, theta in enumerate(angles):
+        path = out / f"delta_e_{theta:g}.exr"
+        write_image(np.repeat(result.delta_e[a][..., None], 3, axis=-1).astype(np.float32), path)
+        written.append(path)
+    path = out / "unreachable.png"
+    with atomic_output(path) as temporary:
+        Image.fromarray(np.where(result.unreachable, 255, 0).astype(np.uint8), mode="L").save(temporary, format="PNG")
+    written.append(path)
+    write_text_atomic(out / "report.json", json.dumps(result.report(angles), indent=2) + "\n")
+    written.append(out / "report.json")
+    return written
+
+
+def read_maps(folder: str | os.PathLike[str]) -> tuple[dict, dict[str, np.ndarray]]:
+    """``params.json`` and the maps of a folder :func:`write_maps` wrote; ``ValueError`` (one line) otherwise."""
+    folder = Path(folder)
+    try:
+        params = json.loads((folder / "params.json").read_text(encoding="utf-8"))
+        names = list(params["free"])
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ValueError(f"{folder / 'params.json'}: not a map folder's parameters ({' '.join(str(error).split())[:100]})") from None
+    maps = {name: _read_exr_channel(folder / f"{name}.exr") for name in names}
+    shapes = {m.shape for m in maps.values()}
+    if len(shapes) > 1:
+        raise ValueError(f"{folder}: the maps differ in size ({', '.join(f'{s[1]}x{s[0]}' for s in sorted(shapes))})")
+    return params, maps
+
+
+def _read_exr_channel(path: Path) -> np.ndarray:
+    """The first channel of a map's EXR (NaN kept: off the mask), ``ValueError`` (one line) when unreadable."""
+    from explorer.views.env import _cv2
+
+    cv2 = _cv2()
+    pixels = cv2.imread(os.fspath(path), cv2.IMREAD_UNCHANGED) if path.is_file() else None
+    if pixels is None:
+        raise ValueError(f"{path}: no map there (or not an EXR OpenCV can read)")
+    pixels = np.asarray(pixels, dtype=np.float64)
+    return pixels if pixels.ndim == 2 else pixels[..., -1]  # BGR: the last is red, all equal
+
+
+def read_target_image(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    A target image as the strips are read (:func:`explorer.views.images.read_linear_image`: 8/16-bit PNG and the
+    like in sRGB, ``.exr``/``.npy`` linear): linear RGB ``(H, W, 3)``, clipped codes ``(H, W, 3)`` (bounds) and
+    the alpha mask ``(H, W)`` (alpha above half; all true without alpha). ``ValueError`` (one line) otherwise.
+    """
+    from explorer.views.images import clipped_codes, read_linear_image
+
+    rgb = read_linear_image(path)
+    clipped = clipped_codes(path)
+    if clipped is None:
+        clipped = np.zeros(rgb.shape, np.int8)
+    return rgb, clipped, _alpha(Path(path), rgb.shape[:2])
+
+
+def _alpha(path: Path, shape) -> np.ndarray:
+    if path.suffix.lower() == ".npy":
+        array = np.load(path, allow_pickle=False)
+        return np.asarray(array[..., 3] > 0.5) if array.ndim == 3 and array.shape[2] >= 4 else np.ones(shape, bool)
+    from explorer.views.env import _cv2
+
+    cv2 = _cv2()
+    pixels = cv2.imdecode(np.fromfile(path, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+    if pixels is None or pixels.ndim != 3 or pixels.shape[2] < 4:
+        return np.ones(shape, bool)
+    alpha = pixels[..., 3].astype(np.float64)
+    if np.issubdtype(pixels.dtype, np.integer):
+        alpha /= np.iinfo(pixels.dtype).max
+    return alpha > 0.5

@@ -1,0 +1,142 @@
+"""
+Painting with structural colour (``design --target-image``, explorer.design.paint): a 2-worker local Dask cluster
+designs a 16 x 16 image back to maps whose colours (``render --maps``) match it, a second run resumes from the cache,
+unreachable colours are flagged and masked pixels skipped, and bad images get one-line errors.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from conftest import one_line_error, run_cli
+
+from explorer.design import bragg_converged_rgb
+from explorer.physics.colorimetry import delta_E_2000
+
+pytest.importorskip("distributed")
+
+ANGLES = (0.0, 45.0)
+#: The material's defaults (n1 = 1, n2 = 1.5, delta = 0.5, N = 20, no host): only Lambda is designed, which keeps the
+#: searches to a second or two each.
+DEFAULTS = dict(n1=1.0, n2=1.5, nh=0.0, delta=0.5, N=20)
+#: A painted structure's colour against tmm's and colour-science's (tests/test_design_independent.py's integral,
+#: 0.5 nm trapezoids): its 20 cells' fringes are narrower than that design test's stacks (measured 0.022).
+INDEPENDENT_DELTA_E = 0.05
+
+
+def _colours(Lambda: float) -> np.ndarray:
+    return bragg_converged_rgb({**DEFAULTS, "Lambda": Lambda}, np.cos(np.radians(ANGLES)))
+
+
+def _two_regions(tmp_path, size=16):
+    a, b = _colours(180.0), _colours(240.0)
+    image = np.zeros((2, size, size, 3))
+    image[:, :, : size // 2] = a[:, None, None]
+    image[:, :, size // 2 :] = b[:, None, None]
+    paths = []
+    for k, theta in enumerate(ANGLES):
+        path = tmp_path / f"target_{theta:g}.npy"
+        np.save(path, image[k].astype(np.float32))
+        paths.append(path)
+    return image, paths
+
+
+def test_a_two_worker_cluster_paints_a_16_pixel_image_that_renders_back(tmp_path):
+    image, (first, second) = _two_regions(tmp_path)
+    out = tmp_path / "maps"
+    args = ("design", "bragg_mirror", "--target-image", first, "--target-image-2", second, "--free", "Lambda",
+            "--out-maps", out, "--workers", "2", "--seed", "3", "--tries", "1")
+    run = run_cli(*args)
+    assert run.returncode == 0, run.stderr
+    assert "2 Dask workers (local)" in run.stderr
+    for name in ("Lambda.exr", "params.json", "delta_e_0.exr", "delta_e_45.exr", "unreachable.png", "report.json"):
+        assert (out / name).is_file(), name
+    assert not (out / "N.exr").exists()  # fixed: in params.json
+    params = json.loads((out / "params.json").read_text())
+    assert params["free"] == ["Lambda"] and params["fixed"]["N"] == 20 and params["angles_deg"] == list(ANGLES)
+    report = json.loads((out / "report.json").read_text())
+    assert report["pixels"] == 256 and report["colours"] == 2 and report["within_1_at_every_angle"] == 1.0
+    assert not np.asarray(Image.open(out / "unreachable.png")).any()
+    from explorer.views.maps import read_maps
+
+    _, maps = read_maps(out)
+    assert maps["Lambda"].shape == (16, 16)
+    np.testing.assert_allclose(maps["Lambda"][:, :8], 180.0, rtol=0.02)
+    np.testing.assert_allclose(maps["Lambda"][:, 8:], 240.0, rtol=0.02)
+    # The maps render back to the targets (render --maps, the same forward model the independent check would use).
+    for k, theta in enumerate(ANGLES):
+        rendered = tmp_path / f"again_{theta:g}.npy"
+        again = run_cli("render", "bragg_mirror", "--maps", out, "--view", "textured", "--engine", "numpy", "--theta", theta, "--out", rendered)
+        assert again.returncode == 0, again.stderr
+        assert np.max(delta_E_2000(np.load(rendered).astype(float), image[k])) < 1.0
+    # A second run reads every task from the cache: the same maps.
+    resumed = run_cli(*args)
+    assert resumed.returncode == 0, resumed.stderr
+    assert "designs: 2 tasks (2 from the cache)" in resumed.stderr
+    _, maps_again = read_maps(out)
+    np.testing.assert_array_equal(maps_again["Lambda"], maps["Lambda"])
+
+
+def test_unreachable_colours_are_flagged_and_masked_pixels_skipped():
+    from explorer.design import ranges_of
+    from explorer.design.paint import PaintTargets, paint
+    from explorer.cli.design import load
+
+    material = load("bragg_mirror")
+    reachable = _colours(200.0)
+    red = np.array([1.0, 0.0, 0.0])  # saturated sRGB red at both angles: no mirror keeps it at 45 degrees
+    rgb = np.zeros((2, 3, 4, 3))
+    rgb[:, :, :2] = red
+    rgb[:, :, 2:] = reachable[:, None, None]
+    mask = np.ones((3, 4), bool)
+    mask[0] = False  # alpha 0: skipped
+    targets = PaintTargets(ANGLES, rgb, np.zeros(rgb.shape, np.int8), mask)
+    # Without a client every task runs here, in turn (the same functions the workers run).
+    result = paint("bragg_mirror", ranges_of(material), DEFAULTS, targets, seed=0, client=None, tries=1, rescue_tries=1)
+    expected = np.zeros((3, 4), bool)
+    expected[1:, :2] = True
+    np.testing.assert_array_equal(result.unreachable, expected)
+    assert np.all(np.isnan(result.maps["Lambda"][0])) and np.all(np.isnan(result.delta_e[:, 0]))
+    assert np.all(result.delta_e[:, 1:, 2:] < 1.0)
+    assert np.all(np.max(result.delta_e[:, 1:, :2], axis=0) > 2.0)
+    # An independent check of a written structure: tmm's spectrum and colour-science's colour (tests/test_design_independent.py)
+    # against the colour the result reports and the target.
+    import colour
+    from test_design_independent import XY_E, lab_of_rgb, mirror_layers, tmm_unpolarised, xyz_of
+
+    structure = {**DEFAULTS, "Lambda": float(result.maps["Lambda"][1, 2])}
+    indices, thicknesses = mirror_layers(structure)
+    for k, theta in enumerate(ANGLES):
+        lab = colour.XYZ_to_Lab(xyz_of(tmm_unpolarised(indices, thicknesses, theta)), XY_E)
+        assert colour.delta_E(lab, lab_of_rgb(result.achieved[k, 1, 2]), method="CIE 2000") <= INDEPENDENT_DELTA_E
+        assert colour.delta_E(lab, lab_of_rgb(reachable[k]), method="CIE 2000") < 1.0
+
+
+def test_a_file_that_is_not_an_image_is_one_line(tmp_path):
+    bad = tmp_path / "notes.png"
+    bad.write_text("not an image\n")
+    run = run_cli("design", "bragg_mirror", "--target-image", bad, "--out-maps", tmp_path / "maps")
+    assert "notes.png" in one_line_error(run)
+
+
+def test_targets_of_different_sizes_are_one_line(tmp_path):
+    np.save(tmp_path / "a.npy", np.full((8, 8, 3), 0.2, np.float32))
+    np.save(tmp_path / "b.npy", np.full((8, 6, 3), 0.2, np.float32))
+    run = run_cli("design", "bragg_mirror", "--target-image", tmp_path / "a.npy", "--target-image-2", tmp_path / "b.npy",
+                  "--out-maps", tmp_path / "maps")
+    line = one_line_error(run)
+    assert "6x8" in line and "8x8" in line
+
+
+def test_paint_options_need_a_target_image(tmp_path):
+    run = run_cli("design", "bragg_mirror", "--target", "0:#3f9f4f", "--out-maps", tmp_path / "maps")
+    assert "--target-image" in one_line_error(run)
+
+
+def test_render_maps_of_a_folder_without_maps_is_one_line(tmp_path):
+    run = run_cli("render", "bragg_mirror", "--maps", tmp_path, "--view", "textured", "--engine", "numpy", "--out", tmp_path / "x.npy")
+    assert "params.json" in one_line_error(run)
