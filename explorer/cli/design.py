@@ -15,6 +15,8 @@ import json
 import os
 import sys
 
+from dataclasses import replace
+
 import click
 import numpy as np
 
@@ -138,8 +140,16 @@ def strip_targets(path: str, theta_range: str | None, count: int = STRIP_TARGETS
     return targets
 
 
-def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE") -> dict[str, float]:
-    """``NAME=VALUE`` items of ``option`` as design values: known names, finite values, each name once."""
+def _named_values(option: str, items, model, material_model: str, expected: str = "NAME=VALUE",
+                  media: dict | None = None) -> dict[str, float]:
+    """
+    ``NAME=VALUE`` items of ``option`` as design values: known names, finite values, each name once; with
+    ``media`` (a dict it fills), an index may name a medium (``n2=chitin``, a file) instead.
+    """
+    from explorer.design.media import MEDIUM_PARAMETERS
+    from explorer.errors import LocatedError
+    from explorer.physics.dispersion import dispersion_named
+
     values: dict[str, float] = {}
     for item in items:
         name, sep, value_text = item.partition("=")
@@ -152,25 +162,39 @@ def _named_values(option: str, items, model, material_model: str, expected: str 
             value = float(value_text)
         except ValueError:
             value = float("nan")
-        if not np.isfinite(value) and option == "--fix" and name in ("n1", "n2", "nh") and value_text.strip() \
+        if not np.isfinite(value) and option == "--fix" and name in MEDIUM_PARAMETERS and value_text.strip() \
                 and not value_text.strip().lower().startswith(("nan", "inf", "-inf", "+inf")):
-            raise click.UsageError(f"{option} {item!r}: the colour design takes an index as a number; a medium is held by "
-                                   f"the spectral fit (design {material_model} --target-spectrum FILE.csv --fix {name}=MEDIUM)")
+            if media is None:
+                raise click.UsageError(f"{option} {item!r}: painting takes an index as a number (the colour design "
+                                       f"and --target-spectrum take media)")
+            if not model.optical:
+                raise click.UsageError(f"{option} {item!r}: the colour design takes media for a Bragg mirror's indices only")
+            if name in values or name in media:
+                raise click.UsageError(f"{option} {name}: given twice")
+            try:
+                media[name] = dispersion_named(value_text.strip(), origin=f"{option} {name}")
+            except LocatedError as error:
+                raise click.UsageError(str(error)) from None
+            continue
         if not np.isfinite(value):
             raise click.UsageError(f"{option} {item!r}: the value must be a finite number")
-        if name in values:
+        if name in values or (media is not None and name in media):
             raise click.UsageError(f"{option} {name}: given twice")
         values[name] = value
     return values
 
 
-def parse_fixes(fixes, free, material):
-    """``--fix NAME=VALUE`` and ``--free NAME,...`` as the fixed values (every design parameter not free)."""
+def parse_fixes(fixes, free, material, media: dict | None = None):
+    """
+    ``--fix NAME=VALUE`` and ``--free NAME,...`` as the fixed values (every design parameter not free); the
+    indices ``--fix`` holds at media go into ``media`` (a dict it fills) instead.
+    """
     from explorer.design import design_model
 
     model = design_model(material.model)
     values = material.resolve({})
-    fixed = _named_values("--fix", fixes, model, material.model)
+    fixed = _named_values("--fix", fixes, model, material.model, media=media)
+    media = {} if media is None else media
     if free is not None:
         names = [n.strip() for n in free.split(",") if n.strip()]
         if not names:
@@ -178,10 +202,10 @@ def parse_fixes(fixes, free, material):
         for name in names:
             if name not in model.parameters:
                 raise click.UsageError(f"--free {name}: not a design parameter of {material.model} ({', '.join(model.parameters)})")
-            if name in fixed:
+            if name in fixed or name in media:
                 raise click.UsageError(f"--free {name}: also fixed by --fix")
         for name in model.parameters:
-            if name not in names and name not in fixed:
+            if name not in names and name not in fixed and name not in media:
                 fixed[name] = float(values[name])  # not free: the material's default
     return fixed
 
@@ -216,7 +240,8 @@ def render_command(material_name: str, values: dict, material=None) -> str:
               help="A colour wanted at THETA degrees: #RRGGBB (sRGB) or r,g,b (linear, as render's .npy). Repeatable.")
 @click.option("--target-strip", metavar="IMAGE", help="Targets from a strip (.png, 8 or 16 bits, sRGB; .npy or .exr linear), theta across.")
 @click.option("--theta-range", metavar="A,B", help="--target-strip: theta (degrees) at its left and right edges.")
-@click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable).")
+@click.option("--fix", "fixes", multiple=True, metavar="NAME=VALUE", help="Hold a design parameter (repeatable); n1, n2 and nh of a mirror may name a medium "
+              "(n2=chitin, melanin, a .csv or .toml file): its dispersion and absorption.")
 @click.option("--free", metavar="NAME,...", help="Search only these parameters; the others keep the material's defaults.")
 @click.option("--guess", "guess_texts", multiple=True, metavar="NAME=VALUE,...",
               help="A structure to start from (omitted parameters: the material's defaults); it joins the first pass. Repeatable.")
@@ -294,10 +319,13 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
             raise click.UsageError("--theta-range goes with --target-strip")
         if not targets:
             raise click.UsageError("give at least one --target THETA:COLOUR or --target-strip IMAGE")
-        fixed = parse_fixes(fixes, free, loaded)
+        media: dict = {}
+        fixed = parse_fixes(fixes, free, loaded, media)
         guesses = [parse_guess(text, loaded) for text in guess_texts]
         result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed, guesses=guesses, tries=tries,
-                        progress=_progress_line(tries))
+                        progress=_progress_line(tries), media=media)
+        # A medium is reported by its name (render and --save take it so), not the number that stood for it.
+        result = replace(result, values={**result.values, **{k: v.name for k, v in media.items()}})
     except (LocatedError, DesignError) as error:
         _fail(str(error))
     name = display_path(loaded.path)

@@ -163,6 +163,9 @@ class DesignModel:
     optical: bool = False
     #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
     spectra: Callable | None = None
+    #: The scan's spectra only approximate the batch model (a medium's index at one wavelength): the scanned
+    #: shapes are ranked again on the screening model before the starts are chosen.
+    rescreen: bool = False
     #: Free by default when painting an image: the structure's lengths and count (its indices are materials,
     #: fixed at the file's values unless named free).
     paint_free: tuple[str, ...] = ()

@@ -12,6 +12,7 @@ from typing import Callable, Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
+from explorer.design.absorbing import absorbing_reflectance_batch
 from explorer.design.base import COARSE_STEP, DesignError, DesignModel
 from explorer.materials.models import BraggLayerModel, BraggMirrorModel, host_index
 from explorer.materials.thinfilm_model import ThinFilmModel
@@ -115,7 +116,10 @@ def bragg_reflectance_batch(
     ``smooth`` (nm, default ``step``) averages out fringes narrower than a few times it: the screening's
     smoother landscape (the envelope's band gaps without the fringes' ripples).
     """
-    col = lambda v: np.asarray(v, dtype=np.float64).reshape(-1, 1, 1)
+    if any(np.iscomplexobj(v) for v in (n1, n2, nh)):
+        return absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta, wavelengths, step, smooth)
+    # An index may also be ``(B, 1, W)``: a dispersive medium's, per wavelength (:mod:`explorer.design.media`).
+    col = lambda v: (lambda a: a.reshape(-1, 1, 1) if a.ndim <= 1 else a)(np.asarray(v, dtype=np.float64))
     n1, n2, Lambda, delta, N, nh = (col(v) for v in (n1, n2, Lambda, delta, N, nh))
     host = nh >= 1.0
     eta_h = np.where(host, nh, n1)

@@ -11,6 +11,8 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
+from explorer.physics.dispersion import Dispersion
+
 from explorer.design.base import (
     DESCENT_STARTS,
     FIRST_PASS_SAMPLES,
@@ -28,6 +30,7 @@ from explorer.design.base import (
     DesignModel,
 )
 from explorer.design.forward import design_model
+from explorer.design.media import reference_value, with_media
 from explorer.design.search import _distinct, _distinct_indices, _polish, _Problem, _refine_coarse, _scan_best, _scan_descent, _variants
 from explorer.design.targets import DesignResult, Target, check_target_rgb, parameter_box
 
@@ -47,6 +50,7 @@ def design(
     cancelled: Callable[[], bool] | None = None,
     guesses: Sequence[Mapping[str, float]] = (),
     tries: int = 1,
+    media: Mapping[str, Dispersion] | None = None,
 ) -> DesignResult:
     """
     The structure whose converged colours come closest (least squares of CIEDE2000) to ``targets``.
@@ -78,6 +82,10 @@ def design(
         fresh first pass (seed + :data:`TRY_SEED_STRIDE` k) with the best structure so far among its
         guesses, so that each try also walks on from the last (an iterated search with restarts); the best
         result is returned, its times and evaluations summed over the tries.
+    media : mapping, optional
+        Index parameters (``n1``, ``n2``, ``nh`` of a Bragg mirror) held at a medium of
+        :mod:`explorer.physics.dispersion` (dispersive, absorbing where ``k > 0``): :mod:`explorer.design.media`.
+        The result reports such a parameter at the medium's real index at :data:`explorer.design.media.REFERENCE_NM`.
 
     Returns
     -------
@@ -97,7 +105,7 @@ def design(
 
         carried = [] if best is None else [best.values]
         result = _design_once(model_name, targets, ranges, fixed, seed + TRY_SEED_STRIDE * k, samples, starts, report,
-                              cancelled, [*guesses, *carried])
+                              cancelled, [*guesses, *carried], media)
         evaluations += result.evaluations
         if best is None or np.sum(result.delta_e2000 ** 2) < np.sum(best.delta_e2000 ** 2):
             best = result
@@ -109,11 +117,17 @@ def design(
                    evaluations=evaluations, tries=k + 1)
 
 
-def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, progress, cancelled, guesses) -> DesignResult:
+def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, progress, cancelled, guesses, media=None) -> DesignResult:
     """One search of :func:`design` (its parameters), from the first pass on."""
     start_time, start_cpu = time.perf_counter(), time.process_time()
     model = design_model(model_name)
     fixed = dict(fixed or {})
+    if media:
+        model = with_media(model, media)
+        for name, medium in media.items():
+            if name in fixed:
+                raise DesignError(f"cannot fix {name} twice (a number and {medium.name})")
+            fixed[name] = reference_value(medium)
     if not targets:
         raise DesignError("give at least one target colour")
     for t in targets:
@@ -157,6 +171,11 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
             U[tops], scores[tops] = _scan_descent(problem, U[tops], scores[tops], np.random.default_rng(seed),
                                                   lambda f: report(0.5 + 0.1 * f, "descent"))
             stages["descent"] = time.perf_counter() - start_time
+            if model.rescreen:
+                found = np.isfinite(scores)
+                for start in range(0, len(U), chunk):
+                    rows = slice(start, start + chunk)
+                    scores[rows] = np.where(found[rows], problem.screen(U[rows]), np.inf)
         else:
             # 1. Space-filling first pass (Sobol) on the screening model.
             U = np.concatenate([guessed, qmc.Sobol(P, scramble=True, seed=seed).random(samples)])
