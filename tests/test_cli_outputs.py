@@ -214,6 +214,8 @@ def test_slow_commands_show_progress_and_quick_ones_stay_quiet(tmp_path, monkeyp
         material = "bragg_mirror" if target == "brdf" else "thin_film"
         run = cli("export", material, "--to", target, tmp_path / out)
         assert run.returncode == 0 and f"export --to {target}: working" in run.stderr, run.stderr
+    run = cli("spectrum", "bragg_mirror", "--set", "sigma=0.05", "--set", "N=4", "--json")  # disorder's realisations
+    assert run.returncode == 0 and "spectrum: working" in run.stderr and json.loads(run.stdout)["R"], run.stderr
     lines = []
     monkeypatch.setattr(albedo.click, "echo", lambda text, err=False: lines.append((text, err)))
     progress = albedo.progress_printer("table", "rows")

@@ -53,7 +53,10 @@ def check_command(material, views, preset, params_file, assignments, as_json):
                                      + (f" ({', '.join(others)}: it has no reflectance(cos_theta))" if others else ""),
                                      param_hint="--views")
         values = resolve_values(loaded, preset, params_file, assignments, opening_values(loaded))
-        results = check_material(Renderer(), loaded, values, chosen)
+        from explorer.cli.albedo import progress_while
+
+        with progress_while(f"check {', '.join(chosen)}"):
+            results = check_material(Renderer(), loaded, values, chosen)
     except (LocatedError, GLUnavailable, ValueError) as error:
         _fail(str(error))
     failed = [r for r in results if not r.passed]

@@ -111,7 +111,10 @@ def spectrum_command(material, preset, params_file, assignments, theta_text, as_
     passed, natural = split_natural(loaded, assignments)
     values = resolve_values(loaded, preset, params_file, passed)
     mirror = natural_mirror(values, natural)
-    document = spectrum_document(mirror, thetas, float(values.get("wavelength_step", 1.0)))
+    from explorer.cli.albedo import progress_while
+
+    with progress_while("spectrum"):  # disorder's realisations take seconds
+        document = spectrum_document(mirror, thetas, float(values.get("wavelength_step", 1.0)))
     if csv_out is not None:
         write_text_atomic(csv_out, csv_text(document), (".csv",))
     if plot_out is not None:

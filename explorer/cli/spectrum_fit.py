@@ -133,7 +133,10 @@ def fit_command(material: str, path: str, theta: float, fixes, as_json: bool, pl
     load_mirror(material, "--target-spectrum fits")
     wavelengths, measured, note = read_measured(path)
     fixed = parse_fixed(fixes)
-    fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed)
+    from explorer.cli.albedo import progress_while
+
+    with progress_while("design --target-spectrum"):
+        fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed)
     sets = " ".join(f"--set {k}={dispersion.describe(v) if isinstance(v, dispersion.Dispersion) else f'{v:.6g}'}"
                     for k, v in {**fixed, **fit.values}.items())
     if plot_out is not None:
