@@ -199,7 +199,7 @@ def test_info_json_schema(cli_runs, name):
     run = cli_runs[1][name]
     assert run.returncode == 0 and run.stderr == "", run.stderr
     info = json.loads(run.stdout)
-    assert set(info) <= {"parameters", "methods"}
+    assert set(info) <= {"parameters", "methods", "capabilities"}
     if "methods" in info:  # the names of an int method parameter's values, from the enumeration
         from explorer.materials.brd import load_material
         from explorer.materials.methods import methods_for

@@ -72,7 +72,7 @@ def progress_while(label: str, started: bool = True):
             go.set()
 
     def beat() -> None:
-        while not go.wait(0.05):
+        while not go.wait(min(0.05, PROGRESS_INTERVAL)):
             if stop.is_set():
                 return
         while not stop.wait(PROGRESS_INTERVAL):
