@@ -8,6 +8,7 @@ the one GL render in a subprocess (conftest.run_cli_process).
 from __future__ import annotations
 
 import json
+import time
 
 import numpy as np
 import pytest
@@ -208,6 +209,15 @@ def test_slow_commands_show_progress_and_quick_ones_stay_quiet(tmp_path, monkeyp
     run = cli("render", "ggx_schlick", "--view", "gradient", "--engine", "numpy", "--size", "8x1", "--out", tmp_path / "g.npy")
     assert run.returncode == 0 and "working" not in run.stderr, run.stderr
     monkeypatch.setattr(albedo, "PROGRESS_INTERVAL", 0.01)  # every command is slow at this scale
+    from explorer.views import render as numpy_views
+
+    drawn = numpy_views.render_numpy
+
+    def slow(*args, **kwargs):  # tables cached by earlier tests make the render itself quicker than any interval
+        time.sleep(0.2)
+        return drawn(*args, **kwargs)
+
+    monkeypatch.setattr(numpy_views, "render_numpy", slow)
     run = cli("render", "bragg_layer", "--view", "slice", "--engine", "numpy", "--size", "48", "--out", tmp_path / "s.npy")
     assert run.returncode == 0 and re.search(r"^bragg-explorer: render slice \(numpy\): working \(\d+ s\)$", run.stderr, re.M), run.stderr
     for target, out in (("brdf", "m.brdf"), ("materialx", "f.mtlx")):
@@ -219,7 +229,6 @@ def test_slow_commands_show_progress_and_quick_ones_stay_quiet(tmp_path, monkeyp
     lines = []
     monkeypatch.setattr(albedo.click, "echo", lambda text, err=False: lines.append((text, err)))
     progress = albedo.progress_printer("table", "rows")
-    import time
 
     for done in range(1, 4):
         time.sleep(0.02)
