@@ -140,3 +140,61 @@ def test_paint_options_need_a_target_image(tmp_path):
 def test_render_maps_of_a_folder_without_maps_is_one_line(tmp_path):
     run = run_cli("render", "bragg_mirror", "--maps", tmp_path, "--view", "textured", "--engine", "numpy", "--out", tmp_path / "x.npy")
     assert "params.json" in one_line_error(run)
+
+
+def _row_model():
+    from explorer.design import design_model, parameter_box, ranges_of
+    from explorer.cli.design import load
+    from explorer.design.pixels import RowModel
+
+    model = design_model("bragg_mirror")
+    fixed = {"n1": 1.0, "n2": 1.5, "nh": 0.0}
+    free = [p for p in parameter_box(model, ranges_of(load("bragg_mirror"))) if p.name not in fixed]
+    return RowModel(model, free, fixed, np.cos(np.radians(ANGLES)))
+
+
+def test_the_batched_polish_recovers_random_mirrors_colours_from_their_neighbours_structures():
+    """
+    Seeded random mirrors (Lambda, delta, N in the round trip's box): every one polished at once from a neighbouring
+    structure (Lambda 1 % off, delta 0.01 off, N one off for a third of them), as a painted pixel starts from its
+    neighbour's (0.5 to 9 CIEDE2000 away). The coarse colours are recovered: four in five below the RMS CIEDE2000 at
+    which the polish walks counts, most of those that started on their own count below its tolerance; no row ends
+    worse than it started.
+    """
+    from explorer.design.pixels import COUNT_WALK_DELTA_E, POLISH_TOLERANCE, polish_whole, residual_rows
+
+    rows = _row_model()
+    rng = np.random.default_rng(7)
+    count = 48
+    truth = {"Lambda": rng.uniform(150.0, 320.0, count), "delta": rng.uniform(0.3, 0.7, count), "N": rng.integers(6, 31, count).astype(float)}
+    target = rows.rgb(rows.unit(truth))
+    start = {"Lambda": truth["Lambda"] * (1.0 + 0.01 * rng.choice([-1.0, 1.0], count)), "delta": truth["delta"] + 0.01 * rng.choice([-1.0, 1.0], count),
+             "N": truth["N"] + np.where(np.arange(count) % 3 == 0, 1.0, 0.0)}
+    U0 = rows.unit(start)
+    U, cost = polish_whole(rows, target, None, U0)
+    before = np.sum(residual_rows(rows.rgb(U0), target, None) ** 2, axis=1)
+    rms = np.sqrt(cost / len(ANGLES))
+    assert np.all(cost <= before + 1e-12)
+    assert np.mean(rms < COUNT_WALK_DELTA_E) >= 0.8, np.sort(rms)[-10:]  # the rest: other basins (the neighbour rounds)
+    assert np.median(rms[np.arange(count) % 3 != 0]) < POLISH_TOLERANCE
+    # The costs are the rows' own: the colours of the polished structures, whole counts, say so.
+    values = rows.values(U, whole=True)
+    assert np.all(values["N"] == np.round(values["N"]))
+    np.testing.assert_allclose(np.sum(residual_rows(rows.rgb(rows.unit(values)), target, None) ** 2, axis=1), cost, rtol=1e-9, atol=1e-12)
+
+
+def test_the_polish_levels_hold_every_colour_once_coarse_grid_first():
+    from explorer.design.paint import COARSEST_GRID, _levels
+
+    side = 4 * COARSEST_GRID
+    colours = np.arange(side * side).reshape(side, side) // 2  # pairs of pixels share a colour
+    colours[0, 0] = -1  # masked
+    possible = np.ones(colours.max() + 1, bool)
+    possible[5] = False
+    levels = _levels(colours, possible)
+    held = np.concatenate([members for members, _ in levels])
+    expected = np.setdiff1d(np.unique(colours[colours >= 0]), [5])
+    np.testing.assert_array_equal(np.sort(held), expected)
+    assert len(levels) == 3 and len(levels[0][0]) == COARSEST_GRID**2 - 1  # the masked corner's colour comes later
+    for members, where in levels:
+        assert all(colours[y, x] == c for c, (y, x) in zip(members, where))

@@ -589,7 +589,7 @@ def presets(material, as_json):
 @click.option("--paint", "paint", is_flag=True,
               help="Instead: painting with structural colour on a local Dask cluster (--workers): a 64x64 round trip and a 256x256 "
                    "image of 8 regions, their ΔE2000 and times.")
-@click.option("--workers", "paint_workers", type=click.IntRange(min=1), default=2, show_default=True, help="--paint: local Dask workers.")
+@click.option("--workers", "paint_workers", type=click.IntRange(min=1), default=2, show_default=True, help="--paint: local Dask workers (the runs are timed on 1 worker and on this many).")
 @_errors
 def bench(as_json, size, repeats, film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
           plot, markdown, mitsuba, spp, paint, paint_workers):

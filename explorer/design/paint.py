@@ -4,19 +4,21 @@ structure maps, as Dask tasks (``dask.distributed``: a local cluster, or an exis
 
 The stages (each timed; each a set of tasks whose results are cached in the output folder):
 
-1. the image's distinct colours (a key per colour: its CIELAB at every angle to 0.01, and its clipped bounds);
+1. the image's distinct colours (a key per colour: its CIELAB at every angle to :data:`KEY_QUANTUM`, and its clipped
+   bounds), so that a colour painted over many pixels is designed once;
 2. their clusters in CIELAB (:func:`explorer.design.pixels.cluster_colours`: k-means, k doubling until every colour
-   lies within :data:`CLUSTER_RADIUS` of its centroid);
+   lies within :data:`CLUSTER_RADIUS` of its centroid, at most :data:`MAX_CLUSTERS`);
 3. one design per cluster centre (:func:`explorer.design.design`, the search with its tries);
-4. the colours on a coarse grid of the image polished from their cluster's structure
-   (:func:`explorer.design.pixels.polish_whole`, least squares on the coarse model, many colours per task), then
-   every other colour from its nearest grid colour's structure;
-5. rounds in which a colour left above :data:`POLISHED_DELTA_E` starts again from its image neighbours' structures
-   (and the nearest other clusters'): neighbouring pixels stay in one basin, so the maps stay smooth;
-6. the converged colours (:func:`explorer.design.forward.bragg_converged_rgb`'s reference), with a polish on the
-   converged model where the coarse one misjudged (:func:`explorer.design.search._polish`);
-7. a full design for the few colours still above :data:`explorer.design.base.REACHABLE_DELTA_E`; what stays above
-   it is flagged as unreachable.
+4. the polish, coarse to fine: the colours on a grid of about :data:`COARSEST_GRID` pixels a side from their
+   cluster's structure and the nearest other clusters', then each finer grid's new colours from the nearest polished
+   pixel's structure (:func:`explorer.design.pixels.polish_whole`: batched Levenberg-Marquardt over all the colours
+   of a task at once, on the coarse model);
+5. rounds in which a colour left above :data:`POLISHED_DELTA_E` starts again from its better neighbours' structures:
+   neighbouring pixels stay in one basin, so the maps stay smooth;
+6. the converged colours (:func:`explorer.design.forward.bragg_converged_rgb`'s reference), and where they miss, a
+   batched correction by the difference between the models (:func:`explorer.design.pixels.polish_corrected`);
+7. a full design for a few colours still above :data:`explorer.design.base.REACHABLE_DELTA_E`, and rounds that spread
+   their structures to their neighbours; what stays above it is flagged as unreachable.
 
 Everything is a pure function of its inputs and the seed: the same image and seed give the same maps, whatever
 the number of workers.
@@ -33,33 +35,38 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from explorer.design.base import REACHABLE_DELTA_E, REACHED_DELTA_E, DesignError, DesignParameter
+from explorer.design.base import REACHABLE_DELTA_E, DesignError, DesignParameter
 from explorer.design.forward import design_model
-from explorer.design.pixels import RowModel, cluster_centres, cluster_colours, delta_e_rows, polish_whole
+from explorer.design.pixels import RowModel, cluster_centres, cluster_colours, delta_e_rows, polish_corrected, polish_whole
 from explorer.design.targets import Target, parameter_box
 from explorer.physics import colorimetry
 
 #: A cluster holds colours within this many CIELAB units of its centroid at every angle.
 CLUSTER_RADIUS = 12.0
 #: At most this many clusters (designs).
-MAX_CLUSTERS = 16
-#: Colours polished per task (small enough that a stage's tasks spread over the workers).
-CHUNK = 64
+MAX_CLUSTERS = 8
+#: Colours per task (small enough that a stage's tasks spread over the workers, large enough that the batched
+#: model runs on long arrays). Fixed, not from the number of workers: the maps must not depend on it.
+CHUNK = 128
 #: A colour whose coarse RMS CIEDE2000 stays above this tries its neighbours' structures.
 POLISHED_DELTA_E = 0.5
 #: Rounds of neighbours' starts.
 NEIGHBOUR_ROUNDS = 3
-#: Converged-model polish: evaluations and CPU seconds per colour.
-CONVERGED_NFEV = 4
-CONVERGED_SECONDS = 0.25
+#: A colour whose converged CIEDE2000 exceeds this at an angle is corrected for the coarse model's error, at most
+#: this many times (:func:`explorer.design.pixels.polish_corrected`).
+CORRECTED_DELTA_E = 0.5
+CORRECTIONS = 2
+#: The coarsest level of the polish holds about this many pixels a side; each finer level halves the stride.
+COARSEST_GRID = 8
 #: At most this many colours get a full design when still unreachable after the polish.
-RESCUE_LIMIT = 16
+RESCUE_LIMIT = 8
 #: Searches per cluster design (:func:`explorer.design.design`'s ``tries``).
 CLUSTER_TRIES = 2
-#: The colour key's CIELAB quantum.
-KEY_QUANTUM = 0.01
+#: The colour key's CIELAB quantum: colours in one cell (at most sqrt(3) times this apart, a fraction of a just
+#: noticeable difference) are designed once. Every pixel's CIEDE2000 is still measured against its own target.
+KEY_QUANTUM = 0.2
 #: What the cache's files hold; a new version ignores older ones.
-CACHE_VERSION = 1
+CACHE_VERSION = 3
 
 
 @dataclass
@@ -137,34 +144,35 @@ def polish_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds:
 
 def converged_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds: np.ndarray, U: np.ndarray) -> dict:
     """
-    The converged colours of unit rows ``U`` (whole counts) and their CIEDE2000; rows above :data:`REACHED_DELTA_E`
-    polished on the converged model (:func:`explorer.design.search._polish`) from there.
+    The converged colours of unit rows ``U`` (whole counts) and their CIEDE2000; rows above :data:`CORRECTED_DELTA_E`
+    corrected by the difference between the two models (:func:`explorer.design.pixels.polish_corrected`, batched, up
+    to :data:`CORRECTIONS` times), each keeping its best structure.
     """
-    from explorer.design.search import _polish, _Problem
-
     start = time.perf_counter()
-    model, box, free, cos_theta = _problem_parts(model_name, ranges, fixed, angles)
+    model, _, free, cos_theta = _problem_parts(model_name, ranges, fixed, angles)
     rows = RowModel(model, free, fixed, cos_theta)
-    values = rows.values(U, whole=True)
-    names = list(values)
-    achieved = np.empty(rgb.shape)
+    limits = bounds if np.any(bounds) else None
     out_U = U.copy()
-    for i in range(U.shape[0]):
-        structure = {k: float(values[k][i]) for k in names}
-        achieved[i] = model.converged(structure, cos_theta, final=True)
-    delta_e = delta_e_rows(achieved, rgb, bounds if np.any(bounds) else None)
-    for i in np.flatnonzero(np.max(delta_e, axis=1) > REACHED_DELTA_E):
-        targets = [Target(float(t), tuple(float(c) for c in rgb[i, a]), tuple(int(b) for b in bounds[i, a])) for a, t in enumerate(angles)]
-        problem = _Problem(model, box, fixed, targets, None)
-        structure = {k: float(values[k][i]) for k in names}
-        polished, _ = _polish(problem, np.clip(problem.unit_row(structure), 0.0, 1.0), max_nfev=CONVERGED_NFEV,
-                              deadline=time.process_time() + CONVERGED_SECONDS)
-        colours = model.converged(polished, cos_theta, final=True)
-        d = problem.delta_e(colours)
-        if np.sum(d**2) < np.sum(delta_e[i] ** 2):
-            achieved[i], delta_e[i] = colours, d
-            out_U[i] = rows.unit({k: np.array([polished[k]]) for k in polished})[0]
+    achieved = _converged_rows(model, rows, out_U)
+    delta_e = delta_e_rows(achieved, rgb, limits)
+    for _ in range(CORRECTIONS):
+        off = np.flatnonzero(np.max(delta_e, axis=1) > CORRECTED_DELTA_E)
+        if off.size == 0:
+            break
+        V = polish_corrected(rows, rgb[off], None if limits is None else limits[off], out_U[off], achieved[off])
+        colours = _converged_rows(model, rows, V)
+        d = delta_e_rows(colours, rgb[off], None if limits is None else limits[off])
+        better = np.sum(d**2, axis=1) < np.sum(delta_e[off] ** 2, axis=1)
+        won = off[better]
+        out_U[won], achieved[won], delta_e[won] = V[better], colours[better], d[better]
     return {"U": out_U, "achieved": achieved, "delta_e": delta_e, "seconds": time.perf_counter() - start}
+
+
+def _converged_rows(model, rows: RowModel, U: np.ndarray) -> np.ndarray:
+    """The converged colours ``(B, A, 3)`` of unit rows (counts whole)."""
+    values = rows.values(U, whole=True)
+    return np.array([model.converged({k: float(v[i]) for k, v in values.items()}, rows.cos_theta, final=True)
+                     for i in range(U.shape[0])]).reshape(U.shape[0], rows.cos_theta.size, 3)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -320,22 +328,30 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
     centre_U = np.array([rows_of.unit({k: np.array([v]) for k, v in d["values"].items()})[0] for d in designs]).reshape(len(centres), len(free))
     lap("designs")
 
-    # 4. Seed colours (on a coarse grid of the image) from their cluster's structure, then every other colour from
-    # its nearest seed's: neighbouring pixels start in the same basin, and a start that close needs few steps.
+    # 4. Coarse to fine: the colours of a coarse grid of the image from their cluster's structure (and the nearest
+    # other clusters'), then each finer grid's new colours from the nearest polished pixel's structure. Neighbours
+    # start in the same basin, so the maps stay smooth, and a start that close needs a step or two.
     U = np.zeros((C, len(free)))
     cost = np.full(C, np.inf)
     pixel_colour = np.full(H * W, -1)
     pixel_colour[pixels] = inverse
     pixel_colour = pixel_colour.reshape(H, W)
     if live.size:
-        seeds, nearest_seed = _seed_colours(pixel_colour, colour_possible)
-        seed_starts = centre_U[labels[seeds]]
-        U[seeds], cost[seeds] = _polish_many(runner, "polish seeds", model_name, ranges, fixed, angles, colour_rgb[seeds],
-                                             colour_bounds[seeds], seed_starts)
-        rest = np.setdiff1d(live, seeds)
-        if rest.size:
-            U[rest], cost[rest] = _polish_many(runner, "polish", model_name, ranges, fixed, angles, colour_rgb[rest],
-                                               colour_bounds[rest], U[nearest_seed[rest]])
+        levels = _levels(pixel_colour, colour_possible)
+        done = np.zeros(C, bool)
+        for level, (members, where) in enumerate(levels):
+            if level == 0:
+                tried = [(c, u) for c in members for u in _cluster_starts(c, labels, centre_U, colour_lab, centres)]
+            else:
+                nearest = _nearest_done(pixel_colour, done)
+                tried = [(c, U[nearest[y, x]]) for c, (y, x) in zip(members, where)]
+            index = np.array([c for c, _ in tried], dtype=np.int64)
+            trial_U, trial_cost = _polish_many(runner, f"polish level {level + 1} of {len(levels)}", model_name, ranges, fixed, angles,
+                                               colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]))
+            for k, c in enumerate(index):
+                if trial_cost[k] < cost[c]:
+                    U[c], cost[c] = trial_U[k], trial_cost[k]
+            done[members] = True
     lap("polish")
 
     # 5. Neighbours' structures for colours left above POLISHED_DELTA_E.
@@ -344,7 +360,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
         poor = live[np.sqrt(cost[live] / len(angles)) > POLISHED_DELTA_E]
         if poor.size == 0:
             break
-        candidates_of = _candidates(poor, cost, neighbour_pairs, labels, centre_U, colour_lab, centres, U, len(angles))
+        candidates_of = _candidates(poor, cost, neighbour_pairs, labels, centre_U, U)
         tried = [(c, u) for c in poor for u in candidates_of[c]]
         if not tried:
             break
@@ -367,18 +383,39 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
             U[c], achieved[c], delta_e[c] = r["U"], r["achieved"], r["delta_e"]
     lap("converged")
 
-    # 7. A full design for the few colours still beyond reach.
+    # 7. A full design for a few of the colours still beyond reach (the most frequent, not neighbours of each other),
+    # then rounds in which the others start from their neighbours' structures, as in 5: a region the polish lost
+    # is found again from the few designed in it.
     far = live[np.max(delta_e[live], axis=1) > REACHABLE_DELTA_E] if live.size else live
-    far = far[np.argsort(-counts[far], kind="stable")][:RESCUE_LIMIT]
-    if far.size:
+    chosen: list[int] = []
+    for c in far[np.argsort(-counts[far], kind="stable")]:
+        if len(chosen) < RESCUE_LIMIT and not any(int(c) in neighbour_pairs.get(k, ()) for k in chosen):
+            chosen.append(int(c))
+    if chosen:
         rescued = runner.map("full designs", design_task, [(model_name, dict(ranges), fixed, angles, colour_rgb[c], colour_bounds[c],
-                                                            seed, rescue_tries) for c in far])
-        for c, d in zip(far, rescued):
+                                                            seed, rescue_tries) for c in chosen])
+        for c, d in zip(chosen, rescued):
             if np.sum(np.square(d["delta_e"])) < np.sum(delta_e[c] ** 2):
                 U[c] = rows_of.unit({k: np.array([v]) for k, v in d["values"].items()})[0]
                 structure = {k: float(v[0]) for k, v in rows_of.values(U[c][None], whole=True).items()}
                 achieved[c] = model.converged(structure, rows_of.cos_theta, final=True)
                 delta_e[c] = delta_e_rows(achieved[c][None], colour_rgb[c][None], colour_bounds[c][None])[0]
+    for round_ in range(NEIGHBOUR_ROUNDS if chosen else 0):
+        score = np.sum(delta_e**2, axis=1)
+        poor = live[np.max(delta_e[live], axis=1) > REACHABLE_DELTA_E]
+        tried = [(c, u) for c, starts in _candidates(poor, score, neighbour_pairs, labels, centre_U, U).items() for u in starts]
+        if not tried:
+            break
+        index = np.array([c for c, _ in tried], dtype=np.int64)
+        trial_U, _ = _polish_many(runner, f"spread {round_ + 1}", model_name, ranges, fixed, angles, colour_rgb[index],
+                                  colour_bounds[index], np.array([u for _, u in tried]))
+        pieces = [slice(s, s + CHUNK) for s in range(0, index.size, CHUNK)]
+        results = runner.map(f"spread {round_ + 1} converged", converged_task,
+                             [(model_name, dict(ranges), fixed, angles, colour_rgb[index[s]], colour_bounds[index[s]], trial_U[s]) for s in pieces])
+        for s, r in zip(pieces, results):
+            for k, c in enumerate(index[s]):
+                if np.sum(r["delta_e"][k] ** 2) < np.sum(delta_e[c] ** 2):
+                    U[c], achieved[c], delta_e[c] = r["U"][k], r["achieved"][k], r["delta_e"][k]
     lap("full designs")
 
     # The maps.
@@ -390,10 +427,14 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
         maps[p.name] = image.reshape(H, W)
     achieved_image = np.zeros((A, H * W, 3))
     achieved_image[:, pixels] = achieved[inverse].transpose(1, 0, 2)
+    # Each pixel against its own target (its colour's structure was designed for its cell's first pixel).
+    pixel_delta = delta_e[inverse].copy()
+    shown = np.isfinite(pixel_delta).all(axis=1)
+    pixel_delta[shown] = delta_e_rows(achieved[inverse[shown]], rgb[shown], bounds[shown] if np.any(bounds) else None)
     delta_image = np.full((A, H * W), np.nan)
-    delta_image[:, pixels] = delta_e[inverse].T
+    delta_image[:, pixels] = pixel_delta.T
     unreachable = np.zeros(H * W, bool)
-    unreachable[pixels] = np.max(delta_e[inverse], axis=1) > REACHABLE_DELTA_E
+    unreachable[pixels] = np.max(pixel_delta, axis=1) > REACHABLE_DELTA_E
     for p in free:  # unreachable pixels keep the closest structure found; impossible colours have none
         maps[p.name].ravel()[pixels[~possible]] = np.nan
     return PaintResult(maps=maps, fixed=fixed, achieved=achieved_image.reshape(A, H, W, 3), delta_e=delta_image.reshape(A, H, W),
@@ -408,38 +449,60 @@ def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, 
     return np.concatenate([r["U"] for r in results]), np.concatenate([r["cost"] for r in results])
 
 
-#: Seed colours lie on a grid of about this many pixels a side.
-SEED_GRID = 16
+def _levels(pixel_colour: np.ndarray, possible: np.ndarray) -> list[tuple[np.ndarray, list[tuple[int, int]]]]:
+    """
+    The polish's levels, coarse to fine: per level, the possible colours first met on its grid (strides halving from
+    about :data:`COARSEST_GRID` cells a side down to 1) and each one's first pixel on that grid.
+    """
+    H, W = pixel_colour.shape
+    if np.count_nonzero(possible) <= COARSEST_GRID**2:  # few colours: every one from the clusters
+        return [_first_pixels(pixel_colour, possible, np.zeros((H, W), dtype=np.int64))[0]]
+    stride = 1 << max(0, int(np.floor(np.log2(max(H, W) / COARSEST_GRID))))
+    strides = [stride >> d for d in range(stride.bit_length())]
+    y, x = np.mgrid[0:H, 0:W]
+    level = np.zeros((H, W), dtype=np.int64)
+    for d in reversed(range(len(strides))):  # a pixel's level: the coarsest (nested) grid it lies on
+        level[(y % strides[d] == 0) & (x % strides[d] == 0)] = d
+    return _first_pixels(pixel_colour, possible, level)
 
 
-def _seed_colours(pixel_colour: np.ndarray, possible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """
-    The colours of the pixels on a grid of about :data:`SEED_GRID` a side (possible colours only; every colour
-    when the image has few), and per colour the seed colour nearest its first pixel.
-    """
+def _first_pixels(pixel_colour: np.ndarray, possible: np.ndarray, level: np.ndarray) -> list[tuple[np.ndarray, list[tuple[int, int]]]]:
+    """Per level of pixels, the possible colours whose coarsest level it is, with their first pixel there."""
+    W = pixel_colour.shape[1]
+    flat, lev = pixel_colour.ravel(), level.ravel()
+    inside = np.flatnonzero((flat >= 0))
+    inside = inside[possible[flat[inside]]]
+    # Per colour, its coarsest level and its first pixel there (raster order breaks ties).
+    order = inside[np.lexsort((inside, lev[inside], flat[inside]))]
+    colours, first = np.unique(flat[order], return_index=True)
+    first_pixel = order[first]
+    colour_level = lev[first_pixel]
+    out = []
+    for d in range(int(colour_level.max()) + 1 if colours.size else 0):
+        pick = np.flatnonzero(colour_level == d)
+        if pick.size:
+            out.append((colours[pick], [(int(p // W), int(p % W)) for p in first_pixel[pick]]))
+    return out
+
+
+def _nearest_done(pixel_colour: np.ndarray, done: np.ndarray) -> np.ndarray:
+    """Per pixel, the colour of the nearest pixel whose colour is polished (a distance transform's indices)."""
     from scipy.ndimage import distance_transform_edt
 
-    H, W = pixel_colour.shape
-    C = possible.size
-    if C <= SEED_GRID * SEED_GRID:
-        return np.flatnonzero(possible), np.arange(C)
-    stride = max(1, int(round(max(H, W) / SEED_GRID)))
-    grid = np.zeros((H, W), bool)
-    grid[stride // 2 :: stride, stride // 2 :: stride] = True
-    grid &= pixel_colour >= 0
-    grid[pixel_colour >= 0] &= possible[pixel_colour[pixel_colour >= 0]]
-    seeds = np.unique(pixel_colour[grid])
-    if seeds.size == 0:
-        return np.flatnonzero(possible), np.arange(C)
-    # The nearest grid pixel of every pixel (a distance transform's indices), then per colour its first pixel's.
-    _, (iy, ix) = distance_transform_edt(~grid, return_indices=True)
-    nearest_pixel_colour = pixel_colour[iy, ix]
-    nearest = np.arange(C)
-    flat = pixel_colour.ravel()
-    order = np.flatnonzero(flat >= 0)
-    colours, first = np.unique(flat[order], return_index=True)
-    nearest[colours] = nearest_pixel_colour.ravel()[order[first]]
-    return seeds, nearest
+    solved = pixel_colour >= 0
+    solved[solved] = done[pixel_colour[solved]]
+    _, (iy, ix) = distance_transform_edt(~solved, return_indices=True)
+    return pixel_colour[iy, ix]
+
+
+def _cluster_starts(c, labels, centre_U, colour_lab, centres) -> list[np.ndarray]:
+    """A colour's own cluster's structure, then the nearest other clusters' (:data:`OTHER_CLUSTERS`)."""
+    starts = [centre_U[labels[c]]]
+    distance = np.sum((colour_lab[centres] - colour_lab[c]) ** 2, axis=(1, 2))
+    for k in np.argsort(distance, kind="stable"):
+        if k != labels[c] and len(starts) < OTHER_CLUSTERS + 1:
+            starts.append(centre_U[k])
+    return starts
 
 
 def _neighbour_colours(pixel_colour: np.ndarray) -> dict[int, set[int]]:
@@ -454,26 +517,20 @@ def _neighbour_colours(pixel_colour: np.ndarray) -> dict[int, set[int]]:
     return pairs
 
 
-#: Starts tried per poor colour and round: its best neighbours' structures, then the nearest other clusters'.
-NEIGHBOUR_STARTS = 3
-OTHER_CLUSTERS = 2  # (besides its own cluster's, when it started elsewhere)
+#: Starts tried per poor colour and round: its best neighbours' structures.
+NEIGHBOUR_STARTS = 2
+#: The coarsest level's colours also start from this many nearest other clusters' structures.
+OTHER_CLUSTERS = 2
 
 
-def _candidates(poor, cost, pairs, labels, centre_U, colour_lab, centres, U, angles) -> dict[int, list[np.ndarray]]:
-    """Per poor colour, distinct starts: neighbours that are better polished, then the nearest other clusters' designs."""
+def _candidates(poor, cost, pairs, labels, centre_U, U) -> dict[int, list[np.ndarray]]:
+    """Per poor colour, distinct starts: its better polished neighbours' structures (its cluster's when it has none)."""
     out = {}
     for c in poor:
-        starts = []
         neighbours = sorted((n for n in pairs.get(int(c), ()) if cost[n] < cost[c]), key=lambda n: (cost[n], n))
-        for n in neighbours[:NEIGHBOUR_STARTS]:
-            starts.append(U[n])
-        if labels[c] >= 0:
+        starts = [U[n] for n in neighbours[:NEIGHBOUR_STARTS]]
+        if not starts and labels[c] >= 0:
             starts.append(centre_U[labels[c]])
-        if centres.size > 1:
-            distance = np.sum((colour_lab[centres] - colour_lab[c]) ** 2, axis=(1, 2))
-            for k in np.argsort(distance, kind="stable"):
-                if k != labels[c] and len(starts) < NEIGHBOUR_STARTS + OTHER_CLUSTERS + 1:
-                    starts.append(centre_U[k])
         distinct = []
         for s in starts:
             if all(np.max(np.abs(s - d)) > 1e-6 for d in distinct) and np.max(np.abs(s - U[c])) > 1e-6:

@@ -20,6 +20,13 @@ from explorer.physics import colorimetry
 POLISH_STEPS = 14
 #: A row stops once its RMS CIEDE2000 per angle is below this.
 POLISH_TOLERANCE = 0.05
+#: ... or once an accepted step lowers its cost by less than this share (a minimum: a held count that does not fit).
+POLISH_STALL = 0.01
+#: ... or once its damping, raised fourfold by each rejected step, passes this (five rejections in a row from the
+#: start: its steps have shrunk to nothing).
+POLISH_DAMPING_LIMIT = 10.0
+#: :func:`polish_whole` walks the counts of rows left above this RMS CIEDE2000 per angle by the held polish.
+COUNT_WALK_DELTA_E = 0.25
 
 
 def target_lab_rows(target_rgb: np.ndarray, bounds: np.ndarray | None, rgb: np.ndarray) -> np.ndarray:
@@ -83,6 +90,10 @@ def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | Non
     """
     Levenberg-Marquardt on every row at once from ``U0`` ``(B, P)``: rows move only while their step lowers their
     cost, each with its own damping. ``held``: parameters that do not move (an integer count once rounded).
+    The Jacobian is taken by forward differences (one batch evaluation per moving parameter) at the start and
+    after a rejected step; otherwise Broyden's rank-one update carries it on from the last step's residuals, so
+    that an accepted step costs one evaluation. A row stops below :data:`POLISH_TOLERANCE`, or once its steps
+    stop paying (:data:`POLISH_STALL`).
     Returns the unit rows and their costs (sum of squared CIEDE2000 over the angles, coarse model).
     """
     U = np.clip(np.array(U0, dtype=np.float64), 0.0, 1.0)
@@ -96,40 +107,83 @@ def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | Non
     tolerance = POLISH_TOLERANCE**2 * angles
     if columns.size == 0:
         return U, cost
+    c = columns.size
+    J = np.zeros((B, c, residuals.shape[1]))  # rows of J^T per row
+    fresh = np.ones(B, bool)  # needs a finite-difference Jacobian
+    live = np.ones(B, bool)
     for _ in range(steps):
-        active = np.flatnonzero((cost > tolerance) & (damping < 1e6))
+        active = np.flatnonzero(live & (cost > tolerance) & (damping < POLISH_DAMPING_LIMIT))
         if active.size == 0:
             break
-        Ua, ra = U[active], residuals[active]
-        h = np.where(Ua[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (b, c)
-        shifted = np.repeat(Ua[:, None, :], columns.size, axis=1)
-        shifted[:, np.arange(columns.size), columns] += h
-        tr = np.repeat(target_rgb[active], columns.size, axis=0)
-        tb = None if bounds is None else np.repeat(bounds[active], columns.size, axis=0)
-        r_shift = residual_rows(rows.rgb(shifted.reshape(-1, P)), tr, tb).reshape(active.size, columns.size, -1)
-        J = (r_shift - ra[:, None, :]) / h[:, :, None]  # (b, c, R): rows of J^T
-        JTJ = np.einsum("bcr,bdr->bcd", J, J)
-        JTr = np.einsum("bcr,br->bc", J, ra)
+        differenced = active[fresh[active]]
+        exact = fresh[active].copy()  # this step's Jacobian by differences, not carried on by Broyden
+        if differenced.size:
+            Ud = U[differenced]
+            h = np.where(Ud[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (b, c)
+            shifted = np.repeat(Ud[:, None, :], c, axis=1)
+            shifted[:, np.arange(c), columns] += h
+            tr = np.repeat(target_rgb[differenced], c, axis=0)
+            tb = None if bounds is None else np.repeat(bounds[differenced], c, axis=0)
+            r_shift = residual_rows(rows.rgb(shifted.reshape(-1, P)), tr, tb).reshape(differenced.size, c, -1)
+            J[differenced] = (r_shift - residuals[differenced][:, None, :]) / h[:, :, None]
+            fresh[differenced] = False
+        Ua, ra, Ja = U[active], residuals[active], J[active]
+        JTJ = np.einsum("bcr,bdr->bcd", Ja, Ja)
+        JTr = np.einsum("bcr,br->bc", Ja, ra)
         diagonal = np.einsum("bcc->bc", JTJ)
-        A = JTJ + damping[active, None, None] * (np.eye(columns.size)[None] * (diagonal[:, :, None] + 1e-9))
+        A = JTJ + damping[active, None, None] * (np.eye(c)[None] * (diagonal[:, :, None] + 1e-9))
         step = -np.linalg.solve(A, JTr[..., None])[..., 0]
         trial = Ua.copy()
         trial[:, columns] = np.clip(Ua[:, columns] + step, 0.0, 1.0)
         r_trial = residual_rows(rows.rgb(trial), target_rgb[active], None if bounds is None else bounds[active])
         c_trial = np.sum(r_trial**2, axis=1)
+        # Broyden: J += s (y - J^T s)^T / |s|^2 for the step s taken (after clipping) and the residuals' change y.
+        s = trial[:, columns] - Ua[:, columns]
+        norm = np.sum(s**2, axis=1)
+        moved = norm > 1e-24
+        y = r_trial - ra - np.einsum("bcr,bc->br", Ja, s)
+        J[active[moved]] = Ja[moved] + s[moved, :, None] * y[moved, None, :] / norm[moved, None, None]
         better = c_trial < cost[active]
         won = active[better]
+        gain = (cost[won] - c_trial[better]) / np.maximum(cost[won], 1e-300)
         U[won], residuals[won], cost[won] = trial[better], r_trial[better], c_trial[better]
         damping[won] = np.maximum(damping[won] / 3.0, 1e-7)
-        damping[active[~better]] *= 4.0
+        # A small gain on a differenced Jacobian is a minimum; on a carried one, the Jacobian is stale: difference it again.
+        slow = gain < POLISH_STALL
+        live[won[slow & exact[better]]] = False
+        fresh[won[slow & ~exact[better]]] = True
+        lost = active[~better]
+        damping[lost] *= 4.0
+        fresh[lost] = True
+        live[active[~moved]] = False
     return U, cost
 
 
 def polish_whole(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,
                  steps: int = POLISH_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """
-    :func:`polish_rows`, then each integer parameter (``N``) at the better of its two neighbouring whole values with the
-    others polished again: the rows' structures with whole counts, and their coarse costs.
+    Every row polished from ``U0`` (whole counts: a neighbour's or a design's structure) with its integer
+    parameters (``N``) held, which is all a start that close needs; the rows left above
+    :data:`COUNT_WALK_DELTA_E` then walk their counts too (:func:`polish_rounded`), and keep the better end.
+    Returns the rows' structures with whole counts, and their coarse costs.
+    """
+    held = [p.integer for p in rows.free]
+    U, cost = polish_rows(rows, target_rgb, bounds, U0, held=held if any(held) else None, steps=steps)
+    if not any(held):
+        return U, cost
+    poor = np.flatnonzero(cost > COUNT_WALK_DELTA_E**2 * rows.cos_theta.size)
+    if poor.size:
+        V, c = polish_rounded(rows, target_rgb[poor], None if bounds is None else bounds[poor], U0[poor], max(4, steps // 2))
+        better = c < cost[poor]
+        U[poor[better]], cost[poor[better]] = V[better], c[better]
+    return U, cost
+
+
+def polish_rounded(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,
+                   steps: int = POLISH_STEPS) -> tuple[np.ndarray, np.ndarray]:
+    """
+    :func:`polish_rows` with every parameter free (a count relaxed to a real number), then each integer parameter
+    at the better of its two neighbouring whole values with the others polished again.
     """
     U, cost = polish_rows(rows, target_rgb, bounds, U0, steps=steps)
     integer = [k for k, p in enumerate(rows.free) if p.integer]
@@ -149,6 +203,20 @@ def polish_whole(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | No
             better = c < best_cost
             best_U[better], best_cost[better] = V[better], c[better]
     return best_U, best_cost
+
+
+def polish_corrected(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U: np.ndarray, achieved: np.ndarray,
+                     steps: int = POLISH_STEPS // 2) -> np.ndarray:
+    """
+    A defect correction: rows ``U`` whose converged colours ``achieved`` ``(B, A, 3)`` differ from their coarse ones
+    polished again on the coarse model towards targets moved by that difference (integer parameters held), so
+    that the converged colours of the result land on the targets where the difference varies slowly near ``U``.
+    The cheap batched model does the walking; the converged one only measures. Returns the new unit rows.
+    """
+    held = [p.integer for p in rows.free]
+    moved = target_rgb - (achieved - rows.rgb(U))
+    V, _ = polish_rows(rows, moved, bounds, U, held=held if any(held) else None, steps=steps)
+    return V
 
 
 # --------------------------------------------------------------------------------------------------
