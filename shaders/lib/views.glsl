@@ -87,7 +87,7 @@ void rusinkiewicz_directions(float theta_h, float theta_d, float phi_d, out vec3
 
 // -- The surface texture (textured and env views; the host #defines SURFACE_TEXTURE): what a material's
 // '# texture:' varies (explorer/views/surface_texture.py). Planar parametrisation of the disc point p:
-// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped.
+// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped (or the nearest texel).
 #ifdef SURFACE_TEXTURE
 uniform sampler2D surface_texture;
 
@@ -102,5 +102,15 @@ float surface_bilinear(vec2 uv) {
     return mix(top, bottom, f.y);
 }
 
-float surface_value(vec2 p) { return surface_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y))); }
+// surface_nearest: the nearest texel's value, unfiltered (structure maps: a texel index, never blended).
+uniform bool surface_nearest;
+
+float surface_value(vec2 p) {
+    vec2 uv = vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y));
+    if (surface_nearest) {
+        ivec2 size = textureSize(surface_texture, 0);
+        return texelFetch(surface_texture, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
+    }
+    return surface_bilinear(uv);
+}
 #endif
