@@ -329,9 +329,9 @@ def _errors(function):
 @click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
-@click.option("--maps", "maps_dir", metavar="DIR", help="textured view, --engine numpy: the structure maps design --target-image wrote; "
-              "one pixel a texel, its colour at --theta.")
-@click.option("--theta", "maps_theta", type=float, help="--maps: the viewing angle in degrees (default 0).")
+@click.option("--maps", "maps_dir", metavar="DIR", help="textured (lit) and env views: the structure maps design --target-image wrote, "
+              "each texel its own mirror on the sphere; with --theta (--engine numpy): one pixel a texel, its colour at that angle.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees.")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
@@ -349,13 +349,27 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
     as a chart (.png) or their values (.npy); --size W sets their samples.
     """
-    if maps_dir is not None:
+    if maps_dir is not None and maps_theta is not None:
         from explorer.cli.paint import render_maps_command
 
         render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
         return
     if maps_theta is not None:
         raise click.UsageError("--theta goes with --maps")
+    if maps_dir is not None:
+        from explorer.views.maps import maps_material
+
+        if click.get_current_context().get_parameter_source("view") == click.core.ParameterSource.DEFAULT:
+            view = "textured"  # the maps on the lit sphere
+        if view not in ("textured", "lit", "env"):
+            raise click.BadParameter(f"the maps are drawn in the textured (lit sphere) and env views, not {view}", param_hint="--maps")
+        if texture is not None or mapping is not None or dinc_range is not None or prefilter == "on":
+            raise click.BadParameter("the maps give the structure of every texel: no --texture, --mapping, --dinc-range or --prefilter",
+                                     param_hint="--maps")
+        if mesh is not None:
+            raise click.BadParameter("the maps are drawn on the sphere (the meshes have no texture coordinates)", param_hint="--mesh")
+        material = material or maps_material(maps_dir)
+        view = "textured" if view == "lit" else view  # the textured view is the lit sphere with its surface
     from explorer.views.geometry import scatter_circles, view_named
 
     if material is None:
@@ -391,7 +405,11 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("the environment fill is the lit view's", param_hint="--fill")
     thickness = None
     surface_given = texture is not None or dinc_range is not None or mapping is not None
-    if view == "textured" or (view == "env" and surface_given):
+    if maps_dir is not None:
+        from explorer.views.surface_texture import MapTexture
+
+        thickness, values = MapTexture.from_folder(maps_dir, loaded, values)
+    elif view == "textured" or (view == "env" and surface_given):
         from explorer.views.surface_texture import BraggTexture, check_texture_kind
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
 
@@ -468,6 +486,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     bad = int((~np.isfinite(image)).sum())
     method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
+    if maps_dir is not None:
+        h, w = thickness.index.shape
+        tabulated = method_labels(loaded).get(4) if round_integer(values["method"]) == 3 else None
+        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {tabulated} per texel" if tabulated else "")
     click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 

@@ -105,6 +105,20 @@ def read_maps(folder: str | os.PathLike[str]) -> tuple[dict, dict[str, np.ndarra
     return params, maps
 
 
+def maps_material(folder: str | os.PathLike[str]) -> str:
+    """The material a map folder's ``params.json`` names (for a command given no MATERIAL); ``LocatedError`` otherwise."""
+    from explorer.errors import LocatedError
+
+    path = Path(folder) / "params.json"
+    try:
+        name = json.loads(path.read_text(encoding="utf-8"))["material"]
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise LocatedError(path, None, f"not a map folder's parameters ({' '.join(str(error).split())[:100]})") from None
+    if not isinstance(name, str) or not name:
+        raise LocatedError(path, None, "names no material: give MATERIAL")
+    return name
+
+
 def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], material) -> dict[str, float]:
     """
     The folder's fixed values, once its maps fit ``material`` (a Bragg mirror's structure: each map a parameter of it,

@@ -110,7 +110,8 @@ class MapTexture:
         try:
             params, maps = read_maps(folder)
         except ValueError as error:
-            raise LocatedError(folder, None, str(error).removeprefix(f"{folder}: ")) from None
+            path, _, message = str(error).partition(": ")  # read_maps's lines begin with the file at fault
+            raise LocatedError(path, None, message) from None
         fixed = check_maps(Path(folder), params, maps, material)
         values = {**values, **fixed}
         return cls(maps, values, str(folder)), values
