@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import one_line_error, run_cli, run_cli_process
+from test_app import x_display  # noqa: F401  (the session's Xvfb fixture)
 from twins import Twins, assert_twins_equal, render_both
 
 #: Not square, so that a swapped width and height or flipped rows show.
@@ -182,3 +183,40 @@ def test_cli_render_maps_bad_folders(folder, tmp_path):
                         (("--texture", "x.png"), "--maps")):
         line = one_line_error(run_cli("render", "bragg_mirror", "--maps", folder, "--engine", "numpy", *args, "--out", out))
         assert named in line, line
+
+
+# -- the app -----------------------------------------------------------------------------------------------
+
+
+def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror):  # noqa: F811
+    """
+    ``open --maps DIR`` (the material from the folder): the Texture window draws the maps on the mirror, as the
+    headless render does, and shows each map with its range.
+    """
+    from test_app import run_session
+
+    actions = [{"set": {"method": 4}}, {"view_size": 128}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
+               {"quit": True}]
+    _, report = run_session(x_display, "bragg_mirror", actions, tmp_path, "--maps", str(folder))
+    shown = report["texture_view"]
+    assert shown is not None and shown.get("maps_folder") == str(folder), shown
+    maps = ramps()
+    assert set(shown["maps"]) == set(maps)
+    for name, image in maps.items():
+        assert shown["maps"][name]["size"] == list(MAP_SIZE)
+        np.testing.assert_allclose([shown["maps"][name]["min"], shown["maps"][name]["max"]], [np.nanmin(image), np.nanmax(image)], rtol=1e-6)
+    values = mirror.resolve(shown["values"])
+    assert (values["n1"], values["n2"], values["method"]) == (1.0, 1.5, 4)
+    texture, _ = map_texture(folder, mirror, **shown["values"])
+    width, height = shown["size"]
+    theta = np.degrees(np.arccos(np.clip(shown["light"][2], -1.0, 1.0)))
+    phi = np.degrees(np.arctan2(shown["light"][1], shown["light"][0]))
+    image = gl_renderer.render(mirror, values, "textured", width, height, light=(theta, phi),
+                               **texture.gl_arguments(mirror, values, width, height))
+    assert np.abs(image).max() > 0.05
+    np.testing.assert_allclose(shown["mean_rgb"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)
+
+
+def test_open_with_a_bad_map_folder_is_one_line(tmp_path):
+    line = one_line_error(run_cli("open", "bragg_mirror", "--maps", tmp_path / "nowhere"))
+    assert "nowhere/params.json" in line, line

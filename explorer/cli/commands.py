@@ -237,7 +237,9 @@ def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() befor
               help="Play a scripted session (a JSON list of actions, docs/app.md), then close: screenshots, tests, bench --app.")
 @click.option("--report", type=click.Path(dir_okay=False), metavar="FILE.json", help="Write the session's JSON report (frame times, values).")
 @click.option("--window-size", metavar="WxH", help="Window size in pixels (default 1280x800).")
-def open_material(materials, preset, script, report, window_size):
+@click.option("--maps", "maps_dir", metavar="DIR", help="Structure maps (design --target-image --out-maps DIR) drawn on the mirror "
+              "in the Texture window, each map shown there; MATERIAL defaults to the one the folder names.")
+def open_material(materials, preset, script, report, window_size, maps_dir):
     """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names; none:
     the default Bragg mirror).
 
@@ -247,9 +249,17 @@ def open_material(materials, preset, script, report, window_size):
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
-    materials = materials or (str(DEFAULT_MATERIAL),)
     try:
+        if maps_dir is not None and not materials:
+            from explorer.views.maps import maps_material
+
+            materials = (maps_material(maps_dir),)
+        materials = materials or (str(DEFAULT_MATERIAL),)
         loaded = _load(materials[0])
+        if maps_dir is not None:  # a bad folder: one line before any window
+            from explorer.views.surface_texture import MapTexture
+
+            MapTexture.from_folder(maps_dir, loaded, loaded.resolve({}))
         more = [_load(other).path for other in materials[1:]]
         if preset is not None:
             from explorer.materials.presets import presets_for
@@ -272,7 +282,7 @@ def open_material(materials, preset, script, report, window_size):
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
                            f"for images without a window use: {command_prefix()} render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
-                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
+                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more, maps=maps_dir)
     except ImportError as error:
         _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
     except (LocatedError, GLUnavailable, OutputError, AppError) as error:
