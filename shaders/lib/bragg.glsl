@@ -526,8 +526,8 @@ BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
 #ifdef SURFACE_TEXTURE
 // Structure maps (design --target-image's output): texture_mapping TEXTURE_MAPS gives each texel its own mirror, T
 // the nearest texel's index (row-major). The host's table holds two RGBA texels a map texel, (n1, n2, Lambda, delta)
-// and (N, nh, inside, 0); false off the maps' mask. Twin: explorer.physics.bragg.mapped_mirrors (structure_table).
-const int TEXTURE_MAPS = 4;
+// and (N, nh, inside, 0); false off the maps' mask (TEXTURE_MAPS: generated). Twin: explorer.physics.bragg.mapped_mirrors
+// (structure_table).
 
 bool mapped_mirror(sampler2D table, float T, out BraggMirror mirror) {
     int width = textureSize(table, 0).x / 2;
