@@ -109,18 +109,90 @@ def test_maps_textured_gl_equals_numpy(gl_renderer, folder, mirror, method):
 
 @pytest.mark.gl
 def test_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
-    """The env view: each texel's Dirac under the environment (exact after one sample), against the exact integral."""
+    """
+    The env view: each texel's Dirac under the environment (exact after one sample), against the exact integral; by the
+    spectral reference, smooth in the angle (the approximations' discrete choices of boxes may flip between float32
+    and float64 where a normal's angle sits on a threshold, and the environment magnifies any difference).
+    """
     from explorer.gpu.env import render_env
     from explorer.materials.models import model_for
     from explorer.views.env import EnvironmentMap, env_integral_numpy
 
-    texture, values = map_texture(folder, mirror, method=3)
+    texture, values = map_texture(folder, mirror, method=0)
     environment = EnvironmentMap.default()
     gl = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer, surface=texture)
     reference = env_integral_numpy(model_for(mirror, values), environment, *SIZE, surface=texture)
     assert_twins_equal(Twins.of(gl, reference, "env"), "maps env")
     plain = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer)
     assert np.abs(plain - gl).max() > 0.02  # the maps show
+
+
+# -- on a mesh, by its texture coordinates ------------------------------------------------------------------
+
+
+def mesh_safe_pixels(mesh, size, texels) -> np.ndarray:
+    """Pixels GL and numpy decide alike: away from triangle edges and overlaps, and from texel borders (nearest reads)."""
+    from test_mesh import MESH_DEPTH_GAP, MESH_EDGE_MARGIN
+
+    from explorer.views.mesh import rasterise
+
+    surface = rasterise(mesh, size, size)
+    scaled = surface.uvs * np.array(texels, np.float64)
+    border = np.abs(scaled - np.rint(scaled)).min(axis=-1) < 1e-3
+    return surface.covered & (surface.margin > MESH_EDGE_MARGIN) & (surface.depth_gap > MESH_DEPTH_GAP) & ~border
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("shape", ["cube", "torus"])
+def test_maps_on_a_mesh_gl_equals_numpy(gl_renderer, folder, mirror, shape):
+    """
+    The maps carried by the mesh's texture coordinates (each cube face, the torus once around), GL against numpy, by
+    the spectral reference (a mesh's float32 normals against float64 ones: the approximations' box choices may flip).
+    """
+    from explorer.gpu.mesh import render_mesh
+    from explorer.materials.models import model_for
+    from explorer.views.mesh import mesh_named
+    from explorer.views.render import render_numpy
+
+    mesh, size = mesh_named(shape), 48
+    texture, values = map_texture(folder, mirror, method=0)
+    gl = render_mesh(gl_renderer, mirror, values, "textured", mesh, size, size, light=(20.0, 30.0),
+                     surface=texture.gl_arguments(mirror, values, size, size))
+    reference = render_numpy(model_for(mirror, values), "textured", size, size, light=(20.0, 30.0), thickness=texture, mesh=mesh)
+    safe = mesh_safe_pixels(mesh, size, MAP_SIZE)
+    assert safe.sum() > 0.3 * (np.abs(reference).sum(axis=-1) > 0).sum()
+    assert np.abs(reference[safe]).std(axis=0).max() > 0.05  # the maps show
+    assert_twins_equal(Twins(gl, reference, safe, "textured", (20.0, 30.0)), f"maps on the {shape}")
+
+
+@pytest.mark.gl
+def test_maps_on_a_mesh_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
+    from explorer.gpu.env import render_env
+    from explorer.materials.models import model_for
+    from explorer.views.env import EnvironmentMap, env_integral_numpy
+    from explorer.views.mesh import torus
+
+    mesh, size = torus(), 32
+    texture, values = map_texture(folder, mirror, method=0)  # the reference: see the sphere's test above
+    environment = EnvironmentMap.default()
+    gl = render_env(mirror, values, size, size, environment=environment, spp=1, renderer=gl_renderer, surface=texture, mesh=mesh)
+    reference = env_integral_numpy(model_for(mirror, values), environment, size, size, surface=texture, mesh=mesh)
+    safe = mesh_safe_pixels(mesh, size, MAP_SIZE)
+    assert_twins_equal(Twins(gl, reference, safe, "env", None), "maps on the torus under the environment")
+
+
+def test_obj_texture_coordinates(tmp_path):
+    """vt read (v from the top, as the sphere's planar v), a vertex per (position, coordinates); none unless every corner has one."""
+    from explorer.views.mesh import MeshError, parse_obj
+
+    quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+    mesh = parse_obj(quad + "f 1/1 2/2 3/3\nf 1/5 3/3 4/4\n")
+    assert mesh.uvs is not None and len(mesh.positions) == 5  # vertex 1 twice: two coordinates
+    by_corner = {tuple(p[:2]) + tuple(t) for p, t in zip(mesh.positions, mesh.uvs)}
+    assert (0.0, 0.0, 0.0, 1.0) in by_corner and (0.0, 0.0, 0.5, 0.5) in by_corner and (1.0, 1.0, 1.0, 0.0) in by_corner
+    assert parse_obj(quad + "f 1/1 2/2 3/3\nf 1 3 4\n").uvs is None
+    with pytest.raises(MeshError, match=r"<obj>:5:"):
+        parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt a b\nf 1/1 2/1 3/1\n")
 
 
 # -- the command line --------------------------------------------------------------------------------------
@@ -179,7 +251,9 @@ def test_cli_render_maps_bad_folders(folder, tmp_path):
                                       "--size", "8", "--out", out))
         assert named in line, f"{name}: {line}"
         assert not out.exists(), name
-    for args, named in (((("--view", "sphere")), "--maps"), (("--mesh", "teapot", "--view", "lit"), "--mesh"),
+    bare = tmp_path / "bare.obj"  # no texture coordinates
+    bare.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="utf-8")
+    for args, named in (((("--view", "sphere")), "--maps"), (("--mesh", bare, "--view", "lit"), "--mesh"),
                         (("--texture", "x.png"), "--maps")):
         line = one_line_error(run_cli("render", "bragg_mirror", "--maps", folder, "--engine", "numpy", *args, "--out", out))
         assert named in line, line

@@ -328,7 +328,7 @@ def _errors(function):
 @click.option("--env", "env_file", metavar="FILE|NAME", help="env view (and lit: what a smooth mirror reflects): equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
-@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
+@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit, textured and env views: this mesh instead of the sphere (an OBJ file, or a generated shape; a texture or --maps by its texture coordinates).")
 @click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env and lit views: the environment turned about the vertical.")
 @click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
 @click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
@@ -376,8 +376,6 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         if texture is not None or mapping is not None or dinc_range is not None or prefilter == "on":
             raise click.BadParameter("the maps give the structure of every texel: no --texture, --mapping, --dinc-range or --prefilter",
                                      param_hint="--maps")
-        if mesh is not None:
-            raise click.BadParameter("the maps are drawn on the sphere (the meshes have no texture coordinates)", param_hint="--mesh")
         material = material or maps_material(maps_dir)
         view = "textured" if view == "lit" else view  # the textured view is the lit sphere with its surface
     from explorer.views.geometry import scatter_circles, view_named
@@ -458,8 +456,8 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if mesh is not None:
         from explorer.views.mesh import mesh_named
 
-        if view not in ("lit", "env") or engine not in ("gl", "numpy"):
-            raise click.BadParameter(f"a mesh is drawn in the lit and env views by the gl and numpy engines, not {view} ({engine})",
+        if view not in ("lit", "env", "textured") or engine not in ("gl", "numpy"):
+            raise click.BadParameter(f"a mesh is drawn in the lit, textured and env views by the gl and numpy engines, not {view} ({engine})",
                                      param_hint="--mesh")
         mesh_shape = mesh_named(mesh)
     if engine == "mitsuba" or variant is not None:

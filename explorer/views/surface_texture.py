@@ -55,6 +55,9 @@ class BraggTexture:
         """``(T, 0)`` at the pixels ``p = (x, y)``: the same bilinear read as the film's (:meth:`ThicknessTexture.sample`)."""
         return ThicknessTexture(self.T).per_pixel(x, y, width, height)
 
+    def at_uv(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        return ThicknessTexture(self.T).at_uv(u, v)
+
     def model_options(self) -> dict:
         return {"mapping": self.mapping}
 
@@ -123,12 +126,15 @@ class MapTexture:
     def per_pixel(self, x, y, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """``(index, 0)`` of the nearest texel at the pixels ``p = (x, y)``: the shader's ``surface_value`` with ``surface_nearest``."""
         f32 = np.float32
+        return self.at_uv(f32(0.5) * (x + f32(1.0)), f32(0.5) * (f32(1.0) - y))
+
+    def at_uv(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest texel's index at texture coordinates ``(u, v)`` (float32, clamped), as ``surface_at``."""
+        f32 = np.float32
         h, w = self.index.shape
-        u = f32(0.5) * (x + f32(1.0))
-        v = f32(0.5) * (f32(1.0) - y)
-        i = np.clip(np.floor(u * f32(w)).astype(np.int64), 0, w - 1)
-        j = np.clip(np.floor(v * f32(h)).astype(np.int64), 0, h - 1)
-        return self.index[j, i].astype(np.float64), np.zeros(np.shape(x))
+        i = np.clip(np.floor(np.asarray(u, f32) * f32(w)).astype(np.int64), 0, w - 1)
+        j = np.clip(np.floor(np.asarray(v, f32) * f32(h)).astype(np.int64), 0, h - 1)
+        return self.index[j, i].astype(np.float64), np.zeros(np.shape(u))
 
     def model_options(self) -> dict:
         return {"mapping": "maps", "structures": self.structures}
@@ -140,6 +146,23 @@ class MapTexture:
         inputs = {"surface_texture": self.index[..., None], "surface_moments": np.zeros((1, 1, 2), np.float32),
                   "bragg_texture_table": np.zeros((1, 1, 3), np.float32), "structure_maps": self.structures}
         return {"inputs": inputs, "uniforms": {"prefilter": False, "surface_nearest": True, "texture_mapping": MAPS_MAPPING}}
+
+
+def surface_values(surface, width: int, height: int, raster=None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    A surface texture's ``(value, sigma)`` per pixel of a ``(height, width)`` image, as the shaders read it
+    (``surface_at(surface_uv(...))``): at the sphere's planar coordinates of each disc point, or at a mesh's
+    interpolated ones (``raster``: :func:`explorer.views.mesh.rasterise`'s image; float32, as the GL pass writes them).
+    """
+    if raster is None:
+        from explorer.views.geometry import disc
+
+        x, y, _ = disc(width, height)
+        return surface.per_pixel(x, y, width, height)
+    if surface.prefilter:
+        raise ValueError("prefiltering is the sphere's (a footprint per pixel of its planar coordinates), not a mesh's")
+    uvs = raster.uvs.astype(np.float32)
+    return surface.at_uv(uvs[..., 0], uvs[..., 1])
 
 
 #: Rows in T of :func:`textured_draft_table` (the exact table refines to up to 129): ~0.1 s, mean |error| ~4e-2
