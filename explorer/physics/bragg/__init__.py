@@ -156,6 +156,7 @@ from explorer.physics.bragg.reflectance import (  # noqa: F401
     reflectance_yeh,
     reflection_coefficient_bragg,
     reflection_coefficient_host,
+    slab_coefficients,
 )
 from explorer.physics.bragg.tables import (  # noqa: F401
     DRAFT_MAX_SUBSTEPS,
