@@ -613,7 +613,7 @@ def env_integral_numpy(
     brdf, mirror = model.brdf, getattr(model, "mirror_reflection", None)
     value = None
     if surface is not None:  # the texture value per pixel, as the shader reads it (surface_at(surface_uv))
-        from explorer.views.surface_texture import surface_values
+        from explorer.views.geometry import surface_values
 
         value = surface_values(surface, width, height, raster)[0]
         options = surface.model_options()

@@ -71,7 +71,7 @@ def render_numpy(
             from explorer.views.surface_texture import BraggTexture
 
             thickness = BraggTexture.from_file() if callable(getattr(model, "texture_table", None)) else ThicknessTexture.from_file()
-        from explorer.views.surface_texture import surface_values
+        from explorer.views.geometry import surface_values
 
         raster = None
         if mesh is not None:  # its normals and texture coordinates (views/mesh/textured.glsl)

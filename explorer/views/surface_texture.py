@@ -148,23 +148,6 @@ class MapTexture:
         return {"inputs": inputs, "uniforms": {"prefilter": False, "surface_nearest": True, "texture_mapping": MAPS_MAPPING}}
 
 
-def surface_values(surface, width: int, height: int, raster=None) -> tuple[np.ndarray, np.ndarray]:
-    """
-    A surface texture's ``(value, sigma)`` per pixel of a ``(height, width)`` image, as the shaders read it
-    (``surface_at(surface_uv(...))``): at the sphere's planar coordinates of each disc point, or at a mesh's
-    interpolated ones (``raster``: :func:`explorer.views.mesh.rasterise`'s image; float32, as the GL pass writes them).
-    """
-    if raster is None:
-        from explorer.views.geometry import disc
-
-        x, y, _ = disc(width, height)
-        return surface.per_pixel(x, y, width, height)
-    if surface.prefilter:
-        raise ValueError("prefiltering is the sphere's (a footprint per pixel of its planar coordinates), not a mesh's")
-    uvs = raster.uvs.astype(np.float32)
-    return surface.at_uv(uvs[..., 0], uvs[..., 1])
-
-
 #: Rows in T of :func:`textured_draft_table` (the exact table refines to up to 129): ~0.1 s, mean |error| ~4e-2
 #: against it on the default mirror (17 rows: 0.2 s, ~1e-2, but half as many drafts a second in the app).
 TEXTURED_DRAFT_ROWS = 9
