@@ -30,12 +30,13 @@ def random_maps(size: int, seed: int = 7) -> dict[str, np.ndarray]:
 
 
 def write_folder(folder: Path, maps: dict[str, np.ndarray]) -> None:
+    from explorer.materials.models import BraggMirrorModel
     from explorer.views.images import write_image
 
     folder.mkdir(parents=True, exist_ok=True)
     for name, image in maps.items():
         write_image(np.repeat(image[..., None], 3, axis=-1).astype(np.float32), folder / f"{name}.exr")
-    params = {"material": "bragg_mirror", "model": "bragg_mirror", "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0}, "free": list(maps),
+    params = {"material": BraggMirrorModel.name, "model": BraggMirrorModel.name, "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0}, "free": list(maps),
               "angles_deg": [0.0], "seed": 7, "shape": list(next(iter(maps.values())).shape)}
     (folder / "params.json").write_text(json.dumps(params), encoding="utf-8")
 
@@ -49,7 +50,7 @@ def main() -> None:
     from explorer.gpu import Renderer
     from explorer.gpu.env import render_env
     from explorer.materials.brd import load_material
-    from explorer.materials.models import model_for
+    from explorer.materials.models import BraggMirrorModel, model_for
     from explorer.resources import material_path
     from explorer.views.env import EnvironmentMap, env_integral_numpy
     from explorer.views.mesh import rasterise, torus
@@ -57,7 +58,7 @@ def main() -> None:
     from explorer.views.twin_check import Twins, compare, compared_pixels
     from explorer.rendering import render_material
 
-    mirror = load_material(material_path("bragg_mirror"))
+    mirror = load_material(material_path(BraggMirrorModel.name))
     renderer = Renderer()
     environment = EnvironmentMap.default()
     size = args.size
