@@ -209,10 +209,11 @@ class TexturePanel(Panel):
         if self._env is None or self._env[0] != self._arguments_key:
             if self._env is not None:
                 self._env[1].release()
-            self.scheduler.env.environment = self.scheduler.env.environment or _default_environment()
+            # The env mode's environment and probe rotation (its loaded maps: EnvScheduler.environment).
+            environment = self.scheduler.env.environment(self.state.environment).rotated(self.state.env_rotation)
             # The tables are those the worker built for these values (cached): no wait here.
-            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values,
-                                          self.scheduler.env.environment, *size, surface=surface)
+            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values, environment, *size,
+                                          surface=surface)
             from explorer.materials.models import model_for
 
             model = model_for(self.state.material, self._values)
@@ -234,12 +235,6 @@ def _needs_table(material, values) -> bool:
 
     model = model_for(material, values)
     return bool(model is not None and getattr(getattr(model, "method", None), "needs_table", False))
-
-
-def _default_environment():
-    from explorer.views.env import EnvironmentMap
-
-    return EnvironmentMap.default()
 
 
 class _EnvWork:
