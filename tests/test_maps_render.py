@@ -269,10 +269,12 @@ def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror
     """
     from test_app import run_session
 
+    # Then under the environment for a few frames (it crashed once: the session must end cleanly).
     actions = [{"set": {"method": 4}}, {"view_size": 128}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
-               {"quit": True}]
+               {"click": "texture_env"}, {"wait": 3}, {"quit": True}]
     _, report = run_session(x_display, "bragg_mirror", actions, tmp_path, "--maps", str(folder))
     shown = report["texture_view"]
+    assert "clicked texture_env" in report["script_log"], report["script_log"]
     assert shown is not None and shown.get("maps_folder") == str(folder), shown
     maps = ramps()
     assert set(shown["maps"]) == set(maps)
