@@ -15,7 +15,7 @@ The stages (each timed; each a set of tasks whose results are cached in the outp
    of a task at once, on the coarse model);
 5. rounds in which a colour left above :data:`POLISHED_DELTA_E` starts again from its better neighbours' structures:
    neighbouring pixels stay in one basin, so the maps stay smooth;
-6. the converged colours (:func:`explorer.design.forward.bragg_converged_rgb`'s reference), and where they miss, a
+6. the converged colours (the design model's ``converged`` reference), and where they miss, a
    batched correction by the difference between the models (:func:`explorer.design.pixels.polish_corrected`);
 7. a full design for a few colours still above :data:`explorer.design.base.REACHABLE_DELTA_E`, and rounds that spread
    their structures to their neighbours; what stays above it is flagged as unreachable.

@@ -17,7 +17,7 @@ from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatt
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
-from explorer.materials.twins import TWINS, Capabilities, registry, twin
+from explorer.materials.twins import TWINS, Capabilities, DesignModel, registry, twin
 
 #: Samples per numpy call of the stack's spectral Eq. 34 (Mitsuba's spectral variants; bounds the (samples, 471) temporaries).
 SPECTRAL_CHUNK = 1 << 14
@@ -88,13 +88,54 @@ def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
     )
 
 
+# --------------------------------------------------------------------------------------------------
+# Inverse design's forward model of a Bragg mirror (declared by both Bragg twins)
+
+
+def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP,
+                    smooth: float | None = None) -> np.ndarray:
+    """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``, ``N`` continuous) at ``cos_theta`` ``(A,)``."""
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    R = bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                      values["nh"], cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
+    wavelengths = np.asarray(wavelengths, dtype=np.float64)
+    return bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                         values["nh"], cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
+
+
+def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours of a mirror (:func:`mirror_of`): :func:`explorer.physics.bragg.reference_rgb` when
+    ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped), which the
+    polish calls many times.
+    """
+    mirror = mirror_of(values)
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final:
+        return bragg.reference_rgb(cos_theta, mirror)
+    return bragg.converged_rgb(cos_theta, mirror)
+
+
+#: What design fits of a Bragg mirror, and on which forward model: its specular colour (the rough layer's too: the
+#: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
+BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+                           integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb,
+                           host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
+                           paint_free=("Lambda", "delta", "N"))
+
+
 @twin
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -145,32 +186,45 @@ class BraggMirrorModel:
         """The tabulated method's table over ``(cos theta, T)`` under ``mapping`` (:func:`explorer.physics.bragg.textured_rgb_table`)."""
         return bragg.textured_rgb_table(self.mirror, mapping)
 
-    def textured_reflectance(self, cos_theta, T, mapping: str = "both") -> np.ndarray:
+    def textured_reflectance(self, cos_theta, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """
         The twin of the shader's ``textured_reflectance``: the mirror at texture values ``T`` (per sample, in [0, 1])
         under ``mapping`` (supplemental Figure 7, :func:`explorer.physics.bragg.textured_mirror`), by ``method``.
+        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:func:`explorer.physics.bragg.structure_table`),
+        each texel its own mirror; the tabulated method has no table per texel and shows the improved approximation
+        there (as an export away from its table's values), 0 off the maps' mask.
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         T = np.broadcast_to(np.asarray(T, dtype=np.float64), cos_theta.shape)
+        if mapping == "maps":
+            rgb = np.zeros(cos_theta.shape + (3,))
+            for samples, mirror in bragg.mapped_mirrors(structures, T):
+                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod.IMPROVED)
+            return rgb
         if self.method == BraggMethod.TABULATED:
             return bragg.textured_tabulated_rgb(self.texture_table(mapping), cos_theta, T)
-        mirror = bragg.textured_mirror(self.mirror, T, mapping)
-        if self.method == BraggMethod.REFERENCE:
+        return self._mirror_rgb(cos_theta, bragg.textured_mirror(self.mirror, T, mapping))
+
+    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, tabulated: BraggMethod | None = None) -> np.ndarray:
+        """A per-sample mirror's colours by ``method`` (``tabulated``: the method that stands for the tabulated one)."""
+        method = tabulated if self.method == BraggMethod.TABULATED else self.method
+        if method == BraggMethod.REFERENCE:
             return bragg.textured_reference_rgb(cos_theta, mirror, self.wavelength_step)
-        s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[self.method]
-        variant = {"variant": "improved"} if self.method == BraggMethod.IMPROVED else {}
+        s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[method]
+        variant = {"variant": "improved"} if method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
 
-    def textured_mirror_reflection(self, V, N, T, mapping: str = "both") -> np.ndarray:
+    def textured_mirror_reflection(self, V, N, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
         cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)
-        return self.textured_reflectance(cos_theta, T, mapping)
+        return self.textured_reflectance(cos_theta, T, mapping, structures)
 
-    def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both") -> np.ndarray:
+    def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both",
+                      structures: np.ndarray | None = None) -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`textured_reflectance` at the half-vector angle (no prefiltering)."""
         if prefiltered:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
-        return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
+        return self.textured_reflectance(_cos_half_angle(L, V), T, mapping, structures)
 
     #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
     #: where the file declares them), and the integer ones among them.
@@ -267,7 +321,7 @@ class BraggLayerModel(BraggMirrorModel):
 
     name = "bragg_layer"
     capabilities = Capabilities(methods=BraggMethod, dirac=False, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
     # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
@@ -384,7 +438,7 @@ class BraggStackModel:
     #: and in the textures the shader reads alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
     facet_reflectance_override: float | None = None
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=False)
+                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -530,7 +584,7 @@ class SchlickFresnelModel:
 
     name = "schlick_fresnel"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table", "gltf"), design=False)
+                                exports=("table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.F0 = float(values["F0"])
@@ -556,7 +610,7 @@ class GGXSchlickModel:
 
     name = "ggx_schlick"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table", "gltf"), design=False)
+                                exports=("table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.alpha = float(values["alpha"])
