@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter, natural
+from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter_stack, natural
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
@@ -342,17 +342,17 @@ def _layer_tables(layer: layered.RoughBraggLayer, n1: float) -> layered.LayerTab
     return layered.layer_tables(layer, n1)
 
 
-_COMPENSATION_CACHE: dict = {}
+_TERMS_CACHE: dict = {}
 
 
-def _layer_compensation(table: layered.LayerTables):
-    """A layer's multiple-scattering compensation from its (cached) tables, cached per layer and host (32 of them)."""
+def _layer_terms(table: layered.LayerTables):
+    """A layer's albedos with multiple scattering from its (cached) tables, cached per layer and host (32 of them)."""
     key = (table.layer, table.n1)
-    if key not in _COMPENSATION_CACHE:
-        if len(_COMPENSATION_CACHE) >= 32:
-            _COMPENSATION_CACHE.pop(next(iter(_COMPENSATION_CACHE)))
-        _COMPENSATION_CACHE[key] = multiscatter.compensation_tables(table.reflectance, table.transmissivity, table.theta, table.layer.alpha)
-    return _COMPENSATION_CACHE[key]
+    if key not in _TERMS_CACHE:
+        if len(_TERMS_CACHE) >= 32:
+            _TERMS_CACHE.pop(next(iter(_TERMS_CACHE)))
+        _TERMS_CACHE[key] = multiscatter_stack.layer_terms_of(table)
+    return _TERMS_CACHE[key]
 
 
 def _flat_tables(table: layered.LayerTables, R: float) -> layered.LayerTables:
@@ -391,7 +391,8 @@ class BraggStackModel:
         self.stack = self.stack_of(values)
         self.multiple_scattering = bool(values.get("multiple_scattering", False))
         self._tables: tuple | None = None
-        self._compensation: tuple | None = None
+        self._compensation = None
+        self._compensation_rgb: np.ndarray | None = None
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
 
     @staticmethod
@@ -432,16 +433,23 @@ class BraggStackModel:
         return self._tables
 
     @property
-    def compensation(self) -> tuple | None:
-        """Every layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter`), or None when off."""
+    def compensation(self):
+        """The structure's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`), or None when off."""
         if not self.multiple_scattering:
             return None
         if self._compensation is None:
-            if self.facet_reflectance_override is None:
-                self._compensation = tuple(_layer_compensation(table) for table in self.tables)
-            else:
-                self._compensation = layered.stack_compensation(self.stack, self.tables)
+            terms = None if self.facet_reflectance_override is not None else tuple(_layer_terms(t) for t in self.tables)
+            self._compensation = multiscatter_stack.stack_compensation(self.stack, self.tables, terms)
         return self._compensation
+
+    @property
+    def compensation_rgb(self) -> np.ndarray | None:
+        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        if self.compensation is None:
+            return None
+        if self._compensation_rgb is None:
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.stack.rho_d)
+        return self._compensation_rgb
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
@@ -454,7 +462,12 @@ class BraggStackModel:
             return np.stack([np.sum(d * X, axis=-1), np.sum(d * Y, axis=-1), np.sum(d * N, axis=-1)], axis=-1)
 
         X, Y, N = (np.asarray(a, dtype=np.float64) for a in (X, Y, N))
-        return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables, compensation=self.compensation)
+        i, o = local(L), local(V)
+        value = layered.single_reflection_brdf(self.stack, i, o, self.tables)
+        if self.compensation_rgb is not None:
+            above = ((i[..., 2] > 0.0) & (o[..., 2] > 0.0))[..., None]
+            value = value + np.where(above, multiscatter_stack.lookup_rgb(self.compensation_rgb, *multiscatter_stack.air_angles(i, o)), 0.0)
+        return value
 
     def mirror_reflection(self, V, N) -> np.ndarray:
         """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
@@ -468,10 +481,20 @@ class BraggStackModel:
         value = np.empty(wavelengths.shape)
         for start in range(0, i.shape[0], SPECTRAL_CHUNK):
             part = slice(start, start + SPECTRAL_CHUNK)
-            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables, compensation=self.compensation)
-            layers = _interp_wavelength(spectra.layers, wavelengths[part])
+            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables)
+            layers = spectra.layers
+            rho = rgb_upsample(np.broadcast_to(self.rho_d, (layers.shape[0], 3)), wavelengths[part])
+            layers = _interp_wavelength(layers, wavelengths[part])
             base = _interp_wavelength(spectra.base, wavelengths[part])
-            value[part] = layers + rgb_upsample(np.broadcast_to(self.rho_d, (base.shape[0], 3)), wavelengths[part]) * base
+            value[part] = layers + rho * base
+            if self.compensation is not None:
+                # The lobe per wavelength (at the sampled ones), its base's bounces with the upsampled albedo.
+                c = self.compensation
+                parts = multiscatter_stack.lobe_parts(c, *multiscatter_stack.air_angles(i[part], o[part]))
+                M, TT, aa = (_interp_wavelength(x, wavelengths[part]) for x in parts)
+                under = _interp_wavelength(np.broadcast_to(c.under, parts[0].shape), wavelengths[part])
+                lobe = M + (TT * rho / (1.0 - rho * under) - rho * aa) * (c.radiance_scale / np.pi)
+                value[part] += np.where(((i[part, 2] > 0.0) & (o[part, 2] > 0.0))[:, None], lobe, 0.0)
         return value
 
     def sampling_lobes(self, cos_o):
@@ -488,7 +511,7 @@ class BraggStackModel:
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator); ``stack_transmittance``
         as ``stack_reflectance``: each smooth layer's ``T_lambda`` (exact for natural layers, else ``1 - R``).
         """
-        return self._textures_of(self.tables, self.compensation)
+        return self._textures_of(self.tables, self.compensation_rgb)
 
     def draft_textures(self) -> dict[str, np.ndarray]:
         """
@@ -496,10 +519,12 @@ class BraggStackModel:
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
         tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
-        return self._textures_of(tables, layered.stack_compensation(self.stack, tables) if self.multiple_scattering else None)
+        rgb = (multiscatter_stack.rgb_table(multiscatter_stack.stack_compensation(self.stack, tables), self.stack.rho_d)
+               if self.multiple_scattering else None)
+        return self._textures_of(tables, rgb)
 
     @staticmethod
-    def _textures_of(tables, compensation=None) -> dict[str, np.ndarray]:
+    def _textures_of(tables, compensation_rgb=None) -> dict[str, np.ndarray]:
         shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
         reflectance = np.zeros(shape, np.float32)
         transmissivity = np.zeros(shape, np.float32)
@@ -509,12 +534,10 @@ class BraggStackModel:
             transmissivity[..., l] = table.transmissivity
             # The smooth limit's T: a natural layer's exact one (absorbing: < 1 - R), else 1 - R.
             transmittance[..., l] = np.float32(1.0) - table.reflectance if table.transmittance is None else table.transmittance
-        # stack_missing: rows theta = k 2 deg (46) of m(theta), then r and r / (pi m_avg) (zeros: no compensation).
-        missing = np.zeros((multiscatter.COMPENSATION_ROWS + 2, colorimetry.WAVELENGTHS.size, 3), np.float32)
-        for l, c in enumerate(compensation or ()):
-            missing[:-2, :, l] = c.missing
-            missing[-2, :, l] = c.up
-            missing[-1, :, l] = c.up / (np.pi * np.maximum(c.missing_average, 1e-12))
+        # stack_missing: the multiple-scattering lobe in RGB, rows theta_i and columns theta_o every 2 deg in air (zeros: off).
+        missing = np.zeros((multiscatter_stack.TABLE_ROWS, multiscatter_stack.TABLE_ROWS, 3), np.float32)
+        if compensation_rgb is not None:
+            missing[...] = compensation_rgb
         return {
             "stack_reflectance": reflectance,
             "stack_transmissivity": transmissivity,

@@ -56,6 +56,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import microfacet
+from explorer.tables import luts
 
 #: Rows of a layer's compensation table: theta = k * COMPENSATION_STEP_DEG, k = 0..45 (in the host).
 COMPENSATION_STEP_DEG = 2.0
@@ -120,29 +121,104 @@ def _quadrature(alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return o_z, cos_d, o_z > 0.0
 
 
-@dataclass(frozen=True)
-class CompensationTables:
+def reflection_albedos(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float,
+                       exits: list) -> tuple[list, list]:
     """
-    A rough Bragg layer's multiple-scattering compensation, per wavelength (471, the last axis).
+    A layer's reflection albedos at the rows of :func:`compensation_theta` (host angles), each weighted by an
+    exit factor ``W(theta_o)`` of the reflected direction (rows of ``theta``, shape (rows, 471), or ``None``
+    for 1): ``E[R(theta_d) w W(theta_o)]`` over the normals visible from ``i`` (16 x 16 stratified), with
+    ``w = (1 + Lambda_i) G2`` (transparent occluders, height-correlated: :func:`correlated_masking_over_cos`)
+    and with Eq. 17's ``w = G1(o)`` (opaque separable occluders: single scattering as published).
+
+    Returns
+    -------
+    correlated, separable : list of ndarray, shape (COMPENSATION_ROWS, 471), float64
+        One per exit factor.
+    """
+    alpha = float(microfacet.check_alpha(alpha))
+    R = np.asarray(reflectance, dtype=np.float64)
+    t = np.asarray(transmissivity, dtype=np.float64)
+    theta = np.asarray(theta, dtype=np.float64)
+    step = theta[1] - theta[0]
+    rows = compensation_theta()
+    cos_rows = np.cos(rows)
+    rho_rows = occluder_reflectance(_at(t, rows, step), cos_rows, alpha)
+    o_z, cos_d, above = _quadrature(alpha)
+    # Nearest table rows (0.25 deg) for the quadrature's angles: a gather, not an interpolation (float32, all rows at once).
+    row_o = np.rint(np.arccos(np.clip(o_z, 0.0, 1.0)) / step).astype(np.int64).ravel()
+    row_d = np.rint(np.arccos(cos_d) / step).astype(np.int64).ravel()
+    t32, R32 = t.astype(np.float32), R.astype(np.float32)
+    shape = o_z.shape + (R.shape[1],)
+    oz = np.clip(o_z, 1e-6, 1.0).ravel()
+    G1_o = microfacet.smith_G1(oz, alpha).astype(np.float32)[:, None]
+    lam_o = smith_lambda(oz, alpha).astype(np.float32).reshape(o_z.shape + (1,))
+    rho_o = np.clip(1.0 - t32[row_o] / np.maximum(G1_o, np.float32(1e-12)), 0.0, 1.0)
+    stop_o = (rho_o * (2.0 - rho_o)).reshape(shape)
+    lam_i = smith_lambda(np.maximum(cos_rows, np.cos(np.radians(89.5))), alpha).astype(np.float32)[:, None, None]
+    stop_i = occluder_stop(rho_rows).astype(np.float32)[:, None, :]
+    R_d = R32[row_d].reshape(shape)
+    # Eq. 17 with correlated_masking_over_cos for G1 G1: f cos / pdf = R G2 / G1(i) = R (1 + Lambda_i) G2.
+    weight = R_d * (above[..., None] * (1.0 + lam_i) / (1.0 + lam_i * stop_i + lam_o * stop_o))
+    separable = R_d * (above[..., None] * G1_o.reshape(o_z.shape + (1,)))
+    correlated_out, separable_out = [], []
+    for W in exits:
+        if W is None:
+            correlated_out.append(weight.mean(axis=1, dtype=np.float64))
+            separable_out.append(separable.mean(axis=1, dtype=np.float64))
+            continue
+        W_o = np.asarray(W, dtype=np.float32)[row_o].reshape(shape)
+        correlated_out.append((weight * W_o).mean(axis=1, dtype=np.float64))
+        separable_out.append((separable * W_o).mean(axis=1, dtype=np.float64))
+    return correlated_out, separable_out
+
+
+def _at(table: np.ndarray, angle: np.ndarray, step: float) -> np.ndarray:
+    """Linear interpolation of a table with rows every ``step`` radians from 0 at ``angle``."""
+    x = np.clip(angle, 0.0, step * (table.shape[0] - 1)) / step
+    k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
+    f = (x - k)[..., None]
+    return table[k] * (1.0 - f) + table[k + 1] * f
+
+
+@dataclass(frozen=True)
+class LayerTerms:
+    """
+    A rough Bragg layer's albedos with multiple scattering, per wavelength (471, the last axis), at the rows of
+    :func:`compensation_theta` (host angles); the layer is the same seen from either side (Smith's heights are
+    symmetric), so each holds for light arriving from above or below.
 
     Attributes
     ----------
-    missing : ndarray, shape (COMPENSATION_ROWS, 471), float32
-        ``m(theta)``: the light single scattering with transparent occluders misses, at ``theta = k * 2 deg``.
-    up : ndarray, shape (471,), float32
-        ``r``: the part of it that leaves upward.
-    missing_average : ndarray, shape (471,), float32
-        ``m_avg = 2 int m cos sin d theta`` (the lobe's normalisation).
+    reflection : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``E_r``: reflected once, occluders transparent (1).
+    ballistic : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``t_b``: crossed without a reflection (2).
+    missing : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``m``: scattered among the facets (3); the facets' absorption taken out for absorbing layers.
+    up : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``r``: the part of ``m`` that leaves upward (:func:`upward_share`, from the random walk).
     """
 
+    reflection: np.ndarray = field(repr=False)
+    ballistic: np.ndarray = field(repr=False)
     missing: np.ndarray = field(repr=False)
     up: np.ndarray = field(repr=False)
-    missing_average: np.ndarray = field(repr=False)
+
+    @property
+    def reflected(self) -> np.ndarray:
+        """All the light the layer sends back: ``E_r + r m``."""
+        return self.reflection + self.up * self.missing
+
+    @property
+    def transmitted(self) -> np.ndarray:
+        """All the light that crosses it: ``t_b + (1 - r) m``."""
+        return self.ballistic + (1.0 - self.up) * self.missing
 
 
-def compensation_tables(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float) -> CompensationTables:
+def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float,
+                lossless_transmissivity: ArrayLike | None = None) -> LayerTerms:
     """
-    Build a layer's :class:`CompensationTables` from its single-scattering tables.
+    A layer's :class:`LayerTerms` from its single-scattering tables.
 
     Parameters
     ----------
@@ -152,63 +228,125 @@ def compensation_tables(reflectance: ArrayLike, transmissivity: ArrayLike, theta
         Their angles (radians, uniform from 0).
     alpha : float
         The layer's roughness.
+    lossless_transmissivity : array_like, optional
+        For absorbing facets (``T < 1 - R``): Eq. 28 with ``1 - R``. Light scattered among the facets meets
+        one more facet at least, so ``m`` is the lossless one times the facets' hemispherical albedo
+        ``R + T`` (``(f_t^lossless - f_t) / G1`` is what one crossing absorbs): it never puts back what a facet absorbed.
     """
     alpha = float(microfacet.check_alpha(alpha))
-    R = np.asarray(reflectance, dtype=np.float64)
-    t = np.asarray(transmissivity, dtype=np.float64)
     theta = np.asarray(theta, dtype=np.float64)
     step = theta[1] - theta[0]
-
-    def at(table, angle):
-        x = np.clip(angle, 0.0, theta[-1]) / step
-        k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
-        f = (x - k)[..., None]
-        return table[k] * (1.0 - f) + table[k + 1] * f
-
     rows = compensation_theta()
     cos_rows = np.cos(rows)
-    rho_rows = occluder_reflectance(at(t, rows), cos_rows, alpha)
-    G_rows = effective_masking(cos_rows, alpha, rho_rows)
-    o_z, cos_d, above = _quadrature(alpha)
-    # E_r(theta) = E_m[R(theta_d) (1 + Lambda_i) G2] over the normals visible from i (Eq. 17 with
-    # correlated_masking_over_cos for G1 G1 / (cos_i cos_o): f cos / pdf = R G2 / G1(i)); float32, all rows at once.
-    # Nearest table rows (0.25 deg) for the quadrature's angles: a gather, not an interpolation (as fast as it gets).
-    row_o = np.rint(np.arccos(np.clip(o_z, 0.0, 1.0)) / step).astype(np.int64).ravel()
-    row_d = np.rint(np.arccos(cos_d) / step).astype(np.int64).ravel()
-    t32, R32 = t.astype(np.float32), R.astype(np.float32)
-    oz = np.clip(o_z, 1e-6, 1.0).ravel()
-    G1_o = microfacet.smith_G1(oz, alpha).astype(np.float32)[:, None]
-    lam_o = smith_lambda(oz, alpha).astype(np.float32).reshape(o_z.shape + (1,))
-    rho_o = np.clip(1.0 - t32[row_o] / np.maximum(G1_o, np.float32(1e-12)), 0.0, 1.0)
-    stop_o = (rho_o * (2.0 - rho_o)).reshape(o_z.shape + (R.shape[1],))
-    lam_i = smith_lambda(np.maximum(cos_rows, np.cos(np.radians(89.5))), alpha).astype(np.float32)[:, None, None]
-    stop_i = occluder_stop(rho_rows).astype(np.float32)[:, None, :]
-    weight = above[..., None] * (1.0 + lam_i) / (1.0 + lam_i * stop_i + lam_o * stop_o)
-    E_r = (R32[row_d].reshape(o_z.shape + (R.shape[1],)) * weight).mean(axis=1, dtype=np.float64)
-    missing = np.clip(1.0 - E_r - ballistic_transmissivity(rho_rows, G_rows), 0.0, 1.0)
-    up = np.clip(hemispherical_average(R, theta), 0.0, 1.0)
-    average = hemispherical_average(missing, rows)
-    return CompensationTables(missing.astype(np.float32), up.astype(np.float32), average.astype(np.float32))
+    t = np.asarray(transmissivity, dtype=np.float64)
+    rho = occluder_reflectance(_at(t, rows, step), cos_rows, alpha)
+    ballistic = ballistic_transmissivity(rho, effective_masking(cos_rows, alpha, rho))
+    (E_r,), _ = reflection_albedos(reflectance, t, theta, alpha, [None])
+    if lossless_transmissivity is None:
+        missing = np.clip(1.0 - E_r - ballistic, 0.0, 1.0)
+        rho_share = rho
+    else:
+        t0 = np.asarray(lossless_transmissivity, dtype=np.float64)
+        rho0 = occluder_reflectance(_at(t0, rows, step), cos_rows, alpha)
+        (E_r0,), _ = reflection_albedos(reflectance, t0, theta, alpha, [None])
+        lossless = np.clip(1.0 - E_r0 - ballistic_transmissivity(rho0, effective_masking(cos_rows, alpha, rho0)), 0.0, 1.0)
+        G1 = microfacet.smith_G1(cos_rows, alpha)[:, None]
+        absorbed = np.clip((_at(t0, rows, step) - _at(t, rows, step)) / np.maximum(G1, 1e-12), 0.0, 1.0)
+        facet_albedo = np.clip(1.0 - hemispherical_average(absorbed, rows), 0.0, 1.0)
+        missing = np.minimum(lossless * facet_albedo, np.clip(1.0 - E_r - ballistic, 0.0, 1.0))
+        rho_share = rho0
+    up = upward_share(alpha, rho_share, rows)
+    return LayerTerms(E_r, ballistic, missing, up)
 
 
-def missing_energy(tables: CompensationTables, theta: ArrayLike) -> np.ndarray:
-    """``m(theta)`` (radians, in the host) by linear interpolation of the table's rows: shape ``theta.shape + (471,)``."""
-    x = np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi) / np.radians(COMPENSATION_STEP_DEG)
-    k = np.minimum(np.floor(x).astype(np.int64), COMPENSATION_ROWS - 2)
-    f = (x - k)[..., None]
-    m = tables.missing.astype(np.float64)
-    return m[k] * (1.0 - f) + m[k + 1] * f
+# --------------------------------------------------------------------------------------------------
+# The upward share of the light scattered among the facets, from the random walk of grey facets
+
+#: The share table's nodes: roughness, the facets' reflectance seen along the direction (``rho``), host angle.
+SHARE_ALPHAS = tuple(round(0.1 * k, 1) for k in range(1, 11))
+SHARE_RHOS = (0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 1.0)
+SHARE_THETA_DEG = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 88.0)
+#: Paths per node of the share table's walk.
+SHARE_PATHS = 16000
+SHARE_SEED = 2017
 
 
-def compensation_lobe(missing_i: ArrayLike, missing_o: ArrayLike, tables: CompensationTables) -> np.ndarray:
-    """The upward multiple-scattering lobe ``r m(i) m(o) / (pi m_avg)`` (1/sr), per wavelength (Kulla & Conty's form)."""
-    average = np.maximum(tables.missing_average.astype(np.float64), 1e-12)
-    return tables.up * np.asarray(missing_i) * np.asarray(missing_o) / (np.pi * average)
+def generate_upward_share() -> np.ndarray:
+    """
+    ``r(alpha, rho, theta)``: of the light a layer of grey facets (``R = rho`` at every angle, ``T = 1 - R``)
+    scatters among its facets, ``m = 1 - E_r - t_b``, the part that leaves upward, ``(up_walk - E_r) / m``, with
+    ``up_walk`` the random walk's reflected light (:func:`explorer.physics.microsurface.walk`, :data:`SHARE_PATHS`
+    paths per node, seeded) and ``E_r``, ``t_b`` this module's first-order terms. Clipped to [0, 1]; 1 where
+    ``m < 1e-3`` (nothing to share).
+    """
+    from explorer.physics import microsurface
+
+    rng = np.random.default_rng(SHARE_SEED)
+    share = np.ones((len(SHARE_ALPHAS), len(SHARE_RHOS), len(SHARE_THETA_DEG)))
+    node_rows = np.rint(np.asarray(SHARE_THETA_DEG) / COMPENSATION_STEP_DEG).astype(np.int64)
+    theta_nodes = np.radians(SHARE_THETA_DEG)
+    for a, alpha in enumerate(SHARE_ALPHAS):
+        filt = microfacet.transmission_filter_table(alpha)
+        R = np.broadcast_to(np.asarray(SHARE_RHOS), (filt.weights.shape[0], len(SHARE_RHOS)))
+        t = filt.weights @ (1.0 - R)
+        theta = np.radians(np.arange(filt.weights.shape[0]) * 0.25)
+        step = theta[1] - theta[0]
+        rows = compensation_theta()
+        rho = occluder_reflectance(_at(t, rows, step), np.cos(rows), alpha)
+        ballistic = ballistic_transmissivity(rho, effective_masking(np.cos(rows), alpha, rho))
+        (E_r,), _ = reflection_albedos(R, t, theta, alpha, [None])
+        m = 1.0 - E_r - ballistic
+        for r, value in enumerate(SHARE_RHOS):
+            n = SHARE_PATHS * len(SHARE_THETA_DEG)
+            which = np.repeat(np.arange(len(SHARE_THETA_DEG)), SHARE_PATHS)
+            d = np.stack([-np.sin(theta_nodes[which]), 0.0 * which, -np.cos(theta_nodes[which])], axis=-1)
+            _, _, _, up, alive, _, _ = microsurface.walk(d, np.ones((n, 1)), np.ones((n, 1)), alpha,
+                                                        lambda c, rows_, v=value: np.full((rows_.size, 1), v), rng)
+            up_walk = np.bincount(which, weights=(up & alive).astype(np.float64), minlength=len(SHARE_THETA_DEG)) / SHARE_PATHS
+            m_nodes = m[node_rows, r]
+            share[a, r] = np.where(m_nodes > 1e-3, np.clip((up_walk - E_r[node_rows, r]) / np.maximum(m_nodes, 1e-3), 0.0, 1.0), 1.0)
+    return share
 
 
-def compensated_transmissivity(ballistic: ArrayLike, missing: ArrayLike, tables: CompensationTables) -> np.ndarray:
-    """A layer's transmission as the layers below see it: the ballistic part plus the downward share ``(1 - r) m``."""
-    return np.asarray(ballistic) + (1.0 - tables.up) * np.asarray(missing)
+luts.register("multiscatter_upward_share", generate_upward_share, {
+    "quantity": "the upward share of the light grey Bragg facets scatter among themselves, alpha x rho x theta "
+    "(explorer.physics.multiscatter: the random walk of Heitz et al. 2016 against the first-order terms)",
+    "alpha": list(SHARE_ALPHAS), "rho": list(SHARE_RHOS), "theta_deg": list(SHARE_THETA_DEG),
+    "paths": SHARE_PATHS, "seed": SHARE_SEED, "quadrature": f"{QUADRATURE_SIDE} x {QUADRATURE_SIDE} visible normals",
+    "resolution_nm": None,
+    "shape": [len(SHARE_ALPHAS), len(SHARE_RHOS), len(SHARE_THETA_DEG)],
+})
+
+
+@functools.lru_cache(maxsize=1)
+def _share_table() -> np.ndarray:
+    return luts.load("multiscatter_upward_share")
+
+
+def upward_share(alpha: float, rho: ArrayLike, theta: ArrayLike) -> np.ndarray:
+    """
+    ``r``: the share table (:func:`generate_upward_share`) interpolated linearly in ``alpha``, ``rho`` and
+    ``theta`` (radians, broadcast with ``rho``'s leading axes; ``rho`` has the wavelengths last). Below the
+    first roughness node the share is that node's (it barely matters: ``m`` vanishes with ``alpha``); ``rho``
+    is clamped to the nodes' range.
+    """
+    table = _share_table()
+    rho = np.asarray(rho, dtype=np.float64)
+    xa = np.interp(float(alpha), SHARE_ALPHAS, np.arange(len(SHARE_ALPHAS)))
+    a0 = min(int(np.floor(xa)), len(SHARE_ALPHAS) - 2)
+    fa = xa - a0
+    plane = table[a0] * (1.0 - fa) + table[a0 + 1] * fa  # (rho, theta)
+    xt = np.interp(np.degrees(np.asarray(theta, dtype=np.float64)), SHARE_THETA_DEG, np.arange(len(SHARE_THETA_DEG)))
+    t0 = np.minimum(np.floor(xt).astype(np.int64), len(SHARE_THETA_DEG) - 2)
+    ft = (xt - t0)[..., None]
+    xr = np.interp(rho, SHARE_RHOS, np.arange(len(SHARE_RHOS)))
+    r0 = np.minimum(np.floor(xr).astype(np.int64), len(SHARE_RHOS) - 2)
+    fr = xr - r0
+    t0 = np.broadcast_to(t0[..., None], rho.shape)
+    ft = np.broadcast_to(ft, rho.shape)
+    low = plane[r0, t0] * (1.0 - ft) + plane[r0, t0 + 1] * ft
+    high = plane[r0 + 1, t0] * (1.0 - ft) + plane[r0 + 1, t0 + 1] * ft
+    return low * (1.0 - fr) + high * fr
 
 
 def occluder_stop(rho: ArrayLike) -> np.ndarray:
