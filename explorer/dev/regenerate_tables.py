@@ -9,7 +9,7 @@ only: an installed package regenerates stale tables into the user cache by itsel
 from __future__ import annotations
 
 from explorer import resources
-from explorer.physics import colorimetry, lobes_fgd, multiscatter, thinfilm  # noqa: F401  (they register the tables)
+from explorer.physics import colorimetry, lobes_fgd, thinfilm  # noqa: F401  (they register the tables)
 from explorer.tables import luts
 
 

@@ -519,9 +519,9 @@ class BraggStackModel:
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
         tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
-        rgb = (multiscatter_stack.rgb_table(multiscatter_stack.stack_compensation(self.stack, tables), self.stack.rho_d)
-               if self.multiple_scattering else None)
-        return self._textures_of(tables, rgb)
+        # The multiple-scattering lobe is not drafted (its walk and quadratures take a second or more): a
+        # draft shows Eq. 34 alone until the real textures follow on release.
+        return self._textures_of(tables, None)
 
     @staticmethod
     def _textures_of(tables, compensation_rgb=None) -> dict[str, np.ndarray]:

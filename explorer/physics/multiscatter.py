@@ -1,13 +1,13 @@
 """
-Multiple scattering among the microfacets of a rough Bragg layer, for the explorer's model: an energy
-compensation after Kulla & Conty (2017), generalised to facets that reflect a spectrum ``R_lambda(theta_d)``
-and let the rest through ballistically (Fourneau et al. 2024, Section 4.2.1). Numpy only; the GLSL twins of
-the same names are in ``shaders/lib/layered.glsl``. Measured against the microsurface random walk
-(:mod:`explorer.physics.microsurface`) in ``docs/layered_validation.md``.
+Multiple scattering among the microfacets of a rough Bragg layer, for the explorer's model: the layer's
+directional albedos (reflected, transmitted) with every bounce among facets that reflect a spectrum
+``R_lambda(theta_d)`` and let the rest through ballistically (Fourneau et al. 2024, Section 4.2.1). Numpy
+only. Measured against the microsurface random walk (:mod:`explorer.physics.microsurface`) in
+``docs/layered_validation.md``.
 
 Three changes to a layer's single-scattering terms (Eq. 17, Eq. 28), per wavelength, each exact for
-facets that reflect everything (the furnace, where it is Kulla & Conty's) and for facets that let
-everything through (where the layer is invisible):
+facets that reflect everything (the furnace) and for facets that let everything through (where the layer
+is invisible):
 
 1. **Transparent occluders.** A facet that masks or shadows another is itself a Bragg mirror: it lets
    ``1 - R`` of the light through. In Smith's model (uncorrelated heights) the occluders a ray meets form
@@ -27,21 +27,18 @@ everything through (where the layer is invisible):
    ``alpha <= 1``, ``theta <= 70 deg``).
 3. **What is still missing**, ``m(theta) = 1 - E_r(theta) - t_b(theta)`` (``E_r`` the directional albedo
    of the reflection of (1), ``t_b`` of (2)), is light scattered among the facets: a part ``r`` leaves
-   upward, as Kulla & Conty's lobe ``r m(i) m(o) / (pi m_avg)`` (whose albedo is ``r m(i)``, reciprocal),
-   and ``1 - r`` downward, added to the layer's transmission seen by the layers below and the base
-   (:func:`compensated_transmissivity`). ``r`` is the facets' hemispherical reflectance ``R_avg``:
-   with ``R = 1`` all goes up (Kulla & Conty's ``E_avg`` normalisation), with small ``R`` light scattered
-   among mostly transparent facets leaves mostly downward (the random walk gives ``r ~ R`` within ~0.1).
+   upward and ``1 - r`` downward (:class:`LayerTerms`). ``r`` comes from the random walk itself
+   (:func:`upward_share`): a few thousand paths walked once per roughness with facets that reflect half the
+   light (:func:`walk_ensemble`), reweighted per wavelength by each event's ``R / 0.5`` or ``T / 0.5``. A
+   path's geometry depends only on its choices, so this is the walk with the layer's own ``R_lambda(theta_d)``
+   in expectation: the share follows the spectrum (light scattered twice is filtered twice), where a grey
+   facets' share at the mean reflectance missed by up to 0.25 between two Bragg bands.
 
-Kulla & Conty colour their lobe with ``F_avg^2 E_avg / (1 - F_avg (1 - E_avg))``; here the colour comes
-from ``m`` itself (per wavelength: the light a Bragg facet does not reflect once is not lost, most of it
-crosses) and ``r``. All of it is per wavelength, before the conversion to RGB.
+For the structure (:mod:`explorer.physics.multiscatter_stack`) these are a layer's albedos; the lobe the
+explorer adds is built there. All of it is per wavelength, before the conversion to RGB.
 
 References
 ----------
-Kulla, Conty (2017). Revisiting physically based shading at Imageworks. SIGGRAPH 2017 course: Physically
-Based Shading in Theory and Practice. The energy compensation lobe ``(1 - E(mu_i))(1 - E(mu_o)) / (pi (1 -
-E_avg))`` and its Fresnel colour ``F_ms``.
 Heitz, Hanika, d'Eon, Dachsbacher (2016). Multiple-scattering microfacet BSDFs with the Smith model. ACM
 TOG 35(4). Smith's occlusion as a process along the ray (the heights' ``C1``).
 Fourneau, Pacanowski, Barla (2024). Computer Graphics Forum 43(2). Eqs. 17-19, 28-30, 34.
@@ -56,7 +53,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import microfacet
-from explorer.tables import luts
 
 #: Rows of a layer's compensation table: theta = k * COMPENSATION_STEP_DEG, k = 0..45 (in the host).
 COMPENSATION_STEP_DEG = 2.0
@@ -216,7 +212,7 @@ class LayerTerms:
 
 
 def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float,
-                lossless_transmissivity: ArrayLike | None = None) -> LayerTerms:
+                lossless_transmissivity: ArrayLike | None = None, transmittance: ArrayLike | None = None) -> LayerTerms:
     """
     A layer's :class:`LayerTerms` from its single-scattering tables.
 
@@ -232,6 +228,8 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
         For absorbing facets (``T < 1 - R``): Eq. 28 with ``1 - R``. Light scattered among the facets meets
         one more facet at least, so ``m`` is the lossless one times the facets' hemispherical albedo
         ``R + T`` (``(f_t^lossless - f_t) / G1`` is what one crossing absorbs): it never puts back what a facet absorbed.
+    transmittance : array_like, optional
+        The facets' ``T_lambda`` (361, 471) when it is below ``1 - R`` (absorbing), for the upward share.
     """
     alpha = float(microfacet.check_alpha(alpha))
     theta = np.asarray(theta, dtype=np.float64)
@@ -244,7 +242,6 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
     (E_r,), _ = reflection_albedos(reflectance, t, theta, alpha, [None])
     if lossless_transmissivity is None:
         missing = np.clip(1.0 - E_r - ballistic, 0.0, 1.0)
-        rho_share = rho
     else:
         t0 = np.asarray(lossless_transmissivity, dtype=np.float64)
         rho0 = occluder_reflectance(_at(t0, rows, step), cos_rows, alpha)
@@ -254,99 +251,102 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
         absorbed = np.clip((_at(t0, rows, step) - _at(t, rows, step)) / np.maximum(G1, 1e-12), 0.0, 1.0)
         facet_albedo = np.clip(1.0 - hemispherical_average(absorbed, rows), 0.0, 1.0)
         missing = np.minimum(lossless * facet_albedo, np.clip(1.0 - E_r - ballistic, 0.0, 1.0))
-        rho_share = rho0
-    up = upward_share(alpha, rho_share, rows)
+    up = upward_share(reflectance, transmittance, alpha)
     return LayerTerms(E_r, ballistic, missing, up)
 
 
 # --------------------------------------------------------------------------------------------------
-# The upward share of the light scattered among the facets, from the random walk of grey facets
+# The upward share of the light scattered among the facets: the random walk's paths, reweighted per wavelength
 
-#: The share table's nodes: roughness, the facets' reflectance seen along the direction (``rho``), host angle.
-SHARE_ALPHAS = tuple(round(0.1 * k, 1) for k in range(1, 11))
-SHARE_RHOS = (0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 1.0)
-SHARE_THETA_DEG = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 88.0)
-#: Paths per node of the share table's walk.
-SHARE_PATHS = 16000
-SHARE_SEED = 2017
+#: Incidence angles (host, degrees) of the walked paths; the share is interpolated linearly between them.
+SHARE_THETA_DEG = (0.0, 20.0, 40.0, 60.0, 75.0, 88.0)
+#: Paths per angle, the facet events kept per path (later ones are taken as the reweighting's mean, 1), the seed.
+SHARE_PATHS = 20000
+SHARE_EVENTS = 10
+SHARE_SEED = 2016
+#: The walk's facets reflect with this probability; any other reflectance reweighs the same paths.
+SHARE_SAMPLING_R = 0.5
+#: The share is reweighted every this many nm and interpolated between (a ratio: smoother than ``R``).
+SHARE_STEP_NM = 3
 
 
-def generate_upward_share() -> np.ndarray:
+@functools.lru_cache(maxsize=8)
+def walk_ensemble(alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
-    ``r(alpha, rho, theta)``: of the light a layer of grey facets (``R = rho`` at every angle, ``T = 1 - R``)
-    scatters among its facets, ``m = 1 - E_r - t_b``, the part that leaves upward, ``(up_walk - E_r) / m``, with
-    ``up_walk`` the random walk's reflected light (:func:`explorer.physics.microsurface.walk`, :data:`SHARE_PATHS`
-    paths per node, seeded) and ``E_r``, ``t_b`` this module's first-order terms. Clipped to [0, 1]; 1 where
-    ``m < 1e-3`` (nothing to share).
+    The random walk's paths through a layer of roughness ``alpha`` (:func:`explorer.physics.microsurface.walk`)
+    whose facets reflect with probability :data:`SHARE_SAMPLING_R`, :data:`SHARE_PATHS` per angle of
+    :data:`SHARE_THETA_DEG`, seeded: only those scattered among the facets (left upward after two reflections or
+    more, or downward after one or more). A path's geometry depends on its choices only, so the same paths serve
+    every reflectance (:func:`upward_share`).
+
+    Returns
+    -------
+    events : ndarray of int, shape (n, SHARE_EVENTS)
+        Per facet event, its row in a 0.25-degree table of ``theta_d`` plus 361 when it reflected; 722 (a row of
+        ones) after the path's last event.
+    up : ndarray of bool, shape (n,)
+    node : ndarray of int, shape (n,)
+        The path's angle, an index into :data:`SHARE_THETA_DEG`.
     """
     from explorer.physics import microsurface
 
     rng = np.random.default_rng(SHARE_SEED)
-    share = np.ones((len(SHARE_ALPHAS), len(SHARE_RHOS), len(SHARE_THETA_DEG)))
-    node_rows = np.rint(np.asarray(SHARE_THETA_DEG) / COMPENSATION_STEP_DEG).astype(np.int64)
-    theta_nodes = np.radians(SHARE_THETA_DEG)
-    for a, alpha in enumerate(SHARE_ALPHAS):
-        filt = microfacet.transmission_filter_table(alpha)
-        R = np.broadcast_to(np.asarray(SHARE_RHOS), (filt.weights.shape[0], len(SHARE_RHOS)))
-        t = filt.weights @ (1.0 - R)
-        theta = np.radians(np.arange(filt.weights.shape[0]) * 0.25)
-        step = theta[1] - theta[0]
-        rows = compensation_theta()
-        rho = occluder_reflectance(_at(t, rows, step), np.cos(rows), alpha)
-        ballistic = ballistic_transmissivity(rho, effective_masking(np.cos(rows), alpha, rho))
-        (E_r,), _ = reflection_albedos(R, t, theta, alpha, [None])
-        m = 1.0 - E_r - ballistic
-        for r, value in enumerate(SHARE_RHOS):
-            n = SHARE_PATHS * len(SHARE_THETA_DEG)
-            which = np.repeat(np.arange(len(SHARE_THETA_DEG)), SHARE_PATHS)
-            d = np.stack([-np.sin(theta_nodes[which]), 0.0 * which, -np.cos(theta_nodes[which])], axis=-1)
-            _, _, _, up, alive, _, _ = microsurface.walk(d, np.ones((n, 1)), np.ones((n, 1)), alpha,
-                                                        lambda c, rows_, v=value: np.full((rows_.size, 1), v), rng)
-            up_walk = np.bincount(which, weights=(up & alive).astype(np.float64), minlength=len(SHARE_THETA_DEG)) / SHARE_PATHS
-            m_nodes = m[node_rows, r]
-            share[a, r] = np.where(m_nodes > 1e-3, np.clip((up_walk - E_r[node_rows, r]) / np.maximum(m_nodes, 1e-3), 0.0, 1.0), 1.0)
-    return share
+    nodes = len(SHARE_THETA_DEG)
+    n = SHARE_PATHS * nodes
+    node = np.repeat(np.arange(nodes), SHARE_PATHS)
+    theta = np.radians(np.asarray(SHARE_THETA_DEG))[node]
+    count = np.zeros(n, dtype=np.int64)
+    events = np.full((n, SHARE_EVENTS), 722, dtype=np.int64)
+
+    def record(rows, cos_d, reflect):
+        k = count[rows]
+        kept = k < SHARE_EVENTS
+        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
+        events[rows[kept], k[kept]] = row[kept] + 361 * reflect[kept]
+        count[rows] += 1
+
+    d = np.stack([-np.sin(theta), 0.0 * theta, -np.cos(theta)], axis=-1)
+    _, _, _, up, alive, _, reflections = microsurface.walk(
+        d, np.ones((n, 1)), np.ones((n, 1)), float(alpha),
+        lambda cos_d, rows: np.full((rows.size, 1), SHARE_SAMPLING_R), rng, record=record)
+    scattered = alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up))
+    return events[scattered], up[scattered], node[scattered]
 
 
-luts.register("multiscatter_upward_share", generate_upward_share, {
-    "quantity": "the upward share of the light grey Bragg facets scatter among themselves, alpha x rho x theta "
-    "(explorer.physics.multiscatter: the random walk of Heitz et al. 2016 against the first-order terms)",
-    "alpha": list(SHARE_ALPHAS), "rho": list(SHARE_RHOS), "theta_deg": list(SHARE_THETA_DEG),
-    "paths": SHARE_PATHS, "seed": SHARE_SEED, "quadrature": f"{QUADRATURE_SIDE} x {QUADRATURE_SIDE} visible normals",
-    "resolution_nm": None,
-    "shape": [len(SHARE_ALPHAS), len(SHARE_RHOS), len(SHARE_THETA_DEG)],
-})
-
-
-@functools.lru_cache(maxsize=1)
-def _share_table() -> np.ndarray:
-    return luts.load("multiscatter_upward_share")
-
-
-def upward_share(alpha: float, rho: ArrayLike, theta: ArrayLike) -> np.ndarray:
+def upward_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha: float) -> np.ndarray:
     """
-    ``r``: the share table (:func:`generate_upward_share`) interpolated linearly in ``alpha``, ``rho`` and
-    ``theta`` (radians, broadcast with ``rho``'s leading axes; ``rho`` has the wavelengths last). Below the
-    first roughness node the share is that node's (it barely matters: ``m`` vanishes with ``alpha``); ``rho``
-    is clamped to the nodes' range.
+    ``r``: of the light scattered among the facets, the part that leaves upward, per wavelength, at the rows of
+    :func:`compensation_theta`: the walk's scattered paths (:func:`walk_ensemble`) weighted by each event's
+    ``R / R_s`` (reflected) or ``T / (1 - R_s)`` (crossed), ``R_s`` :data:`SHARE_SAMPLING_R` (importance
+    reweighting: the walk with these facets, in expectation), the upward ones over all.
+
+    ``reflectance``, ``transmittance``: the facets' ``R_lambda`` and ``T_lambda`` (``None``: ``1 - R``) at
+    ``theta_d = k * 0.25 deg``, shape (361, 471).
     """
-    table = _share_table()
-    rho = np.asarray(rho, dtype=np.float64)
-    xa = np.interp(float(alpha), SHARE_ALPHAS, np.arange(len(SHARE_ALPHAS)))
-    a0 = min(int(np.floor(xa)), len(SHARE_ALPHAS) - 2)
-    fa = xa - a0
-    plane = table[a0] * (1.0 - fa) + table[a0 + 1] * fa  # (rho, theta)
-    xt = np.interp(np.degrees(np.asarray(theta, dtype=np.float64)), SHARE_THETA_DEG, np.arange(len(SHARE_THETA_DEG)))
-    t0 = np.minimum(np.floor(xt).astype(np.int64), len(SHARE_THETA_DEG) - 2)
-    ft = (xt - t0)[..., None]
-    xr = np.interp(rho, SHARE_RHOS, np.arange(len(SHARE_RHOS)))
-    r0 = np.minimum(np.floor(xr).astype(np.int64), len(SHARE_RHOS) - 2)
-    fr = xr - r0
-    t0 = np.broadcast_to(t0[..., None], rho.shape)
-    ft = np.broadcast_to(ft, rho.shape)
-    low = plane[r0, t0] * (1.0 - ft) + plane[r0, t0 + 1] * ft
-    high = plane[r0 + 1, t0] * (1.0 - ft) + plane[r0 + 1, t0 + 1] * ft
-    return low * (1.0 - fr) + high * fr
+    columns = np.unique(np.r_[np.arange(0, np.shape(reflectance)[1], SHARE_STEP_NM), np.shape(reflectance)[1] - 1])
+    R = np.asarray(reflectance, dtype=np.float32)[:, columns]
+    T = np.float32(1.0) - R if transmittance is None else np.asarray(transmittance, dtype=np.float32)[:, columns]
+    factors = np.concatenate([T / np.float32(1.0 - SHARE_SAMPLING_R), R / np.float32(SHARE_SAMPLING_R),
+                              np.ones((1, R.shape[1]), np.float32)])
+    events, up, node = walk_ensemble(float(alpha))
+    share = np.full((len(SHARE_THETA_DEG), R.shape[1]), 0.5)
+    for k in range(len(SHARE_THETA_DEG)):
+        at = np.flatnonzero(node == k)
+        if at.size == 0:
+            continue
+        weight = factors[events[at, 0]]
+        for j in range(1, SHARE_EVENTS):
+            going = np.flatnonzero(events[at, j] != 722)  # only the paths with a j-th event (most have 2 or 3)
+            if going.size == 0:
+                break
+            weight[going] *= factors[events[at[going], j]]
+        upward = weight[up[at]].sum(axis=0, dtype=np.float64)
+        total = weight.sum(axis=0, dtype=np.float64)
+        share[k] = np.where(total > 0.0, upward / np.maximum(total, 1e-300), 0.5)
+    wavelengths = np.arange(np.shape(reflectance)[1])
+    share = np.stack([np.interp(wavelengths, columns, row) for row in share])
+    rows = np.degrees(compensation_theta())
+    return np.stack([np.interp(rows, SHARE_THETA_DEG, share[:, j]) for j in range(share.shape[1])], axis=-1)
 
 
 def occluder_stop(rho: ArrayLike) -> np.ndarray:

@@ -7,7 +7,7 @@ Per wavelength the host computes the structure's directional albedo ``E(theta)``
 
 - each rough layer's albedos with multiple scattering among its facets
   (:func:`explorer.physics.multiscatter.layer_terms`: reflected once ``E_r``, crossed ballistically ``t_b``,
-  and the rest ``m``, of which the share ``r`` measured on the random walk of grey facets goes up);
+  and the rest ``m``, of which the share ``r`` goes up: the random walk's paths reweighted per wavelength);
 - the light a layer reflects once and that leaves straight through the layers above and the coating
   (the visible-normal quadrature of Eq. 17 with each exit's transmissions, as Eq. 34 has it);
 - everything else (light scattered among the facets, reflected back down by the layers above or inside the
@@ -191,7 +191,8 @@ def layer_terms_of(table: layered.LayerTables) -> multiscatter.LayerTerms:
     if table.transmittance is not None:
         filt = layered.transmission_filter_for(table.layer.alpha)
         lossless = filt.weights @ (1.0 - np.asarray(table.reflectance, dtype=np.float64))
-    return multiscatter.layer_terms(table.reflectance, table.transmissivity, table.theta, table.layer.alpha, lossless)
+    return multiscatter.layer_terms(table.reflectance, table.transmissivity, table.theta, table.layer.alpha, lossless,
+                                    table.transmittance)
 
 
 def _rgb_weights() -> np.ndarray:
