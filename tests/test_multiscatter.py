@@ -130,3 +130,17 @@ def test_absorbing_facets_are_not_brightened(stack_material):
               for k in (0.0, 0.05)}
     assert np.all(albedo[0.05] < albedo[0.0]), albedo
     assert np.all(albedo[0.0] - albedo[0.05] >= single[0.0] - single[0.05] - 1e-3), (albedo, single)
+
+
+def test_compensated_layer_is_the_stacks_for_one_layer(stack_material):
+    """bragg_layer's lobe is bragg_stack's for the same layer in air over the same base: the layers' terms
+    agree (method 3's RGB reflectance is the stack's table), the base's within the RGB product of its T."""
+    layer_material = load_material(REPO_ROOT / "shaders" / "bragg_layer.brd")
+    common = {"multiple_scattering": 1, "rho_d": 0.4}
+    layer = model_for(layer_material, layer_material.resolve({**common, "alpha": 0.9, "N": 10, "Lambda": 500.0, "nh": 1.0, "method": 3}))
+    stack = model_for(stack_material, stack_material.resolve({**common, "layers": 1, "nh": 1.0, "alpha_1": 0.9, "N_1": 10, "Lambda_1": 500.0}))
+    np.testing.assert_allclose(layer.compensation_rgb, stack.compensation_rgb, atol=1e-6)
+    theta = (0.0, 60.0)
+    single = albedo_numpy(model_for(layer_material, layer_material.resolve({**common, "multiple_scattering": 0, "alpha": 0.9, "N": 10})), theta)
+    assert np.all(albedo_numpy(layer, theta) @ LUMINANCE > single @ LUMINANCE + 0.05)
+    np.testing.assert_allclose(albedo_numpy(layer, theta) @ LUMINANCE, albedo_numpy(stack, theta) @ LUMINANCE, rtol=0.03)

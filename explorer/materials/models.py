@@ -45,6 +45,16 @@ def _interp_wavelength(table: np.ndarray, wavelengths: np.ndarray) -> np.ndarray
     return table[rows, j0] * (1.0 - f) + table[rows, j0 + 1] * f
 
 
+def _spectral_lobe(compensation, i, o, wavelengths, rho) -> np.ndarray:
+    """The multiple-scattering lobe at local directions ``(n, 3)`` and wavelengths ``(n, W)`` with the base's albedo
+    ``rho`` ``(n, W)`` (:func:`explorer.physics.multiscatter_stack.lobe_parts`), 0 where either is below the horizon."""
+    parts = multiscatter_stack.lobe_parts(compensation, *multiscatter_stack.air_angles(i, o))
+    M, TT, aa = (_interp_wavelength(x, wavelengths) for x in parts)
+    under = _interp_wavelength(np.broadcast_to(compensation.under, parts[0].shape), wavelengths)
+    lobe = M + (TT * rho / (1.0 - rho * under) - rho * aa) * (compensation.radiance_scale / np.pi)
+    return np.where(((i[:, 2] > 0.0) & (o[:, 2] > 0.0))[:, None], lobe, 0.0)
+
+
 @functools.lru_cache(maxsize=16)
 def _layer_transmissivity(mirror: bragg.BraggMirror, alpha: float) -> np.ndarray:
     """The rough layer's spectral integrated transmissivity ``f_t cos theta`` (Eq. 28), ``(361, 471)``."""
@@ -279,6 +289,40 @@ class BraggLayerModel(BraggMirrorModel):
         self.alpha = float(values["alpha"])
         microfacet.check_alpha(self.alpha)
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
+        self.multiple_scattering = bool(values.get("multiple_scattering", False))
+        self._compensation = None
+        self._compensation_rgb: np.ndarray | None = None
+
+    @property
+    def compensation(self):
+        """
+        The layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`, as
+        ``bragg_stack``'s for one layer seen from inside its host, no coating, over the base), or None when off.
+        """
+        if not self.multiple_scattering:
+            return None
+        if self._compensation is None:
+            v = self.values
+            if any(float(v.get(f"medium_{name}", 0)) > 0.5 for name in ("n1", "n2", "nh")):
+                raise ValueError("multiple_scattering is not available with dispersive media (medium_n1, medium_n2, medium_nh)")
+            host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
+            layer = layered.RoughBraggLayer(
+                n2=self.mirror.n2, Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
+                n1=None if self.mirror.n1 == host else self.mirror.n1, k1=float(v.get("k1", 0.0)), k2=float(v.get("k2", 0.0)),
+                sigma=float(v.get("sigma", 0.0)))
+            stack = layered.LayeredBragg(layers=(layer,), n1=host, rho_d=tuple(self.rho_d), coating=False)
+            table = _layer_tables(layer, host)
+            self._compensation = multiscatter_stack.stack_compensation(stack, (table,), (_layer_terms(table),))
+        return self._compensation
+
+    @property
+    def compensation_rgb(self) -> np.ndarray | None:
+        """The compensation's lobe in RGB over (theta_i, theta_o) (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        if self.compensation is None:
+            return None
+        if self._compensation_rgb is None:
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.rho_d)
+        return self._compensation_rgb
 
     @property
     def transmission_table(self) -> np.ndarray:
@@ -301,6 +345,10 @@ class BraggLayerModel(BraggMirrorModel):
         table = self.transmission_table
         base = (self.rho_d / np.pi) * bragg.tabulated_rgb(table, cos_i) * bragg.tabulated_rgb(table, cos_o)
         result[above] = specular + base
+        if self.compensation_rgb is not None:
+            # The lobe needs the polar angles only: atan2(|d - (d.n) n|, d.n), as the shader's atan(length(xy), z).
+            polar = lambda d, c: np.arctan2(np.linalg.norm(np.broadcast_to(d, N.shape)[above] - c[:, None] * N[above], axis=-1), c)  # noqa: E731
+            result[above] += multiscatter_stack.lookup_rgb(self.compensation_rgb, polar(L, cos_i), polar(V, cos_o))
         return result
 
     spectral_reflectance = None
@@ -322,6 +370,8 @@ class BraggLayerModel(BraggMirrorModel):
             Ti = _interp_wavelength(layered.lookup(T, _theta(i)), wavelengths)
             To = _interp_wavelength(layered.lookup(T, _theta(o)), wavelengths)
             value = value + rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths) / np.pi * Ti * To
+        if self.compensation is not None:
+            value = value + _spectral_lobe(self.compensation, i, o, wavelengths, rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths))
         return value
 
     def sampling_lobes(self, cos_o):
@@ -332,8 +382,12 @@ class BraggLayerModel(BraggMirrorModel):
         return [max(self.alpha, 1e-4)], [1.0 - p_trans + 1e-3], p_trans * rho
 
     def textures(self) -> dict[str, np.ndarray]:
-        """The method-3 reflectance table (a placeholder texel otherwise) and ``T_rgb``."""
-        return {**super().textures(), "transmission_table": self.transmission_table}
+        """The method-3 reflectance table (a placeholder texel otherwise), ``T_rgb`` and the multiple-scattering
+        lobe's table ``layer_lobe`` (:func:`explorer.physics.multiscatter_stack.rgb_table`; zeros when off)."""
+        lobe = np.zeros((multiscatter_stack.TABLE_ROWS, multiscatter_stack.TABLE_ROWS, 3), np.float32)
+        if self.compensation_rgb is not None:
+            lobe[...] = self.compensation_rgb
+        return {**super().textures(), "transmission_table": self.transmission_table, "layer_lobe": lobe}
 
 
 @functools.lru_cache(maxsize=32)
@@ -488,13 +542,7 @@ class BraggStackModel:
             base = _interp_wavelength(spectra.base, wavelengths[part])
             value[part] = layers + rho * base
             if self.compensation is not None:
-                # The lobe per wavelength (at the sampled ones), its base's bounces with the upsampled albedo.
-                c = self.compensation
-                parts = multiscatter_stack.lobe_parts(c, *multiscatter_stack.air_angles(i[part], o[part]))
-                M, TT, aa = (_interp_wavelength(x, wavelengths[part]) for x in parts)
-                under = _interp_wavelength(np.broadcast_to(c.under, parts[0].shape), wavelengths[part])
-                lobe = M + (TT * rho / (1.0 - rho * under) - rho * aa) * (c.radiance_scale / np.pi)
-                value[part] += np.where(((i[part, 2] > 0.0) & (o[part, 2] > 0.0))[:, None], lobe, 0.0)
+                value[part] += _spectral_lobe(self.compensation, i[part], o[part], wavelengths[part], rho)
         return value
 
     def sampling_lobes(self, cos_o):

@@ -6,6 +6,7 @@
 #include "lib/microfacet.glsl"
 #include "lib/fresnel.glsl"
 #include "lib/colorimetry.glsl"
+#include "lib/multiscatter.glsl"
 
 #include "generated/layered.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
@@ -87,26 +88,7 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
 
-// Multiple scattering (twin of explorer.physics.multiscatter_stack and BraggStackModel.brdf): Eq. 34 plus the
-// host's lobe, one RGB table over (theta_i, theta_o) in air every COMPENSATION_STEP_DEG (texel (theta_o, theta_i)),
-// read with texelFetch and blended here in float32, as multiscatter_stack.lookup_rgb does.
-void compensation_row(float theta, out int k, out float f) {
-    float x = clamp(theta, 0.0, 0.5 * PI) / radians(COMPENSATION_STEP_DEG);
-    k = min(int(floor(x)), COMPENSATION_ROWS - 2);
-    f = x - float(k);
-}
-
-vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
-    if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
-    int ki, ko;
-    float fi, fo;
-    compensation_row(polar_angle(i), ki, fi);
-    compensation_row(polar_angle(o), ko, fo);
-    vec3 low = mix(texelFetch(lobe_table, ivec2(ko, ki), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki), 0).rgb, fo);
-    vec3 high = mix(texelFetch(lobe_table, ivec2(ko, ki + 1), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki + 1), 0).rgb, fo);
-    return mix(low, high, fi);
-}
-
+// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl).
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
                       sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float tau_h) {
     return single_reflection_brdf(i, o, nh, coating, layer_count, alphas, rho_d, reflectance_table, transmissivity_table, tau_h)
