@@ -89,6 +89,15 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
 }
 
 // Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl).
+vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
+    int ki, ko;
+    float fi, fo;
+    if (!compensation_cell(i, o, ki, fi, ko, fo)) return vec3(0.0);
+    vec3 low = mix(texelFetch(lobe_table, ivec2(ko, ki), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki), 0).rgb, fo);
+    vec3 high = mix(texelFetch(lobe_table, ivec2(ko, ki + 1), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki + 1), 0).rgb, fo);
+    return mix(low, high, fi);
+}
+
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
                       sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float tau_h) {
     return single_reflection_brdf(i, o, nh, coating, layer_count, alphas, rho_d, reflectance_table, transmissivity_table, tau_h)

@@ -1,6 +1,6 @@
 // Multiple scattering's lobe (twin of explorer.physics.multiscatter_stack.lookup_rgb): one RGB table over
 // (theta_i, theta_o) in air every COMPENSATION_STEP_DEG degrees (texel (theta_o, theta_i)), read with texelFetch
-// and blended here in float32, as the numpy twin does.
+// and blended in float32, as the numpy twin does (by the including shader: a .brdf export inlines its table).
 #include "generated/multiscatter.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
 void compensation_row(float theta, out int k, out float f) {
@@ -9,14 +9,10 @@ void compensation_row(float theta, out int k, out float f) {
     f = x - float(k);
 }
 
-// i, o: unit directions in the local frame (n = +z); 0 where either is at or below the horizon.
-vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
-    if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
-    int ki, ko;
-    float fi, fo;
-    compensation_row(atan(length(i.xy), i.z), ki, fi);  // polar angles by atan2, as the twin
-    compensation_row(atan(length(o.xy), o.z), ko, fo);
-    vec3 low = mix(texelFetch(lobe_table, ivec2(ko, ki), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki), 0).rgb, fo);
-    vec3 high = mix(texelFetch(lobe_table, ivec2(ko, ki + 1), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki + 1), 0).rgb, fo);
-    return mix(low, high, fi);
+// The lobe table's cell of (i, o): rows ki (theta_i) and columns ko (theta_o), weights fi, fo; false where i or o
+// is at or below the horizon. i, o: unit directions in the local frame (n = +z); polar angles by atan2, as the twin.
+bool compensation_cell(vec3 i, vec3 o, out int ki, out float fi, out int ko, out float fo) {
+    compensation_row(atan(length(i.xy), max(i.z, 0.0)), ki, fi);
+    compensation_row(atan(length(o.xy), max(o.z, 0.0)), ko, fo);
+    return i.z > 0.0 && o.z > 0.0;
 }
