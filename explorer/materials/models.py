@@ -298,18 +298,26 @@ class BraggLayerModel(BraggMirrorModel):
         """
         The layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`, as
         ``bragg_stack``'s for one layer seen from inside its host, no coating, over the base), or None when off.
+        Natural layers (absorbing, disordered, dispersive) as ``bragg_stack``'s; a dispersive host at 550 nm.
         """
         if not self.multiple_scattering:
             return None
         if self._compensation is None:
-            v = self.values
-            if any(float(v.get(f"medium_{name}", 0)) > 0.5 for name in ("n1", "n2", "nh")):
-                raise ValueError("multiple_scattering is not available with dispersive media (medium_n1, medium_n2, medium_nh)")
-            host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
+            nat = self.natural
+            if nat is None:
+                host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
+                n1, n2, media, k1, k2, sigma = self.mirror.n1, self.mirror.n2, {}, 0.0, 0.0, 0.0
+            else:
+                # A dispersive host enters the compensation at its index at 550 nm (its angles need one number).
+                nh = nat.nh if nat.nh is not None else nat.n1  # no host given: the host is n1
+                host = float(nh) if isinstance(nh, (int, float)) else float(nh.real_at(550.0))
+                media = {f"medium_{k}": m for k, m in (("n1", nat.n1), ("n2", nat.n2)) if not isinstance(m, float)}
+                n1 = nat.n1 if isinstance(nat.n1, float) else host + 1.0  # a medium stands for n1: not the host
+                n2 = nat.n2 if isinstance(nat.n2, float) else 1.5
+                k1, k2, sigma = nat.k1, nat.k2, nat.sigma
             layer = layered.RoughBraggLayer(
-                n2=self.mirror.n2, Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
-                n1=None if self.mirror.n1 == host else self.mirror.n1, k1=float(v.get("k1", 0.0)), k2=float(v.get("k2", 0.0)),
-                sigma=float(v.get("sigma", 0.0)))
+                n2=float(n2), Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
+                n1=None if n1 == host else float(n1), k1=k1, k2=k2, sigma=sigma, **media)
             stack = layered.LayeredBragg(layers=(layer,), n1=host, rho_d=tuple(self.rho_d), coating=False)
             table = _layer_tables(layer, host)
             self._compensation = multiscatter_stack.stack_compensation(stack, (table,), (_layer_terms(table),))
