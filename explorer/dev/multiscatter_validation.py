@@ -1,6 +1,6 @@
 """
 Multiple scattering on rough Bragg layers: single scattering (Eq. 34 as published) and the compensated
-model (:mod:`explorer.physics.multiscatter`, ``bragg_stack.brd`` with ``multiple_scattering``), each
+model (:mod:`explorer.physics.multiscatter_stack`, ``bragg_stack.brd`` with ``multiple_scattering``), each
 against the microsurface random walk (:mod:`explorer.physics.microsurface` inside the position-free
 reference, every bounce among every layer's facets), for shipped layer and stack presets with every
 layer's roughness set to ``alpha``.
