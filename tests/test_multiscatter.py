@@ -144,3 +144,22 @@ def test_compensated_layer_is_the_stacks_for_one_layer(stack_material):
     single = albedo_numpy(model_for(layer_material, layer_material.resolve({**common, "multiple_scattering": 0, "alpha": 0.9, "N": 10})), theta)
     assert np.all(albedo_numpy(layer, theta) @ LUMINANCE > single @ LUMINANCE + 0.05)
     np.testing.assert_allclose(albedo_numpy(layer, theta) @ LUMINANCE, albedo_numpy(stack, theta) @ LUMINANCE, rtol=0.03)
+
+
+def test_upward_share_follows_the_spectrum_as_the_walk_does(stack_material):
+    """Between two Bragg bands (Figure 1's left layer, alpha = 1, 0 deg, 490 nm) the walk sends little of the
+    light scattered among the facets up, far less than the facets' mean reflectance; the reweighted paths'
+    share (:func:`explorer.physics.multiscatter.upward_share`) follows it there and at 640 nm, inside a band."""
+    from explorer.dev import multiscatter_orders as orders
+    from explorer.physics import multiscatter
+
+    values = stack_material.resolve({"layers": 1, "nh": 1.0, "alpha_1": 1.0, "N_1": 20, "Lambda_1": 500.0, "delta_1": 0.25})
+    table = model_for(stack_material, values).tables[0]
+    columns, paths = (130, 280), 6000
+    walk = orders.walk_orders(np.ascontiguousarray(table.reflectance, dtype=np.float32), 1.0, 0.0, columns, paths, seed=3)
+    walk_share = walk["up2"] / (walk["up2"] + walk["down1"])
+    terms = orders.model_terms(table, multiscatter_stack.layer_terms_of(table), 1.0, 0.0, columns)
+    model_share = terms["rm"] / (terms["rm"] + terms["down_m"])
+    mean_R = multiscatter.hemispherical_average(np.asarray(table.reflectance, dtype=np.float64), table.theta)[list(columns)]
+    assert walk_share[0] < mean_R[0] - 0.1, (walk_share, mean_R)  # what a grey facet's share would miss
+    np.testing.assert_allclose(model_share, walk_share, atol=0.08)

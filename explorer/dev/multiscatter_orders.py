@@ -86,7 +86,7 @@ def model_terms(layer_table, terms, alpha: float, theta_deg: float, columns) -> 
     (``terms``: the layer's :class:`explorer.physics.multiscatter.LayerTerms`, interpolated between its 2-degree rows)."""
     t = np.radians(theta_deg)
     f_t = _row(layer_table.transmissivity, t)
-    at = lambda x: multiscatter._at(np.asarray(x, dtype=np.float64), np.asarray([t]), np.radians(multiscatter.COMPENSATION_STEP_DEG))[0]  # noqa: E731
+    at = lambda x: multiscatter.rows_at(np.asarray(x, dtype=np.float64), np.asarray([t]), np.radians(multiscatter.COMPENSATION_STEP_DEG))[0]  # noqa: E731
     E_r, t_b, m, r = at(terms.reflection), at(terms.ballistic), at(terms.missing), at(terms.up)
     cols = np.asarray(columns)
     return {"E_r": E_r[cols], "rm": (r * m)[cols], "t_b": t_b[cols], "down_m": ((1.0 - r) * m)[cols], "eq28": f_t[cols]}

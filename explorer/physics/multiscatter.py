@@ -138,7 +138,7 @@ def reflection_albedos(reflectance: ArrayLike, transmissivity: ArrayLike, theta:
     step = theta[1] - theta[0]
     rows = compensation_theta()
     cos_rows = np.cos(rows)
-    rho_rows = occluder_reflectance(_at(t, rows, step), cos_rows, alpha)
+    rho_rows = occluder_reflectance(rows_at(t, rows, step), cos_rows, alpha)
     o_z, cos_d, above = _quadrature(alpha)
     # Nearest table rows (0.25 deg) for the quadrature's angles: a gather, not an interpolation (float32, all rows at once).
     row_o = np.rint(np.arccos(np.clip(o_z, 0.0, 1.0)) / step).astype(np.int64).ravel()
@@ -168,7 +168,7 @@ def reflection_albedos(reflectance: ArrayLike, transmissivity: ArrayLike, theta:
     return correlated_out, separable_out
 
 
-def _at(table: np.ndarray, angle: np.ndarray, step: float) -> np.ndarray:
+def rows_at(table: np.ndarray, angle: np.ndarray, step: float) -> np.ndarray:
     """Linear interpolation of a table with rows every ``step`` radians from 0 at ``angle``."""
     x = np.clip(angle, 0.0, step * (table.shape[0] - 1)) / step
     k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
@@ -237,18 +237,18 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
     rows = compensation_theta()
     cos_rows = np.cos(rows)
     t = np.asarray(transmissivity, dtype=np.float64)
-    rho = occluder_reflectance(_at(t, rows, step), cos_rows, alpha)
+    rho = occluder_reflectance(rows_at(t, rows, step), cos_rows, alpha)
     ballistic = ballistic_transmissivity(rho, effective_masking(cos_rows, alpha, rho))
     (E_r,), _ = reflection_albedos(reflectance, t, theta, alpha, [None])
     if lossless_transmissivity is None:
         missing = np.clip(1.0 - E_r - ballistic, 0.0, 1.0)
     else:
         t0 = np.asarray(lossless_transmissivity, dtype=np.float64)
-        rho0 = occluder_reflectance(_at(t0, rows, step), cos_rows, alpha)
+        rho0 = occluder_reflectance(rows_at(t0, rows, step), cos_rows, alpha)
         (E_r0,), _ = reflection_albedos(reflectance, t0, theta, alpha, [None])
         lossless = np.clip(1.0 - E_r0 - ballistic_transmissivity(rho0, effective_masking(cos_rows, alpha, rho0)), 0.0, 1.0)
         G1 = microfacet.smith_G1(cos_rows, alpha)[:, None]
-        absorbed = np.clip((_at(t0, rows, step) - _at(t, rows, step)) / np.maximum(G1, 1e-12), 0.0, 1.0)
+        absorbed = np.clip((rows_at(t0, rows, step) - rows_at(t, rows, step)) / np.maximum(G1, 1e-12), 0.0, 1.0)
         facet_albedo = np.clip(1.0 - hemispherical_average(absorbed, rows), 0.0, 1.0)
         missing = np.minimum(lossless * facet_albedo, np.clip(1.0 - E_r - ballistic, 0.0, 1.0))
     up = upward_share(reflectance, transmittance, alpha)

@@ -151,7 +151,7 @@ def stack_compensation(stack: layered.LayeredBragg, tables: Sequence[layered.Lay
     for l, (table, term) in enumerate(zip(tables, terms)):
         (direct, _), (_, single) = multiscatter.reflection_albedos(table.reflectance, table.transmissivity, theta_table,
                                                                     table.layer.alpha, [exit_b, exit_34])
-        exit_avg = avg(multiscatter._at(exit_b, rows, step))
+        exit_avg = avg(multiscatter.rows_at(exit_b, rows, step))
         up_source, down_source = l, L + 1 + (l + 1)  # the gap above layer l (up), the gap below (down)
         host += arrive * (direct + term.reflection * (escape[:, up_source] - exit_avg)
                           + term.up * term.missing * escape[:, up_source]
@@ -162,7 +162,7 @@ def stack_compensation(stack: layered.LayeredBragg, tables: Sequence[layered.Lay
         arrive = arrive * term.ballistic * g_rows[:, None]
         t28 = layered.lookup(table.transmissivity, rows).astype(np.float64)
         arrive_34 = arrive_34 * t28 * g_rows[:, None]
-        exit_b = exit_b * multiscatter._at(term.ballistic, theta_table, np.radians(TABLE_STEP_DEG)) * g_table[:, None]
+        exit_b = exit_b * multiscatter.rows_at(term.ballistic, theta_table, np.radians(TABLE_STEP_DEG)) * g_table[:, None]
         exit_34 = exit_34 * table.transmissivity * g_table[:, None]
     base += arrive
     # From the host's angles to the air's: theta' = asin(sin theta / n1), the coating's 1 - F on the way in.
@@ -172,7 +172,7 @@ def stack_compensation(stack: layered.LayeredBragg, tables: Sequence[layered.Lay
         enter = (1.0 - layered.coating_reflectance(np.cos(theta_air), n1))[:, None]
     else:
         theta_host, enter = theta_air, np.ones((TABLE_ROWS, 1))
-    on_air = lambda x: enter * multiscatter._at(x, theta_host, np.radians(TABLE_STEP_DEG))  # noqa: E731
+    on_air = lambda x: enter * multiscatter.rows_at(x, theta_host, np.radians(TABLE_STEP_DEG))  # noqa: E731
     E, E34 = on_air(host), on_air(host_34)
     missing = np.maximum(E - E34, 0.0)
     weight = np.cos(theta_air) * np.sin(theta_air)
@@ -238,7 +238,7 @@ def lobe_parts(compensation: StackCompensation, theta_i: ArrayLike, theta_o: Arr
     """
     c = compensation
     step = np.radians(TABLE_STEP_DEG)
-    at = lambda x, theta: multiscatter._at(x, np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi), step)  # noqa: E731
+    at = lambda x, theta: multiscatter.rows_at(x, np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi), step)  # noqa: E731
     layers = at(c.missing, theta_i) * at(c.missing, theta_o) / (np.pi * np.maximum(c.missing_average, 1e-12))
     return layers, at(c.through, theta_i) * at(c.through, theta_o), at(c.eq34_through, theta_i) * at(c.eq34_through, theta_o)
 
