@@ -43,7 +43,7 @@ _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 
 #: How the film was found (extras' ``mapping``).
 MAPPINGS = {"direct": "direct: the film's own parameters",
-            "refined": "the film's parameters moved to the nearest minimum of the ΔE2000 (closer than the direct mapping)",
+            "refined": "the film's parameters moved to the least median ΔE2000 over theta (closer than the direct mapping)",
             "fit": "the nearest single film (metallic base)"}
 
 
