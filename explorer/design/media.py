@@ -1,7 +1,7 @@
 """
 The colour design of a mirror whose fixed indices name media (``--fix n2=chitin``): the batch model with each
 medium's ``n + i k`` at the design's own wavelengths (:mod:`explorer.physics.dispersion`), and the converged
-colours of :func:`explorer.physics.natural.natural_rgb`. The batch model takes complex indices by :mod:`explorer.design.absorbing`.
+colours of :func:`explorer.physics.natural.natural_rgb`. The batch model takes complex indices (:func:`explorer.physics.bragg.absorbing_reflectance_batch`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Mapping
 import numpy as np
 
 from explorer.design.base import DesignError, DesignModel
-from explorer.physics import colorimetry
+from explorer.physics import bragg, colorimetry
 from explorer.physics.dispersion import Dispersion
 
 #: The wavelength (nm) whose real index stands for a medium where the search needs one number: the box
@@ -21,7 +21,7 @@ REFERENCE_NM = 550.0
 #: The index parameters that may name a medium.
 MEDIUM_PARAMETERS = ("n1", "n2", "nh")
 #: The non-final converged colours (the polish's) sample the spectrum this finely (nm), fringes narrower
-#: than a few steps averaged (:func:`explorer.design.forward.bragg_reflectance_batch`).
+#: than a few steps averaged (:func:`explorer.physics.bragg.bragg_reflectance_batch`).
 POLISH_STEP = 1.0
 
 
@@ -75,7 +75,6 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion]) -> DesignMod
     """
     from dataclasses import replace
 
-    from explorer.design import forward
     from explorer.physics.natural import natural_rgb
 
     if not media:
@@ -89,13 +88,13 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion]) -> DesignMod
             raise DesignError(f"the host {medium.name} absorbs: light comes from a lossless host")
 
     def rgb_at(values, cos_theta, step, smooth):
-        nodes, weights = forward.coarse_nodes(step)
+        nodes, weights = colorimetry.interpolant_nodes(step)
         n = _indices(values, media, nodes)
-        R = forward.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+        R = bragg.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
                                             cos_theta, nodes, step=step, smooth=smooth)
         return colorimetry.xyz_to_rgb(R @ weights)
 
-    def batch(values, cos_theta, step=forward.COARSE_STEP, smooth=None):
+    def batch(values, cos_theta, step=colorimetry.COARSE_STEP, smooth=None):
         return rgb_at(values, cos_theta, step, smooth)
 
     def spectra(values, cos_theta, wavelengths, smooth_relative):
@@ -103,7 +102,7 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion]) -> DesignMod
         # The real parts: the scan only screens (band positions), on the lossless model's fast path.
         n = {k: np.real(v[:, 0, 0] if np.ndim(v) == 3 else v) for k, v in n.items()}
         wavelengths = np.asarray(wavelengths, dtype=np.float64)
-        return forward.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+        return bragg.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
                                                cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
 
     def converged(values, cos_theta, final=True):

@@ -17,7 +17,7 @@ from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatt
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
-from explorer.materials.twins import TWINS, Capabilities, registry, twin
+from explorer.materials.twins import TWINS, Capabilities, DesignModel, registry, twin
 
 #: Samples per numpy call of the stack's spectral Eq. 34 (Mitsuba's spectral variants; bounds the (samples, 471) temporaries).
 SPECTRAL_CHUNK = 1 << 14
@@ -88,13 +88,54 @@ def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
     )
 
 
+# --------------------------------------------------------------------------------------------------
+# Inverse design's forward model of a Bragg mirror (declared by both Bragg twins)
+
+
+def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP,
+                    smooth: float | None = None) -> np.ndarray:
+    """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``, ``N`` continuous) at ``cos_theta`` ``(A,)``."""
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    R = bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                      values["nh"], cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
+    """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
+    wavelengths = np.asarray(wavelengths, dtype=np.float64)
+    return bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                         values["nh"], cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
+
+
+def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours of a mirror (:func:`mirror_of`): :func:`explorer.physics.bragg.reference_rgb` when
+    ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped), which the
+    polish calls many times.
+    """
+    mirror = mirror_of(values)
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final:
+        return bragg.reference_rgb(cos_theta, mirror)
+    return bragg.converged_rgb(cos_theta, mirror)
+
+
+#: What design fits of a Bragg mirror, and on which forward model: its specular colour (the rough layer's too: the
+#: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
+BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+                           integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb,
+                           host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
+                           paint_free=("Lambda", "delta", "N"))
+
+
 @twin
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -267,7 +308,7 @@ class BraggLayerModel(BraggMirrorModel):
 
     name = "bragg_layer"
     capabilities = Capabilities(methods=BraggMethod, dirac=False, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=True)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
     # A rough layer is no Dirac: the env view integrates its BRDF. No textured view (no '# texture:').
     mirror_reflection = None
     mirror_only = False
@@ -384,7 +425,7 @@ class BraggStackModel:
     #: and in the textures the shader reads alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
     facet_reflectance_override: float | None = None
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=False)
+                                albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -530,7 +571,7 @@ class SchlickFresnelModel:
 
     name = "schlick_fresnel"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table", "gltf"), design=False)
+                                exports=("table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.F0 = float(values["F0"])
@@ -556,7 +597,7 @@ class GGXSchlickModel:
 
     name = "ggx_schlick"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("table", "gltf"), design=False)
+                                exports=("table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.alpha = float(values["alpha"])

@@ -31,7 +31,9 @@ The subpackage by subject (every name is re-exported here, so ``bragg.NAME`` rea
   band edges;
 - :mod:`~explorer.physics.bragg.band_pieces`: the converged colour by Gauss quadrature over band pieces;
 - :mod:`~explorer.physics.bragg.tables`: the tabulated method's converged and draft tables;
-- :mod:`~explorer.physics.bragg.textured`: spatially varying mirrors (supplemental Figure 7).
+- :mod:`~explorer.physics.bragg.textured`: spatially varying mirrors (supplemental Figure 7);
+- :mod:`~explorer.physics.bragg.batch`: Yeh's reflectance of many mirrors at once, ``N`` continuous, fringes averaged
+  where a coarse sampling would alias them (inverse design's forward model).
 """
 
 from explorer.physics.bragg.approximation import (  # noqa: F401
@@ -110,6 +112,12 @@ from explorer.physics.bragg.band_pieces import (  # noqa: F401
     _safeguarded_newton,
     band_pieces_rgb,
 )
+from explorer.physics.bragg.batch import (  # noqa: F401
+    BATCH_EDGE,
+    absorbing_reflectance_batch,
+    bragg_reflectance_batch,
+    chebyshev_U_real_N,
+)
 from explorer.physics.bragg.mirror import (  # noqa: F401
     BISECTION_STEPS,
     COS_THETA_MIN,
@@ -148,6 +156,7 @@ from explorer.physics.bragg.reflectance import (  # noqa: F401
     reflectance_yeh,
     reflection_coefficient_bragg,
     reflection_coefficient_host,
+    slab_coefficients,
 )
 from explorer.physics.bragg.tables import (  # noqa: F401
     DRAFT_MAX_SUBSTEPS,
