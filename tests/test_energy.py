@@ -86,7 +86,9 @@ def _cheap(name: str, values: dict) -> dict:
     if name in ("bragg_mirror", "bragg_layer") and values.get("method") == 3:
         values["N"] = min(values["N"], 100.0)
     if values.get("sigma", 0.0) > 0.0:  # a disordered mirror's table: realisations x layers (explorer.physics.natural)
-        values["N"] = min(values["N"], 10.0)
+        # A rough layer's tables take its spectra at every angle (seconds per cell, as a stack's layer below):
+        # two cells; the mirror's colour table, ten.
+        values["N"] = min(values["N"], 2.0 if name == "bragg_layer" else 10.0)
     if "wavelength_step" in values:
         values["wavelength_step"] = max(values["wavelength_step"], 0.25)
     if name == "bragg_stack":
