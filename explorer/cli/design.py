@@ -322,8 +322,10 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         media: dict = {}
         fixed = parse_fixes(fixes, free, loaded, media)
         guesses = [parse_guess(text, loaded) for text in guess_texts]
+        # The held parameters (k1, k2, sigma: 0 unless fixed) --free names are searched too.
+        released = [name for name in (free or "").split(",") if name.strip() in design_model(loaded.model).held]
         result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed, guesses=guesses, tries=tries,
-                        progress=_progress_line(tries), media=media)
+                        progress=_progress_line(tries), media=media, free=[name.strip() for name in released])
         # A medium is reported by its name (render and --save take it so), not the number that stood for it.
         result = replace(result, values={**result.values, **{k: v.name for k, v in media.items()}})
     except (LocatedError, DesignError) as error:

@@ -199,6 +199,10 @@ class _Geometry:
 def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta: ArrayLike, step: float = COARSE_STEP,
                     smooth: float | None = None) -> np.ndarray:
     """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``) at ``cos_theta`` ``(A,)``."""
+    from explorer.design import media
+
+    if media.natural_values(values):  # absorbing layers (k1, k2): the complex indices' batch
+        return media.natural_batch(values, {}, cos_theta, step, smooth)
     nodes, weights = coarse_nodes(step)
     R = bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
                                 values["nh"], cos_theta, nodes, step=step, smooth=smooth)
@@ -249,6 +253,10 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, final
     ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped),
     which the polish calls many times.
     """
+    from explorer.design import media
+
+    if media.natural_values(values):  # absorbing or disordered layers: the natural mirror's colours
+        return media.natural_converged(values, {}, cos_theta, final)
     mirror = mirror_of(values)
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     if final:
@@ -262,9 +270,9 @@ def thin_film_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, f
                                   float(values["kappa3"]), np.asarray(cos_theta, dtype=np.float64), float(values["d"]))
 
 
-_BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+_BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
               integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, host_parameter="nh",
-              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch, paint_free=("Lambda", "delta", "N"))
+              scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch, paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 #: The forward model of each twin that declares ``design`` (:mod:`explorer.materials.twins`); its specular
 #: colour is what is designed (the rough Bragg layer's: the smooth mirror's colour, which its gradient view shows).
 DESIGN_MODELS: dict[str, DesignModel] = {model.name: model for model in (

@@ -1,0 +1,67 @@
+"""
+Absorption and disorder as design parameters (``design bragg_mirror --fix k2=0.05 --fix sigma=0.1``,
+``--free k2``): seeded round trips of natural mirrors from their own exact colours
+(:func:`explorer.physics.natural.natural_rgb`), and the search's held parameters (0 unless named).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from conftest import run_cli
+
+from explorer import design
+from explorer.design.media import mirror_with_media
+from explorer.physics.natural import natural_rgb
+
+RANGES = dict(n1=(1, 2.5), n2=(1, 2.5), Lambda=(50, 1500), delta=(0, 1), N=(1, 1000), nh=(0, 2.5), k1=(0, 1), k2=(0, 1),
+              sigma=(0, 0.3))
+ANGLES = [0.0, 30.0, 60.0]
+
+
+def _targets(truth):
+    colours = natural_rgb(np.cos(np.radians(ANGLES)), mirror_with_media(truth, {}))
+    return [design.Target(a, tuple(float(c) for c in rgb)) for a, rgb in zip(ANGLES, colours)]
+
+
+def test_a_disordered_absorbing_mirror_is_recovered_with_k2_and_sigma_fixed():
+    rng = np.random.default_rng(7)
+    truth = dict(n1=1.0, n2=1.56, Lambda=float(rng.uniform(160, 260)), delta=float(rng.uniform(0.3, 0.7)), N=8, nh=0.0,
+                 k1=0.0, k2=0.05, sigma=0.1)
+    fixed = {k: truth[k] for k in ("n1", "n2", "nh", "N", "k2", "sigma")}
+    result = design.design("bragg_mirror", _targets(truth), RANGES, fixed, seed=3)
+    assert np.all(result.delta_e2000 < 1.0), result.delta_e2000
+    assert abs(result.values["Lambda"] / truth["Lambda"] - 1.0) < 0.01, (result.values, truth)
+    # The achieved colours are the disordered, absorbing mirror's (an independent recomputation).
+    found = {**truth, **result.values}
+    np.testing.assert_allclose(result.achieved_rgb, natural_rgb(np.cos(np.radians(ANGLES)), mirror_with_media(found, {})),
+                               atol=1e-12)
+
+
+def test_a_free_extinction_is_found():
+    truth = dict(n1=1.0, n2=1.56, Lambda=210.0, delta=0.45, N=8, nh=0.0, k1=0.0, k2=0.08, sigma=0.0)
+    # N fixed: with absorption a thicker stack's colours converge (light no longer reaches its last cells).
+    fixed = {k: truth[k] for k in ("n1", "n2", "nh", "N")}
+    result = design.design("bragg_mirror", _targets(truth), RANGES, fixed, seed=0, free=["k2"], tries=1)
+    assert np.all(result.delta_e2000 < 1.0), (result.values, result.delta_e2000)
+    assert abs(result.values["k2"] - 0.08) < 0.01, result.values
+
+
+def test_held_parameters_stay_off_and_unreported():
+    # Without --fix or --free, k1, k2 and sigma stay 0: the paper's mirror, reported as before.
+    truth = dict(n1=1.0, n2=1.56, Lambda=210.0, delta=0.45, N=8, nh=0.0)
+    fixed = {k: truth[k] for k in ("n1", "n2", "nh", "N")}
+    result = design.design("bragg_mirror", _targets(truth), RANGES, fixed, seed=0, tries=1)
+    assert not {"k1", "k2", "sigma"} & set(result.values) and result.median_delta_e2000 < 0.1, result
+
+
+def test_the_cli_frees_an_extinction_by_name():
+    truth = dict(n1=1.0, n2=1.56, Lambda=210.0, delta=0.45, N=8, nh=0.0, k1=0.0, k2=0.08, sigma=0.0)
+    args = [f"--target={t.theta_deg:g}:{t.rgb[0]!r},{t.rgb[1]!r},{t.rgb[2]!r}" for t in _targets(truth)]
+    run = run_cli("design", "bragg_mirror", *args, "--fix", "n1=1", "--fix", "n2=1.56", "--fix", "nh=0", "--fix", "N=8",
+                  "--free", "Lambda,delta,k2", "--tries", "1", "--json")
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout)["set"]
+    assert abs(found["k2"] - 0.08) < 0.01 and found["sigma"] == 0.0, found
