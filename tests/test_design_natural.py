@@ -65,3 +65,58 @@ def test_the_cli_frees_an_extinction_by_name():
     assert run.returncode == 0, run.stderr
     found = json.loads(run.stdout)["set"]
     assert abs(found["k2"] - 0.08) < 0.01 and found["sigma"] == 0.0, found
+
+
+# --------------------------------------------------------------------------------------------------
+# The same in a measured spectrum's fit (design --target-spectrum)
+
+
+def _spectrum_file(tmp_path, mirror, name="m.csv"):
+    from explorer.physics.natural import mirror_spectrum
+
+    wavelengths = np.arange(380.0, 801.0, 10.0)
+    R = mirror_spectrum(mirror, wavelengths, [0.0])["R"][0]
+    path = tmp_path / name
+    path.write_text("wavelength_nm,R\n" + "".join(f"{w:g},{r:.8f}\n" for w, r in zip(wavelengths, R)))
+    return path, wavelengths, R
+
+
+def test_a_disordered_absorbing_spectrum_is_fitted_with_sigma_and_k2_fixed(tmp_path):
+    from explorer.physics.dispersion import LIBRARY
+    from explorer.physics.natural import NaturalMirror
+
+    rng = np.random.default_rng(11)
+    truth = NaturalMirror(n1=1.0, n2=LIBRARY["chitin"], k2=0.05, sigma=0.1, Lambda=float(rng.uniform(180, 260)),
+                          delta=float(rng.uniform(0.3, 0.7)), N=6, nh=1.0)
+    path, _, _ = _spectrum_file(tmp_path, truth)
+    run = run_cli("design", "bragg_mirror", "--target-spectrum", str(path), "--fix", "n1=1", "--fix", "n2=chitin",
+                  "--fix", "nh=1", "--fix", "k2=0.05", "--fix", "sigma=0.1", "--fix", "N=6", "--fix", "k1=0", "--json")
+    assert run.returncode == 0, run.stderr
+    document = json.loads(run.stdout)
+    assert document["rms"] < 0.01 and document["values"]["sigma"] == 0.1, document["values"]
+    assert abs(document["values"]["Lambda"] / truth.Lambda - 1.0) < 0.02, (document["values"], truth)
+
+
+def test_a_free_sigma_and_extinction_are_fitted_by_name(tmp_path):
+    from explorer.physics.natural import NaturalMirror
+
+    truth = NaturalMirror(n1=1.0, n2=1.56, k2=0.03, sigma=0.08, Lambda=220.0, delta=0.5, N=6, nh=1.0)
+    path, _, _ = _spectrum_file(tmp_path, truth)
+    run = run_cli("design", "bragg_mirror", "--target-spectrum", str(path), "--fix", "n1=1", "--fix", "n2=1.56",
+                  "--fix", "nh=1", "--fix", "N=6", "--free", "Lambda,delta,k2,sigma", "--json")
+    assert run.returncode == 0, run.stderr
+    document = json.loads(run.stdout)
+    values = document["values"]
+    assert document["rms"] < 0.01 and abs(values["sigma"] - 0.08) < 0.04 and abs(values["k2"] - 0.03) < 0.02, document
+
+
+def test_fit_refusals_are_one_line(tmp_path):
+    from conftest import one_line_error
+    from explorer.physics.natural import NaturalMirror
+
+    path, _, _ = _spectrum_file(tmp_path, NaturalMirror(n1=1.0, n2=1.56, Lambda=220.0, delta=0.5, N=6))
+    for args, message in ((["--fix", "sigma=0.5"], "sigma='0.5': a number in [0, 0.3]"),
+                          (["--fix", "k2=-1"], "k2='-1': a number in"),
+                          (["--free", "Lambda,kappa"], "'kappa' is not fitted"),
+                          (["--fix", "N=6", "--free", "N"], "also fixed")):
+        assert message in one_line_error(run_cli("design", "bragg_mirror", "--target-spectrum", str(path), *args))

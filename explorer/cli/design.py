@@ -305,9 +305,9 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     if target_spectrum is not None:
         from explorer.cli.spectrum_fit import fit_command
 
-        if target_texts or target_strip or free or guess_texts:
-            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip, --free or --guess")
-        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed)
+        if target_texts or target_strip or guess_texts:
+            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip or --guess")
+        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed, free)
         return
     try:
         loaded = load(material)
