@@ -206,6 +206,8 @@ def parse_fixes(fixes, free, material, media: dict | None = None):
                 raise click.UsageError(f"--free {name}: also fixed by --fix")
         for name in model.parameters:
             if name not in names and name not in fixed and name not in media:
+                if name in model.held and float(values[name]) == 0.0:
+                    continue  # held at 0 by the search (absorption, disorder off): not reported
                 fixed[name] = float(values[name])  # not free: the material's default
     return fixed
 

@@ -18,6 +18,7 @@ from explorer.materials.models import BraggLayerModel, BraggMirrorModel, host_in
 from explorer.materials.thinfilm_model import ThinFilmModel
 from explorer.materials.twins import capabilities_of
 from explorer.physics import bragg, colorimetry, thinfilm
+from explorer.physics.dispersion import Dispersion
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
 #: The public names (re-exported by :mod:`explorer.design`).
@@ -199,10 +200,8 @@ class _Geometry:
 def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta: ArrayLike, step: float = COARSE_STEP,
                     smooth: float | None = None) -> np.ndarray:
     """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``) at ``cos_theta`` ``(A,)``."""
-    from explorer.design import media
-
-    if media.natural_values(values):  # absorbing layers (k1, k2): the complex indices' batch
-        return media.natural_batch(values, {}, cos_theta, step, smooth)
+    if natural_values(values):  # absorbing layers (k1, k2): the complex indices' batch
+        return natural_batch(values, {}, cos_theta, step, smooth)
     nodes, weights = coarse_nodes(step)
     R = bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
                                 values["nh"], cos_theta, nodes, step=step, smooth=smooth)
@@ -253,10 +252,8 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, final
     ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped),
     which the polish calls many times.
     """
-    from explorer.design import media
-
-    if media.natural_values(values):  # absorbing or disordered layers: the natural mirror's colours
-        return media.natural_converged(values, {}, cos_theta, final)
+    if natural_values(values):  # absorbing or disordered layers: the natural mirror's colours
+        return natural_converged(values, {}, cos_theta, final)
     mirror = mirror_of(values)
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     if final:
@@ -268,6 +265,90 @@ def thin_film_converged_rgb(values: Mapping[str, float], cos_theta: ArrayLike, f
     """The film's converged colours (:func:`explorer.physics.thinfilm.reference_rgb`)."""
     return thinfilm.reference_rgb(float(values["eta1"]), float(values["eta2"]), float(values["eta3"]),
                                   float(values["kappa3"]), np.asarray(cos_theta, dtype=np.float64), float(values["d"]))
+
+
+# --------------------------------------------------------------------------------------------------
+# Natural mirrors: indices naming media (explorer.design.media), absorbing and disordered layers
+
+#: The index parameters that may name a medium.
+MEDIUM_PARAMETERS = ("n1", "n2", "nh")
+#: The natural mirror's other design parameters: each layer's extinction coefficient (added to its index,
+#: a number's or a medium's) and the thickness disorder. The search holds them at 0 unless fixed or freed.
+NATURAL_PARAMETERS = ("k1", "k2", "sigma")
+#: The extinction coefficient of each layer's index.
+EXTINCTION = {"n1": "k1", "n2": "k2"}
+#: The non-final converged colours (the polish's) sample the spectrum this finely (nm), fringes narrower
+#: than a few steps averaged (:func:`explorer.design.forward.bragg_reflectance_batch`).
+POLISH_STEP = 1.0
+
+
+def _indices(values: Mapping[str, np.ndarray], media: Mapping[str, Dispersion], wavelengths: np.ndarray) -> dict[str, np.ndarray]:
+    """``n1``, ``n2``, ``nh`` of rows ``values`` ``(B,)`` with each medium at ``wavelengths`` ``(W,)``: ``(B, 1, W)`` or ``(B,)``."""
+    rows = np.asarray(values["Lambda"]).shape[0]
+    out = {}
+    for name in MEDIUM_PARAMETERS:
+        medium = media.get(name)
+        if medium is None:
+            out[name] = np.asarray(values[name], dtype=np.float64)
+        else:
+            index = medium.index(wavelengths)
+            # A lossless medium stays real: the real batch model (and its coherent fringe average) takes it.
+            if not np.any(np.imag(index)):
+                index = np.real(index)
+            out[name] = np.broadcast_to(index.reshape(1, 1, -1), (rows, 1, index.size))
+        k = values.get(EXTINCTION.get(name, ""))
+        if k is not None and np.any(np.asarray(k) != 0.0):
+            # n + i k, as NaturalMirror.index_1 / index_2 add a layer's k to its number or its medium.
+            k = np.broadcast_to(np.asarray(k, dtype=np.float64), (rows,))
+            out[name] = out[name] + 1j * (k.reshape(-1, 1, 1) if np.ndim(out[name]) == 3 else k)
+    if not any(np.iscomplexobj(v) for v in out.values()):
+        return out
+    # Complex: every index per wavelength (the absorbing batch model's broadcast).
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+def mirror_with_media(values: Mapping[str, float], media: Mapping[str, Dispersion]):
+    """The :class:`explorer.physics.natural.NaturalMirror` of design values (``N`` rounded), media in place of their numbers."""
+    from explorer.materials.models import host_index
+    from explorer.physics.natural import NaturalMirror
+
+    index = lambda name: media[name] if name in media else float(values[name])  # noqa: E731
+    nh = media.get("nh", host_index(float(values["nh"])))
+    natural = {name: float(values.get(name, 0.0)) for name in NATURAL_PARAMETERS}
+    return NaturalMirror(n1=index("n1"), n2=index("n2"), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+                         N=max(1, int(round(float(values["N"])))), nh=nh, **natural)
+
+
+def natural_values(values: Mapping[str, object]) -> bool:
+    """Whether design values ``values`` (numbers or rows) have an absorbing or disordered layer."""
+    return any(np.any(np.asarray(values.get(name, 0.0)) != 0.0) for name in NATURAL_PARAMETERS)
+
+
+def natural_batch(values: Mapping[str, np.ndarray], media: Mapping[str, Dispersion], cos_theta, step: float,
+                  smooth: float | None) -> np.ndarray:
+    """The batch model's colours ``(B, A, 3)`` of rows ``values`` with ``media`` and each layer's ``k`` (the ordered mirror)."""
+    nodes, weights = coarse_nodes(step)
+    n = _indices(values, media, nodes)
+    R = bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+                                        cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def natural_converged(values: Mapping[str, float], media: Mapping[str, Dispersion], cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours ``(A, 3)`` of one structure with ``media``, ``k1``, ``k2`` and ``sigma``:
+    :func:`explorer.physics.natural.natural_rgb` (final, or disordered), else the batch at :data:`POLISH_STEP`.
+    """
+    from explorer.physics.natural import natural_rgb
+
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final or float(values.get("sigma", 0.0)) > 0.0:
+        return natural_rgb(cos_theta, mirror_with_media(values, media))
+    rows = {k: np.array([float(v)]) for k, v in values.items()}
+    rows["N"] = np.array([max(1.0, float(np.round(values["N"])))])
+    return natural_batch(rows, media, cos_theta, POLISH_STEP, None)[0]
+
+
 
 
 _BRAGG = dict(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
