@@ -8,7 +8,8 @@ new one, never a partial one). On any exit before that (an exception, a full dis
 which the CLI turns into ``SystemExit``) the temporary file is removed and the target is untouched.
 :func:`check_output` validates a path (suffix, folder) before any work is done.
 
-Standard library only, no GL: :mod:`explorer.tables` writes its cache through it.
+Standard library only, no GL: :mod:`explorer.tables` writes its cache through it (:func:`save_figure` takes a
+matplotlib figure, and imports pyplot only to close it).
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ from pathlib import Path
 
 from explorer.errors import OutputError
 
-__all__ = ["OutputError", "check_output", "atomic_output", "write_bytes_atomic", "write_text_atomic", "describe_suffixes"]
+__all__ = ["OutputError", "check_output", "atomic_output", "write_bytes_atomic", "write_text_atomic", "save_figure",
+           "describe_suffixes"]
 
 
 def describe_suffixes(suffixes: Sequence[str]) -> str:
@@ -110,3 +112,21 @@ def write_bytes_atomic(out: str | os.PathLike[str], data: bytes, suffixes: Seque
 def write_text_atomic(out: str | os.PathLike[str], text: str, suffixes: Sequence[str] | None = None) -> None:
     """``text`` (UTF-8) into ``out`` through :func:`atomic_output`."""
     write_bytes_atomic(out, text.encode("utf-8"), suffixes)
+
+
+def save_figure(figure, out: str | os.PathLike[str], suffixes: Sequence[str] | None = (".png",), close: bool = True,
+                format: str | None = None, **options) -> None:
+    """
+    A matplotlib ``figure`` into ``out`` through :func:`atomic_output` (its suffix one of ``suffixes``), in
+    ``format`` (default: the one the suffix names); ``options`` go to ``savefig`` (``dpi``). ``close``: the figure
+    is closed afterwards, also when saving fails (pyplot keeps every open figure alive).
+    """
+    try:
+        with atomic_output(out, suffixes) as temporary:
+            with open(temporary, "wb") as stream:
+                figure.savefig(stream, format=format or Path(out).suffix.lower()[1:], **options)
+    finally:
+        if close:
+            import matplotlib.pyplot as plt  # lazily: the package's bottom layer needs no matplotlib
+
+            plt.close(figure)

@@ -12,7 +12,8 @@ compares both versions view by view. The built-in materials are plugins of the s
 - :class:`Twin`: the protocol a twin follows (``reflectance``, ``brdf``, ``textures``; optional hooks in
   docs/plugins.md).
 - :class:`Capabilities`: the declaration (methods, Dirac reflector, Bragg spectrum, engines, exports, design),
-  with :data:`ALBEDO_ENGINES` and :data:`EXPORT_TARGETS`.
+  with :data:`ALBEDO_ENGINES` and :data:`EXPORT_TARGETS`; :class:`DesignModel`: design's forward model and
+  parameters, which a designable twin declares (``Capabilities(design=DesignModel(...))``).
 - :class:`Method`: the base of a ``method`` parameter's enumeration; :class:`Values`: the typed, frozen
   values a twin receives; :func:`round_integer`: the one rounding rule of ``int`` parameters.
 """
@@ -20,7 +21,7 @@ compares both versions view by view. The built-in materials are plugins of the s
 from explorer.materials.brd import Values, round_integer
 from explorer.materials.methods import Method
 from explorer.materials.plugins import PluginError
-from explorer.materials.twins import ALBEDO_ENGINES, EXPORT_TARGETS, Capabilities, Twin, twin
+from explorer.materials.twins import ALBEDO_ENGINES, EXPORT_TARGETS, Capabilities, DesignModel, Twin, twin
 
-__all__ = ["twin", "Twin", "Capabilities", "ALBEDO_ENGINES", "EXPORT_TARGETS", "Method", "Values", "round_integer",
-           "PluginError"]
+__all__ = ["twin", "Twin", "Capabilities", "DesignModel", "ALBEDO_ENGINES", "EXPORT_TARGETS", "Method", "Values",
+           "round_integer", "PluginError"]

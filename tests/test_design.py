@@ -15,22 +15,8 @@ from conftest import one_line_error, run_cli
 
 from explorer import design
 from explorer.design import search, solve
-from explorer.physics import bragg, thinfilm
-
-
-def test_batch_reflectance_equals_yeh_at_integer_N():
-    rng = np.random.default_rng(3)
-    count = 40
-    values = dict(n1=rng.uniform(1, 2.5, count), n2=rng.uniform(1, 2.5, count), Lambda=rng.uniform(50, 1500, count),
-                  delta=rng.uniform(0, 1, count), N=np.round(np.exp(rng.uniform(0, np.log(1000), count))),
-                  nh=rng.uniform(0, 2.5, count))  # half with a host (nh >= 1), total internal reflection included
-    cos_theta = np.cos(np.radians([0.0, 25.0, 50.0, 75.0, 89.0]))
-    wavelengths = np.linspace(360.0, 830.0, 60)
-    batch = design.bragg_reflectance_batch(*(values[k] for k in ("n1", "n2", "Lambda", "delta", "N", "nh")), cos_theta, wavelengths)
-    for b in range(count):
-        mirror = design.mirror_of({k: v[b] for k, v in values.items()})
-        exact = bragg.bragg_reflectance(cos_theta[:, None], wavelengths[None, :], mirror)
-        np.testing.assert_allclose(batch[b], exact, atol=1e-9)
+from explorer.materials import models, thinfilm_model
+from explorer.physics import bragg, colorimetry, thinfilm
 
 
 def test_screening_spectra_batched_equal_one_sample_at_a_time():
@@ -44,8 +30,8 @@ def test_screening_spectra_batched_equal_one_sample_at_a_time():
                   nh=rng.uniform(0, 2.5, count))
     cos_theta = np.cos(np.radians([0.0, 30.0, 60.0, 85.0]))
     wavelengths = 830.0 / 1.005 ** np.arange(0, 170, 3)
-    batched = design.bragg_spectra_batch(values, cos_theta, wavelengths, design.SCAN_SMOOTH)
-    single = np.concatenate([design.bragg_spectra_batch(values, cos_theta, wavelengths[j : j + 1], design.SCAN_SMOOTH)
+    batched = models.bragg_spectra_batch(values, cos_theta, wavelengths, design.SCAN_SMOOTH)
+    single = np.concatenate([models.bragg_spectra_batch(values, cos_theta, wavelengths[j : j + 1], design.SCAN_SMOOTH)
                              for j in range(wavelengths.size)], axis=-1)
     np.testing.assert_allclose(batched, single, atol=1e-12)
     smooth = design.SCAN_SMOOTH * wavelengths
@@ -58,12 +44,11 @@ def test_batch_film_equals_airy():
     values = dict(d=np.array([0.0, 300.0, 1200.0]), eta1=np.array([1.0, 1.2, 1.0]), eta2=np.array([1.5, 2.2, 1.33]),
                   eta3=np.array([1.0, 1.5, 0.2]), kappa3=np.array([0.0, 0.0, 3.0]))
     cos_theta = np.cos(np.radians([0.0, 40.0, 80.0]))
-    nodes, weights = design.coarse_nodes()
+    nodes, weights = colorimetry.interpolant_nodes()
     R = np.stack([thinfilm.airy_reflectance(values["eta1"][b], values["eta2"][b], values["eta3"][b], values["kappa3"][b],
                                             cos_theta[:, None], values["d"][b], nodes) for b in range(3)])
-    from explorer.physics import colorimetry
 
-    np.testing.assert_allclose(design.thin_film_rgb_batch(values, cos_theta), colorimetry.xyz_to_rgb(R @ weights), atol=1e-12)
+    np.testing.assert_allclose(thinfilm_model.thin_film_rgb_batch(values, cos_theta), colorimetry.xyz_to_rgb(R @ weights), atol=1e-12)
 
 
 @pytest.mark.parametrize("ratio", [1.001, 1.0025])
@@ -72,9 +57,8 @@ def test_interpolation_weights_integrate_the_interpolant(ratio):
     # 1 nm too: the 1-nm sum alone reads only the interpolant's 1-nm points (up to 3 % off at 0.1 % steps). A
     # random spectrum at the nodes is the hardest case; the reference is the trapezoid of its interpolant
     # on a 1/512-nm grid.
-    from explorer.physics import colorimetry
 
-    nodes, weights = design.log_nodes(ratio)
+    nodes, weights = colorimetry.log_interpolant_nodes(ratio)
     values = np.random.default_rng(5).uniform(size=nodes.size)
     fine = np.linspace(colorimetry.HAT_LOW, colorimetry.HAT_HIGH, 472 * 512 + 1)
     exact = np.trapezoid(np.interp(fine, nodes, values)[:, None] * colorimetry.colour_matching_functions_at(fine), fine, axis=0)
@@ -84,9 +68,8 @@ def test_interpolation_weights_integrate_the_interpolant(ratio):
 def test_interpolation_weights_at_steps_of_1_nm_or_more_are_the_1_nm_sum():
     # The scan's and the coarse model's nodes: the interpolant read at the CMFs' 1-nm points and summed
     # (the converged colours' convention at 1-nm samples), as before sub-nm nodes were integrated.
-    from explorer.physics import colorimetry
 
-    for nodes, weights in (design.log_nodes(1.0 + design.SCAN_RELATIVE_STEP), design.coarse_nodes()):
+    for nodes, weights in (colorimetry.log_interpolant_nodes(1.0 + design.SCAN_RELATIVE_STEP), colorimetry.interpolant_nodes()):
         values = np.random.default_rng(6).uniform(size=nodes.size)
         one_nm_sum = np.interp(colorimetry.WAVELENGTHS, nodes, values) @ colorimetry.colour_matching_functions()
         np.testing.assert_allclose(values @ weights, one_nm_sum, rtol=1e-13)
@@ -120,7 +103,6 @@ def _scan_problem(fixed):
 def test_scale_scan_equals_direct_colours(fixed, window):
     # The scan's FFT correlation over log s/lambda against each scale's colours summed directly (all
     # free: index scaling; window: the descent's scales around a period).
-    from explorer.physics import colorimetry
 
     problem = _scan_problem(fixed)
     shapes = np.random.default_rng(5).uniform(0.05, 0.95, (3, len(problem.free)))
@@ -131,13 +113,13 @@ def test_scale_scan_equals_direct_colours(fixed, window):
         assert np.all(scales <= around[:, None] * (1 + design.DESCENT_SPAN) * (1 + design.SCAN_RELATIVE_STEP))
     else:
         scores, scales = problem.scale_scan(shapes)
-    nodes, weights = design.log_nodes(1.0 + design.SCAN_RELATIVE_STEP)
+    nodes, weights = colorimetry.log_interpolant_nodes(1.0 + design.SCAN_RELATIVE_STEP)
     for b in range(len(shapes)):
         finite = np.flatnonzero(np.isfinite(scores[b]))
         assert finite.size >= 10
         for m in finite[:: max(1, finite.size // 5)]:
             u = problem.at_scale(shapes[b], scales[b, m])
-            R = design.bragg_spectra_batch(problem.values(u), problem.cos_theta, nodes, design.SCAN_SMOOTH)
+            R = models.bragg_spectra_batch(problem.values(u), problem.cos_theta, nodes, design.SCAN_SMOOTH)
             direct = np.sum(problem.residuals_of(colorimetry.xyz_to_rgb(R @ weights)) ** 2)
             np.testing.assert_allclose(scores[b, m], direct, rtol=1e-6, atol=1e-9)
 
@@ -156,7 +138,7 @@ def test_at_scale_puts_the_structure_in_its_box_with_the_same_colours():
         assert np.all(values[p.name] >= p.low - 1e-9) and np.all(values[p.name] <= p.high + 1e-9), p.name
     unscaled = problem.values(shapes, scale_value=scales[b, pick])
     cos_theta = problem.cos_theta
-    np.testing.assert_allclose(design.bragg_rgb_batch(values, cos_theta), design.bragg_rgb_batch(unscaled, cos_theta), atol=1e-9)
+    np.testing.assert_allclose(models.bragg_rgb_batch(values, cos_theta), models.bragg_rgb_batch(unscaled, cos_theta), atol=1e-9)
 
 
 def test_scan_descent_walks_into_a_basin_the_first_pass_missed():
@@ -223,7 +205,7 @@ def test_design_finds_a_first_order_mirror_and_reports_converged_colours():
     result = design.design("bragg_mirror", targets, RANGES, fixed={"n1": 1.0, "nh": 0.0})
     assert result.values["n1"] == 1.0 and result.values["nh"] == 0.0 and isinstance(result.values["N"], int)
     # The achieved colours are the converged reference's (an independent recomputation).
-    mirror = design.mirror_of(result.values)
+    mirror = models.mirror_of(result.values)
     np.testing.assert_allclose(result.achieved_rgb, bragg.reference_rgb(np.cos(np.radians(angles)), mirror), atol=1e-12)
     assert result.median_delta_e2000 <= 0.5, result
     assert result.reachable.all()
@@ -232,12 +214,11 @@ def test_design_finds_a_first_order_mirror_and_reports_converged_colours():
 def test_reachable_colours_are_whole_stacks():
     # The Design window's chromaticity diagram: every structure behind it has a whole number of cells (a
     # fractional N is the search's relaxation, with colours no stack has), and its points are their colours.
-    from explorer.physics import colorimetry
 
     values = design.reachable_structures("bragg_mirror", RANGES, {"nh": 0.0}, samples=64)
     assert np.all(values["N"] == np.round(values["N"])) and np.all(values["N"] >= 1) and len(np.unique(values["N"])) > 10
     xy, Y = design.reachable_chromaticities("bragg_mirror", 30.0, RANGES, {"nh": 0.0}, samples=64)
-    xyz = colorimetry.rgb_to_xyz(design.bragg_rgb_batch(values, np.cos(np.radians([30.0])))[:, 0])
+    xyz = colorimetry.rgb_to_xyz(models.bragg_rgb_batch(values, np.cos(np.radians([30.0])))[:, 0])
     np.testing.assert_allclose(Y, xyz[:, 1], atol=1e-12)
     np.testing.assert_allclose(xy, xyz[:, :2] / xyz.sum(axis=-1, keepdims=True), atol=1e-9)
 

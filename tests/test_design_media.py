@@ -13,7 +13,8 @@ import pytest
 
 from conftest import one_line_error, run_cli
 
-from explorer.design.forward import DESIGN_MODELS, bragg_reflectance_batch
+from explorer.design import design_model
+from explorer.physics.bragg import bragg_reflectance_batch
 from explorer.design.media import _indices, mirror_with_media, with_media
 from explorer.physics.dispersion import LIBRARY
 from explorer.physics.natural import mirror_spectrum, natural_rgb
@@ -42,7 +43,7 @@ def test_batch_spectra_equal_the_exact_natural_mirror(media, values):
 
 @pytest.mark.parametrize("media, values", MIRRORS, ids=IDS)
 def test_batch_colours_equal_the_exact_colours(media, values):
-    model = with_media(DESIGN_MODELS["bragg_mirror"], media)
+    model = with_media(design_model("bragg_mirror"), media)
     cos_theta = np.cos(np.radians(ANGLES[:3]))
     exact = natural_rgb(cos_theta, mirror_with_media(values, media))
     coarse = model.batch({k: np.array([float(v)]) for k, v in values.items()}, cos_theta)[0]
@@ -57,8 +58,8 @@ def test_real_indices_take_the_same_path_bit_for_bit():
     # A medium of constant real index is the number: the same batch colours, bit for bit.
     values = {k: np.array([v]) for k, v in dict(n1=1.0, n2=1.83, Lambda=250.0, delta=0.5, N=6.0, nh=0.0).items()}
     cos_theta = np.cos(np.radians([0.0, 45.0]))
-    plain = DESIGN_MODELS["bragg_mirror"].batch(values, cos_theta)
-    media = with_media(DESIGN_MODELS["bragg_mirror"], {"n2": LIBRARY["guanine"]}).batch(values, cos_theta)
+    plain = design_model("bragg_mirror").batch(values, cos_theta)
+    media = with_media(design_model("bragg_mirror"), {"n2": LIBRARY["guanine"]}).batch(values, cos_theta)
     np.testing.assert_array_equal(plain, media)
 
 

@@ -14,7 +14,7 @@ from PIL import Image
 
 from conftest import one_line_error, run_cli
 
-from explorer.design import bragg_converged_rgb
+from explorer.materials.models import bragg_converged_rgb
 from explorer.physics.colorimetry import delta_E_2000
 
 pytest.importorskip("distributed")

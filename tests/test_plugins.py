@@ -23,7 +23,7 @@ from explorer.materials.brd import load_material
 from explorer.materials.methods import Method
 from explorer.materials.models import model_for
 from explorer.materials.plugins import PluginError
-from explorer.materials.twins import CAPABILITY_FIELDS, Capabilities, registry, supporting
+from explorer.materials.twins import CAPABILITY_FIELDS, Capabilities, DesignModel, registry, supporting
 
 @pytest.fixture(autouse=True)
 def _plugins_unloaded_afterwards():
@@ -71,6 +71,27 @@ def test_every_shipped_material_declares_every_capability(path):
         assert len(alphas) == len(weights) >= 1 and np.all(np.asarray(cosine) >= 0.0)
     if declared.supports("position-free"):
         assert model.stack.layers
+    if declared.design is not None:
+        _assert_design_declared(material, declared.design)
+
+
+def _assert_design_declared(material, declared) -> None:
+    """A twin's design model: its parameters are the file's floats, and its coarse model agrees with its converged one."""
+    from explorer.design import design_model
+
+    parameters = {p.name: p for p in material.parameters}
+    assert isinstance(declared, DesignModel) and declared.parameters
+    assert all(name in parameters and parameters[name].type in ("float", "int") for name in declared.parameters)
+    assert design_model(material.model).parameters == declared.parameters  # what design asks of the registry
+    values = {name: float(material.resolve()[name]) for name in declared.parameters}
+    cos_theta = np.cos(np.radians([0.0, 45.0]))
+    coarse = declared.batch({k: np.array([v]) for k, v in values.items()}, cos_theta)
+    converged = declared.converged(values, cos_theta, final=True)
+    assert coarse.shape == (1, 2, 3) and converged.shape == (2, 3)
+    np.testing.assert_allclose(coarse[0], converged, atol=0.02)  # the coarse model screens for the converged one
+    if declared.scale_parameter is not None:
+        spectra = declared.spectra({k: np.array([v]) for k, v in values.items()}, cos_theta, np.array([450.0, 550.0]), 0.01)
+        assert spectra.shape == (1, 2, 2) and np.all((spectra >= 0.0) & (spectra <= 1.0))
 
 
 def test_info_json_lists_each_materials_capabilities_from_the_registry(tmp_path):
@@ -85,14 +106,93 @@ def test_info_json_lists_each_materials_capabilities_from_the_registry(tmp_path)
         assert set(listed) == set(CAPABILITY_FIELDS)
         assert listed["albedo"] == list(declared.albedo) and listed["exports"] == list(declared.exports)
         assert (listed["dirac"], listed["bragg_spectrum"], listed["numpy"], listed["design"]) == \
-            (declared.dirac, declared.bragg_spectrum, declared.numpy, declared.design)
+            (declared.dirac, declared.bragg_spectrum, declared.numpy, declared.design is not None)
         assert listed["methods"] == (None if declared.methods is None else [m.name for m in declared.methods])
 
 
-def test_design_models_are_the_twins_that_declare_design():
+def test_design_asks_the_registry_and_refuses_a_twin_without_a_design_model():
     from explorer import design
 
-    assert set(design.DESIGN_MODELS) == set(supporting("design"))
+    assert design.designable() == supporting("design") and len(design.designable()) >= 3
+    for name, cls in registry().items():
+        if cls.capabilities.design is None:
+            with pytest.raises(design.DesignError, match=f"model {name} cannot be designed"):
+                design.design_model(name)
+        else:
+            assert design.design_model(name).name == name
+
+
+def test_design_on_a_plugin_without_a_design_model_is_one_line(tmp_path):
+    line = one_line_error(run_cli("design", _example(tmp_path), "--target", "0:0.5,0.3,0.2"))
+    assert "model tinted_phong cannot be designed" in line
+
+
+#: A plugin that declares design: a grey Schlick reflector whose forward model is its reflectance at ``f0``.
+GREY_BRD = """analytic
+# model: grey_schlick
+::begin parameters
+float f0 0.01 0.9 0.04  # 1: reflectance at normal incidence
+::end parameters
+::begin shader
+vec3 reflectance(float cos_theta) { float m = clamp(1.0 - cos_theta, 0.0, 1.0); return vec3(f0 + (1.0 - f0) * pow(m, 5.0)); }
+vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return reflectance(clamp(dot(normalize(L + V), L), 0.0, 1.0)) / 3.14159265; }
+::end shader
+"""
+GREY_PY = """import numpy as np
+from explorer.plugins import Capabilities, DesignModel, twin
+
+
+def grey(f0, cos_theta):
+    m = np.clip(1.0 - np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    return np.repeat((f0 + (1.0 - f0) * m**5)[..., None], 3, axis=-1)
+
+
+@twin
+class GreySchlick:
+    name = "grey_schlick"
+    capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
+                                exports=(), design=DesignModel(
+                                    parameters=("f0",),
+                                    batch=lambda values, cos_theta, step=None, smooth=None: grey(
+                                        np.asarray(values["f0"], dtype=np.float64)[:, None], cos_theta),
+                                    converged=lambda values, cos_theta, final=True: grey(float(values["f0"]), cos_theta)))
+
+    def __init__(self, values):
+        self.f0 = float(values["f0"])
+
+    def reflectance(self, cos_theta):
+        return grey(self.f0, cos_theta)
+
+    def brdf(self, L, V, N, X, Y):
+        H = np.asarray(L) + np.asarray(V)
+        H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+        return self.reflectance(np.clip(np.sum(H * L, axis=-1), 0.0, 1.0)) / np.pi
+
+    def textures(self):
+        return {}
+"""
+
+
+def test_a_plugin_declares_its_design_model_and_design_finds_its_structure(tmp_path):
+    import json
+
+    (tmp_path / "grey_schlick.brd").write_text(GREY_BRD)
+    (tmp_path / "grey_schlick.py").write_text(GREY_PY)
+    wanted = 0.3 + 0.7 * (1.0 - np.cos(np.radians(60.0))) ** 5  # f0 = 0.3 at 60 degrees
+    run = run_cli("design", tmp_path / "grey_schlick.brd", "--target", f"60:{wanted},{wanted},{wanted}", "--json")
+    assert run.returncode == 0, run.stderr
+    result = json.loads(run.stdout)
+    assert abs(result["set"]["f0"] - 0.3) < 1e-3 and result["median_delta_e2000"] < 0.01, result
+    assert "design yes" in run_cli("info", tmp_path / "grey_schlick.brd").stdout
+
+
+def test_a_design_model_names_only_its_parameters():
+    with pytest.raises(ValueError, match="design names 'd'"):
+        DesignModel(parameters=("f0",), paint_free=("d",), batch=len, converged=len)
+    with pytest.raises(TypeError, match="needs spectra"):
+        DesignModel(parameters=("d",), scale_parameter="d", batch=len, converged=len)
+    with pytest.raises(TypeError, match="must be a DesignModel"):
+        Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy",), exports=(), design=True)
 
 
 def test_capabilities_refuse_an_unknown_engine_or_export():
@@ -169,6 +269,7 @@ def test_a_plugin_loads_from_any_folder_and_renders_in_numpy(tmp_path):
     (("self.exponent = float(values[\"exponent\"])", "self.exponent = float(values[\"exponent\"]) +"), None, "SyntaxError"),
     (("exports=(\"brdf\", \"table\")", "exports=(\"brdf\", \"povray\")"), 17, "unknown engine or export 'povray'"),
     (("name = \"tinted_phong\"", "name = \"bragg_mirror\""), 12, "registered twice"),
+    (("design=None", "design=True"), 17, "must be a DesignModel"),
     (("@twin\n", ""), None, "registers no twin"),
 ])
 def test_a_broken_plugin_is_one_error_with_its_file_and_line(tmp_path, edit, line, message):

@@ -21,7 +21,7 @@ class TintedPhong:
         numpy=True,  # render --engine numpy draws this class
         albedo=("numpy", "gl"),  # albedo --engine numpy and gl
         exports=("brdf", "table"),  # export --to brdf and --to table
-        design=False,  # no inverse design
+        design=None,  # no inverse design (a DesignModel(...) declares its parameters and forward model)
     )
 
     def __init__(self, values):

@@ -5,11 +5,10 @@ What the benchmarks and accuracy studies share: figure output, the Bragg mirrors
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
-from explorer.files import atomic_output
+from explorer import files
 
 #: What matplotlib's figures (``accuracy --plot``, ``figure --out``) and Figure 4's strips are written as.
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
@@ -17,9 +16,8 @@ STRIP_SUFFIXES = (".png",)
 
 
 def save_figure(figure, path, **options) -> None:
-    """A matplotlib figure to ``path`` (a format of :data:`FIGURE_SUFFIXES`, by its suffix), atomically."""
-    with atomic_output(path, FIGURE_SUFFIXES) as temporary:
-        figure.savefig(temporary, format=Path(path).suffix.lower()[1:], **options)
+    """A matplotlib figure to ``path`` (a format of :data:`FIGURE_SUFFIXES`, by its suffix), atomically; left open."""
+    files.save_figure(figure, path, FIGURE_SUFFIXES, close=False, **options)
 
 BENCH_LAMBDAS = (244.0, 500.0, 988.0)
 FIGURE4_LAMBDAS = (244.0, 500.0, 988.0)

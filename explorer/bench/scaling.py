@@ -118,14 +118,9 @@ def plot_scaling(document: dict, path: Path) -> None:
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=8)
     figure.tight_layout()
-    # Atomically: a temporary file beside the plot, renamed over it (mode 0644 under the usual umask).
-    from explorer.files import atomic_output
+    from explorer.files import save_figure
 
-    try:
-        with atomic_output(path) as temporary:
-            figure.savefig(temporary, dpi=110, format="png")
-    finally:
-        plt.close(figure)
+    save_figure(figure, path, None, format="png", dpi=110)
 
 
 def run_scaling_bench(as_json: bool = False, repeats: int = 3, plot: Path | None = None, renderer=None) -> dict:

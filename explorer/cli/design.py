@@ -271,8 +271,8 @@ def render_command(material_name: str, values: dict, material=None) -> str:
 def design_command(material, target_texts, target_strip, theta_range, fixes, free, guess_texts, as_json, target_spectrum,
                    spectrum_theta, spectrum_plot, seed, tries, target_image, target_image_2, angles_text, out_maps, workers,
                    scheduler, save):
-    """Design the structure of MATERIAL (bragg_mirror, bragg_layer: its specular colour, thin_film) whose
-    colours at the target angles come closest to the targets (CIEDE2000).
+    """Design the structure of MATERIAL (one whose twin declares a design model: bragg_mirror, bragg_layer: its
+    specular colour, thin_film, or a plugin's) whose colours at the target angles come closest to the targets (CIEDE2000).
 
     Prints the structure as --set values, a render command line, and per target the achieved colour
     (converged spectral) and its ΔE2000; a target no structure in the declared ranges reaches is reported

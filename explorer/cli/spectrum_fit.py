@@ -18,7 +18,7 @@ import numpy as np
 from explorer.cli.materials import load_mirror, warn
 from explorer.cli.spectrum import INDEX_PARAMETERS, NATURAL_PARAMETERS, describe
 from explorer.errors import LocatedError
-from explorer.files import atomic_output, check_output
+from explorer.files import check_output, save_figure
 from explorer.physics import dispersion
 from explorer.physics.spectral_fit import RANGES, fit_spectrum
 
@@ -118,12 +118,7 @@ def write_fit_plot(fit, out: str, title: str) -> None:
     ax.set_title(title, fontsize=8)
     ax.legend(fontsize=8)
     figure.tight_layout()
-    with atomic_output(out, (".png",)) as temporary:
-        try:
-            with open(temporary, "wb") as stream:
-                figure.savefig(stream, format="png")
-        finally:
-            plt.close(figure)
+    save_figure(figure, out)
 
 
 def parse_free(text: str | None, fixed: dict, loaded) -> bool:

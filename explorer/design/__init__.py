@@ -10,8 +10,9 @@ differences over the targets, in three stages:
 1. a space-filling first pass: a scrambled Sobol sequence of shapes over the free parameters' box (``N`` on
    a log scale, continuous), each at every value of the length that scales it (:meth:`_Problem.scale_scan`:
    one spectrum per shape over ``s / lambda``, a correlation with the CMFs gives every scale); without a
-   free scale, every candidate evaluated at once by a vectorised coarse model (:func:`bragg_rgb_batch`,
-   :func:`thin_film_rgb_batch`: point samples every :data:`COARSE_STEP` nm);
+   free scale, every candidate evaluated at once by the material's vectorised coarse model (its
+   :attr:`DesignModel.batch`, e.g. over :func:`explorer.physics.bragg.bragg_reflectance_batch`: point samples
+   every :data:`COARSE_STEP` nm);
    the best distinct shapes then walk downhill by the same scan, windowed around their period
    (:func:`_scan_descent`: a (1 + lambda) evolution whose moves shrink from 0.08 to 0.01 of the box);
 2. local refinement (``scipy.optimize.least_squares``) of the best distinct candidates on the coarse model,
@@ -36,8 +37,8 @@ Sharma, Wu, Dalal (2005). The CIEDE2000 colour-difference formula. Color Res. Ap
 The package by subject (every public name is re-exported here, so ``design.NAME`` reads the same):
 
 - :mod:`~explorer.design.base`: the search's settings, its errors, a design parameter and a design model;
-- :mod:`~explorer.design.forward`: the forward models (the coarse batch models, the converged colours) and the
-  designable models;
+- :mod:`~explorer.design.forward`: the designable models, asked of the registry (each twin declares its forward
+  model, :class:`explorer.materials.twins.DesignModel`);
 - :mod:`~explorer.design.targets`: target colours (checked, or read from a strip), the result and the parameter box;
 - :mod:`~explorer.design.search`: the problem and the search's stages (scans, descent, refinement, polish);
 - :mod:`~explorer.design.solve`: :func:`design`, with tries;

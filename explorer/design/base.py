@@ -1,6 +1,7 @@
 """
-What the inverse design shares: the search's settings, its errors, a design parameter (its box and scale) and a design
-model (what the search reads of a material).
+What the inverse design shares: the search's settings, its errors and a design parameter (its box and scale). A design
+model (what the search reads of a material) is declared by the material's twin
+(:class:`explorer.materials.twins.DesignModel`), re-exported here.
 """
 
 from __future__ import annotations
@@ -8,9 +9,11 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
+
+from explorer.materials.twins import DesignModel  # noqa: F401  (declared by each twin; re-exported)
+from explorer.physics.colorimetry import COARSE_STEP  # noqa: F401  (the coarse model's wavelength step, nm)
 
 #: The public names (re-exported by :mod:`explorer.design`).
 __all__ = ["REACHABLE_DELTA_E", "REACHED_DELTA_E", "TRY_SEED_STRIDE", "COARSE_STEP", "SCREEN_STEP", "SCREEN_SMOOTH",
@@ -28,9 +31,6 @@ REACHABLE_DELTA_E = 2.0
 REACHED_DELTA_E = 1.0
 #: Successive tries' seeds this far apart: each a fresh scrambled Sobol first pass.
 TRY_SEED_STRIDE = 1000
-#: The coarse model's wavelength step (nm): the spectrum at these nodes, interpolated linearly, against the
-#: 1-nm CMFs.
-COARSE_STEP = 2.0
 #: The first pass's and the scan's wavelength step (nm): screening only, about 4 times cheaper.
 SCREEN_STEP = 4.0
 #: The screening averages out fringes narrower than about this (nm): their ripples make the landscape
@@ -139,39 +139,3 @@ class DesignParameter:
         if self.log:
             return (np.log(value) - math.log(self.low)) / (math.log(self.high) - math.log(self.low))
         return (value - self.low) / (self.high - self.low)
-
-
-@dataclass(frozen=True)
-class DesignModel:
-    """
-    What can be designed of one material model: its structural parameters (the others, such as
-    ``method`` or a roughness, do not change the specular colour), the coarse batch model and the
-    converged one.
-    """
-
-    name: str
-    parameters: tuple[str, ...]
-    log_parameters: tuple[str, ...]
-    integer_parameters: tuple[str, ...]
-    #: ``batch(values: dict of (B,) arrays, cos_theta (A,)) -> (B, A, 3)`` linear RGB, coarse.
-    batch: Callable
-    #: ``converged(values: dict of floats, cos_theta (A,), final: bool) -> (A, 3)`` linear RGB.
-    converged: Callable
-    #: Parameters whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
-    host_parameter: str | None = None
-    host_threshold: float = 1.0
-    #: The length that scales the structure (scanned on every value: :meth:`_Problem.scale_scan`).
-    scale_parameter: str | None = None
-    #: Search a mirror by its optical period and thickness share instead of ``Lambda`` and ``delta``.
-    optical: bool = False
-    #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
-    spectra: Callable | None = None
-    #: The scan's spectra only approximate the batch model (a medium's index at one wavelength): the scanned
-    #: shapes are ranked again on the screening model before the starts are chosen.
-    rescreen: bool = False
-    #: Free by default when painting an image: the structure's lengths and count (its indices are materials,
-    #: fixed at the file's values unless named free).
-    paint_free: tuple[str, ...] = ()
-    #: Parameters the search holds at 0 (an effect off: a layer's absorption, the disorder) unless the caller fixes
-    #: them at another value or frees them by name (:func:`explorer.design.design`'s ``free``).
-    held: tuple[str, ...] = ()

@@ -1,7 +1,7 @@
 """
 The colour design of a mirror whose fixed indices name media (``--fix n2=chitin``): the batch model with each
 medium's ``n + i k`` at the design's own wavelengths (:mod:`explorer.physics.dispersion`), and the converged
-colours of :func:`explorer.physics.natural.natural_rgb`. The batch model takes complex indices by :mod:`explorer.design.absorbing`.
+colours of :func:`explorer.physics.natural.natural_rgb`. The batch model takes complex indices (:func:`explorer.physics.bragg.absorbing_reflectance_batch`).
 """
 
 from __future__ import annotations
@@ -11,19 +11,19 @@ from typing import Mapping
 import numpy as np
 
 from explorer.design.base import DesignError, DesignModel
-from explorer.physics.dispersion import Dispersion
-# The natural mirror's batch and colours live with the other forward models (re-exported here).
-from explorer.design.forward import (  # noqa: F401
+from explorer.materials.models import (  # noqa: F401  (the natural mirror's forward models, declared with the Bragg twins)
     EXTINCTION,
     MEDIUM_PARAMETERS,
     NATURAL_PARAMETERS,
     POLISH_STEP,
-    _indices,
+    design_indices as _indices,
     mirror_with_media,
     natural_batch,
     natural_converged,
     natural_values,
 )
+from explorer.physics import bragg, colorimetry
+from explorer.physics.dispersion import Dispersion
 
 #: The wavelength (nm) whose real index stands for a medium where the search needs one number: the box
 #: check, the optical period's split into ``Lambda`` and ``delta`` (a reparametrisation, exact at any
@@ -53,8 +53,6 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion], natural: boo
     """
     from dataclasses import replace
 
-    from explorer.design import forward
-
     if not media and not natural:
         return model
     if not model.optical:
@@ -65,7 +63,7 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion], natural: boo
         if name == "nh" and medium.absorbing:
             raise DesignError(f"the host {medium.name} absorbs: light comes from a lossless host")
 
-    def batch(values, cos_theta, step=forward.COARSE_STEP, smooth=None):
+    def batch(values, cos_theta, step=colorimetry.COARSE_STEP, smooth=None):
         return natural_batch(values, media, cos_theta, step, smooth)
 
     def spectra(values, cos_theta, wavelengths, smooth_relative):
@@ -73,8 +71,8 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion], natural: boo
         # The real parts: the scan only screens (band positions), on the lossless model's fast path.
         n = {k: np.real(v[:, 0, 0] if np.ndim(v) == 3 else v) for k, v in n.items()}
         wavelengths = np.asarray(wavelengths, dtype=np.float64)
-        return forward.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
-                                               cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
+        return bragg.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+                                             cos_theta, wavelengths, step=1.0, smooth=smooth_relative * wavelengths)
 
     def converged(values, cos_theta, final=True):
         return natural_converged(values, media, cos_theta, final)

@@ -13,7 +13,7 @@ The stages (each timed; each a set of tasks whose results are cached in the outp
    every other colour from its nearest grid colour's structure;
 5. rounds in which a colour left above :data:`POLISHED_DELTA_E` starts again from its image neighbours' structures
    (and the nearest other clusters'): neighbouring pixels stay in one basin, so the maps stay smooth;
-6. the converged colours (:func:`explorer.design.forward.bragg_converged_rgb`'s reference), with a polish on the
+6. the converged colours (the design model's ``converged`` reference), with a polish on the
    converged model where the coarse one misjudged (:func:`explorer.design.search._polish`);
 7. a full design for the few colours still above :data:`explorer.design.base.REACHABLE_DELTA_E`; what stays above
    it is flagged as unreachable.

@@ -37,7 +37,6 @@ from explorer.design.base import (
     DesignModel,
     DesignParameter,
 )
-from explorer.design.forward import log_nodes
 from explorer.design.targets import Target
 from explorer.physics import colorimetry
 
@@ -214,7 +213,7 @@ class _Problem:
         # With index scaling, a shape's periods reach k_high / k_low further (at most n1's box ratio).
         widest = self.box["n1"].high / self.box["n1"].low if self.index_scale else 1.0
         G = int(np.ceil(np.log((high / low * widest) if around is None else (1.0 + span) ** 2) / np.log(ratio))) + 1
-        nodes, weights = log_nodes(ratio)  # ascending: node J - j is lambda_j
+        nodes, weights = colorimetry.log_interpolant_nodes(ratio)  # ascending: node J - j is lambda_j
         J = nodes.size - 1
         # Row b's structure at scale s_b seen at lambda_max r^-k is its spectrum at x_k = (s_b / lambda_max) r^k.
         wavelengths = nodes[-1] / ratio ** np.arange(G + J)

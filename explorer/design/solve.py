@@ -60,7 +60,7 @@ def design(
     Parameters
     ----------
     model_name : str
-        A key of :data:`DESIGN_MODELS` (the material's ``# model:``).
+        The material's ``# model:``, whose twin declares a design model (:func:`explorer.design.design_model`).
     targets : sequence of Target
         Colours at angles in [0, 90) degrees.
     ranges : mapping

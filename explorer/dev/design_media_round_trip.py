@@ -15,7 +15,8 @@ import argparse
 import numpy as np
 
 from explorer import design
-from explorer.design.forward import mirror_with_media
+from explorer.design.media import mirror_with_media
+from explorer.materials.models import BraggMirrorModel
 from explorer.physics.dispersion import LIBRARY
 from explorer.physics.natural import natural_rgb
 
@@ -41,7 +42,7 @@ def round_trip(case: str, count: int, tries: int, seed: int = 0):
             truth[name] = 0.0
         colours = natural_rgb(np.cos(np.radians(design.ROUND_TRIP_ANGLES)), mirror_with_media(truth, media))
         targets = [design.Target(a, tuple(float(c) for c in rgb)) for a, rgb in zip(design.ROUND_TRIP_ANGLES, colours)]
-        result = design.design("bragg_mirror", targets, RANGES, dict(numbers), seed=seed + k, tries=tries, media=media)
+        result = design.design(BraggMirrorModel.name, targets, RANGES, dict(numbers), seed=seed + k, tries=tries, media=media)
         rows.append((truth, result))
         yield truth, result
 

@@ -60,7 +60,7 @@ class LayeredLobesModel:
 
     name = "layered_lobes"
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "table", "gltf"), design=False)
+                                exports=("mitsuba", "table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)

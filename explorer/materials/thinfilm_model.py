@@ -18,8 +18,8 @@ from typing import Mapping
 
 import numpy as np
 
-from explorer.physics import microfacet, thinfilm
-from explorer.materials.twins import Capabilities, twin
+from explorer.physics import colorimetry, microfacet, thinfilm
+from explorer.materials.twins import Capabilities, DesignModel, twin
 from explorer.materials.brd import round_integer
 from explorer.materials.methods import ThinFilmMethod
 
@@ -43,13 +43,48 @@ def film_rgb(method: ThinFilmMethod, film, cos_theta, d) -> np.ndarray:
     return FILM_RGB[method](film, cos_theta, d)
 
 
+# --------------------------------------------------------------------------------------------------
+# Inverse design's forward model of a film
+
+
+def thin_film_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP,
+                        smooth: float | None = None) -> np.ndarray:
+    """
+    The coarse colours ``(B, A, 3)`` of films ``values`` (``d``, ``eta1``, ``eta2``, ``eta3``, ``kappa3``); a
+    film's few fringes are its colour, so ``smooth`` is not used.
+    """
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    return colorimetry.xyz_to_rgb(thin_film_spectra_batch(values, cos_theta, nodes) @ weights)
+
+
+def thin_film_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float = 0.0) -> np.ndarray:
+    """The films' Airy spectra ``(B, A, W)`` (not smoothed: a film's fringes are its colour)."""
+    col = lambda name: np.asarray(values[name], dtype=np.float64).reshape(-1, 1, 1)
+    cos = np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1)
+    return thinfilm.airy_reflectance(col("eta1"), col("eta2"), col("eta3"), col("kappa3"), cos, col("d"),
+                                     np.asarray(wavelengths, float))
+
+
+def thin_film_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = True) -> np.ndarray:
+    """The film's converged colours (:func:`explorer.physics.thinfilm.reference_rgb`)."""
+    return thinfilm.reference_rgb(float(values["eta1"]), float(values["eta2"]), float(values["eta3"]),
+                                  float(values["kappa3"]), np.asarray(cos_theta, dtype=np.float64), float(values["d"]))
+
+
+#: What design fits of a film, on its Airy reflectance: the thickness scanned, the indices and absorption.
+THIN_FILM_DESIGN = DesignModel(parameters=("d", "eta1", "eta2", "eta3", "kappa3"), batch=thin_film_rgb_batch,
+                               converged=thin_film_converged_rgb, scale_parameter="d", spectra=thin_film_spectra_batch,
+                               paint_free=("d",))
+
+
 @twin
 class ThinFilmModel:
     """Twin of ``shaders/thin_film.brd``: ``reflectance(cos_theta)`` and ``brdf(L, V, N, X, Y)``, every method."""
 
     name = "thin_film"
     capabilities = Capabilities(methods=ThinFilmMethod, dirac=False, bragg_spectrum=False, numpy=True,
-                                albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx", "gltf"), design=True)
+                                albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx", "gltf"),
+                                design=THIN_FILM_DESIGN)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)

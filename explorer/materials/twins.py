@@ -6,7 +6,8 @@ A twin (``# model: NAME`` in a material file) computes in float64 what the mater
 in float32; the GL-vs-numpy harness (:mod:`explorer.views.twin_check`, ``bragg-explorer check``) compares
 them view by view. Each twin class declares itself with :func:`twin`, and declares with its
 :class:`Capabilities` everything the rest of the code would otherwise look up by the material's name:
-its methods, whether it is a Dirac reflector or has a Bragg spectrum, its engines and its exports.
+its methods, whether it is a Dirac reflector or has a Bragg spectrum, its engines, its exports and, for inverse
+design, its forward model (:class:`DesignModel`).
 :data:`TWINS` is the one registry: the app, the CLI, the exports, Mitsuba, design, albedo and the
 accuracy badge query it (:func:`capabilities_of`, :func:`names_with`), in the spirit of Mitsuba 3's
 plugins. The built-in twins register when :func:`registry` first runs; a plugin's on loading its file
@@ -29,6 +30,59 @@ EXPORT_TARGETS = ("mitsuba", "brdf", "table", "materialx", "gltf")
 
 
 @dataclass(frozen=True, kw_only=True)
+class DesignModel:
+    """
+    What inverse design (:mod:`explorer.design`, ``bragg-explorer design``) reads of a material, declared by its
+    twin (``Capabilities(design=DesignModel(...))``): its structural parameters (the others, such as ``method``
+    or a roughness, do not change the specular colour) and its forward models, the coarse batch model the search
+    screens and refines on and the converged one it polishes and reports. Colours are linear sRGB.
+    """
+
+    #: The parameters design may fit (names of the material file's parameters).
+    parameters: tuple[str, ...]
+    #: Those it walks on a log scale, and those it rounds to integers (a count).
+    log_parameters: tuple[str, ...] = ()
+    integer_parameters: tuple[str, ...] = ()
+    #: ``batch(values: dict of (B,) arrays, cos_theta (A,), step=COARSE_STEP, smooth=None) -> (B, A, 3)``, coarse
+    #: (:data:`explorer.physics.colorimetry.COARSE_STEP`; integer parameters may be fractional).
+    batch: Callable
+    #: ``converged(values: dict of floats, cos_theta (A,), final: bool) -> (A, 3)``: the reference when ``final``.
+    converged: Callable
+    #: A parameter whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
+    host_parameter: str | None = None
+    host_threshold: float = 1.0
+    #: The length that scales the structure (scanned on every value: :meth:`explorer.design.search._Problem.scale_scan`;
+    #: needs ``spectra``).
+    scale_parameter: str | None = None
+    #: Search a mirror by its optical period and thickness share instead of ``Lambda`` and ``delta``.
+    optical: bool = False
+    #: ``spectra(values, cos_theta (A,), wavelengths (W,), smooth_relative) -> (B, A, W)`` for the scale scan.
+    spectra: Callable | None = None
+    #: The scan's spectra only approximate the batch model (a medium's index at one wavelength): the scanned
+    #: shapes are ranked again on the screening model before the starts are chosen.
+    rescreen: bool = False
+    #: Free by default when painting an image: the structure's lengths and count (its indices are materials,
+    #: fixed at the file's values unless named free).
+    paint_free: tuple[str, ...] = ()
+    #: Parameters the search holds at 0 (an effect off: a layer's absorption, the disorder) unless the caller fixes
+    #: them at another value or frees them by name (:func:`explorer.design.design`'s ``free``).
+    held: tuple[str, ...] = ()
+    #: The ``# model:`` name it designs: set by :func:`explorer.design.design_model` from the registry.
+    name: str | None = None
+
+    def __post_init__(self):
+        named = (*self.log_parameters, *self.integer_parameters, *self.paint_free, *self.held,
+                 *(p for p in (self.host_parameter, self.scale_parameter) if p is not None))
+        stray = [p for p in named if p not in self.parameters]
+        if stray:
+            raise ValueError(f"design names {stray[0]!r}, not one of its parameters ({', '.join(self.parameters)})")
+        if not callable(self.batch) or not callable(self.converged):
+            raise TypeError("design needs its forward models: batch(values, cos_theta, ...) and converged(values, cos_theta, final)")
+        if self.scale_parameter is not None and not callable(self.spectra):
+            raise TypeError(f"design scans {self.scale_parameter!r}: it needs spectra(values, cos_theta, wavelengths, smooth)")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Capabilities:
     """
     What a material can do, declared by its twin class (every field, no default: a built-in states each).
@@ -40,7 +94,8 @@ class Capabilities:
     accuracy badge); ``numpy``: ``render --engine numpy`` draws its twin; ``albedo``: the engines of
     :data:`ALBEDO_ENGINES` it supports; ``exports``: the targets of :data:`EXPORT_TARGETS` it supports
     (``mitsuba`` needs the twin's ``spectral_brdf`` and ``sampling_lobes``, or ``dirac`` and
-    ``spectral_reflectance``); ``design``: ``design`` fits its parameters (its ``design_model``).
+    ``spectral_reflectance``); ``design``: its :class:`DesignModel` (``design`` fits its parameters on that
+    forward model), or None: not designable.
     """
 
     methods: type | None
@@ -49,9 +104,11 @@ class Capabilities:
     numpy: bool
     albedo: tuple[str, ...]
     exports: tuple[str, ...]
-    design: bool
+    design: DesignModel | None
 
     def __post_init__(self):
+        if not (self.design is None or self.design is False or isinstance(self.design, DesignModel)):
+            raise TypeError("design must be a DesignModel(...) (its parameters and forward model), or None")
         unknown = [e for e in self.albedo if e not in ALBEDO_ENGINES] + [e for e in self.exports if e not in EXPORT_TARGETS]
         if unknown:
             raise ValueError(f"unknown engine or export {unknown[0]!r} (albedo engines: {', '.join(ALBEDO_ENGINES)}; "
@@ -70,6 +127,7 @@ class Capabilities:
         """The declaration as JSON (``info --json``): ``methods`` as the enumeration's member names."""
         document = {f.name: getattr(self, f.name) for f in fields(self)}
         document["methods"] = None if self.methods is None else [m.name for m in self.methods]
+        document["design"] = bool(self.design)
         document.update(albedo=list(self.albedo), exports=list(self.exports))
         return document
 
@@ -84,10 +142,10 @@ class Capabilities:
 CAPABILITY_FIELDS = tuple(f.name for f in fields(Capabilities))
 #: What a material without a twin can do: the GLSL engines only (any file of the format renders in GL).
 NO_TWIN = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=False, albedo=("gl",), exports=(),
-                       design=False)
+                       design=None)
 #: What a twin that declares nothing can do (a test's twin, a measured table): its numpy engine and albedo.
 UNDECLARED = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True, albedo=("numpy", "gl"),
-                          exports=(), design=False)
+                          exports=(), design=None)
 
 
 @runtime_checkable

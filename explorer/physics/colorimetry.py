@@ -20,6 +20,7 @@ Mirrors, Section 3.2.2 (Eqs. 15-16).
 from __future__ import annotations
 
 import functools
+import math
 import warnings
 from typing import Callable
 
@@ -185,6 +186,51 @@ def hat_average(fine: np.ndarray, substeps: int) -> np.ndarray:
     for j in range(-K + 1, K):
         total += ((K - abs(j)) / (K * K)) * fine[..., K + j : K + j + count * K : K]
     return total
+
+
+#: The coarse colours' wavelength step (nm): a spectrum at nodes this far apart, interpolated linearly, against the
+#: 1-nm CMFs (:func:`interpolant_nodes`; the batch forward models of inverse design).
+COARSE_STEP = 2.0
+
+
+def _interpolant_weights_at(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    ``(nodes, weights)`` such that ``XYZ = R(nodes) @ weights`` integrates the linear interpolant of a spectrum
+    sampled at ascending ``nodes`` (nm, spanning the CMFs' range): the interpolant sampled every ``1 / K`` nm and
+    integrated against the CMFs' hats as the converged colours are (:func:`hat_average`), ``K`` the power of two
+    that puts a sample in every node interval (``K = 1``, the 1-nm sum, for nodes 1 nm apart or more).
+    """
+    count = nodes.size
+    K = 2 ** max(0, math.ceil(math.log2(1.0 / float(np.min(np.diff(nodes))))))
+    fine = fine_wavelengths(K)
+    position = np.interp(fine, nodes, np.arange(count))
+    left = np.minimum(np.floor(position).astype(int), count - 2)
+    frac = position - left
+    interpolation = np.zeros((fine.size, count))
+    interpolation[np.arange(fine.size), left] = 1.0 - frac
+    interpolation[np.arange(fine.size), left + 1] += frac
+    # Fortran order: at K = 1 the same product, bit for bit, as the 1-nm sum of the interpolant.
+    return nodes, np.asfortranarray(hat_average(interpolation.T, K)) @ colour_matching_functions()
+
+
+@functools.lru_cache(maxsize=None)
+def interpolant_nodes(step: float = COARSE_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Nodes every ``step`` nm over the CMFs' range and the XYZ weights that integrate the spectrum's linear
+    interpolant between them against the 1-nm CMFs: ``XYZ = R(nodes) @ weights`` (cached).
+    """
+    count = int(math.ceil((WAVELENGTH_MAX - WAVELENGTH_MIN) / step)) + 1
+    return _interpolant_weights_at(np.linspace(WAVELENGTH_MIN, WAVELENGTH_MAX, count))
+
+
+@functools.lru_cache(maxsize=None)
+def log_interpolant_nodes(ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """
+    :func:`interpolant_nodes` at the wavelengths ``lambda_max r^-j`` (ascending) down to below ``lambda_min``
+    (the scale scan's of inverse design: its spectra are functions of ``s / lambda``).
+    """
+    count = int(np.ceil(np.log(WAVELENGTH_MAX / WAVELENGTH_MIN) / np.log(ratio))) + 1
+    return _interpolant_weights_at(WAVELENGTH_MAX / ratio ** np.arange(count)[::-1])
 
 
 def _power_of_two_at_least(x: float) -> int:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.files import atomic_output
+from explorer.files import atomic_output, check_output, save_figure
 from explorer.views.plots import ABSCISSAE, PlotSettings, abscissa, lobe_directions
 
 #: The chart's size in inches and dots per inch (640 x 440 pixels).
@@ -64,20 +64,13 @@ def write_plot(view: str, values: np.ndarray, settings: PlotSettings, out: Path,
     ``.npy`` gets :func:`plot_table`, ``.png`` a matplotlib chart (Agg), ``title`` above it; ``light`` (degrees) is
     drawn in the lobe and named in the caption; ``mirror``: a smooth mirror's (its values are a reflectance).
     """
-    suffix = Path(out).suffix.lower()
-    with atomic_output(out, (".png", ".npy")) as temporary:
-        if suffix == ".npy":
+    check_output(out, (".png", ".npy"))
+    if Path(out).suffix.lower() == ".npy":
+        with atomic_output(out, (".npy",)) as temporary:
             with open(temporary, "wb") as stream:
                 np.save(stream, plot_table(view, values, settings))
-            return
-        figure = chart(view, values, settings, title, light, mirror)
-        try:
-            with open(temporary, "wb") as stream:
-                figure.savefig(stream, format="png", dpi=DPI)
-        finally:
-            import matplotlib.pyplot as plt
-
-            plt.close(figure)
+        return
+    save_figure(chart(view, values, settings, title, light, mirror), out, dpi=DPI)
 
 
 def chart(view: str, values: np.ndarray, settings: PlotSettings, title: str = "", light=None, mirror: bool = False):

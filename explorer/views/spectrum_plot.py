@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.errors import LocatedError
-from explorer.files import atomic_output
+from explorer.files import save_figure
 from explorer.physics import dispersion
 from explorer.physics.natural import NaturalMirror, band_gaps, mirror_spectrum, wavelength_grid
 
@@ -65,12 +65,7 @@ def write_plot(document: dict, mirror: NaturalMirror, out, title: str) -> None:
             ax.legend(loc="upper right", fontsize=7, ncols=5)
     axes[-1, 0].set_xlabel("wavelength (nm)")
     figure.tight_layout()
-    with atomic_output(out, (".png",)) as temporary:
-        try:
-            with open(temporary, "wb") as stream:
-                figure.savefig(stream, format="png")
-        finally:
-            plt.close(figure)
+    save_figure(figure, out)
 
 
 def describe(mirror: NaturalMirror) -> str:

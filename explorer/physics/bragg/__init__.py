@@ -31,7 +31,9 @@ The subpackage by subject (every name is re-exported here, so ``bragg.NAME`` rea
   band edges;
 - :mod:`~explorer.physics.bragg.band_pieces`: the converged colour by Gauss quadrature over band pieces;
 - :mod:`~explorer.physics.bragg.tables`: the tabulated method's converged and draft tables;
-- :mod:`~explorer.physics.bragg.textured`: spatially varying mirrors (supplemental Figure 7).
+- :mod:`~explorer.physics.bragg.textured`: spatially varying mirrors (supplemental Figure 7);
+- :mod:`~explorer.physics.bragg.batch`: Yeh's reflectance of many mirrors at once, ``N`` continuous, fringes averaged
+  where a coarse sampling would alias them (inverse design's forward model).
 """
 
 from explorer.physics.bragg.approximation import (  # noqa: F401
@@ -109,6 +111,12 @@ from explorer.physics.bragg.band_pieces import (  # noqa: F401
     _pieces_xyz,
     _safeguarded_newton,
     band_pieces_rgb,
+)
+from explorer.physics.bragg.batch import (  # noqa: F401
+    BATCH_EDGE,
+    absorbing_reflectance_batch,
+    bragg_reflectance_batch,
+    chebyshev_U_real_N,
 )
 from explorer.physics.bragg.mirror import (  # noqa: F401
     BISECTION_STEPS,

@@ -1,0 +1,240 @@
+"""
+Yeh's reflectance of many mirrors at once (Section 3.1, Eqs. 2, 8-10, Appendix D): the batched forward model that
+inverse design screens, scans and refines on (parameters as arrays, ``N`` continuous, complex indices allowed).
+Numpy only; no GLSL twin (no view draws it).
+
+It is :func:`explorer.physics.bragg.bragg_reflectance` (tested equal to 1e-9 at integer ``N``) with three
+intended differences, each what a search over structures needs:
+
+- ``N`` is real: ``U_{N-1}(cos t) = sin(N t) / sin t`` continues the Chebyshev polynomials to fractional cell
+  counts (:func:`chebyshev_U_real_N`), so that the count is a continuous search variable;
+- sampled ``step`` nm apart, fringes narrower than a few steps are blended into their average over a fringe
+  (:func:`explorer.physics.bragg.fringe_average_under_host`), with the weight
+  ``w = clip((lambda^2 / (2 N P) / s - 1) / 3, 0, 1)`` of the point value (``P`` the cell's optical thickness
+  along z, ``lambda^2 / (2 N P)`` the fringes' spacing, ``s`` the step or the ``smooth`` width): the converged
+  colour of such a mirror integrates that average, and point samples would alias;
+- the slabs' phases ``k_z d`` have their decay capped (:func:`explorer.physics.bragg.clamp_decay`) before the
+  exponentials, as in the dispersion relation, rather than only there.
+
+With complex indices (a medium's ``n + i k``) the characteristic-matrix form holds at each wavelength with a
+complex ``cos K Lambda`` (:func:`absorbing_reflectance_batch`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from explorer.physics import multilayer
+from explorer.physics.bragg.approximation import fringe_average_under_host
+from explorer.physics.bragg.mirror import COS_THETA_MIN, POLARISATIONS, Omega
+from explorer.physics.bragg.reflectance import chebyshev_U, clamp_decay, reflection_coefficient_host
+from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
+
+#: Below this ``|sin K Lambda|`` (real indices) or ``|1 - z^2|`` (complex ones) the band edge's limits
+#: ``U_{N-1} -> N``, ``U_{N-2} -> N - 1`` are taken: a continuous ``N`` lands there at any value.
+BATCH_EDGE = 1e-9
+
+
+def chebyshev_U_real_N(a: ArrayLike, N: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    :func:`explorer.physics.bragg.chebyshev_U` for a real (array) ``N``, with the band edges' limits ``N`` and
+    ``N - 1`` where ``|sin t| <`` :data:`BATCH_EDGE`.
+    """
+    U_N1, U_N2, scale = chebyshev_U(a, N)
+    in_band = np.abs(a) < 1.0
+    edge = in_band & (np.abs(np.sin(np.arccos(np.clip(a, -1.0, 1.0)))) < BATCH_EDGE)
+    if edge.any():
+        N = np.broadcast_to(np.asarray(N, dtype=np.float64), U_N1.shape)
+        U_N1, U_N2 = np.where(edge, N, U_N1), np.where(edge, N - 1.0, U_N2)
+    return U_N1, U_N2, scale
+
+
+@dataclass
+class _CellPhases:
+    """A cell's slab phases ``psi = k_1z d1``, ``phi = k_2z d2`` (decay capped) as exponentials, cosines and sines."""
+
+    e_psi: np.ndarray
+    e_phi: np.ndarray
+    cos_psi: np.ndarray
+    sin_psi: np.ndarray
+    cos_phi: np.ndarray
+    sin_phi: np.ndarray
+
+
+def _cell_phases(omega: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> _CellPhases:
+    """
+    :class:`_CellPhases` of optical thicknesses ``p1``, ``p2`` along z (real or complex): ``cos x = (e^{ix} + e^{-ix}) / 2``
+    and ``sin x = (e^{ix} - e^{-ix}) / 2i`` from one exponential each.
+    """
+    e_psi, e_phi = np.exp(1j * clamp_decay(omega * p1)), np.exp(1j * clamp_decay(omega * p2))
+    return _CellPhases(e_psi, e_phi, (e_psi + 1.0 / e_psi) / 2.0, (e_psi - 1.0 / e_psi) / 2j,
+                       (e_phi + 1.0 / e_phi) / 2.0, (e_phi - 1.0 / e_phi) / 2j)
+
+
+def _point_weight(p1, p2, wavelengths, N, step: float | None, smooth, shape) -> np.ndarray:
+    """
+    The point value's weight ``w`` (module docstring) of shape ``shape``: 1 without a ``step``. Fringes
+    ``lambda^2 / (2 N P)`` apart (``P = Re p1 + Re p2``); a point sample per step resolves them from ~4 per
+    fringe, and averages them out below 1 per fringe.
+    """
+    if step is None:
+        return np.ones(shape)
+    path = np.maximum(np.real(p1) + np.real(p2), 1e-9)
+    fringe = wavelengths**2 / (2.0 * N * path)
+    return np.broadcast_to(np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0), shape)
+
+
+def _slab(r12, e_phi) -> tuple[np.ndarray, np.ndarray]:
+    """The slab's ``r1, t1`` (Eq. 10) from ``r12`` and ``e^{i phi}``, as :func:`explorer.physics.bragg.airy_slab_coefficients`."""
+    phase2 = e_phi * e_phi
+    r12_2 = r12 * r12
+    denominator = 1.0 - r12_2 * phase2
+    return r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * e_phi / denominator
+
+
+def _column(v, dtype=None) -> np.ndarray:
+    """A parameter ``(B,)`` as ``(B, 1, 1)``; ``(B, 1, W)`` (a dispersive medium's index per wavelength) as it is."""
+    a = np.asarray(v, dtype=dtype)
+    return a.reshape(-1, 1, 1) if a.ndim <= 1 else a
+
+
+def bragg_reflectance_batch(
+    n1: ArrayLike, n2: ArrayLike, Lambda: ArrayLike, delta: ArrayLike, N: ArrayLike, nh: ArrayLike, cos_theta: ArrayLike,
+    wavelengths: ArrayLike, step: float | None = None, smooth: float | None = None,
+) -> np.ndarray:
+    """
+    Unpolarised ``R_lambda`` of many mirrors at once: parameters of shape ``(B,)`` (``nh < 1``: the host is
+    ``n1``; ``N`` may be fractional; an index may also be ``(B, 1, W)``, per wavelength), ``cos_theta`` ``(A,)``
+    in the host, ``wavelengths`` ``(W,)`` nm; returns ``(B, A, W)``. Appendix D's coefficient
+    ``r_hN = (r_N + r_h1) / (1 + r_h1 r_N)`` with ``r_N = r1 U_{N-1} / (U_{N-1} - U_{N-2} t1 e^{i k_1z d1})`` and the
+    slab's ``r1, t1`` (Eq. 10); ``|r_N|^2`` is Yeh's Eq. 2 when the host is ``n1`` (``r_h1 = 0``). Equals
+    :func:`explorer.physics.bragg.bragg_reflectance` at integer ``N`` (tested) when ``step`` is None.
+
+    ``step`` (nm): the spectrum is to be sampled that coarsely, so where the fringes are narrower than a
+    few steps it is blended into its average over the fringes (the module docstring's ``w``).
+    ``smooth`` (nm, default ``step``) averages out fringes narrower than a few times it: the screening's
+    smoother landscape (the envelope's band gaps without the fringes' ripples). Complex indices:
+    :func:`absorbing_reflectance_batch`.
+    """
+    if any(np.iscomplexobj(v) for v in (n1, n2, nh)):
+        return absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta, wavelengths, step, smooth)
+    n1, n2, Lambda, delta, N, nh = (_column(v, np.float64) for v in (n1, n2, Lambda, delta, N, nh))
+    host = nh >= 1.0
+    eta_h = np.where(host, nh, n1)
+    cos_h = np.maximum(np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1), COS_THETA_MIN)
+    wavelengths = np.asarray(wavelengths, dtype=np.float64).reshape(1, 1, -1)
+    omega = 2.0 * np.pi / wavelengths
+    cos_1 = cos_theta_transmitted(cos_h, eta_h, n1)
+    cos_2 = cos_theta_transmitted(cos_h, eta_h, n2)
+    p1 = n1 * cos_1 * delta * Lambda
+    p2 = n2 * cos_2 * (1.0 - delta) * Lambda
+    ph = _cell_phases(omega, p1, p2)
+    w_point = _point_weight(p1, p2, wavelengths, N, step, smooth, np.broadcast_shapes(cos_1.shape, wavelengths.shape, n1.shape))
+    # Each sample computes only the reflectances its weight needs: a scan's spectrum runs from point
+    # samples (thin, short cells) to averages (thick stacks), blending both over a factor ~4 in between.
+    point, averaged = w_point > 0.0, w_point < 1.0
+    total = 0.0
+    for pol in POLARISATIONS:
+        r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
+        a = np.real(ph.cos_psi * ph.cos_phi - 0.5 * Omega(pol, n1, cos_1, n2, cos_2) * ph.sin_psi * ph.sin_phi)  # Eq. 8
+        r1, t1 = _slab(r12, ph.e_phi)
+        r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
+        R = _where_needed(point, _point_reflectance, a, N, r1, t1, ph.e_psi, r_h1)
+        if averaged.any():
+            average = _where_needed(averaged, _averaged_reflectance, r1, t1, omega, p1, r_h1, a)
+            R = w_point * R + (1.0 - w_point) * average
+        total = total + R
+    return np.clip(total / 2.0, 0.0, 1.0)
+
+
+def _point_reflectance(a, N, r1, t1, e_psi, r_h1) -> np.ndarray:
+    """``|r_hN|^2`` of :func:`bragg_reflectance_batch` at its samples (Appendix D, ``N`` real)."""
+    U_N1, U_N2, _ = chebyshev_U_real_N(a, N)
+    r_N = r1 * U_N1 / (U_N1 - U_N2 * t1 * e_psi)
+    return np.abs(reflection_coefficient_host(r_N, r_h1)) ** 2
+
+
+def _averaged_reflectance(r1, t1, omega, p1, r_h1, a) -> np.ndarray:
+    """``|r_hN|^2`` of :func:`bragg_reflectance_batch` averaged over its fringes (Appendix D)."""
+    return fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), a)
+
+
+def _where_needed(mask: np.ndarray, function: Callable[..., np.ndarray], *arrays) -> np.ndarray:
+    """``function(*arrays)`` where ``mask`` (the arrays broadcast to its shape), 0 elsewhere."""
+    if mask.all():
+        return np.broadcast_to(function(*arrays), mask.shape)
+    out = np.zeros(mask.shape)
+    if mask.any():
+        out[mask] = function(*(np.broadcast_to(v, mask.shape)[mask] for v in arrays))
+    return out
+
+
+@dataclass
+class _Geometry:
+    """What :func:`explorer.physics.bragg.fringe_average_under_host` reads of a cell (``r_h1 = 0``: no host)."""
+
+    p1: np.ndarray
+    r_h1: np.ndarray
+
+
+def absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta: ArrayLike, wavelengths: ArrayLike,
+                                step: float | None = None, smooth: float | None = None) -> np.ndarray:
+    """
+    :func:`bragg_reflectance_batch` with complex indices ``n1``, ``n2`` (``(B,)`` or ``(B, 1, W)``) under a lossless
+    host ``nh`` (``nh < 1``: ``Re n1``, as :class:`explorer.physics.natural.NaturalMirror`).
+
+    Yeh's ``[M]^N = U_{N-1} M - U_{N-2} I`` (Appendix D) holds at each wavelength with complex indices, where
+    ``cos K Lambda`` is complex, and so is ``K Lambda = t``. With ``Im t >= 0`` and ``z = e^{i t}`` (``|z| <= 1``),
+    ``z^{N-1} (1 - z^2) U_{N-1} = 1 - z^{2N}`` and ``z^{N-1} (1 - z^2) U_{N-2} = z (1 - z^{2N-2})``: ``r_N`` is a
+    ratio of these, finite for any (real) ``N``. At point samples (``step`` None, or fringes wide against it) it
+    is the exact unpolarised reflectance of :func:`explorer.physics.natural.mirror_spectrum` (tested to 1e-9).
+    Fringes narrower than a few steps are blended into :func:`explorer.physics.bragg.fringe_average_under_host`
+    taken at ``Re cos K Lambda`` (the screening's approximation), less so where absorption damps them
+    (visibility ``exp(-2 N Im K Lambda)``).
+    """
+    n1, n2 = _column(n1).astype(np.complex128), _column(n2).astype(np.complex128)
+    Lambda, delta, N = (_column(v, np.float64) for v in (Lambda, delta, N))
+    nh = np.real(_column(nh)).astype(np.float64)
+    eta_h = np.where(nh >= 1.0, nh, np.real(n1))
+    cos_h = np.maximum(np.asarray(cos_theta, dtype=np.float64).reshape(1, -1, 1), COS_THETA_MIN)
+    wavelengths = np.asarray(wavelengths, dtype=np.float64).reshape(1, 1, -1)
+    omega = 2.0 * np.pi / wavelengths
+    n_sin = eta_h * np.sqrt(1.0 - cos_h * cos_h)
+    kz_h = (eta_h * cos_h).astype(np.complex128)
+    kz1, kz2 = multilayer.forward_kz(n1, n_sin), multilayer.forward_kz(n2, n_sin)
+    p1, p2 = kz1 * delta * Lambda, kz2 * (1.0 - delta) * Lambda
+    ph = _cell_phases(omega, p1, p2)
+    shape = np.broadcast_shapes(kz1.shape, kz2.shape, wavelengths.shape, N.shape, Lambda.shape)
+    w_point = _point_weight(p1, p2, wavelengths, N, step, smooth, shape)
+    total = 0.0
+    for pol in POLARISATIONS:
+        r12, _ = multilayer.interface(pol, n1, kz1, n2, kz2)
+        r_h1, _ = multilayer.interface(pol, eta_h.astype(np.complex128), kz_h, n1, kz1)
+        x = kz2 / kz1 if pol == "s" else (n1 * n1 * kz2) / (n2 * n2 * kz1)
+        x = np.where(np.abs(x) < 1e-10, 1e-10, x)
+        a = ph.cos_psi * ph.cos_phi - 0.5 * (x + 1.0 / x) * ph.sin_psi * ph.sin_phi  # Eq. 8, complex
+        r1, t1 = _slab(r12, ph.e_phi)
+        # Below the gap at K Lambda ~ pi, U_n(-b) = (-1)^n U_n(b): the ratio U_{N-2} / U_{N-1} of -a, negated,
+        # continues the count N as the real model does (chebyshev_U's gap: no phase e^{2 pi i N} between counts).
+        flip = np.real(a) < -1.0
+        t = np.arccos(np.where(flip, -a, a).astype(np.complex128))
+        t = np.where(np.imag(t) < 0.0, -t, t)  # U_n(cos t) is even in t: the decaying branch
+        z = np.exp(1j * t)
+        one_z2 = 1.0 - z * z
+        edge = np.abs(one_z2) < BATCH_EDGE
+        safe = np.where(edge, 1.0, one_z2)
+        W1 = np.where(edge, N, (1.0 - np.exp(2j * N * t)) / safe)
+        W2 = np.where(edge, z * (N - 1.0), z * (1.0 - np.exp(2j * (N - 1.0) * t)) / safe)
+        W2 = np.where(flip, -W2, W2)
+        r_N = r1 * W1 / (W1 - W2 * t1 * ph.e_psi)
+        R = np.abs(reflection_coefficient_host(r_N, r_h1)) ** 2
+        if step is not None and np.any(w_point < 1.0):
+            average = fringe_average_under_host(r1, t1, omega, _Geometry(p1, r_h1), np.real(a))
+            w = 1.0 - (1.0 - w_point) * np.exp(-2.0 * N * np.imag(t))
+            R = w * R + (1.0 - w) * average
+        total = total + R
+    return np.clip(total / 2.0, 0.0, 1.0)
