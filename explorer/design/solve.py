@@ -237,6 +237,10 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
             if time.process_time() > deadline or best[1] < problem.polished_cost:
                 break
         values = best[0]
+        if best[1] > REACHED_DELTA_E**2 * len(targets):
+            # 4b. Neighbouring counts: an absorbing stack's colours change little with N (light no longer reaches
+            # its last cells), so the coarse stages may settle on a count whose basin holds no exact match.
+            values = _neighbouring_counts(problem, values, best[1], POLISH_SECONDS)
         stages["polish"] = time.perf_counter() - start_time
     achieved = problem.fine_rgb(values, final=True)
     report(1.0, "done")
@@ -251,6 +255,40 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
         evaluations=problem.evaluations,
         stages=stages,
     )
+
+
+#: The counts tried beside a polished count that leaves a target above REACHED_DELTA_E.
+COUNT_NEIGHBOURS = (-2, -1, 1, 2)
+COUNT_WALKS = 3
+
+
+def _neighbouring_counts(problem: _Problem, values: Mapping[str, float], cost: float, seconds: float) -> dict[str, float]:
+    """
+    ``values`` polished again at each count of :data:`COUNT_NEIGHBOURS` around its own (the other parameters as
+    they are), each within ``seconds`` of CPU, walking on from a better count while one is found (at most
+    :data:`COUNT_WALKS` times): the best of these and ``values``.
+    """
+    k = next((j for j, p in enumerate(problem.free) if p.integer), None)
+    if k is None:
+        return dict(values)
+    p = problem.free[k]
+    best = (dict(values), cost)
+    tried = {int(round(float(values[p.name])))}
+    for _ in range(COUNT_WALKS):
+        centre, u = best[0], problem.unit_row(best[0])
+        for step in COUNT_NEIGHBOURS:
+            count = int(round(float(centre[p.name]))) + step
+            if not p.low <= count <= p.high or count in tried:
+                continue
+            tried.add(count)
+            trial = u.copy()
+            trial[k] = p.to_unit(float(count))
+            found, found_cost = _polish(problem, np.clip(trial, 0.0, 1.0), max_nfev=20, deadline=time.process_time() + seconds)
+            if found_cost < best[1]:
+                best = (found, found_cost)
+        if best[0] is centre or best[1] < problem.polished_cost:
+            break
+    return best[0]
 
 
 def _reported_values(problem: _Problem, values: Mapping[str, float]) -> dict[str, float]:
