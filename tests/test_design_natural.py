@@ -120,3 +120,25 @@ def test_fit_refusals_are_one_line(tmp_path):
                           (["--free", "Lambda,kappa"], "'kappa' is not fitted"),
                           (["--fix", "N=6", "--free", "N"], "also fixed")):
         assert message in one_line_error(run_cli("design", "bragg_mirror", "--target-spectrum", str(path), *args))
+
+
+def test_a_count_off_by_two_is_walked_back():
+    # Keratin over melanin: its colours change little with N, so a polish may end at another count; the walk to
+    # neighbouring counts (explorer.design.solve._neighbouring_counts) finds the truth's from two cells off.
+    from explorer.design.media import with_media
+    from explorer.design.search import _Problem
+    from explorer.design.solve import _neighbouring_counts
+    from explorer.design.targets import parameter_box
+    from explorer.physics.dispersion import LIBRARY
+
+    media = {"n1": LIBRARY["keratin"], "n2": LIBRARY["melanin"]}
+    truth = dict(n1=1.5515, n2=1.7263, Lambda=173.9, delta=0.4536, N=6, nh=0.0)
+    colours = natural_rgb(np.cos(np.radians(ANGLES)), mirror_with_media(truth, media))
+    model = with_media(design.design_model("bragg_mirror"), media)
+    fixed = {k: truth[k] for k in ("n1", "n2", "nh")}
+    problem = _Problem(model, parameter_box(model, RANGES), fixed, [design.Target(a, tuple(c)) for a, c in zip(ANGLES, colours)], None)
+    start = {**truth, "N": 8, "k1": 0.0, "k2": 0.0, "sigma": 0.0}
+    cost = float(np.sum(problem.fine_residuals(problem.unit_row(start))[1] ** 2))
+    assert cost > len(ANGLES), cost  # two cells off: above ΔE2000 1 per target
+    found = _neighbouring_counts(problem, start, cost, 1.5)
+    assert found["N"] == 6 and abs(found["Lambda"] - 173.9) < 0.5, found
