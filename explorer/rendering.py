@@ -131,6 +131,11 @@ def render_material(
                                                          "sigma and media (the sphere, lit and env views show them)")
         thickness = default_texture(material) if thickness is None else thickness
         check_prefilter(round_integer(values.get("method", 0)), thickness.prefilter)
+    if mesh is not None and thickness is not None:
+        if mesh.uvs is None:
+            raise LocatedError("--mesh", None, f"{mesh.name} has no texture coordinates ('vt'): no surface texture on it")
+        if thickness.prefilter:
+            raise LocatedError("--prefilter", None, "prefiltering is the sphere's, not a mesh's")
     if engine == "numpy":
         from explorer.materials.models import model_for
         from explorer.views.geometry import BRDF_VIEWS
@@ -153,6 +158,11 @@ def render_material(
     if view == "textured":
         renderer.limits.check_texture(thickness.d_inc.shape[1], thickness.d_inc.shape[0], 1, thickness.source)
         checked()
+        if mesh is not None:
+            from explorer.gpu.mesh import render_mesh
+
+            return render_mesh(renderer, material, values, view, mesh, width, height, light=light,
+                               surface=thickness.gl_arguments(material, values, width, height))
         return renderer.render(material, values, view, width, height,
                                **gl_inputs(view, light=light, surface=thickness.gl_arguments(material, values, width, height)))
     view_named(view)  # an unknown view: one line listing them

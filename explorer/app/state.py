@@ -145,6 +145,7 @@ class AppState:
     design: dict | None = None  # the Design window's targets, progress and result (reported)
     plots: dict | None = None  # the Plots window's plot, settings, light and plotted values (reported)
     texture_view: dict | None = None  # the Texture window's settings and its image's mean RGB (reported)
+    maps_folder: str = ""  # structure maps the Texture window draws on the mirror (open --maps; "" the grey image)
     error: str = ""  # the material's load/compile error, shown in red; the last good shader stays
     # Requests, served when the frame allows.
     pending_screenshot: str | None = None

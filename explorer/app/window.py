@@ -69,13 +69,17 @@ class App:
 
     def __init__(self, material_path, preset: str | None = None, *, script: list | None = None,
                  report: str | os.PathLike | None = None, window_size=DEFAULT_WINDOW, view_size: int | None = None,
-                 is_default: bool = False, more_paths=()):
+                 is_default: bool = False, more_paths=(), maps: str | None = None):
         material = load_material(Path(material_path))
         values = initial_values(material, preset, is_default)
+        if maps is not None:  # the folder's fixed values (checked by the command): the maps complete them
+            from explorer.views.surface_texture import MapTexture
+
+            values = material.resolve(MapTexture.from_folder(maps, material, values)[1])
         self.state = AppState(
             material_path=Path(material_path), material=material, values=values, compare=CompareState(values_b=dict(values)),
             preset=preset, view_size=int(view_size or DEFAULT_VIEW_SIZE), view_size_auto=view_size is None,
-            mode="sphere" if has_reflectance(material) else "lit",
+            mode="sphere" if has_reflectance(material) else "lit", maps_folder=str(maps or ""),
         )
         self.state.materials.append(MaterialEntry(Path(material_path), material, values, self.state.next_colour()))
         for path in more_paths:
@@ -482,8 +486,8 @@ def _style(imgui, implot) -> None:
 
 
 def run_app(material_path, preset: str | None = None, *, script=None, report=None, window_size=DEFAULT_WINDOW,
-            view_size: int | None = None, is_default: bool = False, more_paths=()) -> int:
-    """Open the explorer on ``material_path`` (and ``more_paths``); :class:`AppError` when no window can be opened."""
+            view_size: int | None = None, is_default: bool = False, more_paths=(), maps: str | None = None) -> int:
+    """Open the explorer on ``material_path`` (and ``more_paths``; ``maps``: a map folder on the first); :class:`AppError` when no window can be opened."""
     app = App(material_path, preset, script=script, report=report, window_size=window_size, view_size=view_size,
-              is_default=is_default, more_paths=more_paths)
+              is_default=is_default, more_paths=more_paths, maps=maps)
     return app.run()

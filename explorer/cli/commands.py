@@ -237,7 +237,9 @@ def cli(ctx: click.Context, debug: bool) -> None:  # debug: read by main() befor
               help="Play a scripted session (a JSON list of actions, docs/app.md), then close: screenshots, tests, bench --app.")
 @click.option("--report", type=click.Path(dir_okay=False), metavar="FILE.json", help="Write the session's JSON report (frame times, values).")
 @click.option("--window-size", metavar="WxH", help="Window size in pixels (default 1280x800).")
-def open_material(materials, preset, script, report, window_size):
+@click.option("--maps", "maps_dir", metavar="DIR", help="Structure maps (design --target-image --out-maps DIR) drawn on the mirror "
+              "in the Texture window, each map shown there; MATERIAL defaults to the one the folder names.")
+def open_material(materials, preset, script, report, window_size, maps_dir):
     """Open the interactive explorer on MATERIALS (.brd, BRDF Explorer's .brdf, or built-ins' names; none:
     the default Bragg mirror).
 
@@ -247,9 +249,17 @@ def open_material(materials, preset, script, report, window_size):
     from explorer.app import DEFAULT_WINDOW, AppError, display_available, run_app
     from explorer.gpu import GLUnavailable
 
-    materials = materials or (str(DEFAULT_MATERIAL),)
     try:
+        if maps_dir is not None and not materials:
+            from explorer.views.maps import maps_material
+
+            materials = (maps_material(maps_dir),)
+        materials = materials or (str(DEFAULT_MATERIAL),)
         loaded = _load(materials[0])
+        if maps_dir is not None:  # a bad folder: one line before any window
+            from explorer.views.surface_texture import MapTexture
+
+            MapTexture.from_folder(maps_dir, loaded, loaded.resolve({}))
         more = [_load(other).path for other in materials[1:]]
         if preset is not None:
             from explorer.materials.presets import presets_for
@@ -272,7 +282,7 @@ def open_material(materials, preset, script, report, window_size):
             raise AppError("no display: the explorer needs a window (set DISPLAY, or run under xvfb-run); "
                            f"for images without a window use: {command_prefix()} render")
         status = run_app(loaded.path, preset, script=actions, report=report, window_size=size,
-                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more)
+                         is_default=Path(loaded.path).resolve() == DEFAULT_MATERIAL.resolve(), more_paths=more, maps=maps_dir)
     except ImportError as error:
         _fail(f"the explorer needs imgui-bundle and PyOpenGL ({error}); run: python3 -m explorer")
     except (LocatedError, GLUnavailable, OutputError, AppError) as error:
@@ -318,7 +328,7 @@ def _errors(function):
 @click.option("--env", "env_file", metavar="FILE|NAME", help="env view (and lit: what a smooth mirror reflects): equirectangular .hdr or .exr (default shaders/environments/default.hdr), or sky, studio, 'white furnace'.")
 @click.option("--spp", type=click.IntRange(min=1), help="env view, or --engine position-free: Monte Carlo samples per pixel (default 64).")
 @click.option("--variant", help="--engine mitsuba: llvm_ad_rgb (default), llvm_ad_spectral, scalar_rgb or scalar_spectral.")
-@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit and env views: this mesh instead of the sphere (an OBJ file, or a generated shape).")
+@click.option("--mesh", metavar="FILE.obj|teapot|cube|torus", help="lit, textured and env views: this mesh instead of the sphere (an OBJ file, or a generated shape; a texture or --maps by its texture coordinates).")
 @click.option("--env-rotation", "env_rotation", type=float, metavar="DEGREES", help="env and lit views: the environment turned about the vertical.")
 @click.option("--background", is_flag=True, help="env view: the environment drawn behind the object (else black).")
 @click.option("--mapping", type=click.Choice(["both", "lambda", "delta", "none"]),
@@ -329,9 +339,9 @@ def _errors(function):
 @click.option("--log", "log_scale", is_flag=True, help="Plots: log10(1 + x).")
 @click.option("--channel", type=click.Choice(["rgb", "r", "g", "b", "luminance"]), help="Plots: the channel plotted (default rgb, all three).")
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
-@click.option("--maps", "maps_dir", metavar="DIR", help="textured view, --engine numpy: the structure maps design --target-image wrote; "
-              "one pixel a texel, its colour at --theta.")
-@click.option("--theta", "maps_theta", type=float, help="--maps: the viewing angle in degrees (default 0).")
+@click.option("--maps", "maps_dir", metavar="DIR", help="textured (lit) and env views: the structure maps design --target-image wrote, "
+              "each texel its own mirror on the sphere; with --theta (--engine numpy): one pixel a texel, its colour at that angle.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees.")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
@@ -349,13 +359,25 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     --phi-v), theta_h (with --theta-d), theta_d (with --theta-h), lobe3d (the lobe for --light) and albedo,
     as a chart (.png) or their values (.npy); --size W sets their samples.
     """
-    if maps_dir is not None:
+    if maps_dir is not None and maps_theta is not None:
         from explorer.cli.paint import render_maps_command
 
         render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
         return
     if maps_theta is not None:
         raise click.UsageError("--theta goes with --maps")
+    if maps_dir is not None:
+        from explorer.views.maps import maps_material
+
+        if click.get_current_context().get_parameter_source("view") == click.core.ParameterSource.DEFAULT:
+            view = "textured"  # the maps on the lit sphere
+        if view not in ("textured", "lit", "env"):
+            raise click.BadParameter(f"the maps are drawn in the textured (lit sphere) and env views, not {view}", param_hint="--maps")
+        if texture is not None or mapping is not None or dinc_range is not None or prefilter == "on":
+            raise click.BadParameter("the maps give the structure of every texel: no --texture, --mapping, --dinc-range or --prefilter",
+                                     param_hint="--maps")
+        material = material or maps_material(maps_dir)
+        view = "textured" if view == "lit" else view  # the textured view is the lit sphere with its surface
     from explorer.views.geometry import scatter_circles, view_named
 
     if material is None:
@@ -391,7 +413,11 @@ def render(material, view, assignments, size, out, engine, light, preset, params
         raise click.BadParameter("the environment fill is the lit view's", param_hint="--fill")
     thickness = None
     surface_given = texture is not None or dinc_range is not None or mapping is not None
-    if view == "textured" or (view == "env" and surface_given):
+    if maps_dir is not None:
+        from explorer.views.surface_texture import MapTexture
+
+        thickness, values = MapTexture.from_folder(maps_dir, loaded, values)
+    elif view == "textured" or (view == "env" and surface_given):
         from explorer.views.surface_texture import BraggTexture, check_texture_kind
         from explorer.views.thickness import DEFAULT_TEXTURE, ThicknessTexture, parse_dinc_range
 
@@ -430,8 +456,8 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if mesh is not None:
         from explorer.views.mesh import mesh_named
 
-        if view not in ("lit", "env") or engine not in ("gl", "numpy"):
-            raise click.BadParameter(f"a mesh is drawn in the lit and env views by the gl and numpy engines, not {view} ({engine})",
+        if view not in ("lit", "env", "textured") or engine not in ("gl", "numpy"):
+            raise click.BadParameter(f"a mesh is drawn in the lit, textured and env views by the gl and numpy engines, not {view} ({engine})",
                                      param_hint="--mesh")
         mesh_shape = mesh_named(mesh)
     if engine == "mitsuba" or variant is not None:
@@ -468,6 +494,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     bad = int((~np.isfinite(image)).sum())
     method = method_labels(loaded).get(round_integer(values["method"])) if "method" in values else None
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
+    if maps_dir is not None:
+        h, w = thickness.index.shape
+        tabulated = method_labels(loaded).get(4) if round_integer(values["method"]) == 3 else None
+        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {tabulated} per texel" if tabulated else "")
     click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 

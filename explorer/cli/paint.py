@@ -141,9 +141,10 @@ def render_maps_command(material: str | None, maps: str, view: str, theta: float
     from explorer.views.maps import map_colours
 
     if view != "textured":
-        raise click.UsageError(f"--maps renders the textured view (the maps' colours at --theta), not {view}")
+        raise click.UsageError(f"--maps with --theta renders the textured view flat (the maps' colours at --theta), not {view}")
     if engine != "numpy":
-        raise click.UsageError("--maps renders with --engine numpy (each texel's converged spectral colour)")
+        raise click.UsageError("--maps with --theta renders with --engine numpy (each texel's converged spectral colour); "
+                               "without --theta the maps are drawn on the sphere, in GL or numpy")
     try:
         exposure_factor = 1.0 if exposure is None else float(exposure)
     except ValueError:

@@ -100,8 +100,8 @@ class ProgressiveEnvRender:
     ):
         if not 0 <= int(seed) < 1 << 32:
             raise ValueError(f"seed must be in [0, 2^32), got {seed}")
-        if mesh is not None and surface is not None:
-            raise LocatedError("--mesh", None, "a surface texture is mapped on the sphere, not on a mesh")
+        if mesh is not None and surface is not None and mesh.uvs is None:
+            raise LocatedError("--mesh", None, f"{mesh.name} has no texture coordinates ('vt'): no surface texture on it")
         self.renderer = renderer
         self.ctx = renderer.ctx
         self.material = material
@@ -129,12 +129,15 @@ class ProgressiveEnvRender:
         self._marginal = renderer.resources.texture(marginal, origin=environment.name)
         self._conditional = renderer.resources.texture(conditional, origin=environment.name)
         self._framebuffer = renderer.target(self.width, self.height, count=2, texture=True)
-        #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals, read by views/mesh/env.glsl.
-        self._mesh_normals = None
+        #: A mesh drawn instead of the sphere (explorer.gpu.mesh): its rasterised normals and texture coordinates, read
+        #: by views/mesh/env.glsl.
+        self._mesh_normals = self._mesh_uvs = None
         if mesh is not None:
-            from explorer.gpu.mesh import mesh_normals
+            from explorer.gpu.mesh import mesh_surface
 
-            self._mesh_normals = renderer.resources.texture(mesh_normals(renderer, mesh, self.width, self.height), origin="--mesh")
+            normals, uvs = mesh_surface(renderer, mesh, self.width, self.height)
+            self._mesh_normals = renderer.resources.texture(normals, origin="--mesh")
+            self._mesh_uvs = renderer.resources.texture(uvs, origin="--mesh")
         self._row_weights = disc_weights(self.width, self.height)
         self._cumulative_weights = np.concatenate([[0.0], np.cumsum(self._row_weights)])
         self._targets = list(self._framebuffer.color_attachments)
@@ -182,6 +185,7 @@ class ProgressiveEnvRender:
         textures["environment"] = self._texture
         if self._mesh_normals is not None:
             textures["mesh_normals"] = self._mesh_normals
+            textures["mesh_uvs"] = self._mesh_uvs
         return {"uniforms": uniforms, "textures": textures}
 
     def _pass(self, bindings: dict, count: int, rows: tuple[int, int] | None = None) -> float:
@@ -296,7 +300,7 @@ class ProgressiveEnvRender:
 
     def release(self) -> None:
         """Free the GL objects (textures, framebuffer)."""
-        self.renderer.resources.release(self._framebuffer, self._texture, self._mesh_normals, self._marginal, self._conditional,
+        self.renderer.resources.release(self._framebuffer, self._texture, self._mesh_normals, self._mesh_uvs, self._marginal, self._conditional,
                                         *self._surface_textures.values())
         self._surface_textures = {}
 

@@ -51,7 +51,8 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
     builder.define("VIEW_" + "".join(c if c.isalnum() else "_" for c in view.upper()), 1)  # mesh/lit -> VIEW_MESH_LIT
     from explorer.views.geometry import VIEW_REGISTRY
 
-    if view in VIEW_REGISTRY and VIEW_REGISTRY[view].surface_texture:
+    registered = VIEW_REGISTRY.get(view.removeprefix("mesh/"))  # a mesh's template: the view it replaces
+    if registered is not None and registered.surface_texture:
         builder.define("SURFACE_TEXTURE", 1)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")
     builder.add_source(material.shader, str(material.path), material.shader_line)

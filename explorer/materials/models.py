@@ -269,32 +269,45 @@ class BraggMirrorModel:
         """The tabulated method's table over ``(cos theta, T)`` under ``mapping`` (:func:`explorer.physics.bragg.textured_rgb_table`)."""
         return bragg.textured_rgb_table(self.mirror, mapping)
 
-    def textured_reflectance(self, cos_theta, T, mapping: str = "both") -> np.ndarray:
+    def textured_reflectance(self, cos_theta, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """
         The twin of the shader's ``textured_reflectance``: the mirror at texture values ``T`` (per sample, in [0, 1])
         under ``mapping`` (supplemental Figure 7, :func:`explorer.physics.bragg.textured_mirror`), by ``method``.
+        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:func:`explorer.physics.bragg.structure_table`),
+        each texel its own mirror; the tabulated method has no table per texel and shows the improved approximation
+        there (as an export away from its table's values), 0 off the maps' mask.
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         T = np.broadcast_to(np.asarray(T, dtype=np.float64), cos_theta.shape)
+        if mapping == "maps":
+            rgb = np.zeros(cos_theta.shape + (3,))
+            for samples, mirror in bragg.mapped_mirrors(structures, T):
+                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod.IMPROVED)
+            return rgb
         if self.method == BraggMethod.TABULATED:
             return bragg.textured_tabulated_rgb(self.texture_table(mapping), cos_theta, T)
-        mirror = bragg.textured_mirror(self.mirror, T, mapping)
-        if self.method == BraggMethod.REFERENCE:
+        return self._mirror_rgb(cos_theta, bragg.textured_mirror(self.mirror, T, mapping))
+
+    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, tabulated: BraggMethod | None = None) -> np.ndarray:
+        """A per-sample mirror's colours by ``method`` (``tabulated``: the method that stands for the tabulated one)."""
+        method = tabulated if self.method == BraggMethod.TABULATED else self.method
+        if method == BraggMethod.REFERENCE:
             return bragg.textured_reference_rgb(cos_theta, mirror, self.wavelength_step)
-        s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[self.method]
-        variant = {"variant": "improved"} if self.method == BraggMethod.IMPROVED else {}
+        s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[method]
+        variant = {"variant": "improved"} if method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
 
-    def textured_mirror_reflection(self, V, N, T, mapping: str = "both") -> np.ndarray:
+    def textured_mirror_reflection(self, V, N, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
         cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)
-        return self.textured_reflectance(cos_theta, T, mapping)
+        return self.textured_reflectance(cos_theta, T, mapping, structures)
 
-    def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both") -> np.ndarray:
+    def textured_brdf(self, L, V, N, X, Y, T, sigma, prefiltered: bool, mapping: str = "both",
+                      structures: np.ndarray | None = None) -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`textured_reflectance` at the half-vector angle (no prefiltering)."""
         if prefiltered:
             raise ValueError("a textured Bragg mirror has no prefiltering (Section 5's is the thin film's)")
-        return self.textured_reflectance(_cos_half_angle(L, V), T, mapping)
+        return self.textured_reflectance(_cos_half_angle(L, V), T, mapping, structures)
 
     #: The parameters the tabulated method's table depends on (:func:`mirror_of`, :func:`natural_mirror_of`
     #: where the file declares them), and the integer ones among them.

@@ -61,6 +61,7 @@ GENERATED: dict[str, Callable[[], str]] = {
         "N_RESOLVE": bragg.N_RESOLVE,
         "GROW_EXPONENT": bragg.GROW_EXPONENT,
         "MAX_RESOLVED_PIECES": bragg.MAX_RESOLVED_PIECES,
+        "TEXTURE_MAPS": bragg.MAPS_MAPPING,
     }, "explorer/physics/bragg/"),
     "generated/colorimetry.glsl": lambda: _block({
         "CMF_COUNT": colorimetry.WAVELENGTHS.size,

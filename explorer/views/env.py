@@ -602,8 +602,7 @@ def env_integral_numpy(
     """
     from explorer.views.geometry import brdf_view_geometry, view_brdf
 
-    if mesh is not None and surface is not None:
-        raise ValueError("a surface texture is mapped on the sphere, not on a mesh")
+    raster = None
     if mesh is not None:
         from explorer.views.mesh import mesh_view_geometry, rasterise
 
@@ -613,11 +612,10 @@ def env_integral_numpy(
         _, V, N, X, Y, inside, _ = brdf_view_geometry("lit", width, height)
     brdf, mirror = model.brdf, getattr(model, "mirror_reflection", None)
     value = None
-    if surface is not None:  # the texture value per pixel, as the shader reads it (surface_value)
-        from explorer.views.geometry import disc
+    if surface is not None:  # the texture value per pixel, as the shader reads it (surface_at(surface_uv))
+        from explorer.views.geometry import surface_values
 
-        x, y, _ = disc(width, height)
-        value = surface.per_pixel(x, y, width, height)[0]
+        value = surface_values(surface, width, height, raster)[0]
         options = surface.model_options()
     if pixels is None:
         rows, columns = np.nonzero(inside)

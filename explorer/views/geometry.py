@@ -151,6 +151,21 @@ def disc(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, y, x * x + y * y
 
 
+def surface_values(surface, width: int, height: int, raster=None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    A surface texture's ``(value, sigma)`` per pixel of a ``(height, width)`` image, as the shaders read it
+    (``surface_at(surface_uv(...))``): at the sphere's planar coordinates of each disc point, or at a mesh's
+    interpolated ones (``raster``: :func:`explorer.views.mesh.rasterise`'s image; float32, as the GL pass writes them).
+    """
+    if raster is None:
+        x, y, _ = disc(width, height)
+        return surface.per_pixel(x, y, width, height)
+    if surface.prefilter:
+        raise ValueError("prefiltering is the sphere's (a footprint per pixel of its planar coordinates), not a mesh's")
+    uvs = raster.uvs.astype(np.float32)
+    return surface.at_uv(uvs[..., 0], uvs[..., 1])
+
+
 def _rotate(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rodrigues' rotation of ``v`` about the unit ``axis`` (the slice view's ``slice_rotate``), float32."""
     n = axis * np.sum(axis * v, axis=-1, keepdims=True)

@@ -95,10 +95,64 @@ def read_maps(folder: str | os.PathLike[str]) -> tuple[dict, dict[str, np.ndarra
     except (OSError, ValueError, KeyError, TypeError) as error:
         raise ValueError(f"{folder / 'params.json'}: not a map folder's parameters ({' '.join(str(error).split())[:100]})") from None
     maps = {name: _read_exr_channel(folder / f"{name}.exr") for name in names}
-    shapes = {m.shape for m in maps.values()}
-    if len(shapes) > 1:
-        raise ValueError(f"{folder}: the maps differ in size ({', '.join(f'{s[1]}x{s[0]}' for s in sorted(shapes))})")
+    if not maps:
+        raise ValueError(f"{folder / 'params.json'}: no free parameter, so no map to read")
+    first = names[0]
+    for name, m in maps.items():
+        if m.shape != maps[first].shape:
+            (h, w), (h0, w0) = m.shape, maps[first].shape
+            raise ValueError(f"{folder / (name + '.exr')}: {w}x{h} texels, but {first}.exr has {w0}x{h0}: the maps differ in size")
     return params, maps
+
+
+def maps_material(folder: str | os.PathLike[str]) -> str:
+    """The material a map folder's ``params.json`` names (for a command given no MATERIAL); ``LocatedError`` otherwise."""
+    from explorer.errors import LocatedError
+
+    path = Path(folder) / "params.json"
+    try:
+        name = json.loads(path.read_text(encoding="utf-8"))["material"]
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise LocatedError(path, None, f"not a map folder's parameters ({' '.join(str(error).split())[:100]})") from None
+    if not isinstance(name, str) or not name:
+        raise LocatedError(path, None, "names no material: give MATERIAL")
+    return name
+
+
+def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], material) -> dict[str, float]:
+    """
+    The folder's fixed values, once its maps fit ``material`` (a Bragg mirror's structure: each map a parameter of it,
+    within its range); a one-line :class:`explorer.errors.LocatedError` naming the file otherwise.
+    """
+    from explorer.errors import LocatedError
+    from explorer.physics.bragg import STRUCTURE_FIELDS
+
+    declared = {p.name: p for p in material.parameters}
+    if params.get("model") != material.model:
+        raise LocatedError(folder / "params.json", None, f"maps of a {params.get('model')}, not of {material.model} ({Path(material.path).name})")
+    if material.texture != "bragg":
+        raise LocatedError(folder / "params.json", None, f"maps are drawn on a Bragg mirror's structure; {Path(material.path).name} has none")
+    fixed = params.get("fixed") or {}
+    if not isinstance(fixed, Mapping):
+        raise LocatedError(folder / "params.json", None, "'fixed' is not an object of NAME: VALUE")
+    for name, value in fixed.items():
+        if name not in declared or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise LocatedError(folder / "params.json", None, f"fixed {name} = {value!r}: not a number of a parameter of {Path(material.path).name}")
+    for name, image in maps.items():
+        path = folder / f"{name}.exr"
+        if name not in declared or name not in STRUCTURE_FIELDS:
+            raise LocatedError(path, None, f"a map of {name}, which is not a structure parameter of {Path(material.path).name} "
+                                           f"({', '.join(n for n in STRUCTURE_FIELDS if n in declared)})")
+        parameter = declared[name]
+        finite = np.isfinite(image)
+        outside = finite & ((image < parameter.min) | (image > parameter.max))
+        if outside.any():
+            j, i = np.argwhere(outside)[0]
+            raise LocatedError(path, None, f"texel ({i}, {j}) = {image[j, i]:g}, outside {name}'s range {parameter.min:g}..{parameter.max:g}")
+        if np.isinf(image).any():
+            j, i = np.argwhere(np.isinf(image))[0]
+            raise LocatedError(path, None, f"texel ({i}, {j}) is infinite (NaN marks a texel off the mask)")
+    return {name: float(value) for name, value in fixed.items()}
 
 
 def _read_exr_channel(path: Path) -> np.ndarray:

@@ -11,10 +11,13 @@ vertex lies at :data:`FILL` of that half-width, and turned for a three-quarter v
 frame around it (``X = normalize(cross((0, 1, 0), N))``, ``Y = cross(N, X)``; ``X = (1, 0, 0)`` where
 ``N`` is vertical), so that a pixel is evaluated exactly as the sphere's pixel of the same normal.
 
-An OBJ file: ``v x y z [w]``, ``vn x y z``, ``f a b c ...`` with ``v``, ``v/vt``, ``v//vn`` or ``v/vt/vn``
-references (1-based, negative from the end); polygons are split into fans. Other statements (``vt``,
-``o``, ``g``, ``s``, ``usemtl``, ``mtllib``, ``l``, ``p``) are ignored. A face without normals gets the
-area-weighted average of its vertices' face normals (for every face: a mesh is smooth or given).
+An OBJ file: ``v x y z [w]``, ``vn x y z``, ``vt u [v [w]]``, ``f a b c ...`` with ``v``, ``v/vt``, ``v//vn`` or
+``v/vt/vn`` references (1-based, negative from the end); polygons are split into fans. Other statements (``o``,
+``g``, ``s``, ``usemtl``, ``mtllib``, ``l``, ``p``) are ignored. A face without normals gets the
+area-weighted average of its vertices' face normals (for every face: a mesh is smooth or given). Texture
+coordinates (where every corner has one; the generated shapes have theirs) carry a surface texture or structure
+maps (:mod:`explorer.views.surface_texture`) onto the mesh: ``(u, v)`` with ``v`` from the top, as the sphere's
+planar ``(u, v)`` (an OBJ's ``vt`` counts ``v`` from the bottom: ``1 - v``).
 """
 
 from __future__ import annotations
@@ -46,12 +49,16 @@ class MeshError(LocatedError):
 
 @dataclass(frozen=True)
 class Mesh:
-    """Triangles: ``positions`` and unit ``normals`` ``(V, 3)`` float64, ``triangles`` ``(T, 3)`` int64, ``name``."""
+    """
+    Triangles: ``positions`` and unit ``normals`` ``(V, 3)`` float64, ``triangles`` ``(T, 3)`` int64, ``name``, and the
+    texture coordinates ``uvs`` ``(V, 2)`` (``v`` from the top), or None.
+    """
 
     positions: np.ndarray
     normals: np.ndarray
     triangles: np.ndarray
     name: str
+    uvs: np.ndarray | None = None
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -89,7 +96,8 @@ def parse_obj(text: str, path: str = "<obj>") -> Mesh:
     """An OBJ file's triangles (see the module's docstring); :class:`MeshError` with the line for a malformed one."""
     positions: list[tuple[float, float, float]] = []
     normals: list[tuple[float, float, float]] = []
-    corners: list[tuple[int, int]] = []  # (position, normal or -1) per triangle corner
+    uvs: list[tuple[float, float]] = []
+    corners: list[tuple[int, int, int]] = []  # (position, normal or -1, texture coordinates or -1) per triangle corner
     for number, raw in enumerate(text.splitlines(), start=1):
         line = raw.split("#", 1)[0].strip()
         if not line:
@@ -105,6 +113,14 @@ def parse_obj(text: str, path: str = "<obj>") -> Mesh:
             if not all(math.isfinite(c) for c in xyz):
                 raise MeshError(path, number, f"'{keyword}' has a non-finite coordinate")
             (positions if keyword == "v" else normals).append(xyz)
+        elif keyword == "vt":
+            try:
+                uv = tuple(float(f) for f in fields[:2]) + ((0.0,) if len(fields) == 1 else ())
+            except ValueError:
+                raise MeshError(path, number, f"'vt' has a field that is not a number: {' '.join(fields)[:60]!r}") from None
+            if not fields or len(fields) > 3 or not all(math.isfinite(c) for c in uv):
+                raise MeshError(path, number, f"'vt' needs 1 to 3 finite numbers (u [v [w]]), got {' '.join(fields)[:60]!r}")
+            uvs.append((uv[0], 1.0 - uv[1]))  # rows from the top, as the sphere's planar v
         elif keyword == "f":
             if len(fields) < 3:
                 raise MeshError(path, number, f"a face needs at least 3 vertices, got {len(fields)}")
@@ -115,24 +131,30 @@ def parse_obj(text: str, path: str = "<obj>") -> Mesh:
                     raise MeshError(path, number, f"face vertex {field!r} is not v, v/vt, v//vn or v/vt/vn")
                 p = _index(parts[0], len(positions), "vertex", path, number)
                 n = _index(parts[2], len(normals), "normal", path, number) if len(parts) == 3 and parts[2] else -1
-                face.append((p, n))
+                t = _index(parts[1], len(uvs), "texture coordinate", path, number) if len(parts) >= 2 and parts[1] else -1
+                face.append((p, n, t))
             for k in range(1, len(face) - 1):  # a fan
                 corners += [face[0], face[k], face[k + 1]]
             if len(corners) > 3 * MAX_FACES:
                 raise MeshError(path, number, f"more than {MAX_FACES} triangles")
-        # vt, o, g, s, usemtl, mtllib, l, p and others: not geometry this view draws
+        # o, g, s, usemtl, mtllib, l, p and others: not geometry this view draws
     if not corners:
         raise MeshError(path, None, "no faces ('f' lines): nothing to draw")
     corner = np.array(corners, dtype=np.int64)
     position_array = np.array(positions, dtype=np.float64)
+    textured = bool((corner[:, 2] >= 0).all())  # texture coordinates only where every corner has them
+    uv_array = np.array(uvs, dtype=np.float64).reshape(-1, 2)
     if (corner[:, 1] < 0).any():  # a corner without a normal: every normal computed (smooth shading)
-        triangles = corner[:, 0].reshape(-1, 3)
-        return Mesh(position_array, vertex_normals(position_array, triangles), triangles, path)
-    unique, inverse = np.unique(corner, axis=0, return_inverse=True)
+        smooth = vertex_normals(position_array, corner[:, 0].reshape(-1, 3))
+        if not textured:
+            return Mesh(position_array, smooth, corner[:, 0].reshape(-1, 3), path)
+        unique, inverse = np.unique(corner[:, [0, 2]], axis=0, return_inverse=True)  # a vertex per (position, uv)
+        return Mesh(position_array[unique[:, 0]], smooth[unique[:, 0]], inverse.reshape(-1, 3), path, uv_array[unique[:, 1]])
+    unique, inverse = np.unique(corner if textured else corner[:, :2], axis=0, return_inverse=True)
     normal_array = _unit(np.array(normals, dtype=np.float64)[unique[:, 1]])
     if (np.linalg.norm(normal_array, axis=-1) == 0.0).any():
         raise MeshError(path, None, "a 'vn' normal is zero")
-    return Mesh(position_array[unique[:, 0]], normal_array, inverse.reshape(-1, 3), path)
+    return Mesh(position_array[unique[:, 0]], normal_array, inverse.reshape(-1, 3), path, uv_array[unique[:, 2]] if textured else None)
 
 
 def load_obj(path: str | os.PathLike[str]) -> Mesh:
@@ -157,7 +179,7 @@ def load_obj(path: str | os.PathLike[str]) -> Mesh:
 
 def cube() -> Mesh:
     """A unit cube, flat-shaded: 6 faces of 4 vertices each with the face's normal."""
-    positions, normals, triangles = [], [], []
+    positions, normals, triangles, uvs = [], [], [], []
     for axis in range(3):
         for sign in (-1.0, 1.0):
             n = np.zeros(3)
@@ -169,23 +191,29 @@ def cube() -> Mesh:
             for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
                 positions.append(0.5 * (n + a * u + b * v))
                 normals.append(n)
+                uvs.append((0.5 * (a + 1), 0.5 * (1 - b)))  # each face the whole texture
             triangles += [(base, base + 1, base + 2), (base, base + 2, base + 3)]
-    return Mesh(np.array(positions), np.array(normals), np.array(triangles, dtype=np.int64), "cube")
+    return Mesh(np.array(positions), np.array(normals), np.array(triangles, dtype=np.int64), "cube", np.array(uvs))
 
 
 def torus(major: float = 1.0, minor: float = 0.4, around: int = 64, across: int = 32) -> Mesh:
-    """A torus about the vertical ``y`` axis, its exact normals: ``around`` x ``across`` quads."""
-    u = 2.0 * np.pi * np.arange(around) / around
-    v = 2.0 * np.pi * np.arange(across) / across
+    """
+    A torus about the vertical ``y`` axis, its exact normals: ``around`` x ``across`` quads; the texture once around
+    each way (the seams' vertices doubled, so that the coordinates do not run back across a quad).
+    """
+    u = 2.0 * np.pi * np.arange(around + 1) / around
+    v = 2.0 * np.pi * np.arange(across + 1) / across
     U, V = np.meshgrid(u, v, indexing="ij")
     normals = np.stack([np.cos(V) * np.cos(U), np.sin(V), np.cos(V) * np.sin(U)], axis=-1)
     centre = np.stack([major * np.cos(U), np.zeros_like(U), major * np.sin(U)], axis=-1)
     positions = centre + minor * normals
+    side = across + 1
     i, j = np.meshgrid(np.arange(around), np.arange(across), indexing="ij")
-    a, b = i * across + j, ((i + 1) % around) * across + j
-    c, d = ((i + 1) % around) * across + (j + 1) % across, i * across + (j + 1) % across
+    a, b = i * side + j, (i + 1) * side + j
+    c, d = (i + 1) * side + j + 1, i * side + j + 1
     triangles = np.concatenate([np.stack([a, d, c], -1).reshape(-1, 3), np.stack([a, c, b], -1).reshape(-1, 3)])
-    return Mesh(positions.reshape(-1, 3), normals.reshape(-1, 3), triangles, "torus")
+    uvs = np.stack([U / (2.0 * np.pi), V / (2.0 * np.pi)], axis=-1).reshape(-1, 2)
+    return Mesh(positions.reshape(-1, 3), normals.reshape(-1, 3), triangles, "torus", uvs)
 
 
 def read_bezier_patches(path: str | os.PathLike[str] = TEAPOT_PATCHES) -> np.ndarray:
@@ -247,14 +275,15 @@ def bezier_mesh(patches: np.ndarray, divisions: int, name: str) -> Mesh:
         welded, index = np.unique(np.round(positions, 9), axis=0, return_inverse=True)
         index = index.reshape(-1)
         normals[degenerate] = vertex_normals(welded, index[faces])[index][degenerate]
-    return Mesh(positions, normals, faces, name)
+    uvs = np.tile(np.stack(np.meshgrid(t, t, indexing="ij"), axis=-1).reshape(-1, 2), (count, 1))  # each patch the whole texture
+    return Mesh(positions, normals, faces, name, uvs)
 
 
 def teapot(divisions: int = TEAPOT_DIVISIONS) -> Mesh:
     """The Utah teapot (:data:`TEAPOT_PATCHES`), turned from its data's z-up to the view's y-up."""
     mesh = bezier_mesh(read_bezier_patches(), divisions, "teapot")
     up = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])  # (x, y, z) -> (x, z, -y), a rotation
-    return Mesh(mesh.positions @ up.T, mesh.normals @ up.T, mesh.triangles, "teapot")
+    return Mesh(mesh.positions @ up.T, mesh.normals @ up.T, mesh.triangles, "teapot", mesh.uvs)
 
 
 #: The shapes ``--mesh NAME`` generates.
@@ -316,6 +345,8 @@ class Rasterised:
     covered: np.ndarray
     margin: np.ndarray
     depth_gap: np.ndarray
+    #: The interpolated texture coordinates ``(H, W, 2)`` (zeros for a mesh without them).
+    uvs: np.ndarray | None = None
 
 
 def rasterise(mesh: Mesh, width: int, height: int) -> Rasterised:
@@ -331,6 +362,8 @@ def rasterise(mesh: Mesh, width: int, height: int) -> Rasterised:
     depth = np.full((height, width), -np.inf)
     second = np.full((height, width), -np.inf)
     out = np.zeros((height, width, 3))
+    uv_out = np.zeros((height, width, 2))
+    uvs = np.zeros((len(positions), 2)) if mesh.uvs is None else mesh.uvs.astype(np.float32).astype(np.float64)  # as GL receives them
     margin = np.zeros((height, width))
     for a, b, c in mesh.triangles:
         xs, ys = px[[a, b, c]], py[[a, b, c]]
@@ -357,11 +390,13 @@ def rasterise(mesh: Mesh, width: int, height: int) -> Rasterised:
         depth[window] = np.where(nearest, z, depth[window])
         n = w0[..., None] * normals[a] + w1[..., None] * normals[b] + w2[..., None] * normals[c]
         out[window] = np.where(nearest[..., None], n, out[window])
+        t = w0[..., None] * uvs[a] + w1[..., None] * uvs[b] + w2[..., None] * uvs[c]
+        uv_out[window] = np.where(nearest[..., None], t, uv_out[window])
         margin[window] = np.where(nearest, smallest, margin[window])
     covered = np.isfinite(depth)
     with np.errstate(invalid="ignore"):  # -inf - -inf off the mesh
         gap = np.where(covered, depth - second, np.inf)
-    return Rasterised(out, covered, margin, gap)
+    return Rasterised(out, covered, margin, gap, uv_out)
 
 
 def surface_frame(N: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.views.geometry import brdf_view_geometry, disc, view_brdf, view_cos_theta, view_named
+from explorer.views.geometry import brdf_view_geometry, view_brdf, view_cos_theta, view_named
 
 #: Pixels a model evaluates at once: a spectral model's per-wavelength arrays stay a few hundred MB
 #: whatever the image size (every model is per pixel, so the chunks change no value).
@@ -49,8 +49,8 @@ def render_numpy(
     ``fill`` (``lit``, not a smooth mirror): the environment fill's radiance (:mod:`explorer.views.fill`); 0: the light alone.
     """
     evaluates = view_named(view).evaluates
-    if mesh is not None and view not in ("lit", "env"):
-        raise ValueError(f"a mesh is drawn in the lit and env views, not {view}")
+    if mesh is not None and view not in ("lit", "env", "textured"):
+        raise ValueError(f"a mesh is drawn in the lit, textured and env views, not {view}")
     if view_named(view).plot is not None:
         from explorer.views.geometry import light_direction
         from explorer.views.plots import PlotSettings, plot_numpy
@@ -71,9 +71,17 @@ def render_numpy(
             from explorer.views.surface_texture import BraggTexture
 
             thickness = BraggTexture.from_file() if callable(getattr(model, "texture_table", None)) else ThicknessTexture.from_file()
-        L, V, N, X, Y, inside, factor = brdf_view_geometry("lit", width, height, light)
-        x, y, _ = disc(width, height)
-        d_inc, sigma = thickness.per_pixel(x, y, width, height)
+        from explorer.views.geometry import surface_values
+
+        raster = None
+        if mesh is not None:  # its normals and texture coordinates (views/mesh/textured.glsl)
+            from explorer.views.mesh import mesh_view_geometry, rasterise
+
+            raster = rasterise(mesh, width, height)
+            L, V, N, X, Y, inside, factor = mesh_view_geometry(raster.normals, raster.covered, light)
+        else:
+            L, V, N, X, Y, inside, factor = brdf_view_geometry("lit", width, height, light)
+        d_inc, sigma = surface_values(thickness, width, height, raster)
         image = np.zeros((height, width, 3), dtype=np.float32)
         vectors = [a[inside] for a in (L, V, N, X, Y)]
 

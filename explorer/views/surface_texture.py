@@ -55,6 +55,9 @@ class BraggTexture:
         """``(T, 0)`` at the pixels ``p = (x, y)``: the same bilinear read as the film's (:meth:`ThicknessTexture.sample`)."""
         return ThicknessTexture(self.T).per_pixel(x, y, width, height)
 
+    def at_uv(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        return ThicknessTexture(self.T).at_uv(u, v)
+
     def model_options(self) -> dict:
         return {"mapping": self.mapping}
 
@@ -75,6 +78,74 @@ class BraggTexture:
                 table = np.asarray(model.texture_table(self.mapping), np.float32)
         inputs = {"surface_texture": self.T[..., None], "surface_moments": np.zeros((1, 1, 2), np.float32), "bragg_texture_table": table}
         return {"inputs": inputs, "uniforms": {"prefilter": False, "texture_mapping": int(TEXTURE_MAPPINGS[self.mapping])}}
+
+
+@dataclass
+class MapTexture:
+    """
+    Structure maps (``design --target-image``'s output, :mod:`explorer.views.maps`) on a Bragg mirror: each texel its
+    own mirror, the mapped parameters from their maps, the others the mirror's values (``values``: the folder's fixed
+    ones over the material's). Read as the textured view reads ``T`` (planar, ``shaders/views/textured.glsl``), but
+    the nearest texel unfiltered: ``T`` is the texel's index into :func:`explorer.physics.bragg.structure_table`
+    (``mapped_mirror`` in lib/bragg.glsl). Off the maps' mask the surface is black.
+    """
+
+    #: The maps as read (name: float ``(H, W)``, NaN off the mask), for the Texture window.
+    maps: dict
+    #: The mirror's values the maps complete (the material's, the folder's fixed ones over them).
+    values: dict
+    source: str = "<maps>"
+    prefilter = False
+
+    def __post_init__(self):
+        from explorer.materials.models import mirror_of
+        from explorer.physics.bragg import structure_table
+
+        self.structures = structure_table(mirror_of(self.values), self.maps)
+        height, width = next(iter(self.maps.values())).shape
+        self.index = np.arange(height * width, dtype=np.float32).reshape(height, width)
+
+    @classmethod
+    def from_folder(cls, folder, material, values) -> tuple["MapTexture", dict]:
+        """The maps of ``folder`` on ``material`` and the values they complete (``values`` with the folder's fixed ones)."""
+        from explorer.views.maps import check_maps, read_maps
+
+        try:
+            params, maps = read_maps(folder)
+        except ValueError as error:
+            path, _, message = str(error).partition(": ")  # read_maps's lines begin with the file at fault
+            raise LocatedError(path, None, message) from None
+        fixed = check_maps(Path(folder), params, maps, material)
+        values = {**values, **fixed}
+        return cls(maps, values, str(folder)), values
+
+    @property
+    def d_inc(self) -> np.ndarray:  # the texture's array, as ThicknessTexture names it (size checks)
+        return self.index
+
+    def per_pixel(self, x, y, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(index, 0)`` of the nearest texel at the pixels ``p = (x, y)``: the shader's ``surface_value`` with ``surface_nearest``."""
+        f32 = np.float32
+        return self.at_uv(f32(0.5) * (x + f32(1.0)), f32(0.5) * (f32(1.0) - y))
+
+    def at_uv(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest texel's index at texture coordinates ``(u, v)`` (float32, clamped), as ``surface_at``."""
+        f32 = np.float32
+        h, w = self.index.shape
+        i = np.clip(np.floor(np.asarray(u, f32) * f32(w)).astype(np.int64), 0, w - 1)
+        j = np.clip(np.floor(np.asarray(v, f32) * f32(h)).astype(np.int64), 0, h - 1)
+        return self.index[j, i].astype(np.float64), np.zeros(np.shape(u))
+
+    def model_options(self) -> dict:
+        return {"mapping": "maps", "structures": self.structures}
+
+    def gl_arguments(self, material, values, width: int, height: int, draft: bool = False) -> dict:
+        """``inputs`` and ``uniforms`` of :meth:`explorer.gpu.Renderer.render`: the texel indices and the structure table."""
+        from explorer.physics.bragg import MAPS_MAPPING
+
+        inputs = {"surface_texture": self.index[..., None], "surface_moments": np.zeros((1, 1, 2), np.float32),
+                  "bragg_texture_table": np.zeros((1, 1, 3), np.float32), "structure_maps": self.structures}
+        return {"inputs": inputs, "uniforms": {"prefilter": False, "surface_nearest": True, "texture_mapping": MAPS_MAPPING}}
 
 
 #: Rows in T of :func:`textured_draft_table` (the exact table refines to up to 129): ~0.1 s, mean |error| ~4e-2

@@ -188,7 +188,11 @@ class ThicknessTexture:
         f32 = np.float32
         u = f32(0.5) * (x + f32(1.0))
         v = f32(0.5) * (f32(1.0) - y)
-        return self.sample(u, v), np.zeros(x.shape)
+        return self.at_uv(u, v)
+
+    def at_uv(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(D_inc, 0)`` at texture coordinates ``(u, v)`` (a mesh's; the shader's ``surface_at``), unfiltered by any footprint."""
+        return self.sample(u, v), np.zeros(np.shape(u))
 
 
 def check_prefilter(method: int, prefilter: bool) -> None:

@@ -23,6 +23,8 @@ void lit_sphere_frame(vec2 p, float r2, out vec3 normal, out vec3 tangent, out v
 // the surface. Twins: explorer/views/geometry.py (brdf_view_geometry), explorer/views/mesh.py (surface_frame).
 #ifdef MESH_NORMALS
 uniform sampler2D mesh_normals;
+// The interpolated texture coordinates (u, v, 0, 1) of the same pass (zeros for a mesh without them).
+uniform sampler2D mesh_uvs;
 bool view_surface(vec2 resolution, out vec3 normal, out vec3 tangent, out vec3 bitangent) {
     // The texel under the pixel: the same size (a headless render), or the app's preview at a smaller one.
     vec4 surface = texelFetch(mesh_normals, ivec2(gl_FragCoord.xy * vec2(textureSize(mesh_normals, 0)) / resolution), 0);
@@ -87,7 +89,7 @@ void rusinkiewicz_directions(float theta_h, float theta_d, float phi_d, out vec3
 
 // -- The surface texture (textured and env views; the host #defines SURFACE_TEXTURE): what a material's
 // '# texture:' varies (explorer/views/surface_texture.py). Planar parametrisation of the disc point p:
-// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped.
+// u = (x + 1) / 2, v = (1 - y) / 2 (rows from the top), bilinear between texel centres, clamped (or the nearest texel).
 #ifdef SURFACE_TEXTURE
 uniform sampler2D surface_texture;
 
@@ -102,5 +104,27 @@ float surface_bilinear(vec2 uv) {
     return mix(top, bottom, f.y);
 }
 
-float surface_value(vec2 p) { return surface_bilinear(vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y))); }
+// surface_nearest: the nearest texel's value, unfiltered (structure maps: a texel index, never blended).
+uniform bool surface_nearest;
+
+float surface_at(vec2 uv) {
+    if (surface_nearest) {
+        ivec2 size = textureSize(surface_texture, 0);
+        return texelFetch(surface_texture, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
+    }
+    return surface_bilinear(uv);
+}
+
+// The texture coordinates of the fragment: the sphere's planar ones of its disc point, or a mesh's interpolated ones
+// (explorer/gpu/mesh.py; twin: explorer.views.mesh.rasterise's uvs). Its surface value: surface_at(surface_uv(...)).
+vec2 surface_uv(vec2 resolution) {
+#ifdef MESH_NORMALS
+    return texelFetch(mesh_uvs, ivec2(gl_FragCoord.xy * vec2(textureSize(mesh_uvs, 0)) / resolution), 0).xy;
+#else
+    vec2 p;
+    float r2;
+    disc_point(resolution, p, r2);
+    return vec2(0.5 * (p.x + 1.0), 0.5 * (1.0 - p.y));
+#endif
+}
 #endif

@@ -125,12 +125,7 @@ void main() {
     float surface = 0.0;
 #ifdef HAS_TEXTURED_BRDF
     use_texture = textured;
-    if (use_texture) {  // the sphere's disc point, as the textured view reads the texture (not with a mesh)
-        vec2 p;
-        float r2;
-        disc_point(resolution, p, r2);
-        surface = surface_value(p);
-    }
+    if (use_texture) surface = surface_at(surface_uv(resolution));  // as the textured view reads it (sphere or mesh)
 #endif
     vec3 mirror = vec3(0.0);
 #ifdef HAS_MIRROR_REFLECTION

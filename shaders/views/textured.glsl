@@ -8,7 +8,8 @@
 // prefilter (the film only): the value's mean and variance over the pixel's footprint come from surface_moments
 // (computed by the host, one texel per pixel, rows from the top) and the material averages Eq. 10 over that Gaussian.
 // The rule of lib/views.glsl's view_brdf applies: 0 unless N.L > 0 and N.V > 0, non-finite channels 0.
-// Twin: explorer.views.render.render_numpy(model, 'textured', ..., thickness=...).
+// On a mesh (views/mesh/textured.glsl, MESH_NORMALS): its normals and its texture coordinates instead (no prefiltering).
+// Twin: explorer.views.render.render_numpy(model, 'textured', ..., thickness=..., mesh=...).
 #include "lib/views.glsl"
 
 uniform vec2 resolution;
@@ -18,14 +19,11 @@ uniform bool prefilter;
 out vec4 frag_colour;
 
 void main() {
-    vec2 p;
-    float r2;
-    if (!disc_point(resolution, p, r2)) {
+    vec3 normal, tangent, bitangent;
+    if (!view_surface(resolution, normal, tangent, bitangent)) {  // the sphere, or a mesh
         frag_colour = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    vec3 normal, tangent, bitangent;
-    lit_sphere_frame(p, r2, normal, tangent, bitangent);
     vec3 view = vec3(0.0, 0.0, 1.0);
     float D_inc_, sigma = 0.0;
     if (prefilter) {
@@ -34,7 +32,7 @@ void main() {
         D_inc_ = moments.x;
         sigma = sqrt(max(moments.y, 0.0));
     } else {
-        D_inc_ = surface_value(p);
+        D_inc_ = surface_at(surface_uv(resolution));
     }
     vec3 f = above_surface(light_direction, view, normal)
         ? finite_or_zero(textured_BRDF(light_direction, view, normal, tangent, bitangent, D_inc_, sigma, prefilter))

@@ -1,7 +1,8 @@
 """
 The Texture window: the textured view (:mod:`explorer.views.surface_texture`) of a material that declares
 ``# texture:``: a thin film's D_inc over a range, or a Bragg mirror's Lambda and/or delta (supplemental
-Figure 7), from a grey image (the shipped noise by default), lit by the app's light.
+Figure 7), from a grey image (the shipped noise by default), lit by the app's light; or a mirror's structure maps
+(a folder ``design --target-image`` wrote, :class:`explorer.views.surface_texture.MapTexture`), each map shown below.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
 from explorer.errors import LocatedError
 from explorer.resources import DEFAULT_TEXTURE
-from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture, textured_builtins
+from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture, MapTexture, textured_builtins
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
 
 #: Samples per pixel the window's env render stops at (a smooth mirror's Dirac is exact after one).
@@ -59,14 +60,23 @@ class TexturePanel(Panel):
         #: Under the environment: the env view's progressive Monte Carlo with the surface texture.
         self.environment = False
         self._env = None  # (key, ProgressiveEnvRender, AccumulatedImage)
+        #: A map folder (open --maps, or typed here): its maps on the mirror instead of the grey image.
+        self.maps_path = app.state.maps_folder
+        self._map_textures: dict = {}  # map name -> texture of its image, for the current folder
 
     def _texture(self, kind: str):
         """The surface texture of the current settings (loaded again only when they change)."""
-        key = (kind, self.path, self.mapping, tuple(self.dinc_range))
+        maps = self.maps_path.strip() if kind == "bragg" else ""
+        key = (kind, self.path, self.mapping, tuple(self.dinc_range), maps)
         if key != self._surface_key:
             self._surface_key = key
             try:
-                if kind == "bragg":
+                if maps:
+                    self._surface, values = MapTexture.from_folder(maps, self.state.material, self.state.values)
+                    self.state.values = self.state.material.resolve(values)  # the folder's fixed values
+                    self.state.maps_folder = maps
+                    self._map_images(self._surface)
+                elif kind == "bragg":
                     self._surface = BraggTexture.from_file(self.path, self.mapping)
                 else:
                     self._surface = ThicknessTexture.from_file(self.path, tuple(sorted(self.dinc_range)))
@@ -83,8 +93,14 @@ class TexturePanel(Panel):
             imgui.text_wrapped(text)
             state.texture_view = {"message": text}
             return
-        _, self.path = imgui.input_text("texture (grey image)", self.path)
         if kind == "bragg":
+            _, self.maps_path = imgui.input_text("map folder (design --out-maps)", self.maps_path)
+            record(state, "maps_folder")
+        if not (kind == "bragg" and self.maps_path.strip()):
+            _, self.path = imgui.input_text("texture (grey image)", self.path)
+        if kind == "bragg" and self.maps_path.strip():
+            imgui.text_wrapped("each texel its own mirror: the maps below, the other values the folder's")
+        elif kind == "bragg":
             self.mapping = combo(state, "mapping", self.mapping, [(n, n) for n in MAPPINGS], self.mapping, "mapping",
                                  "mapping_combo") or self.mapping
             imgui.text_wrapped("Lambda (0.5 + 0.5 T), delta^T (supplemental Fig. 7)")
@@ -129,6 +145,8 @@ class TexturePanel(Panel):
         if self._arguments is None:
             imgui.text("building the texture's tables…")
             return
+        if isinstance(surface, MapTexture):
+            self._draw_maps(imgui, surface)
         if self.environment:
             source = self._env_source(surface, size)
             show_image(state, self.scheduler.show("textured_env", size, source), size, "textured_image")
@@ -149,6 +167,39 @@ class TexturePanel(Panel):
                                   "values": {k: (list(v) if isinstance(v, tuple) else v) for k, v in self._values.items()},
                                   "light": list(light_vector(state.light, state.camera)), "size": list(size), "draft": False,
                                   "mean_rgb": np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()}
+            if isinstance(surface, MapTexture):
+                state.texture_view["maps_folder"] = self.maps_path.strip()
+                state.texture_view["maps"] = {name: shown for name, (_, shown) in self._map_textures.items()}
+
+    def _map_images(self, surface: MapTexture) -> None:
+        """Each map as a grey image (its finite range black to white, off the mask dark red), uploaded once per folder."""
+        for texture, _ in self._map_textures.values():
+            self.app.renderer.resources.release(texture)
+        self._map_textures = {}
+        for name, image in surface.maps.items():
+            finite = np.isfinite(image)
+            low, high = (float(image[finite].min()), float(image[finite].max())) if finite.any() else (0.0, 0.0)
+            grey = np.where(finite, (image - low) / (high - low) if high > low else 0.5, 0.0)
+            rgb = np.stack([np.where(finite, grey, 0.5), grey, grey], axis=-1).astype(np.float32)
+            texture = self.app.renderer.resources.texture(rgb, origin=f"map {name}")
+            self._map_textures[name] = (texture, {"min": low, "max": high, "size": [image.shape[1], image.shape[0]],
+                                                  "mean_grey": float(grey[finite].mean()) if finite.any() else 0.0})
+
+    def _draw_maps(self, imgui, surface: MapTexture) -> None:
+        """The maps side by side (rows from the top, nearest texels), each with its range."""
+        if not self._map_textures:
+            return
+        count = len(self._map_textures)
+        side = max(32.0, (imgui.get_content_region_avail().x - 8.0 * count) / count)
+        for k, (name, (texture, shown)) in enumerate(self._map_textures.items()):
+            if k:
+                imgui.same_line()
+            imgui.begin_group()
+            w, h = shown["size"]
+            imgui.image(imgui.ImTextureRef(texture.glo), imgui.ImVec2(side, side * h / w), imgui.ImVec2(0, 0), imgui.ImVec2(1, 1))
+            record(self.state, f"map:{name}")
+            imgui.text(f"{name} {shown['min']:.4g}..{shown['max']:.4g}")
+            imgui.end_group()
 
     def _env_source(self, surface, size):
         """The env render of the current arguments' values under ``surface`` (a new one when they change)."""
@@ -158,10 +209,11 @@ class TexturePanel(Panel):
         if self._env is None or self._env[0] != self._arguments_key:
             if self._env is not None:
                 self._env[1].release()
-            self.scheduler.env.environment = self.scheduler.env.environment or _default_environment()
+            # The env mode's environment and probe rotation (its loaded maps: EnvScheduler.environment).
+            environment = self.scheduler.env.environment(self.state.environment).rotated(self.state.env_rotation)
             # The tables are those the worker built for these values (cached): no wait here.
-            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values,
-                                          self.scheduler.env.environment, *size, surface=surface)
+            render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values, environment, *size,
+                                          surface=surface)
             from explorer.materials.models import model_for
 
             model = model_for(self.state.material, self._values)
@@ -183,12 +235,6 @@ def _needs_table(material, values) -> bool:
 
     model = model_for(material, values)
     return bool(model is not None and getattr(getattr(model, "method", None), "needs_table", False))
-
-
-def _default_environment():
-    from explorer.views.env import EnvironmentMap
-
-    return EnvironmentMap.default()
 
 
 class _EnvWork:

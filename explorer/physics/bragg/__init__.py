@@ -156,6 +156,7 @@ from explorer.physics.bragg.reflectance import (  # noqa: F401
     reflectance_yeh,
     reflection_coefficient_bragg,
     reflection_coefficient_host,
+    slab_coefficients,
 )
 from explorer.physics.bragg.tables import (  # noqa: F401
     DRAFT_MAX_SUBSTEPS,
@@ -182,7 +183,11 @@ from explorer.physics.bragg.textured import (  # noqa: F401
     TEXTURE_TABLE_MAX_ROWS,
     TEXTURE_TABLE_ROWS,
     _mirror_rows,
+    MAPS_MAPPING,
+    STRUCTURE_FIELDS,
     _textured_row,
+    mapped_mirrors,
+    structure_table,
     textured_mirror,
     textured_reference_rgb,
     textured_rgb_table,

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from explorer.physics import multilayer
 from explorer.physics.bragg.approximation import fringe_average_under_host
 from explorer.physics.bragg.mirror import COS_THETA_MIN, POLARISATIONS, Omega
-from explorer.physics.bragg.reflectance import chebyshev_U, clamp_decay, reflection_coefficient_host
+from explorer.physics.bragg.reflectance import chebyshev_U, clamp_decay, reflection_coefficient_host, slab_coefficients
 from explorer.physics.fresnel import cos_theta_transmitted, fresnel_r
 
 #: Below this ``|sin K Lambda|`` (real indices) or ``|1 - z^2|`` (complex ones) the band edge's limits
@@ -88,14 +88,6 @@ def _point_weight(p1, p2, wavelengths, N, step: float | None, smooth, shape) -> 
     return np.broadcast_to(np.clip((fringe / (step if smooth is None else smooth) - 1.0) / 3.0, 0.0, 1.0), shape)
 
 
-def _slab(r12, e_phi) -> tuple[np.ndarray, np.ndarray]:
-    """The slab's ``r1, t1`` (Eq. 10) from ``r12`` and ``e^{i phi}``, as :func:`explorer.physics.bragg.airy_slab_coefficients`."""
-    phase2 = e_phi * e_phi
-    r12_2 = r12 * r12
-    denominator = 1.0 - r12_2 * phase2
-    return r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * e_phi / denominator
-
-
 def _column(v, dtype=None) -> np.ndarray:
     """A parameter ``(B,)`` as ``(B, 1, 1)``; ``(B, 1, W)`` (a dispersive medium's index per wavelength) as it is."""
     a = np.asarray(v, dtype=dtype)
@@ -141,7 +133,7 @@ def bragg_reflectance_batch(
     for pol in POLARISATIONS:
         r12 = fresnel_r(pol, n1, cos_1, n2, cos_2)
         a = np.real(ph.cos_psi * ph.cos_phi - 0.5 * Omega(pol, n1, cos_1, n2, cos_2) * ph.sin_psi * ph.sin_phi)  # Eq. 8
-        r1, t1 = _slab(r12, ph.e_phi)
+        r1, t1 = slab_coefficients(r12, ph.e_phi)
         r_h1 = np.where(host, fresnel_r(pol, eta_h, cos_h.astype(np.complex128), n1, cos_1), 0.0)
         R = _where_needed(point, _point_reflectance, a, N, r1, t1, ph.e_psi, r_h1)
         if averaged.any():
@@ -217,7 +209,7 @@ def absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta: ArrayLi
         x = kz2 / kz1 if pol == "s" else (n1 * n1 * kz2) / (n2 * n2 * kz1)
         x = np.where(np.abs(x) < 1e-10, 1e-10, x)
         a = ph.cos_psi * ph.cos_phi - 0.5 * (x + 1.0 / x) * ph.sin_psi * ph.sin_phi  # Eq. 8, complex
-        r1, t1 = _slab(r12, ph.e_phi)
+        r1, t1 = slab_coefficients(r12, ph.e_phi)
         # Below the gap at K Lambda ~ pi, U_n(-b) = (-1)^n U_n(b): the ratio U_{N-2} / U_{N-1} of -a, negated,
         # continues the count N as the real model does (chebyshev_U's gap: no phase e^{2 pi i N} between counts).
         flip = np.real(a) < -1.0

@@ -23,11 +23,18 @@ def airy_slab_coefficients(omega: ArrayLike, geometry: CellGeometry) -> tuple[np
     ``r1 = r12 (1 - e^{2i phi}) / (1 - r12^2 e^{2i phi})`` with ``phi = k_2z d2``, and
     ``t1 = (1 - r12^2) e^{i phi} / (1 - r12^2 e^{2i phi})`` (as ``t12 t21 = 1 - r12^2``).
     """
-    phase = np.exp(1j * omega * geometry.p2)
+    return slab_coefficients(geometry.r12, np.exp(1j * omega * geometry.p2))
+
+
+def slab_coefficients(r12: ArrayLike, phase: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """
+    :func:`airy_slab_coefficients` from the interface's ``r12`` and the slab's ``phase = e^{i phi}`` (numpy only: the
+    batched model's phases have their decay capped, :mod:`explorer.physics.bragg.batch`).
+    """
     phase2 = phase * phase
-    r12_2 = geometry.r12 * geometry.r12
+    r12_2 = r12 * r12
     denominator = 1.0 - r12_2 * phase2
-    return geometry.r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * phase / denominator
+    return r12 * (1.0 - phase2) / denominator, (1.0 - r12_2) * phase / denominator
 
 
 def cos_K_Lambda(omega: ArrayLike, geometry: CellGeometry) -> np.ndarray:
