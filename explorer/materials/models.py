@@ -105,6 +105,8 @@ def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
 def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP,
                     smooth: float | None = None) -> np.ndarray:
     """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``, ``N`` continuous) at ``cos_theta`` ``(A,)``."""
+    if natural_values(values):  # absorbing layers (k1, k2): the complex indices' batch
+        return natural_batch(values, {}, cos_theta, step, smooth)
     nodes, weights = colorimetry.interpolant_nodes(step)
     R = bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
                                       values["nh"], cos_theta, nodes, step=step, smooth=smooth)
@@ -124,6 +126,8 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped), which the
     polish calls many times.
     """
+    if natural_values(values):  # absorbing or disordered layers: the natural mirror's colours
+        return natural_converged(values, {}, cos_theta, final)
     mirror = mirror_of(values)
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     if final:
@@ -131,12 +135,91 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     return bragg.converged_rgb(cos_theta, mirror)
 
 
+# Natural mirrors in design: indices naming media (explorer.design.media), absorbing and disordered layers.
+
+#: The index parameters that may name a medium.
+MEDIUM_PARAMETERS = ("n1", "n2", "nh")
+#: The natural mirror's other design parameters: each layer's extinction coefficient (added to its index,
+#: a number's or a medium's) and the thickness disorder. The search holds them at 0 unless fixed or freed.
+NATURAL_PARAMETERS = ("k1", "k2", "sigma")
+#: The extinction coefficient of each layer's index.
+EXTINCTION = {"n1": "k1", "n2": "k2"}
+#: The non-final converged colours (the polish's) sample the spectrum this finely (nm), fringes narrower
+#: than a few steps averaged (:func:`explorer.physics.bragg.bragg_reflectance_batch`).
+POLISH_STEP = 1.0
+
+
+def design_indices(values: Mapping[str, np.ndarray], media: Mapping, wavelengths: np.ndarray) -> dict[str, np.ndarray]:
+    """
+    ``n1``, ``n2``, ``nh`` of rows ``values`` ``(B,)`` with each medium at ``wavelengths`` ``(W,)`` and each layer's
+    ``k`` added: ``(B, 1, W)`` or ``(B,)``.
+    """
+    rows = np.asarray(values["Lambda"]).shape[0]
+    out = {}
+    for name in MEDIUM_PARAMETERS:
+        medium = media.get(name)
+        if medium is None:
+            out[name] = np.asarray(values[name], dtype=np.float64)
+        else:
+            index = medium.index(wavelengths)
+            # A lossless medium stays real: the real batch model (and its coherent fringe average) takes it.
+            if not np.any(np.imag(index)):
+                index = np.real(index)
+            out[name] = np.broadcast_to(index.reshape(1, 1, -1), (rows, 1, index.size))
+        k = values.get(EXTINCTION.get(name, ""))
+        if k is not None and np.any(np.asarray(k) != 0.0):
+            # n + i k, as NaturalMirror.index_1 / index_2 add a layer's k to its number or its medium.
+            k = np.broadcast_to(np.asarray(k, dtype=np.float64), (rows,))
+            out[name] = out[name] + 1j * (k.reshape(-1, 1, 1) if np.ndim(out[name]) == 3 else k)
+    if not any(np.iscomplexobj(v) for v in out.values()):
+        return out
+    # Complex: every index per wavelength (the absorbing batch model's broadcast).
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+def mirror_with_media(values: Mapping[str, float], media: Mapping) -> natural.NaturalMirror:
+    """The :class:`explorer.physics.natural.NaturalMirror` of design values (``N`` rounded), media in place of their numbers."""
+    index = lambda name: media[name] if name in media else float(values[name])  # noqa: E731
+    nh = media.get("nh", host_index(float(values["nh"])))
+    extra = {name: float(values.get(name, 0.0)) for name in NATURAL_PARAMETERS}
+    return natural.NaturalMirror(n1=index("n1"), n2=index("n2"), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+                                 N=max(1, int(round(float(values["N"])))), nh=nh, **extra)
+
+
+def natural_values(values: Mapping[str, object]) -> bool:
+    """Whether design values ``values`` (numbers or rows) have an absorbing or disordered layer."""
+    return any(np.any(np.asarray(values.get(name, 0.0)) != 0.0) for name in NATURAL_PARAMETERS)
+
+
+def natural_batch(values: Mapping[str, np.ndarray], media: Mapping, cos_theta, step: float, smooth: float | None) -> np.ndarray:
+    """The batch model's colours ``(B, A, 3)`` of rows ``values`` with ``media`` and each layer's ``k`` (the ordered mirror)."""
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    n = design_indices(values, media, nodes)
+    R = bragg.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+                                      cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def natural_converged(values: Mapping[str, float], media: Mapping, cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours ``(A, 3)`` of one structure with ``media``, ``k1``, ``k2`` and ``sigma``:
+    :func:`explorer.physics.natural.natural_rgb` (final, or disordered: its realisations seeded, a smooth function
+    of the structure), else the batch at :data:`POLISH_STEP`.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final or float(values.get("sigma", 0.0)) > 0.0:
+        return natural.natural_rgb(cos_theta, mirror_with_media(values, media))
+    rows = {k: np.array([float(v)]) for k, v in values.items()}
+    rows["N"] = np.array([max(1.0, float(np.round(values["N"])))])
+    return natural_batch(rows, media, cos_theta, POLISH_STEP, None)[0]
+
+
 #: What design fits of a Bragg mirror, and on which forward model: its specular colour (the rough layer's too: the
 #: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
-BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
                            integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb,
                            host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
-                           paint_free=("Lambda", "delta", "N"))
+                           paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 
 
 @twin
