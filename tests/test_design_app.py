@@ -60,3 +60,34 @@ def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_disp
     assert design["seed"] == 1 and len(design["guesses"]) == 1, design
     assert [t["theta_deg"] for t in design["targets"]] == [t.theta_deg for t in expected]
     np.testing.assert_allclose([t["target_rgb"] for t in design["targets"]], [t.rgb for t in expected], atol=1e-12)
+
+
+def test_the_window_designs_with_a_medium_as_the_cli_does(x_display, tmp_path):  # noqa: F811
+    # The mirror's n2 names chitin (its combo): the window designs with chitin's dispersion held, as
+    # design --fix n2=chitin does, and reports it by name.
+    import json
+
+    from conftest import run_cli
+    from explorer.design.media import mirror_with_media
+    from explorer.physics.dispersion import LIBRARY
+    from explorer.physics.natural import natural_rgb
+
+    actions = [{"wait": 2}, {"set": {"n2": "chitin", "n1": 1.0}}, {"focus": "Design"}, {"wait": 2}, {"click": "design:run"},
+               {"wait_for": "design", "timeout": 4000}, {"quit": True}]
+    _, report = run_session(x_display, BRAGG_MATERIAL, actions, tmp_path)
+    design = report["design"]
+    assert design is not None and design["set"]["n2"] == "chitin", (design, report["script_log"])
+    assert report["values"]["medium_n2"] > 0, report["values"]  # applied: the medium kept, not its number
+    theta = [t["theta_deg"] for t in design["targets"]]
+    found = {k: v for k, v in design["set"].items() if k != "n2"}
+    np.testing.assert_allclose(natural_rgb(np.cos(np.radians(theta)), mirror_with_media(found, {"n2": LIBRARY["chitin"]})),
+                               [t["achieved_rgb"] for t in design["targets"]], atol=1e-9)
+    # The CLI's design of the same targets from the same start and seed.
+    targets = [f"--target={t['theta_deg']:g}:" + ",".join(repr(c) for c in t["target_rgb"]) for t in design["targets"]]
+    guess = ",".join(f"{k}={v}" for k, v in design["guesses"][0].items() if k != "n2")
+    run = run_cli("design", "bragg_mirror", *targets, "--fix", "n2=chitin", "--guess", guess, "--seed", str(design["seed"]),
+                  "--tries", "1", "--fix", "k1=0", "--fix", "k2=0", "--fix", "sigma=0", "--json")
+    assert run.returncode == 0, run.stderr
+    cli = json.loads(run.stdout)
+    assert cli["set"]["n2"] == "chitin" and set(cli["set"]) == set(design["set"]), (cli["set"], design["set"])
+    assert abs(cli["median_delta_e2000"] - design["median_delta_e2000"]) < 0.3, (cli, design)

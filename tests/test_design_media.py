@@ -103,7 +103,9 @@ def test_design_with_an_absorbing_medium_reports_it_by_name():
     (["--fix", "nh=melanin"], "absorbs"),
     (["--fix", "n2=chitin", "--fix", "n2=1.5"], "given twice"),
     (["--fix", "n2=chitin", "--free", "n2"], "also fixed"),
-    (["--fix", "sigma=0.1"], "not a design parameter"),
+    (["--fix", "sigma=0.5"], "outside its range"),
+    (["--fix", "k2=-0.1"], "outside its range"),
+    (["--free", "Lambda,kappa"], "not a design parameter"),
 ])
 def test_media_refusals_are_one_line(args, message):
     assert message in one_line_error(run_cli("design", "bragg_mirror", "--target", "0:#3f9f4f", *args))

@@ -78,34 +78,64 @@ def test_tabulated_gl_equals_spectral_reference_on_a_smooth_mirror(gl_renderer, 
         assert_twins_equal(Twins.of(tabulated, reference, view), f"method 3 against the reference, {view}", COLOUR_TOLERANCE)
 
 
-def random_parameters(material, rng) -> dict:
+#: bragg_mirror's natural-structure parameters (explorer/physics/natural.py): any of them above 0 makes every
+#: method show the host's exact table (shaders/bragg_mirror.brd, natural_structure()), so the paper's sweep
+#: leaves them at 0 and the natural sweep below draws them.
+NATURAL_PARAMETERS = ("k1", "k2", "sigma")
+
+
+def random_parameters(material, rng, natural: bool = False) -> dict:
     """Uniform values inside each float or int parameter's declared range (ints: any float, rounded by resolve;
     method 0's wavelength step left at the paper's 1 nm: finer steps cost proportionally more, and
     tests/test_converged.py checks one; the media, which pick a dispersion by index, are swept in
-    tests/test_natural_render.py)."""
+    tests/test_natural_render.py; :data:`NATURAL_PARAMETERS` only when ``natural``)."""
     values = {}
     for parameter in material.parameters:
         if parameter.type in ("float", "int") and parameter.name not in ("method", "wavelength_step") \
-                and not parameter.name.startswith("medium_"):
+                and not parameter.name.startswith("medium_") and (natural or parameter.name not in NATURAL_PARAMETERS):
             values[parameter.name] = float(rng.uniform(parameter.min, parameter.max))
     return values
 
 
-@pytest.mark.gl
-def test_gl_sweep_is_finite_and_bounded(gl_renderer, bragg_material):
-    rng = np.random.default_rng(4242)
+def sweep_failures(renderer, material, draws: list[dict]) -> list[str]:
+    """Every method of every draw in both sweep views: what is not finite or leaves the object-colour box."""
     low, high = object_colour_bounds()
     failures = []
-    for _ in range(10):
-        parameters = random_parameters(bragg_material, rng)
+    for parameters in draws:
         for method in METHODS:
-            values = bragg_material.resolve({**parameters, "method": method})
+            values = material.resolve({**parameters, "method": method})
             for view, size in SWEEP_SIZES.items():
-                image = gl_renderer.render(bragg_material, values, view, *size)
+                image = renderer.render(material, values, view, *size)
                 if not np.isfinite(image).all():
                     failures.append(f"non-finite: method {method}, {view}, {parameters}")
                 elif (image < low - OBJECT_COLOUR_SLACK).any() or (image > high + OBJECT_COLOUR_SLACK).any():
                     failures.append(f"outside the object-colour box: method {method}, {view}, {parameters}")
+    return failures
+
+
+@pytest.mark.gl
+def test_gl_sweep_is_finite_and_bounded(gl_renderer, bragg_material):
+    """The paper's mirror (lossless, ordered layers: each method's own GLSL) at random values."""
+    rng = np.random.default_rng(4242)
+    draws = [random_parameters(bragg_material, rng) for _ in range(10)]
+    assert not any(bragg_material.resolve(d)[name] for d in draws for name in NATURAL_PARAMETERS)
+    failures = sweep_failures(gl_renderer, bragg_material, draws)
+    assert not failures, "\n".join(failures)
+
+
+@pytest.mark.gl
+def test_gl_natural_sweep_is_finite_and_bounded(gl_renderer, bragg_material):
+    """
+    Natural mirrors at random values, one absorbing (ordered), one also disordered: every method shows the host's
+    exact table, whose GL path these reach. The disordered table's cost grows with N (realisations x layers: 30-60 s
+    on two cores near N = 1000), its GL lookup does not: that draw keeps to N <= 100. The tables' energy is swept
+    in numpy (tests/test_natural_render.py, tests/test_energy.py).
+    """
+    rng = np.random.default_rng(4242)
+    absorbing, disordered = (random_parameters(bragg_material, rng, natural=True) for _ in range(2))
+    draws = [{**absorbing, "sigma": 0.0}, {**disordered, "N": 1.0 + disordered["N"] % 100.0}]
+    assert all(d["k1"] > 0 and d["k2"] > 0 for d in draws) and draws[1]["sigma"] > 0 and draws[1]["N"] <= 100
+    failures = sweep_failures(gl_renderer, bragg_material, draws)
     assert not failures, "\n".join(failures)
 
 

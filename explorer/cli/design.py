@@ -206,6 +206,8 @@ def parse_fixes(fixes, free, material, media: dict | None = None):
                 raise click.UsageError(f"--free {name}: also fixed by --fix")
         for name in model.parameters:
             if name not in names and name not in fixed and name not in media:
+                if name in model.held and float(values[name]) == 0.0:
+                    continue  # held at 0 by the search (absorption, disorder off): not reported
                 fixed[name] = float(values[name])  # not free: the material's default
     return fixed
 
@@ -305,9 +307,9 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
     if target_spectrum is not None:
         from explorer.cli.spectrum_fit import fit_command
 
-        if target_texts or target_strip or free or guess_texts:
-            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip, --free or --guess")
-        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed)
+        if target_texts or target_strip or guess_texts:
+            raise click.UsageError("--target-spectrum fits alone: no --target, --target-strip or --guess")
+        fit_command(material, target_spectrum, spectrum_theta, fixes, as_json, spectrum_plot, seed, free)
         return
     try:
         loaded = load(material)
@@ -322,8 +324,10 @@ def design_command(material, target_texts, target_strip, theta_range, fixes, fre
         media: dict = {}
         fixed = parse_fixes(fixes, free, loaded, media)
         guesses = [parse_guess(text, loaded) for text in guess_texts]
+        # The held parameters (k1, k2, sigma: 0 unless fixed) --free names are searched too.
+        released = [name for name in (free or "").split(",") if name.strip() in design_model(loaded.model).held]
         result = design(loaded.model, targets, ranges_of(loaded), fixed, seed=seed, guesses=guesses, tries=tries,
-                        progress=_progress_line(tries), media=media)
+                        progress=_progress_line(tries), media=media, free=[name.strip() for name in released])
         # A medium is reported by its name (render and --save take it so), not the number that stood for it.
         result = replace(result, values={**result.values, **{k: v.name for k, v in media.items()}})
     except (LocatedError, DesignError) as error:

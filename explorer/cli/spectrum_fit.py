@@ -91,10 +91,10 @@ def parse_fixed(fixes) -> dict:
             if number != round(number) or not 1 <= number <= 1000:
                 raise LocatedError("--fix", None, f"N={value!r}: an integer in [1, 1000]")
             fixed[name] = int(number)
-        elif name == "sigma":
-            low, high = NATURAL_PARAMETERS["sigma"]
+        elif name in NATURAL_PARAMETERS:
+            low, high = NATURAL_PARAMETERS[name]
             if not low <= number <= high:
-                raise LocatedError("--fix", None, f"sigma={value!r}: a number in [{low:g}, {high:g}]")
+                raise LocatedError("--fix", None, f"{name}={value!r}: a number in [{low:g}, {high:g}]")
             fixed[name] = number
         else:
             low, high = RANGES.get(name, (1.0, 3.0))
@@ -121,17 +121,43 @@ def write_fit_plot(fit, out: str, title: str) -> None:
     save_figure(figure, out)
 
 
-def fit_command(material: str, path: str, theta: float, fixes, as_json: bool, plot_out: str | None, seed: int) -> None:
+def parse_free(text: str | None, fixed: dict, loaded) -> bool:
+    """
+    ``--free NAME,...``: only these are fitted, the others held at the material's values (added to ``fixed``;
+    a host below 1 stays "the host is n1"). Returns whether ``sigma`` is free (else 0 unless fixed).
+    """
+    if text is None:
+        return False
+    known = set(RANGES) | {"N", "nh", "sigma"}
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise LocatedError("--free", None, f"{text!r}: name at least one of {', '.join(sorted(known))}")
+    for name in names:
+        if name not in known:
+            raise LocatedError("--free", None, f"{name!r} is not fitted (one of {', '.join(sorted(known))})")
+        if name in fixed:
+            raise LocatedError("--free", None, f"{name} is also fixed by --fix")
+    values = loaded.resolve({})
+    for name in sorted(known - set(names) - set(fixed)):
+        if name == "nh" and float(values["nh"]) < 1.0:
+            continue
+        fixed[name] = int(round(float(values[name]))) if name == "N" else float(values[name])
+    return "sigma" in names
+
+
+def fit_command(material: str, path: str, theta: float, fixes, as_json: bool, plot_out: str | None, seed: int,
+                free: str | None = None) -> None:
     """What ``design --target-spectrum`` prints: the structure as ``--set`` values, the RMS residual; ``--plot``."""
     if plot_out is not None:
         check_output(plot_out, (".png",))
-    load_mirror(material, "--target-spectrum fits")
+    loaded = load_mirror(material, "--target-spectrum fits")
     wavelengths, measured, note = read_measured(path)
     fixed = parse_fixed(fixes)
+    free_sigma = parse_free(free, fixed, loaded)
     from explorer.cli.albedo import progress_while
 
     with progress_while("design --target-spectrum"):
-        fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed)
+        fit = fit_spectrum(wavelengths, measured, theta, fixed, seed=seed, free_sigma=free_sigma)
     sets = " ".join(f"--set {k}={dispersion.describe(v) if isinstance(v, dispersion.Dispersion) else f'{v:.6g}'}"
                     for k, v in {**fixed, **fit.values}.items())
     if plot_out is not None:

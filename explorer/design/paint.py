@@ -275,7 +275,8 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
         clock = now
 
     model = design_model(model_name)
-    fixed = {k: float(v) for k, v in fixed.items()}
+    # The held parameters (absorption, disorder) stay at 0 unless fixed: painting searches the structure only.
+    fixed = {**{name: 0.0 for name in model.held}, **{k: float(v) for k, v in fixed.items()}}
     box = parameter_box(model, ranges)
     for name in fixed:
         if name not in {p.name for p in box}:

@@ -45,10 +45,13 @@ class _Problem:
     """The free parameters, the fixed values and the targets, with the residuals of both models."""
 
     def __init__(self, model: DesignModel, box: list[DesignParameter], fixed: Mapping[str, float],
-                 targets: Sequence[Target], cancelled: Callable[[], bool] | None):
+                 targets: Sequence[Target], cancelled: Callable[[], bool] | None, free: Sequence[str] = ()):
         self.model = model
         self.box = {p.name: p for p in box}
         self.fixed = {k: float(v) for k, v in fixed.items()}
+        # The model's held parameters (an effect off) stay at 0 unless fixed otherwise or named free.
+        self.held = [name for name in model.held if name not in self.fixed and name not in free]
+        self.fixed.update({name: 0.0 for name in self.held})
         self.free = [p for p in box if p.name not in self.fixed]
         # A mirror whose period and thickness ratio are both free is searched by its optical period and
         # the first layer's share of it (see :meth:`values`): the band positions then depend on one

@@ -19,6 +19,7 @@ from explorer.design.base import (
     GOOD_ENOUGH,
     LOCAL_STARTS,
     POLISH_DISTINCT,
+    DISORDERED_POLISH_SECONDS,
     POLISH_SECONDS,
     POLISHED,
     REACHED_DELTA_E,
@@ -51,6 +52,7 @@ def design(
     guesses: Sequence[Mapping[str, float]] = (),
     tries: int = 1,
     media: Mapping[str, Dispersion] | None = None,
+    free: Sequence[str] = (),
 ) -> DesignResult:
     """
     The structure whose converged colours come closest (least squares of CIEDE2000) to ``targets``.
@@ -86,6 +88,8 @@ def design(
         Index parameters (``n1``, ``n2``, ``nh`` of a Bragg mirror) held at a medium of
         :mod:`explorer.physics.dispersion` (dispersive, absorbing where ``k > 0``): :mod:`explorer.design.media`.
         The result reports such a parameter at the medium's real index at :data:`explorer.design.media.REFERENCE_NM`.
+    free : sequence of str, optional
+        The model's held parameters (a mirror's ``k1``, ``k2``, ``sigma``: 0 unless fixed) to search as well.
 
     Returns
     -------
@@ -105,7 +109,7 @@ def design(
 
         carried = [] if best is None else [best.values]
         result = _design_once(model_name, targets, ranges, fixed, seed + TRY_SEED_STRIDE * k, samples, starts, report,
-                              cancelled, [*guesses, *carried], media)
+                              cancelled, [*guesses, *carried], media, free)
         evaluations += result.evaluations
         if best is None or np.sum(result.delta_e2000 ** 2) < np.sum(best.delta_e2000 ** 2):
             best = result
@@ -117,13 +121,21 @@ def design(
                    evaluations=evaluations, tries=k + 1)
 
 
-def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, progress, cancelled, guesses, media=None) -> DesignResult:
+def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, progress, cancelled, guesses, media=None,
+                 free=()) -> DesignResult:
     """One search of :func:`design` (its parameters), from the first pass on."""
     start_time, start_cpu = time.perf_counter(), time.process_time()
     model = design_model(model_name)
     fixed = dict(fixed or {})
-    if media:
-        model = with_media(model, media)
+    media = dict(media or {})
+    unknown = [name for name in free if name not in model.held]
+    if unknown:
+        raise DesignError(f"free {unknown[0]}: not one of {model.name}'s held parameters ({', '.join(model.held) or 'none'})")
+    # Absorbing or disordered layers (held parameters free, or fixed above 0): the natural mirror's models.
+    natural = any(name in free or fixed.get(name, 0.0) != 0.0 for name in model.held)
+    disordered = "sigma" in model.held and ("sigma" in free or fixed.get("sigma", 0.0) != 0.0)
+    if media or natural:
+        model = with_media(model, media, natural)
         for name, medium in media.items():
             if name in fixed:
                 raise DesignError(f"cannot fix {name} twice (a number and {medium.name})")
@@ -145,8 +157,8 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
             raise DesignError(f"cannot fix {name} = {value:g}: outside its range [{low:g}, {p.high:g}]")
         if p.integer and value != round(value):
             raise DesignError(f"cannot fix {name} = {value:g}: {name} is a whole number")
-    problem = _Problem(model, box, fixed, targets, cancelled)
-    guessed = np.array([np.clip(problem.unit_row(_guess_values(model, g, fixed)), 0.0, 1.0) for g in guesses]).reshape(len(guesses), len(problem.free))
+    problem = _Problem(model, box, fixed, targets, cancelled, free)
+    guessed = np.array([np.clip(problem.unit_row(_guess_values(model, g, problem.fixed)), 0.0, 1.0) for g in guesses]).reshape(len(guesses), len(problem.free))
     report = progress or (lambda fraction, stage: None)
     stages: dict[str, float] = {}
     P = len(problem.free)
@@ -213,7 +225,7 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
         # was refined out of it (the truth among the scan's shapes, explorer/dev/design_ceiling.py: 84 % of round
         # trips within 1 without this ranking, 90 % with it).
         best = None
-        deadline = time.process_time() + POLISH_SECONDS
+        deadline = time.process_time() + (DISORDERED_POLISH_SECONDS if disordered else POLISH_SECONDS)
         pool = np.array([u for _, _, u in refined] + (list(U[tops]) if scale is not None else []))
         # Distinct ones: the second scan's refinements often end in the first's basin.
         polished = _distinct(pool, np.array([problem.fine_cost(u) for u in pool]), POLISHED, spacing=POLISH_DISTINCT)
@@ -225,6 +237,10 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
             if time.process_time() > deadline or best[1] < problem.polished_cost:
                 break
         values = best[0]
+        if best[1] > REACHED_DELTA_E**2 * len(targets):
+            # 4b. Neighbouring counts: an absorbing stack's colours change little with N (light no longer reaches
+            # its last cells), so the coarse stages may settle on a count whose basin holds no exact match.
+            values = _neighbouring_counts(problem, values, best[1], POLISH_SECONDS)
         stages["polish"] = time.perf_counter() - start_time
     achieved = problem.fine_rgb(values, final=True)
     report(1.0, "done")
@@ -241,6 +257,40 @@ def _design_once(model_name, targets, ranges, fixed, seed, samples, starts, prog
     )
 
 
+#: The counts tried beside a polished count that leaves a target above REACHED_DELTA_E.
+COUNT_NEIGHBOURS = (-2, -1, 1, 2)
+COUNT_WALKS = 3
+
+
+def _neighbouring_counts(problem: _Problem, values: Mapping[str, float], cost: float, seconds: float) -> dict[str, float]:
+    """
+    ``values`` polished again at each count of :data:`COUNT_NEIGHBOURS` around its own (the other parameters as
+    they are), each within ``seconds`` of CPU, walking on from a better count while one is found (at most
+    :data:`COUNT_WALKS` times): the best of these and ``values``.
+    """
+    k = next((j for j, p in enumerate(problem.free) if p.integer), None)
+    if k is None:
+        return dict(values)
+    p = problem.free[k]
+    best = (dict(values), cost)
+    tried = {int(round(float(values[p.name])))}
+    for _ in range(COUNT_WALKS):
+        centre, u = best[0], problem.unit_row(best[0])
+        for step in COUNT_NEIGHBOURS:
+            count = int(round(float(centre[p.name]))) + step
+            if not p.low <= count <= p.high or count in tried:
+                continue
+            tried.add(count)
+            trial = u.copy()
+            trial[k] = p.to_unit(float(count))
+            found, found_cost = _polish(problem, np.clip(trial, 0.0, 1.0), max_nfev=20, deadline=time.process_time() + seconds)
+            if found_cost < best[1]:
+                best = (found, found_cost)
+        if best[0] is centre or best[1] < problem.polished_cost:
+            break
+    return best[0]
+
+
 def _reported_values(problem: _Problem, values: Mapping[str, float]) -> dict[str, float]:
     """
     The design values as reported: integers whole, and a free host found below its threshold (any value
@@ -248,7 +298,9 @@ def _reported_values(problem: _Problem, values: Mapping[str, float]) -> dict[str
     host", rather than an arbitrary number that reads like an index.
     """
     model = problem.model
-    out = {k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters}
+    # A held parameter left at 0 (an effect off that the caller did not name) is not reported.
+    out = {k: (int(round(values[k])) if problem.box[k].integer else float(values[k])) for k in model.parameters
+           if k not in problem.held}
     host = model.host_parameter
     if host is not None and host not in problem.fixed and out[host] < model.host_threshold:
         out[host] = float(min(problem.box[host].low, out[host]))

@@ -80,6 +80,9 @@ def random_structure(model_name: str, ranges: Mapping[str, tuple[float, float]],
     model = design_model(model_name)
     values = {}
     for p in parameter_box(model, ranges):
+        if p.name in model.held:  # the round trip's mirrors are the paper's (absorption and disorder off)
+            values[p.name] = 0.0
+            continue
         value = float(p.from_unit(rng.uniform())) if p.name in model.integer_parameters else float(rng.uniform(*ranges[p.name]))
         values[p.name] = float(p.whole(value))
     return values

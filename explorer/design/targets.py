@@ -142,6 +142,9 @@ def parameter_box(model: DesignModel, ranges: Mapping[str, tuple[float, float]])
     """The design parameters of ``model`` over ``ranges`` (name -> (low, high), the material's declared ranges)."""
     box = []
     for name in model.parameters:
+        if name not in ranges and name in model.held:  # an effect the caller's ranges leave off
+            box.append(DesignParameter(name, 0.0, 0.0))
+            continue
         if name not in ranges:
             raise DesignError(f"the material declares no range for {name}")
         low, high = (float(v) for v in ranges[name])

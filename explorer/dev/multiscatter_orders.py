@@ -27,7 +27,7 @@ import argparse
 
 import numpy as np
 
-from explorer.physics import microfacet, microsurface, multiscatter
+from explorer.physics import microfacet, microsurface, multiscatter, multiscatter_stack
 
 THETA = (0.0, 20.0, 40.0, 55.0, 70.0)
 #: Wavelength columns studied (of 471, 360-830 nm): every 30 nm from 400 to 700.
@@ -81,17 +81,13 @@ def eq17_albedo(reflectance: np.ndarray, alpha: float, theta_deg: float, columns
     return np.array(out)
 
 
-def model_terms(layer_table, compensation, alpha: float, theta_deg: float, columns) -> dict:
-    """The model's terms at ``theta`` for the columns: ``E_r``, ``r m``, ``t_b``, ``(1 - r) m`` and Eq. 28's ``(1 - rho) G1``."""
+def model_terms(layer_table, terms, alpha: float, theta_deg: float, columns) -> dict:
+    """The model's terms at ``theta`` for the columns: ``E_r``, ``r m``, ``t_b``, ``(1 - r) m`` and Eq. 28's ``(1 - rho) G1``
+    (``terms``: the layer's :class:`explorer.physics.multiscatter.LayerTerms`, interpolated between its 2-degree rows)."""
     t = np.radians(theta_deg)
-    c = np.cos(t)
     f_t = _row(layer_table.transmissivity, t)
-    rho = multiscatter.occluder_reflectance(f_t, c, alpha)
-    G = multiscatter.effective_masking(c, alpha, rho)
-    t_b = multiscatter.ballistic_transmissivity(rho, G)
-    m = multiscatter.missing_energy(compensation, t).astype(np.float64)
-    r = compensation.up.astype(np.float64)
-    E_r = 1.0 - t_b - m  # m = 1 - E_r - t_b (clipped at 0 in the table)
+    at = lambda x: multiscatter.rows_at(np.asarray(x, dtype=np.float64), np.asarray([t]), np.radians(multiscatter.COMPENSATION_STEP_DEG))[0]  # noqa: E731
+    E_r, t_b, m, r = at(terms.reflection), at(terms.ballistic), at(terms.missing), at(terms.up)
     cols = np.asarray(columns)
     return {"E_r": E_r[cols], "rm": (r * m)[cols], "t_b": t_b[cols], "down_m": ((1.0 - r) * m)[cols], "eq28": f_t[cols]}
 
@@ -116,7 +112,8 @@ def study(name: str, alpha: float, paths: int) -> list[dict]:
     for k in range(1, 4):
         values[f"alpha_{k}"] = float(alpha)
     model = model_for(material, {**values, "multiple_scattering": True})
-    table, comp = model.tables[0], model.compensation[0]
+    table = model.tables[0]
+    comp = multiscatter_stack.layer_terms_of(table)
     R = np.ascontiguousarray(table.reflectance, dtype=np.float32)
     rows = []
     for k, theta in enumerate(THETA):

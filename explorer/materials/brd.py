@@ -465,7 +465,10 @@ class Material:
             not fit (naming the parameter, the value and the range).
         """
         values: dict[str, Value] = {p.name: p.default for p in self.parameters}
-        for name, value in overrides.items():
+        # An index naming a medium goes last: it selects its medium_NAME whatever number that held before
+        # (values read back from a state and a design's n2=chitin, in one mapping).
+        names_medium = lambda item: isinstance(item[1], str) and not _NUMBER_RE.match(item[1].strip())  # noqa: E731
+        for name, value in sorted(overrides.items(), key=names_medium):
             if isinstance(value, str) and f"medium_{name}" in values and not _NUMBER_RE.match(value.strip()):
                 # An index naming a medium (n2=chitin): the material's medium_NAME selects it (explorer.materials.media).
                 from explorer.materials.media import medium_values

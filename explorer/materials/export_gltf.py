@@ -43,7 +43,7 @@ _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 
 #: How the film was found (extras' ``mapping``).
 MAPPINGS = {"direct": "direct: the film's own parameters",
-            "refined": "the film's parameters moved to the nearest minimum of the ΔE2000 (closer than the direct mapping)",
+            "refined": "the film's parameters moved to the least median ΔE2000 over theta (closer than the direct mapping)",
             "fit": "the nearest single film (metallic base)"}
 
 
@@ -86,12 +86,10 @@ def film_for(material, values) -> gltf_film.Film:
         raise GltfExportError(material.path, None, "this material has no numpy twin to fit a film to (no known '# model:' line)")
     if not capabilities_of(material).supports("gltf"):
         raise GltfExportError(material.path, None, f"its twin declares no glTF export (exports: {', '.join(supporting('gltf'))})")
-    target = gltf_film.target_rgb(model)
     direct = gltf_film.direct_film(model)
     if direct is None:
-        return gltf_film.fit_film(target)
-    direct.delta_e = gltf_film.delta_e(direct, target)
-    film = gltf_film.refine_film(direct, target)
+        return gltf_film.fit_film(gltf_film.target_rgb(model))
+    film = gltf_film.refine_film(direct, gltf_film.target_rgb(model, gltf_film.DENSE_THETA_DEG))
     film.direct = direct
     return film
 

@@ -24,8 +24,16 @@ import numpy as np
 
 from explorer.physics import colorimetry
 
-#: The angles (degrees from the normal) at which a film is fitted and its ΔE2000 reported.
-THETA_DEG = np.arange(0.0, 90.0, 5.0)
+#: The view angles over which a thin film's global fit takes its median (every degree of the hemisphere, so
+#: that the fit leans on no reporting grid).
+DENSE_THETA_DEG = np.arange(0.0, 90.0, 1.0)
+#: The angles (degrees from the normal) at which a film is fitted and its ΔE2000 reported: every fifth.
+_REPORTED = slice(None, None, 5)
+THETA_DEG = DENSE_THETA_DEG[_REPORTED]
+#: The global fit's objective: the mean of the middle of the sorted ΔE2000 (these quantiles) plus this weight
+#: times their mean (of two films equally close at the median, the closer at the rim).
+MEDIAN_BAND = (0.44, 0.56)
+TAIL_WEIGHT = 0.02
 
 # The specification's Gaussian fits of the XYZ sensitivities in Fourier space (evalSensitivity) and its
 # XYZ -> Rec. 709 matrix (row-major here: rgb = M @ xyz).
@@ -140,9 +148,9 @@ def delta_e(film: Film, target_rgb: np.ndarray) -> np.ndarray:
     return colorimetry.delta_E_2000(specular_reflectance(film, np.cos(np.radians(THETA_DEG))), target_rgb)
 
 
-def target_rgb(model) -> np.ndarray:
-    """A material twin's smooth reflectance at :data:`THETA_DEG` (what its sphere and gradient views show)."""
-    return np.asarray(model.reflectance(np.cos(np.radians(THETA_DEG))), dtype=np.float64)
+def target_rgb(model, theta_deg: np.ndarray = THETA_DEG) -> np.ndarray:
+    """A material twin's smooth reflectance at ``theta_deg`` (what its sphere and gradient views show)."""
+    return np.asarray(model.reflectance(np.cos(np.radians(theta_deg))), dtype=np.float64)
 
 
 def direct_film(model) -> Film | None:
@@ -244,24 +252,90 @@ def fit_film(target: np.ndarray, starts: int = 3) -> Film:
     return _film_of(min(fits, key=lambda f: f[1])[0], True, "fit", target)
 
 
-def refine_film(film: Film, target: np.ndarray) -> Film:
+def _median_band(e: np.ndarray) -> np.ndarray:
+    """The global fit's objective of ΔE2000 rows ``(K, n)``: :data:`MEDIAN_BAND`'s mean plus :data:`TAIL_WEIGHT` x the mean."""
+    n = e.shape[1]
+    middle = np.sort(e, axis=1)[:, int(round(MEDIAN_BAND[0] * n)):int(round(MEDIAN_BAND[1] * n))]
+    return middle.mean(axis=1) + TAIL_WEIGHT * e.mean(axis=1)
+
+
+#: The per-channel base index range of the global fit's second search (F0 up to 0.51).
+_BASE_INDEX_RANGE = (1.0, 6.0)
+
+
+def _from_base_indices(x: np.ndarray) -> np.ndarray:
+    """Dielectric films ``(K, 7)`` (thickness, film index, factor, the base's index per channel, specular factor)
+    as :func:`_films_rgb`'s ``(K, 8)``: KHR_materials_ior at the top of :data:`IOR_RANGE`, its F0 coloured down."""
+    f0 = _ior_to_f0(x[:, 3:6], 1.0) / _ior_to_f0(IOR_RANGE[1], 1.0)
+    return np.column_stack([x[:, :3], np.full(len(x), IOR_RANGE[1]), f0, x[:, 6]])
+
+
+def _global(start, lower, upper, dense_lab, dense_cos) -> np.ndarray:
+    """
+    A dielectric film ``(8,)`` of low :func:`_median_band`: differential evolution (scipy, seeded, so every run
+    writes the same film) over the box, and again with the base as an index per channel (the same films,
+    searched in other coordinates: either alone misses some minima), on every second degree; then Nelder-Mead
+    from the better one on every degree.
+    """
+    from scipy.optimize import differential_evolution, minimize
+
+    coarse_lab, coarse_cos = dense_lab[::2], dense_cos[::2]
+
+    def search(decode, bounds, x0, popsize):
+        result = differential_evolution(lambda x: _median_band(_films_delta_e(decode(x.T), False, coarse_lab, coarse_cos)),
+                                        bounds, x0=x0, vectorized=True, updating="deferred", popsize=popsize,
+                                        maxiter=200, tol=1e-8, seed=0, polish=False)
+        return decode(result.x[None])[0]
+
+    found = [search(lambda x: x, list(zip(lower, upper)), np.clip(start, lower, upper), 15)]
+    index_bounds = [(lower[0], upper[0]), IOR_RANGE, (0.0, 1.0), *[_BASE_INDEX_RANGE] * 3, (0.0, 1.0)]
+    found.append(search(_from_base_indices, index_bounds, np.array([*start[:3], *[start[3]] * 3, 1.0]), 20))
+
+    def dense(p):
+        return float(_median_band(_films_delta_e(np.clip(p, lower, upper)[None], False, dense_lab, dense_cos))[0])
+
+    best = min(found, key=dense)
+    polished = minimize(dense, best, method="Nelder-Mead", options={"maxfev": 1500, "xatol": 1e-4, "fatol": 1e-5})
+    return np.clip(polished.x, lower, upper)
+
+
+def dense_delta_e(film: Film, dense_target: np.ndarray) -> np.ndarray:
+    """ΔE2000 at :data:`DENSE_THETA_DEG` between the film's reflection and ``dense_target`` (``(90, 3)``)."""
+    return colorimetry.delta_E_2000(specular_reflectance(film, np.cos(np.radians(DENSE_THETA_DEG))), dense_target)
+
+
+def refine_film(film: Film, dense_target: np.ndarray) -> Film:
     """
     ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour; the
-    dielectric's index, specular colour and factor: KHR_materials_specular) moved to a nearby minimum of the
-    ΔE2000 to ``target``, by plain and by robust (soft L1) least squares: the spec's Schlick Fresnel cannot
-    follow the polarised film at oblique angles, and the robust fit keeps those few angles from pulling the
-    rest. Of ``film`` and the two, the one of least median ΔE2000 is kept.
+    dielectric's index, specular colour and factor: KHR_materials_specular) moved to lower the ΔE2000 to
+    ``dense_target`` (the material at :data:`DENSE_THETA_DEG`).
+
+    The spec's formula (Gaussian sensitivities, a matrix without white balance, unpolarised Schlick
+    interfaces) cannot follow the polarised film at every angle with one set of parameters; least squares
+    over all angles (plain and soft L1, from ``film``) lets the rim pull the centre, and stays near
+    ``film``. A global search (:func:`_global`) of the median over every degree finds films that match
+    the centre of the view closely and give way at the rim. Of ``film`` and the three, the one of least
+    median ΔE2000 over :data:`DENSE_THETA_DEG` is kept; its ΔE is reported at :data:`THETA_DEG`.
     """
-    cos = np.cos(np.radians(THETA_DEG))
-    target = np.asarray(target, np.float64)
+    dense_target = np.asarray(dense_target, np.float64)
+    target = dense_target[_REPORTED]
     metallic = film.metallic >= 0.5
     base = film.base_color if metallic else (film.base_ior, *film.specular_color, film.specular)
     start = np.array([film.thickness, film.ior, film.factor, *base])
     lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0, 0.0, 0.0, 0.0, 0.0))])
     upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0,
                       *((1.0,) * 3 if metallic else (3.0, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, 1.0))])
+    film.delta_e = delta_e(film, target)
     candidates = [film]
     for loss in ("linear", "soft_l1"):
-        params, _ = _refine(start, lower, upper, metallic, _lab(target), cos, loss)
+        params, _ = _refine(start, lower, upper, metallic, _lab(target), np.cos(np.radians(THETA_DEG)), loss)
         candidates.append(_film_of(params, metallic, "refined", target))
-    return min(candidates, key=lambda f: (float(np.median(f.delta_e)), float(np.sum(f.delta_e**2))))
+    if not metallic:
+        dense_cos = np.cos(np.radians(DENSE_THETA_DEG))
+        candidates.append(_film_of(_global(start, lower, upper, _lab(dense_target), dense_cos), False, "refined", target))
+
+    def key(f: Film):
+        e = dense_delta_e(f, dense_target)
+        return float(np.median(e)), float(np.sum(e**2))
+
+    return min(candidates, key=key)

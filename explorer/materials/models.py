@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter, natural
+from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter_stack, natural
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
@@ -43,6 +43,16 @@ def _interp_wavelength(table: np.ndarray, wavelengths: np.ndarray) -> np.ndarray
     f = x - j0
     rows = np.arange(table.shape[0])[:, None]
     return table[rows, j0] * (1.0 - f) + table[rows, j0 + 1] * f
+
+
+def _spectral_lobe(compensation, i, o, wavelengths, rho) -> np.ndarray:
+    """The multiple-scattering lobe at local directions ``(n, 3)`` and wavelengths ``(n, W)`` with the base's albedo
+    ``rho`` ``(n, W)`` (:func:`explorer.physics.multiscatter_stack.lobe_parts`), 0 where either is below the horizon."""
+    parts = multiscatter_stack.lobe_parts(compensation, *multiscatter_stack.air_angles(i, o))
+    M, TT, aa = (_interp_wavelength(x, wavelengths) for x in parts)
+    under = _interp_wavelength(np.broadcast_to(compensation.under, parts[0].shape), wavelengths)
+    lobe = M + (TT * rho / (1.0 - rho * under) - rho * aa) * (compensation.radiance_scale / np.pi)
+    return np.where(((i[:, 2] > 0.0) & (o[:, 2] > 0.0))[:, None], lobe, 0.0)
 
 
 @functools.lru_cache(maxsize=16)
@@ -95,6 +105,8 @@ def mirror_of(values: Mapping[str, object]) -> bragg.BraggMirror:
 def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP,
                     smooth: float | None = None) -> np.ndarray:
     """The coarse colours ``(B, A, 3)`` of mirrors ``values`` (arrays ``(B,)``, ``N`` continuous) at ``cos_theta`` ``(A,)``."""
+    if natural_values(values):  # absorbing layers (k1, k2): the complex indices' batch
+        return natural_batch(values, {}, cos_theta, step, smooth)
     nodes, weights = colorimetry.interpolant_nodes(step)
     R = bragg.bragg_reflectance_batch(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
                                       values["nh"], cos_theta, nodes, step=step, smooth=smooth)
@@ -114,6 +126,8 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     ``final``, otherwise the tabulated method's own nodes (float32 where it applies, substeps capped), which the
     polish calls many times.
     """
+    if natural_values(values):  # absorbing or disordered layers: the natural mirror's colours
+        return natural_converged(values, {}, cos_theta, final)
     mirror = mirror_of(values)
     cos_theta = np.asarray(cos_theta, dtype=np.float64)
     if final:
@@ -121,12 +135,91 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     return bragg.converged_rgb(cos_theta, mirror)
 
 
+# Natural mirrors in design: indices naming media (explorer.design.media), absorbing and disordered layers.
+
+#: The index parameters that may name a medium.
+MEDIUM_PARAMETERS = ("n1", "n2", "nh")
+#: The natural mirror's other design parameters: each layer's extinction coefficient (added to its index,
+#: a number's or a medium's) and the thickness disorder. The search holds them at 0 unless fixed or freed.
+NATURAL_PARAMETERS = ("k1", "k2", "sigma")
+#: The extinction coefficient of each layer's index.
+EXTINCTION = {"n1": "k1", "n2": "k2"}
+#: The non-final converged colours (the polish's) sample the spectrum this finely (nm), fringes narrower
+#: than a few steps averaged (:func:`explorer.physics.bragg.bragg_reflectance_batch`).
+POLISH_STEP = 1.0
+
+
+def design_indices(values: Mapping[str, np.ndarray], media: Mapping, wavelengths: np.ndarray) -> dict[str, np.ndarray]:
+    """
+    ``n1``, ``n2``, ``nh`` of rows ``values`` ``(B,)`` with each medium at ``wavelengths`` ``(W,)`` and each layer's
+    ``k`` added: ``(B, 1, W)`` or ``(B,)``.
+    """
+    rows = np.asarray(values["Lambda"]).shape[0]
+    out = {}
+    for name in MEDIUM_PARAMETERS:
+        medium = media.get(name)
+        if medium is None:
+            out[name] = np.asarray(values[name], dtype=np.float64)
+        else:
+            index = medium.index(wavelengths)
+            # A lossless medium stays real: the real batch model (and its coherent fringe average) takes it.
+            if not np.any(np.imag(index)):
+                index = np.real(index)
+            out[name] = np.broadcast_to(index.reshape(1, 1, -1), (rows, 1, index.size))
+        k = values.get(EXTINCTION.get(name, ""))
+        if k is not None and np.any(np.asarray(k) != 0.0):
+            # n + i k, as NaturalMirror.index_1 / index_2 add a layer's k to its number or its medium.
+            k = np.broadcast_to(np.asarray(k, dtype=np.float64), (rows,))
+            out[name] = out[name] + 1j * (k.reshape(-1, 1, 1) if np.ndim(out[name]) == 3 else k)
+    if not any(np.iscomplexobj(v) for v in out.values()):
+        return out
+    # Complex: every index per wavelength (the absorbing batch model's broadcast).
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+def mirror_with_media(values: Mapping[str, float], media: Mapping) -> natural.NaturalMirror:
+    """The :class:`explorer.physics.natural.NaturalMirror` of design values (``N`` rounded), media in place of their numbers."""
+    index = lambda name: media[name] if name in media else float(values[name])  # noqa: E731
+    nh = media.get("nh", host_index(float(values["nh"])))
+    extra = {name: float(values.get(name, 0.0)) for name in NATURAL_PARAMETERS}
+    return natural.NaturalMirror(n1=index("n1"), n2=index("n2"), Lambda=float(values["Lambda"]), delta=float(values["delta"]),
+                                 N=max(1, int(round(float(values["N"])))), nh=nh, **extra)
+
+
+def natural_values(values: Mapping[str, object]) -> bool:
+    """Whether design values ``values`` (numbers or rows) have an absorbing or disordered layer."""
+    return any(np.any(np.asarray(values.get(name, 0.0)) != 0.0) for name in NATURAL_PARAMETERS)
+
+
+def natural_batch(values: Mapping[str, np.ndarray], media: Mapping, cos_theta, step: float, smooth: float | None) -> np.ndarray:
+    """The batch model's colours ``(B, A, 3)`` of rows ``values`` with ``media`` and each layer's ``k`` (the ordered mirror)."""
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    n = design_indices(values, media, nodes)
+    R = bragg.bragg_reflectance_batch(n["n1"], n["n2"], values["Lambda"], values["delta"], values["N"], n["nh"],
+                                      cos_theta, nodes, step=step, smooth=smooth)
+    return colorimetry.xyz_to_rgb(R @ weights)
+
+
+def natural_converged(values: Mapping[str, float], media: Mapping, cos_theta, final: bool = True) -> np.ndarray:
+    """
+    The converged colours ``(A, 3)`` of one structure with ``media``, ``k1``, ``k2`` and ``sigma``:
+    :func:`explorer.physics.natural.natural_rgb` (final, or disordered: its realisations seeded, a smooth function
+    of the structure), else the batch at :data:`POLISH_STEP`.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64)
+    if final or float(values.get("sigma", 0.0)) > 0.0:
+        return natural.natural_rgb(cos_theta, mirror_with_media(values, media))
+    rows = {k: np.array([float(v)]) for k, v in values.items()}
+    rows["N"] = np.array([max(1.0, float(np.round(values["N"])))])
+    return natural_batch(rows, media, cos_theta, POLISH_STEP, None)[0]
+
+
 #: What design fits of a Bragg mirror, and on which forward model: its specular colour (the rough layer's too: the
 #: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
-BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh"), log_parameters=("N", "Lambda"),
+BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
                            integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb,
                            host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
-                           paint_free=("Lambda", "delta", "N"))
+                           paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 
 
 @twin
@@ -333,6 +426,48 @@ class BraggLayerModel(BraggMirrorModel):
         self.alpha = float(values["alpha"])
         microfacet.check_alpha(self.alpha)
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
+        self.multiple_scattering = bool(values.get("multiple_scattering", False))
+        self._compensation = None
+        self._compensation_rgb: np.ndarray | None = None
+
+    @property
+    def compensation(self):
+        """
+        The layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`, as
+        ``bragg_stack``'s for one layer seen from inside its host, no coating, over the base), or None when off.
+        Natural layers (absorbing, disordered, dispersive) as ``bragg_stack``'s; a dispersive host at 550 nm.
+        """
+        if not self.multiple_scattering:
+            return None
+        if self._compensation is None:
+            nat = self.natural
+            if nat is None:
+                host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
+                n1, n2, media, k1, k2, sigma = self.mirror.n1, self.mirror.n2, {}, 0.0, 0.0, 0.0
+            else:
+                # A dispersive host enters the compensation at its index at 550 nm (its angles need one number).
+                nh = nat.nh if nat.nh is not None else nat.n1  # no host given: the host is n1
+                host = float(nh) if isinstance(nh, (int, float)) else float(nh.real_at(550.0))
+                media = {f"medium_{k}": m for k, m in (("n1", nat.n1), ("n2", nat.n2)) if not isinstance(m, float)}
+                n1 = nat.n1 if isinstance(nat.n1, float) else host + 1.0  # a medium stands for n1: not the host
+                n2 = nat.n2 if isinstance(nat.n2, float) else 1.5
+                k1, k2, sigma = nat.k1, nat.k2, nat.sigma
+            layer = layered.RoughBraggLayer(
+                n2=float(n2), Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
+                n1=None if n1 == host else float(n1), k1=k1, k2=k2, sigma=sigma, **media)
+            stack = layered.LayeredBragg(layers=(layer,), n1=host, rho_d=tuple(self.rho_d), coating=False)
+            table = _layer_tables(layer, host)
+            self._compensation = multiscatter_stack.stack_compensation(stack, (table,), (_layer_terms(table),))
+        return self._compensation
+
+    @property
+    def compensation_rgb(self) -> np.ndarray | None:
+        """The compensation's lobe in RGB over (theta_i, theta_o) (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        if self.compensation is None:
+            return None
+        if self._compensation_rgb is None:
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.rho_d)
+        return self._compensation_rgb
 
     @property
     def transmission_table(self) -> np.ndarray:
@@ -355,6 +490,10 @@ class BraggLayerModel(BraggMirrorModel):
         table = self.transmission_table
         base = (self.rho_d / np.pi) * bragg.tabulated_rgb(table, cos_i) * bragg.tabulated_rgb(table, cos_o)
         result[above] = specular + base
+        if self.compensation_rgb is not None:
+            # The lobe needs the polar angles only: atan2(|d - (d.n) n|, d.n), as the shader's atan(length(xy), z).
+            polar = lambda d, c: np.arctan2(np.linalg.norm(np.broadcast_to(d, N.shape)[above] - c[:, None] * N[above], axis=-1), c)  # noqa: E731
+            result[above] += multiscatter_stack.lookup_rgb(self.compensation_rgb, polar(L, cos_i), polar(V, cos_o))
         return result
 
     spectral_reflectance = None
@@ -376,6 +515,8 @@ class BraggLayerModel(BraggMirrorModel):
             Ti = _interp_wavelength(layered.lookup(T, _theta(i)), wavelengths)
             To = _interp_wavelength(layered.lookup(T, _theta(o)), wavelengths)
             value = value + rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths) / np.pi * Ti * To
+        if self.compensation is not None:
+            value = value + _spectral_lobe(self.compensation, i, o, wavelengths, rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths))
         return value
 
     def sampling_lobes(self, cos_o):
@@ -386,8 +527,12 @@ class BraggLayerModel(BraggMirrorModel):
         return [max(self.alpha, 1e-4)], [1.0 - p_trans + 1e-3], p_trans * rho
 
     def textures(self) -> dict[str, np.ndarray]:
-        """The method-3 reflectance table (a placeholder texel otherwise) and ``T_rgb``."""
-        return {**super().textures(), "transmission_table": self.transmission_table}
+        """The method-3 reflectance table (a placeholder texel otherwise), ``T_rgb`` and the multiple-scattering
+        lobe's table ``layer_lobe`` (:func:`explorer.physics.multiscatter_stack.rgb_table`; zeros when off)."""
+        lobe = np.zeros((multiscatter_stack.TABLE_ROWS, multiscatter_stack.TABLE_ROWS, 3), np.float32)
+        if self.compensation_rgb is not None:
+            lobe[...] = self.compensation_rgb
+        return {**super().textures(), "transmission_table": self.transmission_table, "layer_lobe": lobe}
 
 
 @functools.lru_cache(maxsize=32)
@@ -396,17 +541,17 @@ def _layer_tables(layer: layered.RoughBraggLayer, n1: float) -> layered.LayerTab
     return layered.layer_tables(layer, n1)
 
 
-_COMPENSATION_CACHE: dict = {}
+_TERMS_CACHE: dict = {}
 
 
-def _layer_compensation(table: layered.LayerTables):
-    """A layer's multiple-scattering compensation from its (cached) tables, cached per layer and host (32 of them)."""
+def _layer_terms(table: layered.LayerTables):
+    """A layer's albedos with multiple scattering from its (cached) tables, cached per layer and host (32 of them)."""
     key = (table.layer, table.n1)
-    if key not in _COMPENSATION_CACHE:
-        if len(_COMPENSATION_CACHE) >= 32:
-            _COMPENSATION_CACHE.pop(next(iter(_COMPENSATION_CACHE)))
-        _COMPENSATION_CACHE[key] = multiscatter.compensation_tables(table.reflectance, table.transmissivity, table.theta, table.layer.alpha)
-    return _COMPENSATION_CACHE[key]
+    if key not in _TERMS_CACHE:
+        if len(_TERMS_CACHE) >= 32:
+            _TERMS_CACHE.pop(next(iter(_TERMS_CACHE)))
+        _TERMS_CACHE[key] = multiscatter_stack.layer_terms_of(table)
+    return _TERMS_CACHE[key]
 
 
 def _flat_tables(table: layered.LayerTables, R: float) -> layered.LayerTables:
@@ -445,7 +590,8 @@ class BraggStackModel:
         self.stack = self.stack_of(values)
         self.multiple_scattering = bool(values.get("multiple_scattering", False))
         self._tables: tuple | None = None
-        self._compensation: tuple | None = None
+        self._compensation = None
+        self._compensation_rgb: np.ndarray | None = None
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
 
     @staticmethod
@@ -486,16 +632,23 @@ class BraggStackModel:
         return self._tables
 
     @property
-    def compensation(self) -> tuple | None:
-        """Every layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter`), or None when off."""
+    def compensation(self):
+        """The structure's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`), or None when off."""
         if not self.multiple_scattering:
             return None
         if self._compensation is None:
-            if self.facet_reflectance_override is None:
-                self._compensation = tuple(_layer_compensation(table) for table in self.tables)
-            else:
-                self._compensation = layered.stack_compensation(self.stack, self.tables)
+            terms = None if self.facet_reflectance_override is not None else tuple(_layer_terms(t) for t in self.tables)
+            self._compensation = multiscatter_stack.stack_compensation(self.stack, self.tables, terms)
         return self._compensation
+
+    @property
+    def compensation_rgb(self) -> np.ndarray | None:
+        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        if self.compensation is None:
+            return None
+        if self._compensation_rgb is None:
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.stack.rho_d)
+        return self._compensation_rgb
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
@@ -508,7 +661,12 @@ class BraggStackModel:
             return np.stack([np.sum(d * X, axis=-1), np.sum(d * Y, axis=-1), np.sum(d * N, axis=-1)], axis=-1)
 
         X, Y, N = (np.asarray(a, dtype=np.float64) for a in (X, Y, N))
-        return layered.single_reflection_brdf(self.stack, local(L), local(V), self.tables, compensation=self.compensation)
+        i, o = local(L), local(V)
+        value = layered.single_reflection_brdf(self.stack, i, o, self.tables)
+        if self.compensation_rgb is not None:
+            above = ((i[..., 2] > 0.0) & (o[..., 2] > 0.0))[..., None]
+            value = value + np.where(above, multiscatter_stack.lookup_rgb(self.compensation_rgb, *multiscatter_stack.air_angles(i, o)), 0.0)
+        return value
 
     def mirror_reflection(self, V, N) -> np.ndarray:
         """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
@@ -522,10 +680,14 @@ class BraggStackModel:
         value = np.empty(wavelengths.shape)
         for start in range(0, i.shape[0], SPECTRAL_CHUNK):
             part = slice(start, start + SPECTRAL_CHUNK)
-            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables, compensation=self.compensation)
-            layers = _interp_wavelength(spectra.layers, wavelengths[part])
+            spectra = layered.single_reflection_spectra(self.stack, i[part], o[part], self.tables)
+            layers = spectra.layers
+            rho = rgb_upsample(np.broadcast_to(self.rho_d, (layers.shape[0], 3)), wavelengths[part])
+            layers = _interp_wavelength(layers, wavelengths[part])
             base = _interp_wavelength(spectra.base, wavelengths[part])
-            value[part] = layers + rgb_upsample(np.broadcast_to(self.rho_d, (base.shape[0], 3)), wavelengths[part]) * base
+            value[part] = layers + rho * base
+            if self.compensation is not None:
+                value[part] += _spectral_lobe(self.compensation, i[part], o[part], wavelengths[part], rho)
         return value
 
     def sampling_lobes(self, cos_o):
@@ -542,7 +704,7 @@ class BraggStackModel:
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator); ``stack_transmittance``
         as ``stack_reflectance``: each smooth layer's ``T_lambda`` (exact for natural layers, else ``1 - R``).
         """
-        return self._textures_of(self.tables, self.compensation)
+        return self._textures_of(self.tables, self.compensation_rgb)
 
     def draft_textures(self) -> dict[str, np.ndarray]:
         """
@@ -550,10 +712,12 @@ class BraggStackModel:
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
         tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
-        return self._textures_of(tables, layered.stack_compensation(self.stack, tables) if self.multiple_scattering else None)
+        # The multiple-scattering lobe is not drafted (its walk and quadratures take a second or more): a
+        # draft shows Eq. 34 alone until the real textures follow on release.
+        return self._textures_of(tables, None)
 
     @staticmethod
-    def _textures_of(tables, compensation=None) -> dict[str, np.ndarray]:
+    def _textures_of(tables, compensation_rgb=None) -> dict[str, np.ndarray]:
         shape = (microfacet.THETA_COUNT, colorimetry.WAVELENGTHS.size, 3)
         reflectance = np.zeros(shape, np.float32)
         transmissivity = np.zeros(shape, np.float32)
@@ -563,12 +727,10 @@ class BraggStackModel:
             transmissivity[..., l] = table.transmissivity
             # The smooth limit's T: a natural layer's exact one (absorbing: < 1 - R), else 1 - R.
             transmittance[..., l] = np.float32(1.0) - table.reflectance if table.transmittance is None else table.transmittance
-        # stack_missing: rows theta = k 2 deg (46) of m(theta), then r and r / (pi m_avg) (zeros: no compensation).
-        missing = np.zeros((multiscatter.COMPENSATION_ROWS + 2, colorimetry.WAVELENGTHS.size, 3), np.float32)
-        for l, c in enumerate(compensation or ()):
-            missing[:-2, :, l] = c.missing
-            missing[-2, :, l] = c.up
-            missing[-1, :, l] = c.up / (np.pi * np.maximum(c.missing_average, 1e-12))
+        # stack_missing: the multiple-scattering lobe in RGB, rows theta_i and columns theta_o every 2 deg in air (zeros: off).
+        missing = np.zeros((multiscatter_stack.TABLE_ROWS, multiscatter_stack.TABLE_ROWS, 3), np.float32)
+        if compensation_rgb is not None:
+            missing[...] = compensation_rgb
         return {
             "stack_reflectance": reflectance,
             "stack_transmissivity": transmissivity,

@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, multiscatter, thinfilm
+from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, multiscatter_stack, thinfilm
 
 
 def declaration(name: str, value) -> str:
@@ -77,9 +77,11 @@ GENERATED: dict[str, Callable[[], str]] = {
         "THETA_ROWS": microfacet.THETA_COUNT,
         "THETA_STEP": float(microfacet.THETA_STEP),
         "LAYER_COS_THETA_MIN": microfacet.COS_THETA_MIN,
-        "COMPENSATION_ROWS": multiscatter.COMPENSATION_ROWS,
-        "COMPENSATION_STEP_DEG": float(multiscatter.COMPENSATION_STEP_DEG),
-    }, "explorer/physics/layered.py, microfacet.py and multiscatter.py"),
+    }, "explorer/physics/layered.py and microfacet.py"),
+    "generated/multiscatter.glsl": lambda: _block({
+        "COMPENSATION_ROWS": multiscatter_stack.TABLE_ROWS,
+        "COMPENSATION_STEP_DEG": float(multiscatter_stack.TABLE_STEP_DEG),
+    }, "explorer/physics/multiscatter_stack.py"),
     "generated/lobes.glsl": lambda: _block({
         "LOBES_MAX": lobes.MAX_INTERFACES,
         "FGD_COS_COUNT": lobes_fgd.FGD_COS_COUNT,

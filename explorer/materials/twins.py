@@ -64,11 +64,14 @@ class DesignModel:
     #: Free by default when painting an image: the structure's lengths and count (its indices are materials,
     #: fixed at the file's values unless named free).
     paint_free: tuple[str, ...] = ()
+    #: Parameters the search holds at 0 (an effect off: a layer's absorption, the disorder) unless the caller fixes
+    #: them at another value or frees them by name (:func:`explorer.design.design`'s ``free``).
+    held: tuple[str, ...] = ()
     #: The ``# model:`` name it designs: set by :func:`explorer.design.design_model` from the registry.
     name: str | None = None
 
     def __post_init__(self):
-        named = (*self.log_parameters, *self.integer_parameters, *self.paint_free,
+        named = (*self.log_parameters, *self.integer_parameters, *self.paint_free, *self.held,
                  *(p for p in (self.host_parameter, self.scale_parameter) if p is not None))
         stray = [p for p in named if p not in self.parameters]
         if stray:

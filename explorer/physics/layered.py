@@ -37,7 +37,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from explorer.physics import bragg, colorimetry, microfacet, multiscatter
+from explorer.physics import bragg, colorimetry, microfacet
 from explorer.physics.fresnel import fresnel_reflectance
 
 #: At most this many rough Bragg layers in a stack.
@@ -468,7 +468,6 @@ class SingleReflectionSpectra:
 
 def single_reflection_spectra(
     stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False,
-    compensation: Sequence[multiscatter.CompensationTables] | None = None,
 ) -> SingleReflectionSpectra:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34), spectrally:
@@ -488,10 +487,6 @@ def single_reflection_spectra(
     exact_reflectance : bool
         ``True`` evaluates Yeh's ``R_lambda`` at the exact half-vector angle (Table 2's "Model"),
         ``False`` interpolates the layer's table (Table 2's "Model-LUT").
-    compensation : sequence of explorer.physics.multiscatter.CompensationTables, optional
-        One per layer (:func:`stack_compensation`): multiple scattering among each layer's facets
-        (:mod:`explorer.physics.multiscatter`: Eq. 17's masking by transparent occluders, their ballistic
-        transmission and Kulla & Conty's lobe for the rest). ``None``: Eq. 34 as published.
 
     Returns
     -------
@@ -532,11 +527,6 @@ def single_reflection_spectra(
     layers = 0.0
     for l, (layer, table) in enumerate(zip(stack.layers, tables)):
         path = path * gap
-        if compensation is not None:
-            layer_term, t_i, t_o = _compensated_layer(layer, table, compensation[l], h, theta_d, theta_i, theta_o, cos_i_host, cos_o_host)
-            layers = layers + layer_term * path
-            path = path * t_i * t_o
-            continue
         # Eq. 17: D(h) G1(i) G1(o) R(i.h) / (4 cos_i cos_o), G1/cos finite at grazing angles.
         lobe = (
             0.25
@@ -557,37 +547,8 @@ def single_reflection_spectra(
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
 
 
-def _compensated_layer(layer, table, compensation, h, theta_d, theta_i, theta_o, cos_i, cos_o):
-    """
-    One layer's reflection with multiple scattering (:mod:`explorer.physics.multiscatter`) and its transmissions
-    along ``i`` and ``o`` as the layers below see them, per wavelength.
-    """
-    alpha = layer.alpha
-    t_i, t_o = lookup(table.transmissivity, theta_i), lookup(table.transmissivity, theta_o)
-    rho_i = multiscatter.occluder_reflectance(t_i, cos_i, alpha)
-    rho_o = multiscatter.occluder_reflectance(t_o, cos_o, alpha)
-    # Eq. 17 with the occluders' height-correlated masking-shadowing for G1 G1: D(h) G2 R(i.h) / (4 cos_i cos_o).
-    lobe = 0.25 * microfacet.ggx_D(h[..., 2], alpha)[..., None]
-    masking = multiscatter.correlated_masking_over_cos(cos_i, cos_o, alpha, multiscatter.occluder_stop(rho_i), multiscatter.occluder_stop(rho_o))
-    reflection = lobe * masking * lookup(table.reflectance, theta_d)
-    m_i, m_o = multiscatter.missing_energy(compensation, theta_i), multiscatter.missing_energy(compensation, theta_o)
-    through_i = multiscatter.compensated_transmissivity(
-        multiscatter.ballistic_transmissivity(rho_i, multiscatter.effective_masking(cos_i, alpha, rho_i)), m_i, compensation)
-    through_o = multiscatter.compensated_transmissivity(
-        multiscatter.ballistic_transmissivity(rho_o, multiscatter.effective_masking(cos_o, alpha, rho_o)), m_o, compensation)
-    return reflection + multiscatter.compensation_lobe(m_i, m_o, compensation), through_i, through_o
-
-
-def stack_compensation(stack: LayeredBragg, tables: Sequence[LayerTables] | None = None) -> tuple[multiscatter.CompensationTables, ...]:
-    """Every layer's multiple-scattering compensation (:func:`explorer.physics.multiscatter.compensation_tables`), top to bottom."""
-    tables = stack_tables(stack) if tables is None else tuple(tables)
-    return tuple(multiscatter.compensation_tables(t.reflectance, t.transmissivity, t.theta, layer.alpha)
-                 for layer, t in zip(stack.layers, tables))
-
-
 def single_reflection_brdf(
     stack: LayeredBragg, i: ArrayLike, o: ArrayLike, tables: Sequence[LayerTables] | None = None, exact_reflectance: bool = False,
-    compensation: Sequence[multiscatter.CompensationTables] | None = None,
 ) -> np.ndarray:
     """
     The single-reflection BRDF of a layered Bragg structure (Eq. 34) in linear sRGB (1/sr): the Bragg
@@ -612,7 +573,7 @@ def single_reflection_brdf(
     ----------
     Fourneau et al. (2024), Eq. 34; the colour convention of :mod:`explorer.physics.colorimetry`.
     """
-    spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance, compensation)
+    spectra = single_reflection_spectra(stack, i, o, tables, exact_reflectance)
     return colorimetry.spectrum_to_rgb(spectra.layers) + np.asarray(stack.rho_d) * colorimetry.spectrum_to_rgb(spectra.base)
 
 

@@ -63,7 +63,7 @@ def smith_lambda(cos_theta: np.ndarray, alpha: float) -> np.ndarray:
 def walk(
     direction: np.ndarray, beta: np.ndarray, pi: np.ndarray, alpha: float,
     reflectance: Callable[[np.ndarray, np.ndarray], np.ndarray], rng: np.random.Generator,
-    max_events: int = MAX_WALK_EVENTS,
+    max_events: int = MAX_WALK_EVENTS, record: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """
     Walk ``n`` paths through one rough Bragg layer until they leave it.
@@ -85,6 +85,10 @@ def walk(
     rng : numpy.random.Generator
     max_events : int
         Facet events at most per path.
+    record : callable, optional
+        ``record(rows, cos_theta_d, reflect)`` at every facet event: which paths, their facet angles, whether
+        each reflected (for reweighting the paths to other reflectances: the path's geometry depends on the
+        choices only).
 
     Returns
     -------
@@ -142,6 +146,8 @@ def walk(
         cos_d = np.clip(np.sum(wi * m, axis=-1), 0.0, 1.0)
         R = np.clip(reflectance(cos_d, rows), 0.0, 1.0)
         reflect = rng.random(rows.size) < R[:, 0]
+        if record is not None:
+            record(rows, cos_d, reflect)
         reflections[rows] += reflect
         # Reflection: about m, on the same side; crossing: the same direction, on the other side.
         beta[rows] *= np.where(reflect[:, None], R, 1.0 - R)

@@ -1,13 +1,13 @@
 """
-Multiple scattering among the microfacets of a rough Bragg layer, for the explorer's model: an energy
-compensation after Kulla & Conty (2017), generalised to facets that reflect a spectrum ``R_lambda(theta_d)``
-and let the rest through ballistically (Fourneau et al. 2024, Section 4.2.1). Numpy only; the GLSL twins of
-the same names are in ``shaders/lib/layered.glsl``. Measured against the microsurface random walk
-(:mod:`explorer.physics.microsurface`) in ``docs/layered_validation.md``.
+Multiple scattering among the microfacets of a rough Bragg layer, for the explorer's model: the layer's
+directional albedos (reflected, transmitted) with every bounce among facets that reflect a spectrum
+``R_lambda(theta_d)`` and let the rest through ballistically (Fourneau et al. 2024, Section 4.2.1). Numpy
+only. Measured against the microsurface random walk (:mod:`explorer.physics.microsurface`) in
+``docs/layered_validation.md``.
 
 Three changes to a layer's single-scattering terms (Eq. 17, Eq. 28), per wavelength, each exact for
-facets that reflect everything (the furnace, where it is Kulla & Conty's) and for facets that let
-everything through (where the layer is invisible):
+facets that reflect everything (the furnace) and for facets that let everything through (where the layer
+is invisible):
 
 1. **Transparent occluders.** A facet that masks or shadows another is itself a Bragg mirror: it lets
    ``1 - R`` of the light through. In Smith's model (uncorrelated heights) the occluders a ray meets form
@@ -27,21 +27,18 @@ everything through (where the layer is invisible):
    ``alpha <= 1``, ``theta <= 70 deg``).
 3. **What is still missing**, ``m(theta) = 1 - E_r(theta) - t_b(theta)`` (``E_r`` the directional albedo
    of the reflection of (1), ``t_b`` of (2)), is light scattered among the facets: a part ``r`` leaves
-   upward, as Kulla & Conty's lobe ``r m(i) m(o) / (pi m_avg)`` (whose albedo is ``r m(i)``, reciprocal),
-   and ``1 - r`` downward, added to the layer's transmission seen by the layers below and the base
-   (:func:`compensated_transmissivity`). ``r`` is the facets' hemispherical reflectance ``R_avg``:
-   with ``R = 1`` all goes up (Kulla & Conty's ``E_avg`` normalisation), with small ``R`` light scattered
-   among mostly transparent facets leaves mostly downward (the random walk gives ``r ~ R`` within ~0.1).
+   upward and ``1 - r`` downward (:class:`LayerTerms`). ``r`` comes from the random walk itself
+   (:func:`upward_share`): a few thousand paths walked once per roughness with facets that reflect half the
+   light (:func:`walk_ensemble`), reweighted per wavelength by each event's ``R / 0.5`` or ``T / 0.5``. A
+   path's geometry depends only on its choices, so this is the walk with the layer's own ``R_lambda(theta_d)``
+   in expectation: the share follows the spectrum (light scattered twice is filtered twice), where a grey
+   facets' share at the mean reflectance missed by up to 0.25 between two Bragg bands.
 
-Kulla & Conty colour their lobe with ``F_avg^2 E_avg / (1 - F_avg (1 - E_avg))``; here the colour comes
-from ``m`` itself (per wavelength: the light a Bragg facet does not reflect once is not lost, most of it
-crosses) and ``r``. All of it is per wavelength, before the conversion to RGB.
+For the structure (:mod:`explorer.physics.multiscatter_stack`) these are a layer's albedos; the lobe the
+explorer adds is built there. All of it is per wavelength, before the conversion to RGB.
 
 References
 ----------
-Kulla, Conty (2017). Revisiting physically based shading at Imageworks. SIGGRAPH 2017 course: Physically
-Based Shading in Theory and Practice. The energy compensation lobe ``(1 - E(mu_i))(1 - E(mu_o)) / (pi (1 -
-E_avg))`` and its Fresnel colour ``F_ms``.
 Heitz, Hanika, d'Eon, Dachsbacher (2016). Multiple-scattering microfacet BSDFs with the Smith model. ACM
 TOG 35(4). Smith's occlusion as a process along the ray (the heights' ``C1``).
 Fourneau, Pacanowski, Barla (2024). Computer Graphics Forum 43(2). Eqs. 17-19, 28-30, 34.
@@ -120,29 +117,104 @@ def _quadrature(alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return o_z, cos_d, o_z > 0.0
 
 
-@dataclass(frozen=True)
-class CompensationTables:
+def reflection_albedos(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float,
+                       exits: list) -> tuple[list, list]:
     """
-    A rough Bragg layer's multiple-scattering compensation, per wavelength (471, the last axis).
+    A layer's reflection albedos at the rows of :func:`compensation_theta` (host angles), each weighted by an
+    exit factor ``W(theta_o)`` of the reflected direction (rows of ``theta``, shape (rows, 471), or ``None``
+    for 1): ``E[R(theta_d) w W(theta_o)]`` over the normals visible from ``i`` (16 x 16 stratified), with
+    ``w = (1 + Lambda_i) G2`` (transparent occluders, height-correlated: :func:`correlated_masking_over_cos`)
+    and with Eq. 17's ``w = G1(o)`` (opaque separable occluders: single scattering as published).
+
+    Returns
+    -------
+    correlated, separable : list of ndarray, shape (COMPENSATION_ROWS, 471), float64
+        One per exit factor.
+    """
+    alpha = float(microfacet.check_alpha(alpha))
+    R = np.asarray(reflectance, dtype=np.float64)
+    t = np.asarray(transmissivity, dtype=np.float64)
+    theta = np.asarray(theta, dtype=np.float64)
+    step = theta[1] - theta[0]
+    rows = compensation_theta()
+    cos_rows = np.cos(rows)
+    rho_rows = occluder_reflectance(rows_at(t, rows, step), cos_rows, alpha)
+    o_z, cos_d, above = _quadrature(alpha)
+    # Nearest table rows (0.25 deg) for the quadrature's angles: a gather, not an interpolation (float32, all rows at once).
+    row_o = np.rint(np.arccos(np.clip(o_z, 0.0, 1.0)) / step).astype(np.int64).ravel()
+    row_d = np.rint(np.arccos(cos_d) / step).astype(np.int64).ravel()
+    t32, R32 = t.astype(np.float32), R.astype(np.float32)
+    shape = o_z.shape + (R.shape[1],)
+    oz = np.clip(o_z, 1e-6, 1.0).ravel()
+    G1_o = microfacet.smith_G1(oz, alpha).astype(np.float32)[:, None]
+    lam_o = smith_lambda(oz, alpha).astype(np.float32).reshape(o_z.shape + (1,))
+    rho_o = np.clip(1.0 - t32[row_o] / np.maximum(G1_o, np.float32(1e-12)), 0.0, 1.0)
+    stop_o = (rho_o * (2.0 - rho_o)).reshape(shape)
+    lam_i = smith_lambda(np.maximum(cos_rows, np.cos(np.radians(89.5))), alpha).astype(np.float32)[:, None, None]
+    stop_i = occluder_stop(rho_rows).astype(np.float32)[:, None, :]
+    R_d = R32[row_d].reshape(shape)
+    # Eq. 17 with correlated_masking_over_cos for G1 G1: f cos / pdf = R G2 / G1(i) = R (1 + Lambda_i) G2.
+    weight = R_d * (above[..., None] * (1.0 + lam_i) / (1.0 + lam_i * stop_i + lam_o * stop_o))
+    separable = R_d * (above[..., None] * G1_o.reshape(o_z.shape + (1,)))
+    correlated_out, separable_out = [], []
+    for W in exits:
+        if W is None:
+            correlated_out.append(weight.mean(axis=1, dtype=np.float64))
+            separable_out.append(separable.mean(axis=1, dtype=np.float64))
+            continue
+        W_o = np.asarray(W, dtype=np.float32)[row_o].reshape(shape)
+        correlated_out.append((weight * W_o).mean(axis=1, dtype=np.float64))
+        separable_out.append((separable * W_o).mean(axis=1, dtype=np.float64))
+    return correlated_out, separable_out
+
+
+def rows_at(table: np.ndarray, angle: np.ndarray, step: float) -> np.ndarray:
+    """Linear interpolation of a table with rows every ``step`` radians from 0 at ``angle``."""
+    x = np.clip(angle, 0.0, step * (table.shape[0] - 1)) / step
+    k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
+    f = (x - k)[..., None]
+    return table[k] * (1.0 - f) + table[k + 1] * f
+
+
+@dataclass(frozen=True)
+class LayerTerms:
+    """
+    A rough Bragg layer's albedos with multiple scattering, per wavelength (471, the last axis), at the rows of
+    :func:`compensation_theta` (host angles); the layer is the same seen from either side (Smith's heights are
+    symmetric), so each holds for light arriving from above or below.
 
     Attributes
     ----------
-    missing : ndarray, shape (COMPENSATION_ROWS, 471), float32
-        ``m(theta)``: the light single scattering with transparent occluders misses, at ``theta = k * 2 deg``.
-    up : ndarray, shape (471,), float32
-        ``r``: the part of it that leaves upward.
-    missing_average : ndarray, shape (471,), float32
-        ``m_avg = 2 int m cos sin d theta`` (the lobe's normalisation).
+    reflection : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``E_r``: reflected once, occluders transparent (1).
+    ballistic : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``t_b``: crossed without a reflection (2).
+    missing : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``m``: scattered among the facets (3); the facets' absorption taken out for absorbing layers.
+    up : ndarray, shape (COMPENSATION_ROWS, 471)
+        ``r``: the part of ``m`` that leaves upward (:func:`upward_share`, from the random walk).
     """
 
+    reflection: np.ndarray = field(repr=False)
+    ballistic: np.ndarray = field(repr=False)
     missing: np.ndarray = field(repr=False)
     up: np.ndarray = field(repr=False)
-    missing_average: np.ndarray = field(repr=False)
+
+    @property
+    def reflected(self) -> np.ndarray:
+        """All the light the layer sends back: ``E_r + r m``."""
+        return self.reflection + self.up * self.missing
+
+    @property
+    def transmitted(self) -> np.ndarray:
+        """All the light that crosses it: ``t_b + (1 - r) m``."""
+        return self.ballistic + (1.0 - self.up) * self.missing
 
 
-def compensation_tables(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float) -> CompensationTables:
+def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayLike, alpha: float,
+                lossless_transmissivity: ArrayLike | None = None, transmittance: ArrayLike | None = None) -> LayerTerms:
     """
-    Build a layer's :class:`CompensationTables` from its single-scattering tables.
+    A layer's :class:`LayerTerms` from its single-scattering tables.
 
     Parameters
     ----------
@@ -152,63 +224,129 @@ def compensation_tables(reflectance: ArrayLike, transmissivity: ArrayLike, theta
         Their angles (radians, uniform from 0).
     alpha : float
         The layer's roughness.
+    lossless_transmissivity : array_like, optional
+        For absorbing facets (``T < 1 - R``): Eq. 28 with ``1 - R``. Light scattered among the facets meets
+        one more facet at least, so ``m`` is the lossless one times the facets' hemispherical albedo
+        ``R + T`` (``(f_t^lossless - f_t) / G1`` is what one crossing absorbs): it never puts back what a facet absorbed.
+    transmittance : array_like, optional
+        The facets' ``T_lambda`` (361, 471) when it is below ``1 - R`` (absorbing), for the upward share.
     """
     alpha = float(microfacet.check_alpha(alpha))
-    R = np.asarray(reflectance, dtype=np.float64)
-    t = np.asarray(transmissivity, dtype=np.float64)
     theta = np.asarray(theta, dtype=np.float64)
     step = theta[1] - theta[0]
-
-    def at(table, angle):
-        x = np.clip(angle, 0.0, theta[-1]) / step
-        k = np.minimum(np.floor(x).astype(np.int64), table.shape[0] - 2)
-        f = (x - k)[..., None]
-        return table[k] * (1.0 - f) + table[k + 1] * f
-
     rows = compensation_theta()
     cos_rows = np.cos(rows)
-    rho_rows = occluder_reflectance(at(t, rows), cos_rows, alpha)
-    G_rows = effective_masking(cos_rows, alpha, rho_rows)
-    o_z, cos_d, above = _quadrature(alpha)
-    # E_r(theta) = E_m[R(theta_d) (1 + Lambda_i) G2] over the normals visible from i (Eq. 17 with
-    # correlated_masking_over_cos for G1 G1 / (cos_i cos_o): f cos / pdf = R G2 / G1(i)); float32, all rows at once.
-    # Nearest table rows (0.25 deg) for the quadrature's angles: a gather, not an interpolation (as fast as it gets).
-    row_o = np.rint(np.arccos(np.clip(o_z, 0.0, 1.0)) / step).astype(np.int64).ravel()
-    row_d = np.rint(np.arccos(cos_d) / step).astype(np.int64).ravel()
-    t32, R32 = t.astype(np.float32), R.astype(np.float32)
-    oz = np.clip(o_z, 1e-6, 1.0).ravel()
-    G1_o = microfacet.smith_G1(oz, alpha).astype(np.float32)[:, None]
-    lam_o = smith_lambda(oz, alpha).astype(np.float32).reshape(o_z.shape + (1,))
-    rho_o = np.clip(1.0 - t32[row_o] / np.maximum(G1_o, np.float32(1e-12)), 0.0, 1.0)
-    stop_o = (rho_o * (2.0 - rho_o)).reshape(o_z.shape + (R.shape[1],))
-    lam_i = smith_lambda(np.maximum(cos_rows, np.cos(np.radians(89.5))), alpha).astype(np.float32)[:, None, None]
-    stop_i = occluder_stop(rho_rows).astype(np.float32)[:, None, :]
-    weight = above[..., None] * (1.0 + lam_i) / (1.0 + lam_i * stop_i + lam_o * stop_o)
-    E_r = (R32[row_d].reshape(o_z.shape + (R.shape[1],)) * weight).mean(axis=1, dtype=np.float64)
-    missing = np.clip(1.0 - E_r - ballistic_transmissivity(rho_rows, G_rows), 0.0, 1.0)
-    up = np.clip(hemispherical_average(R, theta), 0.0, 1.0)
-    average = hemispherical_average(missing, rows)
-    return CompensationTables(missing.astype(np.float32), up.astype(np.float32), average.astype(np.float32))
+    t = np.asarray(transmissivity, dtype=np.float64)
+    rho = occluder_reflectance(rows_at(t, rows, step), cos_rows, alpha)
+    ballistic = ballistic_transmissivity(rho, effective_masking(cos_rows, alpha, rho))
+    (E_r,), _ = reflection_albedos(reflectance, t, theta, alpha, [None])
+    if lossless_transmissivity is None:
+        missing = np.clip(1.0 - E_r - ballistic, 0.0, 1.0)
+    else:
+        t0 = np.asarray(lossless_transmissivity, dtype=np.float64)
+        rho0 = occluder_reflectance(rows_at(t0, rows, step), cos_rows, alpha)
+        (E_r0,), _ = reflection_albedos(reflectance, t0, theta, alpha, [None])
+        lossless = np.clip(1.0 - E_r0 - ballistic_transmissivity(rho0, effective_masking(cos_rows, alpha, rho0)), 0.0, 1.0)
+        G1 = microfacet.smith_G1(cos_rows, alpha)[:, None]
+        absorbed = np.clip((rows_at(t0, rows, step) - rows_at(t, rows, step)) / np.maximum(G1, 1e-12), 0.0, 1.0)
+        facet_albedo = np.clip(1.0 - hemispherical_average(absorbed, rows), 0.0, 1.0)
+        missing = np.minimum(lossless * facet_albedo, np.clip(1.0 - E_r - ballistic, 0.0, 1.0))
+    up = upward_share(reflectance, transmittance, alpha)
+    return LayerTerms(E_r, ballistic, missing, up)
 
 
-def missing_energy(tables: CompensationTables, theta: ArrayLike) -> np.ndarray:
-    """``m(theta)`` (radians, in the host) by linear interpolation of the table's rows: shape ``theta.shape + (471,)``."""
-    x = np.clip(np.asarray(theta, dtype=np.float64), 0.0, 0.5 * np.pi) / np.radians(COMPENSATION_STEP_DEG)
-    k = np.minimum(np.floor(x).astype(np.int64), COMPENSATION_ROWS - 2)
-    f = (x - k)[..., None]
-    m = tables.missing.astype(np.float64)
-    return m[k] * (1.0 - f) + m[k + 1] * f
+# --------------------------------------------------------------------------------------------------
+# The upward share of the light scattered among the facets: the random walk's paths, reweighted per wavelength
+
+#: Incidence angles (host, degrees) of the walked paths; the share is interpolated linearly between them.
+SHARE_THETA_DEG = (0.0, 20.0, 40.0, 60.0, 75.0, 88.0)
+#: Paths per angle, the facet events kept per path (later ones are taken as the reweighting's mean, 1), the seed.
+SHARE_PATHS = 20000
+SHARE_EVENTS = 10
+SHARE_SEED = 2016
+#: The walk's facets reflect with this probability; any other reflectance reweighs the same paths.
+SHARE_SAMPLING_R = 0.5
+#: The share is reweighted every this many nm and interpolated between (a ratio: smoother than ``R``).
+SHARE_STEP_NM = 3
 
 
-def compensation_lobe(missing_i: ArrayLike, missing_o: ArrayLike, tables: CompensationTables) -> np.ndarray:
-    """The upward multiple-scattering lobe ``r m(i) m(o) / (pi m_avg)`` (1/sr), per wavelength (Kulla & Conty's form)."""
-    average = np.maximum(tables.missing_average.astype(np.float64), 1e-12)
-    return tables.up * np.asarray(missing_i) * np.asarray(missing_o) / (np.pi * average)
+@functools.lru_cache(maxsize=8)
+def walk_ensemble(alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    The random walk's paths through a layer of roughness ``alpha`` (:func:`explorer.physics.microsurface.walk`)
+    whose facets reflect with probability :data:`SHARE_SAMPLING_R`, :data:`SHARE_PATHS` per angle of
+    :data:`SHARE_THETA_DEG`, seeded: only those scattered among the facets (left upward after two reflections or
+    more, or downward after one or more). A path's geometry depends on its choices only, so the same paths serve
+    every reflectance (:func:`upward_share`).
+
+    Returns
+    -------
+    events : ndarray of int, shape (n, SHARE_EVENTS)
+        Per facet event, its row in a 0.25-degree table of ``theta_d`` plus 361 when it reflected; 722 (a row of
+        ones) after the path's last event.
+    up : ndarray of bool, shape (n,)
+    node : ndarray of int, shape (n,)
+        The path's angle, an index into :data:`SHARE_THETA_DEG`.
+    """
+    from explorer.physics import microsurface
+
+    rng = np.random.default_rng(SHARE_SEED)
+    nodes = len(SHARE_THETA_DEG)
+    n = SHARE_PATHS * nodes
+    node = np.repeat(np.arange(nodes), SHARE_PATHS)
+    theta = np.radians(np.asarray(SHARE_THETA_DEG))[node]
+    count = np.zeros(n, dtype=np.int64)
+    events = np.full((n, SHARE_EVENTS), 722, dtype=np.int64)
+
+    def record(rows, cos_d, reflect):
+        k = count[rows]
+        kept = k < SHARE_EVENTS
+        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
+        events[rows[kept], k[kept]] = row[kept] + 361 * reflect[kept]
+        count[rows] += 1
+
+    d = np.stack([-np.sin(theta), 0.0 * theta, -np.cos(theta)], axis=-1)
+    _, _, _, up, alive, _, reflections = microsurface.walk(
+        d, np.ones((n, 1)), np.ones((n, 1)), float(alpha),
+        lambda cos_d, rows: np.full((rows.size, 1), SHARE_SAMPLING_R), rng, record=record)
+    scattered = alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up))
+    return events[scattered], up[scattered], node[scattered]
 
 
-def compensated_transmissivity(ballistic: ArrayLike, missing: ArrayLike, tables: CompensationTables) -> np.ndarray:
-    """A layer's transmission as the layers below see it: the ballistic part plus the downward share ``(1 - r) m``."""
-    return np.asarray(ballistic) + (1.0 - tables.up) * np.asarray(missing)
+def upward_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha: float) -> np.ndarray:
+    """
+    ``r``: of the light scattered among the facets, the part that leaves upward, per wavelength, at the rows of
+    :func:`compensation_theta`: the walk's scattered paths (:func:`walk_ensemble`) weighted by each event's
+    ``R / R_s`` (reflected) or ``T / (1 - R_s)`` (crossed), ``R_s`` :data:`SHARE_SAMPLING_R` (importance
+    reweighting: the walk with these facets, in expectation), the upward ones over all.
+
+    ``reflectance``, ``transmittance``: the facets' ``R_lambda`` and ``T_lambda`` (``None``: ``1 - R``) at
+    ``theta_d = k * 0.25 deg``, shape (361, 471).
+    """
+    columns = np.unique(np.r_[np.arange(0, np.shape(reflectance)[1], SHARE_STEP_NM), np.shape(reflectance)[1] - 1])
+    R = np.asarray(reflectance, dtype=np.float32)[:, columns]
+    T = np.float32(1.0) - R if transmittance is None else np.asarray(transmittance, dtype=np.float32)[:, columns]
+    factors = np.concatenate([T / np.float32(1.0 - SHARE_SAMPLING_R), R / np.float32(SHARE_SAMPLING_R),
+                              np.ones((1, R.shape[1]), np.float32)])
+    events, up, node = walk_ensemble(float(alpha))
+    share = np.full((len(SHARE_THETA_DEG), R.shape[1]), 0.5)
+    for k in range(len(SHARE_THETA_DEG)):
+        at = np.flatnonzero(node == k)
+        if at.size == 0:
+            continue
+        weight = factors[events[at, 0]]
+        for j in range(1, SHARE_EVENTS):
+            going = np.flatnonzero(events[at, j] != 722)  # only the paths with a j-th event (most have 2 or 3)
+            if going.size == 0:
+                break
+            weight[going] *= factors[events[at[going], j]]
+        upward = weight[up[at]].sum(axis=0, dtype=np.float64)
+        total = weight.sum(axis=0, dtype=np.float64)
+        share[k] = np.where(total > 0.0, upward / np.maximum(total, 1e-300), 0.5)
+    wavelengths = np.arange(np.shape(reflectance)[1])
+    share = np.stack([np.interp(wavelengths, columns, row) for row in share])
+    rows = np.degrees(compensation_theta())
+    return np.stack([np.interp(rows, SHARE_THETA_DEG, share[:, j]) for j in range(share.shape[1])], axis=-1)
 
 
 def occluder_stop(rho: ArrayLike) -> np.ndarray:

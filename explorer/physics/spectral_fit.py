@@ -5,14 +5,16 @@ A global pass evaluates a scrambled Sobol sample of the free continuous paramete
 cell count ``N`` on a coarse subset of the measured wavelengths (vectorised over the sample), then the
 best few are refined by ``scipy.optimize.least_squares`` (bounded, trust-region reflective) on every
 measured wavelength, ``N`` held and then moved by one while it improves. The model is the exact
-unpolarised reflectance of :func:`explorer.physics.natural.mirror_spectrum` (``sigma = 0``: disorder is
-held at its fixed value only in the final report, too costly inside a fit).
+unpolarised reflectance of :func:`explorer.physics.natural.mirror_spectrum`. A disordered mirror (``sigma``
+fixed above 0, or free) is searched so on the ordered mirror, then its best :data:`DISORDERED_REFINED` ends are
+refined on the ensemble mean over :data:`FIT_REALISATIONS` seeded realisations at the coarse wavelengths (a
+smooth function of the structure: the realisations' noise is fixed by their seed), ``sigma`` with them when free.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -29,6 +31,10 @@ N_MAX = 60
 #: Sobol samples of the continuous parameters per cell count, and the wavelengths the global pass uses.
 GLOBAL_SAMPLES = 1024
 COARSE_WAVELENGTHS = 48
+#: The disorder's box when free, and the realisations and starts of the disordered refinement.
+SIGMA_RANGE = (0.0, 0.3)
+FIT_REALISATIONS = 256
+DISORDERED_REFINED = 2
 #: Starts kept per cell count, and refined by least squares (the best over every count).
 PER_COUNT = 2
 REFINED = 12
@@ -88,12 +94,13 @@ def mirror_of(free: list[str], fixed: dict, vector: ArrayLike, N: int) -> Natura
     return NaturalMirror(N=int(N), **values)
 
 
-def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float, fixed: dict, seed: int = 0) -> SpectrumFit:
+def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float, fixed: dict, seed: int = 0,
+                 free_sigma: bool = False) -> SpectrumFit:
     """
     The mirror whose unpolarised reflectance at ``theta_deg`` best matches ``measured`` at ``wavelength_nm``.
 
     ``fixed`` holds values not fitted (``n1``/``n2``/``nh`` may be media; ``N`` an integer; ``nh`` absent:
-    the host is ``n1``); the others in :data:`RANGES` and ``N`` are free.
+    the host is ``n1``; ``sigma`` absent: 0 unless ``free_sigma``); the others in :data:`RANGES` and ``N`` are free.
     """
     from scipy.optimize import least_squares
     from scipy.stats import qmc
@@ -130,7 +137,7 @@ def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float
                                  max_nfev=200 * len(free))
         return solution.x, float(np.sqrt(np.mean(solution.fun ** 2)))
 
-    best = (np.inf, None, None)
+    best, ends = (np.inf, None, None), []
     for _, N, vector in candidates[:REFINED]:
         vector, rms = refine(vector, N)
         if "N" not in fixed:  # move N by one while it improves (the band's width and fringes follow N)
@@ -142,15 +149,59 @@ def fit_spectrum(wavelength_nm: ArrayLike, measured: ArrayLike, theta_deg: float
                         break
                     vector, rms, N = trial, trial_rms, M
                     M += step
+        ends.append((rms, N, vector))
         if rms < best[0]:
             best = (rms, N, vector)
     rms, N, vector = best
     mirror = mirror_of(free, fixed, vector, N)
-    if "sigma" in fixed and fixed["sigma"]:
-        mirror = replace(mirror, sigma=float(fixed["sigma"]))
-    fitted = mirror_spectrum(mirror, wavelength_nm, [theta_deg])["R"][0]
     values = {name: float(x) for name, x in zip(free, vector)}
+    if free_sigma or fixed.get("sigma", 0.0) > 0.0:
+        ends = [best] + [(r, M, v) for r, M, v in ends if v is not vector]
+        mirror, values = _refine_disordered(ends[:DISORDERED_REFINED], free, fixed, free_sigma, wavelength_nm[coarse],
+                                            measured[coarse], theta_deg)
+    fitted = mirror_spectrum(mirror, wavelength_nm, [theta_deg])["R"][0]
     if "N" not in fixed:
-        values["N"] = int(N)
+        values["N"] = int(mirror.N)
     return SpectrumFit(mirror, values, float(np.sqrt(np.mean((fitted - measured) ** 2))), wavelength_nm, measured, fitted,
                        time.perf_counter() - start)
+
+
+def _refine_disordered(ends, free: list[str], fixed: dict, free_sigma: bool, wavelength_nm: np.ndarray,
+                       measured: np.ndarray, theta_deg: float) -> tuple[NaturalMirror, dict]:
+    """
+    The ordered fit's best ``ends`` ``(rms, N, vector)`` refined on the disordered mirror's ensemble mean (``N``
+    held; ``sigma`` free from 0.05 when ``free_sigma``): the best mirror and its fitted values.
+    """
+    from scipy.optimize import least_squares
+
+    from explorer.physics.natural import _unpolarised
+
+    names = free + (["sigma"] if free_sigma else [])
+    low = np.array([SIGMA_RANGE[0] if n == "sigma" else RANGES[n][0] for n in names])
+    high = np.array([SIGMA_RANGE[1] if n == "sigma" else RANGES[n][1] for n in names])
+    cos_theta = np.array([[np.cos(np.radians(theta_deg))]])
+    base = {k: v for k, v in fixed.items() if k != "N"}
+
+    def mirror(vector, N):
+        return mirror_of(names, base, vector, N)
+
+    def residual(vector, N):
+        m = mirror(vector, N)
+        thicknesses = np.array([m.d2, m.d1] * int(m.N))
+        realised = multilayer.disordered_thicknesses(thicknesses, m.sigma, FIT_REALISATIONS)
+        return _unpolarised(m, wavelength_nm[np.newaxis, :], cos_theta, realised)[0] - measured
+
+    best = (np.inf, None, None)
+    for _, N, vector in ends:
+        start = np.concatenate([vector, [0.05]]) if free_sigma else np.asarray(vector)
+        if start.size:
+            solution = least_squares(residual, np.clip(start, low, high), bounds=(low, high), args=(N,),
+                                     x_scale=np.maximum(high - low, 1e-9), max_nfev=30 * len(names))
+            x, cost = solution.x, float(np.mean(solution.fun ** 2))
+        else:
+            x, cost = start, float(np.mean(residual(start, N) ** 2))
+        if cost < best[0]:
+            best = (cost, N, x)
+    _, N, x = best
+    values = {name: float(v) for name, v in zip(names, x)}
+    return mirror(x, N), values

@@ -6,6 +6,7 @@
 #include "lib/microfacet.glsl"
 #include "lib/fresnel.glsl"
 #include "lib/colorimetry.glsl"
+#include "lib/multiscatter.glsl"
 
 #include "generated/layered.glsl"  // the constants shared with explorer/physics (generated at assembly)
 
@@ -87,84 +88,20 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
 
-// Multiple scattering among a layer's facets (twin of explorer/physics/multiscatter.py and of
-// explorer.physics.layered.single_reflection_spectra with its compensation): per wavelength and layer, the
-// occluders' reflectance rho = 1 - f_t cos / G1 (Eqs. 28, 30), their masking G_eff = 1 / (1 + Lambda rho), Eq. 17
-// with the height-correlated masking-shadowing of occluders that stop rho (2 - rho) for G1 G1, the ballistic transmission (1 - rho) G_eff^2 plus the downward share (1 - r) m(theta) of
-// the missing light m, and Kulla & Conty's lobe r m(i) m(o) / (pi m_avg) for its upward share.
-// missing_table: rows theta = k 2 deg (k = 0..45) of m, row 46 r, row 47 r / (pi m_avg); channel l layer l.
-float smith_lambda(float c, float alpha) {
-    c = clamp(c, 1e-6, 1.0);
-    return (sqrt(c * c + alpha * alpha * (1.0 - c * c)) - c) / (2.0 * c);
-}
-
-// correlated_masking_over_cos of multiscatter.py: G2 / (cos_i cos_o), G2 = 1 / (1 + Lambda_i s_i + Lambda_o s_o),
-// s = rho (2 - rho) the chance an occluder stops the ray (it is passed by crossing the heightfield twice).
-vec3 correlated_masking_over_cos(float ci, float co, vec3 root_i, vec3 root_o, vec3 stop_i, vec3 stop_o) {
-    return (ci > 0.0 && co > 0.0) ? 2.0 / max(2.0 * ci * co + co * stop_i * root_i + ci * stop_o * root_o, vec3(1e-12)) : vec3(0.0);
-}
-
-void compensation_row(float theta, out int k, out float f) {
-    float x = clamp(theta, 0.0, 0.5 * PI) / radians(COMPENSATION_STEP_DEG);
-    k = min(int(floor(x)), COMPENSATION_ROWS - 2);
-    f = x - float(k);
+// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl).
+vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
+    int ki, ko;
+    float fi, fo;
+    if (!compensation_cell(i, o, ki, fi, ko, fo)) return vec3(0.0);
+    vec3 low = mix(texelFetch(lobe_table, ivec2(ko, ki), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki), 0).rgb, fo);
+    vec3 high = mix(texelFetch(lobe_table, ivec2(ko, ki + 1), 0).rgb, texelFetch(lobe_table, ivec2(ko + 1, ki + 1), 0).rgb, fo);
+    return mix(low, high, fi);
 }
 
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D missing_table, float tau_h) {
-    if (i.z <= 0.0 || o.z <= 0.0) return vec3(0.0);
-    float path = 1.0;
-    vec3 ih = i, oh = o;
-    if (coating) {
-        path = (1.0 - coating_reflectance(i.z, nh)) * (1.0 - coating_reflectance(o.z, nh)) / (nh * nh);
-        ih = refract_into_host(i, nh);
-        oh = refract_into_host(o, nh);
-    }
-    vec3 used = layer_mask(layer_count);
-    vec3 h = normalize(ih + oh);
-    float ci = max(ih.z, 0.0), co = max(oh.z, 0.0);
-    // The host's gaps (tau_h), as in single_reflection_brdf.
-    float gap = gap_transmittance(tau_h, ci) * gap_transmittance(tau_h, co);
-    path *= gap;
-    vec3 g = mix(vec3(1.0), vec3(gap), used);
-    vec3 lobe, G1_i, G1_o, lambda_i, lambda_o, root_i, root_o;  // per layer, wavelength-independent
-    for (int l = 0; l < MAX_LAYERS; ++l) {
-        float a = alphas[l];
-        lobe[l] = used[l] * 0.25 * ggx_D(h.z, a);
-        G1_i[l] = smith_G1(ci, a);
-        G1_o[l] = smith_G1(co, a);
-        lambda_i[l] = smith_lambda(ci, a);
-        lambda_o[l] = smith_lambda(co, a);
-        root_i[l] = sqrt(ci * ci + a * a * (1.0 - ci * ci)) - ci;
-        root_o[l] = sqrt(co * co + a * a * (1.0 - co * co)) - co;
-    }
-    int k_i, k_o, k_d, c_i, c_o;
-    float f_i, f_o, f_d, g_i, g_o;
-    float theta_i = polar_angle(ih), theta_o = polar_angle(oh);
-    table_row(theta_i, k_i, f_i);
-    table_row(theta_o, k_o, f_o);
-    table_row(atan(length(ih - oh), length(ih + oh)), k_d, f_d);
-    compensation_row(theta_i, c_i, g_i);
-    compensation_row(theta_o, c_o, g_o);
-    vec3 xyz_layers = vec3(0.0), xyz_base = vec3(0.0);
-    for (int j = 0; j < CMF_COUNT; ++j) {
-        vec3 R = table_fetch(reflectance_table, j, k_d, f_d);
-        vec3 t_i = table_fetch(transmissivity_table, j, k_i, f_i), t_o = table_fetch(transmissivity_table, j, k_o, f_o);
-        vec3 m_i = table_fetch(missing_table, j, c_i, g_i), m_o = table_fetch(missing_table, j, c_o, g_o);
-        vec3 up = texelFetch(missing_table, ivec2(j, COMPENSATION_ROWS), 0).rgb;
-        vec3 scale = texelFetch(missing_table, ivec2(j, COMPENSATION_ROWS + 1), 0).rgb;
-        vec3 rho_i = clamp(1.0 - t_i / max(G1_i, vec3(1e-12)), 0.0, 1.0), rho_o = clamp(1.0 - t_o / max(G1_o, vec3(1e-12)), 0.0, 1.0);
-        vec3 Ge_i = 1.0 / (1.0 + lambda_i * rho_i), Ge_o = 1.0 / (1.0 + lambda_o * rho_o);
-        vec3 masking = correlated_masking_over_cos(ci, co, root_i, root_o, rho_i * (2.0 - rho_i), rho_o * (2.0 - rho_o));
-        vec3 layer = lobe * masking * R + scale * m_i * m_o;
-        vec3 t = mix(vec3(1.0), ((1.0 - rho_i) * Ge_i * Ge_i + (1.0 - up) * m_i) * ((1.0 - rho_o) * Ge_o * Ge_o + (1.0 - up) * m_o), used);
-        float p2 = path * t.x * g.y, p3 = p2 * t.y * g.z;
-        float layers_term = used.x * layer.x * path + used.y * layer.y * p2 + used.z * layer.z * p3;
-        vec3 cmf = colour_matching_functions(j);
-        xyz_layers += cmf * layers_term;
-        xyz_base += cmf * (p3 * t.z * gap);
-    }
-    return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float tau_h) {
+    return single_reflection_brdf(i, o, nh, coating, layer_count, alphas, rho_d, reflectance_table, transmissivity_table, tau_h)
+         + compensation_lobe(i, o, lobe_table);
 }
 
 // The smooth limit's specular colour at incidence cos_theta (what the gradient and sphere views show):

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from explorer.app.panels.base import Panel, checkbox_width, flow, record
 from explorer.physics import colorimetry
 from explorer import design as inverse_design
+from explorer.design.media import with_media
 from explorer.materials.models import BraggMirrorModel
 from explorer.materials.twins import capabilities_of, supporting
 from explorer.resources import DEFAULT_MATERIAL
@@ -56,6 +58,28 @@ def _target(theta: float, rgb) -> list:
     """A target row: ``[theta, sRGB picker values (clipped, 8-bit), linear RGB as given]``."""
     rgb = np.asarray(rgb, dtype=np.float64)
     return [float(theta), [float(c) for c in colorimetry.encode_srgb8(rgb) / 255.0], tuple(float(c) for c in rgb)]
+
+
+def design_request(material, values, n1_air: bool = False) -> tuple[dict, dict]:
+    """
+    ``(fixed, media)`` of a design from the window, as ``design --fix`` takes them: the indices whose
+    ``medium_*`` names a medium held at it, each layer's ``k`` and the disorder held at the material's values
+    (``design --fix n2=chitin --fix k2=... --fix sigma=...``), and with ``n1_air`` air layers (``n1 = 1``, no host).
+    """
+    from explorer.design.media import MEDIUM_PARAMETERS
+    from explorer.materials.media import index_value
+    from explorer.physics.dispersion import Dispersion
+
+    model = inverse_design.design_model(material.model)
+    fixed = {"n1": 1.0, "nh": 0.0} if n1_air and capabilities_of(material).bragg_spectrum else {}
+    media = {}
+    for name in MEDIUM_PARAMETERS:
+        chosen = index_value(values, name) if f"medium_{name}" in values else None
+        if isinstance(chosen, Dispersion):
+            media[name] = chosen
+            fixed.pop(name, None)
+    fixed.update({name: float(values[name]) for name in model.held if name in values})
+    return fixed, media
 
 
 class DesignPanel(Panel):
@@ -124,7 +148,7 @@ class DesignPanel(Panel):
         if self.running or not capabilities_of(material).design:
             return
         ranges = {p.name: (float(p.min), float(p.max)) for p in material.parameters if p.min is not None}
-        fixed = {"n1": 1.0, "nh": 0.0} if self.fixed_n1_air and capabilities_of(material).bragg_spectrum else {}
+        fixed, media = design_request(material, self.state.values, self.fixed_n1_air)
         targets = self.target_list()
         parameters = inverse_design.design_model(material.model).parameters
         current = {name: float(self.state.values[name]) for name in parameters if name in self.state.values}
@@ -140,9 +164,13 @@ class DesignPanel(Panel):
             started = time.perf_counter()
             try:
                 result = inverse_design.design(material.model, targets, ranges, fixed, seed=seed, progress=self._progress,
-                                               cancelled=lambda: self._cancel, guesses=guesses)
+                                               cancelled=lambda: self._cancel, guesses=guesses, media=media)
                 theta = 90.0 * (np.arange(STRIP_COLUMNS) + 0.5) / STRIP_COLUMNS
-                strip = inverse_design.forward_rgb(material.model, result.values, theta)
+                model = with_media(inverse_design.design_model(material.model), media, natural=True) if media else None
+                strip = (model.converged(result.values, np.cos(np.radians(theta))) if model is not None
+                         else inverse_design.forward_rgb(material.model, result.values, theta))
+                # A medium is reported and applied by its name (as design --fix n2=chitin reports it).
+                result = replace(result, values={**result.values, **{k: v.name for k, v in media.items()}})
             except inverse_design.DesignCancelled:
                 with self._lock:
                     self.error, self.state.design = "cancelled", {"running": False, "cancelled": True}
