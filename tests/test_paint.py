@@ -148,8 +148,10 @@ def _row_model():
     from explorer.design.pixels import RowModel
 
     model = design_model("bragg_mirror")
-    fixed = {"n1": 1.0, "n2": 1.5, "nh": 0.0}
-    free = [p for p in parameter_box(model, ranges_of(load("bragg_mirror"))) if p.name not in fixed]
+    material = load("bragg_mirror")
+    defaults = material.resolve({})
+    fixed = {name: float(defaults[name]) for name in model.parameters if name not in ("Lambda", "delta", "N")}
+    free = [p for p in parameter_box(model, ranges_of(material)) if p.name not in fixed]
     return RowModel(model, free, fixed, np.cos(np.radians(ANGLES)))
 
 
