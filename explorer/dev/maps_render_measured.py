@@ -50,6 +50,7 @@ def main() -> None:
     from explorer.gpu import Renderer
     from explorer.gpu.env import render_env
     from explorer.materials.brd import load_material
+    from explorer.materials.methods import BraggMethod
     from explorer.materials.models import BraggMirrorModel, model_for
     from explorer.resources import material_path
     from explorer.views.env import EnvironmentMap, env_integral_numpy
@@ -66,7 +67,7 @@ def main() -> None:
         folder = Path(temporary) / "maps"
         write_folder(folder, random_maps(args.maps))
         print(f"{args.maps}x{args.maps} random maps, {size}x{size} images")
-        for method in (3, 0):
+        for method in (int(BraggMethod.TABULATED), int(BraggMethod.REFERENCE)):
             texture, values = MapTexture.from_folder(folder, mirror, mirror.resolve({"method": method}))
             for what, mesh in (("sphere", None), ("torus", torus())):
                 times = {}
