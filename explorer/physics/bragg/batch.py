@@ -173,7 +173,8 @@ class _Geometry:
     r_h1: np.ndarray
 
 
-def absorbing_reflectance_batch(n1, n2, Lambda, delta, N, nh, cos_theta: ArrayLike, wavelengths: ArrayLike,
+def absorbing_reflectance_batch(n1: ArrayLike, n2: ArrayLike, Lambda: ArrayLike, delta: ArrayLike, N: ArrayLike, nh: ArrayLike,
+                                cos_theta: ArrayLike, wavelengths: ArrayLike,
                                 step: float | None = None, smooth: float | None = None) -> np.ndarray:
     """
     :func:`bragg_reflectance_batch` with complex indices ``n1``, ``n2`` (``(B,)`` or ``(B, 1, W)``) under a lossless

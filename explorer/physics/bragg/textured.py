@@ -7,6 +7,7 @@ the tabulated method's table over ``(cos theta, T)``. Numpy only; GLSL twins of 
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -163,7 +164,7 @@ def structure_table(mirror: BraggMirror, maps: dict[str, np.ndarray]) -> np.ndar
     return table
 
 
-def mapped_mirrors(table: np.ndarray, T: ArrayLike):
+def mapped_mirrors(table: np.ndarray, T: ArrayLike) -> Iterator[tuple[np.ndarray, BraggMirror]]:
     """
     The twin of ``mapped_mirror`` (lib/bragg.glsl): the mirrors at texel indices ``T`` (per sample, row-major), grouped
     by what the approximations take as scalars. Yields ``(samples, mirror)``: a bool mask of ``T``'s shape and a mirror
