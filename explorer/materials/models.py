@@ -462,12 +462,17 @@ class BraggLayerModel(BraggMirrorModel):
 
     @property
     def compensation_rgb(self) -> np.ndarray | None:
-        """The compensation's lobe in RGB over (theta_i, theta_o) (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
         if self.compensation is None:
             return None
         if self._compensation_rgb is None:
-            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.rho_d)
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self._base_albedo)
         return self._compensation_rgb
+
+    @property
+    def _base_albedo(self):
+        """The base's albedo the compensation's lobe bounces on."""
+        return self.rho_d
 
     @property
     def transmission_table(self) -> np.ndarray:
@@ -641,14 +646,11 @@ class BraggStackModel:
             self._compensation = multiscatter_stack.stack_compensation(self.stack, self.tables, terms)
         return self._compensation
 
+    compensation_rgb = BraggLayerModel.compensation_rgb
+
     @property
-    def compensation_rgb(self) -> np.ndarray | None:
-        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
-        if self.compensation is None:
-            return None
-        if self._compensation_rgb is None:
-            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self.stack.rho_d)
-        return self._compensation_rgb
+    def _base_albedo(self):
+        return self.stack.rho_d
 
     def reflectance(self, cos_theta) -> np.ndarray:
         """The smooth limit's specular colour (:func:`explorer.physics.layered.stack_specular_rgb`)."""
