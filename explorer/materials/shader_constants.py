@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, multiscatter_stack, thinfilm
+from explorer.physics import bragg, colorimetry, compensation, layered, lobes, lobes_fgd, microfacet, multiscatter_stack, thinfilm
 
 
 def declaration(name: str, value) -> str:
@@ -81,7 +81,9 @@ GENERATED: dict[str, Callable[[], str]] = {
     "generated/multiscatter.glsl": lambda: _block({
         "COMPENSATION_ROWS": multiscatter_stack.TABLE_ROWS,
         "COMPENSATION_STEP_DEG": float(multiscatter_stack.TABLE_STEP_DEG),
-    }, "explorer/physics/multiscatter_stack.py"),
+        "COMPENSATION_FADE_START": compensation.FADE_START,
+        "COMPENSATION_FADE_END": compensation.FADE_END,
+    }, "explorer/physics/multiscatter_stack.py and compensation.py"),
     "generated/lobes.glsl": lambda: _block({
         "LOBES_MAX": lobes.MAX_INTERFACES,
         "FGD_COS_COUNT": lobes_fgd.FGD_COS_COUNT,

@@ -88,7 +88,7 @@ vec3 single_reflection_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_co
     return xyz_to_rgb(xyz_layers) + rho_d * (1.0 / PI) * xyz_to_rgb(xyz_base);
 }
 
-// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl).
+// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl) times its weight.
 vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
     int ki, ko;
     float fi, fo;
@@ -99,9 +99,10 @@ vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
 }
 
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float tau_h) {
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float weight,
+                      float tau_h) {
     return single_reflection_brdf(i, o, nh, coating, layer_count, alphas, rho_d, reflectance_table, transmissivity_table, tau_h)
-         + compensation_lobe(i, o, lobe_table);
+         + weight * compensation_lobe(i, o, lobe_table);
 }
 
 // The smooth limit's specular colour at incidence cos_theta (what the gradient and sphere views show):
