@@ -193,3 +193,14 @@ def test_layer_white_furnace_walk(layer_material, white_facets, alpha):
 def test_the_hook_needs_the_tables(layer_material, white_facets):
     with pytest.raises(ValueError, match="tabulated method"):
         model_for(layer_material, layer_material.resolve({**FURNACE, "method": 1, "alpha": 0.6}))
+
+
+def test_blender_tables_carry_the_faded_lobe(layer_material):
+    """Blender's converged table is the twin's albedo: the lobe (weighted) from alpha 0.5, none at 0.4."""
+    from explorer.blender import converged_tables
+
+    def table(alpha, on):
+        return converged_tables(layer_material, layer_material.resolve({"alpha": alpha, "N": 10, "multiple_scattering": on}), size=8)[0]
+
+    np.testing.assert_array_equal(table(0.4, 1), table(0.4, 0))
+    assert np.all(table(0.8, 1)[1:] @ LUMINANCE > table(0.8, 0)[1:] @ LUMINANCE + 0.05)

@@ -379,7 +379,7 @@ def _mitsuba_eval_rgb(mi, material, values, l, v):
     bsdf = mi.load_dict(bsdf_properties(material, values))
     spectral = "spectral" in mi.variant()
     lanes = 4 if spectral else 1
-    groups = -(-colorimetry.WAVELENGTHS.size // lanes)  # 118 groups of 4 wavelengths (the last one's 4th unused)
+    groups = -(-colorimetry.WAVELENGTHS.size // 4) if spectral else 1  # 118 groups of 4 wavelengths (the last one's 4th unused)
     n = l.shape[0]
     rep = lambda a: np.repeat(a, groups, axis=0)  # noqa: E731
     si = mi.SurfaceInteraction3f()
@@ -406,8 +406,9 @@ def test_compensated_path_equals_the_numpy_twin(mi_llvm, name, values):
     The multiple-scattering lobe in Mitsuba's RGB and spectral variants is the numpy twin's: what the compensation
     adds (on less off) at incidences 0 and 40 deg, over the exits on the lobe table's nodes, per direction and as
     albedo. The spectral plugin's lobe summed against the CMFs is the RGB table by construction (one linear map,
-    the base grey, so its upsampled spectrum is flat): they differ by float32 rounding only (measured: 2e-6 of
-    the lobe's albedo), bounded here by 1e-4 of the largest value.
+    the base grey, so its upsampled spectrum is flat): they differ by float32 rounding only. Measured: per
+    direction up to 3.1e-6 of the largest value (on less off: float32 evaluations of f, where the specular peak
+    is many times the lobe), as albedo up to 1e-7; bounded here by 2e-5 and 1e-6.
     """
     from explorer.mitsuba import register
 
@@ -419,14 +420,14 @@ def test_compensated_path_equals_the_numpy_twin(mi_llvm, name, values):
     expected = (twin.brdf(l, v, e[2], e[0], e[1]) - model_for(material, resolved[0]).brdf(l, v, e[2], e[0], e[1])) * l[:, 2:3]
     per_incidence = lambda x: np.einsum("an,anc->ac", weight.reshape(len(COMPENSATION_THETA_I), -1),  # noqa: E731
                                         x.reshape(len(COMPENSATION_THETA_I), -1, 3))
-    assert np.all(per_incidence(expected) @ np.array([0.2126, 0.7152, 0.0722]) > 0.02)  # the lobe is there
+    assert np.all(per_incidence(expected) @ np.array([0.2126, 0.7152, 0.0722]) > 0.01)  # the lobe is there
     try:
         for variant in ("llvm_ad_rgb", "llvm_ad_spectral"):
             mi = register(variant)
             got = _mitsuba_eval_rgb(mi, material, resolved[1], l, v) - _mitsuba_eval_rgb(mi, material, resolved[0], l, v)
             scale = np.abs(expected).max()
-            np.testing.assert_allclose(got, expected, atol=1e-4 * scale, err_msg=variant)
-            np.testing.assert_allclose(per_incidence(got), per_incidence(expected), atol=1e-4 * np.abs(per_incidence(expected)).max(),
-                                       err_msg=variant)
+            np.testing.assert_allclose(got, expected, rtol=0.0, atol=2e-5 * scale, err_msg=variant)
+            np.testing.assert_allclose(per_incidence(got), per_incidence(expected), rtol=0.0,
+                                       atol=1e-6 * np.abs(per_incidence(expected)).max(), err_msg=variant)
     finally:
         register("llvm_ad_rgb")
