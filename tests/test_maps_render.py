@@ -28,7 +28,7 @@ def write_map_folder(folder, maps: dict[str, np.ndarray], fixed: dict | None = N
     folder.mkdir(parents=True, exist_ok=True)
     for name, image in maps.items():
         write_image(np.repeat(np.asarray(image, np.float32)[..., None], 3, axis=-1), folder / f"{name}.exr")
-    params = {"material": "bragg_mirror", "model": model, "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0} if fixed is None else fixed,
+    params = {"material": model, "model": model, "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0} if fixed is None else fixed,
               "free": list(maps), "angles_deg": [0.0], "seed": 0, "shape": list(next(iter(maps.values())).shape)}
     (folder / "params.json").write_text(json.dumps(params), encoding="utf-8")
 

@@ -496,8 +496,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
     if maps_dir is not None:
         h, w = thickness.index.shape
-        tabulated = method_labels(loaded).get(4) if round_integer(values["method"]) == 3 else None
-        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {tabulated} per texel" if tabulated else "")
+        chosen = round_integer(values["method"]) if "method" in values else None
+        texel = None if chosen is None else thickness.declaration.texel_method(chosen)  # a table's method: its stand-in
+        stand_in = method_labels(loaded).get(texel) if texel != chosen else None
+        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {stand_in} per texel" if stand_in else "")
     click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 

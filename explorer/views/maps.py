@@ -121,17 +121,21 @@ def maps_material(folder: str | os.PathLike[str]) -> str:
 
 def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], material) -> dict[str, float]:
     """
-    The folder's fixed values, once its maps fit ``material`` (a Bragg mirror's structure: each map a parameter of it,
-    within its range); a one-line :class:`explorer.errors.LocatedError` naming the file otherwise.
+    The folder's fixed values, once its maps fit ``material`` (the structure its twin declares it maps,
+    :class:`explorer.materials.twins.StructureMaps`: each map a field of it, within its range); a one-line
+    :class:`explorer.errors.LocatedError` naming the file otherwise.
     """
     from explorer.errors import LocatedError
-    from explorer.physics.bragg import STRUCTURE_FIELDS
+    from explorer.materials.twins import capabilities_of
 
     declared = {p.name: p for p in material.parameters}
     if params.get("model") != material.model:
         raise LocatedError(folder / "params.json", None, f"maps of a {params.get('model')}, not of {material.model} ({Path(material.path).name})")
-    if material.texture != "bragg":
-        raise LocatedError(folder / "params.json", None, f"maps are drawn on a Bragg mirror's structure; {Path(material.path).name} has none")
+    declaration = capabilities_of(material).maps
+    if declaration is None:
+        raise LocatedError(folder / "params.json", None, f"maps are drawn on a structure a material's twin declares; "
+                                                         f"{Path(material.path).name} declares none")
+    fields = declaration.fields
     fixed = params.get("fixed") or {}
     if not isinstance(fixed, Mapping):
         raise LocatedError(folder / "params.json", None, "'fixed' is not an object of NAME: VALUE")
@@ -140,9 +144,9 @@ def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], ma
             raise LocatedError(folder / "params.json", None, f"fixed {name} = {value!r}: not a number of a parameter of {Path(material.path).name}")
     for name, image in maps.items():
         path = folder / f"{name}.exr"
-        if name not in declared or name not in STRUCTURE_FIELDS:
+        if name not in declared or name not in fields:
             raise LocatedError(path, None, f"a map of {name}, which is not a structure parameter of {Path(material.path).name} "
-                                           f"({', '.join(n for n in STRUCTURE_FIELDS if n in declared)})")
+                                           f"({', '.join(n for n in fields if n in declared)})")
         parameter = declared[name]
         finite = np.isfinite(image)
         outside = finite & ((image < parameter.min) | (image > parameter.max))

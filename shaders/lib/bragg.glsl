@@ -524,19 +524,15 @@ BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
 
 // Only in the views that read a surface texture (the host defines SURFACE_TEXTURE): no sampler in a .brdf export.
 #ifdef SURFACE_TEXTURE
-// Structure maps (design --target-image's output): texture_mapping TEXTURE_MAPS gives each texel its own mirror, T
-// the nearest texel's index (row-major). The host's table holds two RGBA texels a map texel, (n1, n2, Lambda, delta)
-// and (N, nh, inside, 0); false off the maps' mask (TEXTURE_MAPS: generated). Twin: explorer.physics.bragg.mapped_mirrors
-// (structure_table).
+#include "lib/structure_maps.glsl"
 
+// Structure maps (lib/structure_maps.glsl): the texel's mirror, its fields (n1, n2, Lambda, delta) and (N, nh) in the
+// order of explorer.physics.bragg.STRUCTURE_FIELDS; false off the maps' mask. Twin: explorer.physics.bragg.mapped_mirrors.
 bool mapped_mirror(sampler2D table, float T, out BraggMirror mirror) {
-    int width = textureSize(table, 0).x / 2;
-    int index = int(T);  // an integer below 2^24: exact in float32
-    ivec2 texel = ivec2(2 * (index % width), index / width);
-    vec4 a = texelFetch(table, texel, 0);
-    vec4 b = texelFetch(table, texel + ivec2(1, 0), 0);
-    mirror = BraggMirror(a.x, a.y, a.z, a.w, b.x, b.y);
-    return b.z > 0.5;
+    vec4 a, b;
+    bool inside = structure_texels(table, T, a, b);
+    mirror = BraggMirror(a.x, a.y, a.z, a.w, max(b.x, 1.0), b.y);
+    return inside;
 }
 
 // The tabulated method of a textured mirror: the table over (cos theta across, T down), rows at T = k / (rows - 1),
