@@ -264,14 +264,21 @@ def test_cli_render_maps_bad_folders(folder, tmp_path):
 
 def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror):  # noqa: F811
     """
-    ``open --maps DIR`` (the material from the folder): the Texture window draws the maps on the mirror, as the
-    headless render does, and shows each map with its range.
+    ``open --maps DIR`` (the material from the folder): the Texture window shows each map with its range and draws the
+    maps on the sphere, then on the torus, lit and under the environment: each image's mean RGB equals what ``render
+    --maps DIR [--mesh torus] --view textured|env`` draws (:func:`explorer.rendering.render_material` and
+    :func:`explorer.gpu.env.render_env`; the smooth mirror's Dirac is exact after one sample).
     """
     from test_app import run_session
 
-    # Then under the environment for a few frames (it crashed once: the session must end cleanly).
-    actions = [{"set": {"method": 4}}, {"view_size": 128}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
-               {"click": "texture_env"}, {"wait": 3}, {"quit": True}]
+    from explorer.gpu.env import render_env
+    from explorer.rendering import render_material
+    from explorer.views.env import ENVIRONMENTS
+    from explorer.views.mesh import mesh_named
+
+    actions = [{"set": {"method": 4}}, {"view_size": 64}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
+               {"click": "texture_model_combo"}, {"wait": 2}, {"click": "texture_model:torus"}, {"wait": 3}, {"wait_for": "texture_view"},
+               {"click": "texture_env"}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
     _, report = run_session(x_display, "bragg_mirror", actions, tmp_path, "--maps", str(folder))
     shown = report["texture_view"]
     assert "clicked texture_env" in report["script_log"], report["script_log"]
@@ -281,18 +288,26 @@ def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror
     for name, image in maps.items():
         assert shown["maps"][name]["size"] == list(MAP_SIZE)
         np.testing.assert_allclose([shown["maps"][name]["min"], shown["maps"][name]["max"]], [np.nanmin(image), np.nanmax(image)], rtol=1e-6)
+    assert shown["model"] == "torus" and set(shown["shown"]) == {"textured:sphere", "textured:torus", "env:torus"}, shown
     values = mirror.resolve(shown["values"])
     assert (values["n1"], values["n2"], values["method"]) == (1.0, 1.5, 4)
     texture, _ = map_texture(folder, mirror, **shown["values"])
     width, height = shown["size"]
+    torus = mesh_named("torus")
     theta = np.degrees(np.arccos(np.clip(shown["light"][2], -1.0, 1.0)))
     phi = np.degrees(np.arctan2(shown["light"][1], shown["light"][0]))
-    image = gl_renderer.render(mirror, values, "textured", width, height, light=(theta, phi),
-                               **texture.gl_arguments(mirror, values, width, height))
-    assert np.abs(image).max() > 0.05
-    np.testing.assert_allclose(shown["mean_rgb"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)
+    images = {f"textured:{name}": render_material(mirror, values, "textured", width, height, "gl", light=(theta, phi), thickness=texture,
+                                                  mesh=mesh, renderer=gl_renderer)
+              for name, mesh in (("sphere", None), ("torus", torus))}
+    images["env:torus"] = render_env(mirror, values, width, height, environment=ENVIRONMENTS[shown["environment"]](), spp=1,
+                                     renderer=gl_renderer, surface=texture, mesh=torus)
+    for name, image in images.items():
+        assert np.abs(image).max() > 0.05, name
+        np.testing.assert_allclose(shown["shown"][name], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5, err_msg=name)
+    assert np.abs(np.subtract(shown["shown"]["textured:torus"], shown["shown"]["env:torus"])).max() > 1e-3
 
 
 def test_open_with_a_bad_map_folder_is_one_line(tmp_path):
     line = one_line_error(run_cli("open", "bragg_mirror", "--maps", tmp_path / "nowhere"))
     assert "nowhere/params.json" in line, line
+
