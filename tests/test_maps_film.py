@@ -174,3 +174,16 @@ def test_cli_a_material_without_maps_is_one_line(folder, tmp_path):
     line = one_line_error(run_cli("render", "bragg_layer", "--maps", layer, "--engine", "numpy", "--size", "8", "--out", out))
     assert "layer/params.json" in line and "declares none" in line, line
     assert not out.exists()
+
+
+@pytest.mark.gl
+def test_film_flat_maps_gl_equals_numpy(gl_renderer, folder, film):
+    """The flat image (``render --maps --theta --engine gl``) of a film's maps against its twin."""
+    from explorer.materials.models import model_for
+    from explorer.views.maps import flat_gl, flat_numpy
+
+    texture, values = map_texture(folder, film, method=3)
+    gl = flat_gl(gl_renderer, film, values, texture, 30.0)
+    reference = flat_numpy(model_for(film, values), texture, 30.0)
+    assert hue_spread(reference) > 0.05
+    assert_twins_equal(Twins(gl, reference, np.ones(gl.shape[:2], bool), "gradient"), "film flat maps")

@@ -108,21 +108,22 @@ def test_maps_textured_gl_equals_numpy(gl_renderer, folder, mirror, method):
 
 
 @pytest.mark.gl
-def test_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
+@pytest.mark.parametrize("method", [0, 4])
+def test_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror, method):
     """
     The env view: each texel's Dirac under the environment (exact after one sample), against the exact integral; by the
-    spectral reference, smooth in the angle (the approximations' discrete choices of boxes may flip between float32
-    and float64 where a normal's angle sits on a threshold, and the environment magnifies any difference).
+    spectral reference and the improved approximation (the tabulated method's stand-in per texel; its fringe count takes
+    the band edges' Bloch phase exactly, so float32 no longer moves its sub-boxes: explorer.physics.bragg.bloch_phase).
     """
     from explorer.gpu.env import render_env
     from explorer.materials.models import model_for
     from explorer.views.env import EnvironmentMap, env_integral_numpy
 
-    texture, values = map_texture(folder, mirror, method=0)
+    texture, values = map_texture(folder, mirror, method=method)
     environment = EnvironmentMap.default()
     gl = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer, surface=texture)
     reference = env_integral_numpy(model_for(mirror, values), environment, *SIZE, surface=texture)
-    assert_twins_equal(Twins.of(gl, reference, "env"), "maps env")
+    assert_twins_equal(Twins.of(gl, reference, "env"), f"maps env method {method}")
     plain = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer)
     assert np.abs(plain - gl).max() > 0.02  # the maps show
 
@@ -166,19 +167,20 @@ def test_maps_on_a_mesh_gl_equals_numpy(gl_renderer, folder, mirror, shape):
 
 
 @pytest.mark.gl
-def test_maps_on_a_mesh_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
+@pytest.mark.parametrize("method", [0, 4])
+def test_maps_on_a_mesh_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror, method):
     from explorer.gpu.env import render_env
     from explorer.materials.models import model_for
     from explorer.views.env import EnvironmentMap, env_integral_numpy
     from explorer.views.mesh import torus
 
     mesh, size = torus(), 32
-    texture, values = map_texture(folder, mirror, method=0)  # the reference: see the sphere's test above
+    texture, values = map_texture(folder, mirror, method=method)  # see the sphere's test above
     environment = EnvironmentMap.default()
     gl = render_env(mirror, values, size, size, environment=environment, spp=1, renderer=gl_renderer, surface=texture, mesh=mesh)
     reference = env_integral_numpy(model_for(mirror, values), environment, size, size, surface=texture, mesh=mesh)
     safe = mesh_safe_pixels(mesh, size, MAP_SIZE)
-    assert_twins_equal(Twins(gl, reference, safe, "env", None), "maps on the torus under the environment")
+    assert_twins_equal(Twins(gl, reference, safe, "env", None), f"maps on the torus under the environment, method {method}")
 
 
 def test_obj_texture_coordinates(tmp_path):
@@ -311,3 +313,36 @@ def test_open_with_a_bad_map_folder_is_one_line(tmp_path):
     line = one_line_error(run_cli("open", "bragg_mirror", "--maps", tmp_path / "nowhere"))
     assert "nowhere/params.json" in line, line
 
+
+
+# -- the flat image (--theta): one pixel a texel ------------------------------------------------------------
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("method", [0, 4])
+def test_flat_maps_gl_equals_numpy(gl_renderer, folder, mirror, method):
+    """``shaders/views/flat/textured.glsl`` against its twin (flat_numpy), at 0 and 45 degrees; off the mask black."""
+    from explorer.materials.models import model_for
+    from explorer.views.maps import flat_gl, flat_numpy
+
+    texture, values = map_texture(folder, mirror, method=method)
+    for theta in (0.0, 45.0):
+        gl = flat_gl(gl_renderer, mirror, values, texture, theta)
+        reference = flat_numpy(model_for(mirror, values), texture, theta)
+        assert gl.shape == reference.shape == (MAP_SIZE[1], MAP_SIZE[0], 3)
+        assert np.abs(reference).max() > 0.3 and np.all(reference[MAP_SIZE[1] // 2, MAP_SIZE[0] // 2] == 0.0)
+        assert_twins_equal(Twins(gl, reference, np.ones(gl.shape[:2], bool), "gradient"), f"flat maps method {method} at {theta:g}")
+
+
+@pytest.mark.gl
+def test_cli_flat_maps_gl_is_near_the_converged_colours(folder, tmp_path):
+    """``render --maps --theta`` by GL at the spectral reference: within 1e-2 of ``--engine numpy``'s converged colours."""
+    images = {}
+    for engine in ("gl", "numpy"):
+        out = tmp_path / f"{engine}.npy"
+        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", "textured", "--engine", engine,
+                                                              "--set", "method=0", "--theta", "30", "--out", out)
+        assert run.returncode == 0, run.stderr
+        images[engine] = np.load(out)
+    assert images["gl"].shape == (MAP_SIZE[1], MAP_SIZE[0], 3)
+    assert np.abs(images["gl"] - images["numpy"]).max() < 1e-2

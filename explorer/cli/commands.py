@@ -341,7 +341,8 @@ def _errors(function):
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @click.option("--maps", "maps_dir", metavar="DIR", help="textured (lit) and env views: the structure maps design --target-image wrote, "
               "each texel its own mirror on the sphere; with --theta (--engine numpy): one pixel a texel, its colour at that angle.")
-@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees "
+              "(--engine numpy: converged spectral colours; gl: by the material's method).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
@@ -362,7 +363,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if maps_dir is not None and maps_theta is not None:
         from explorer.cli.paint import render_maps_command
 
-        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
+        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure, assignments)
         return
     if maps_theta is not None:
         raise click.UsageError("--theta goes with --maps")

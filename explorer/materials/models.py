@@ -312,6 +312,10 @@ class BraggMirrorModel:
         variant = {"variant": "improved"} if method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
 
+    def surface_reflectance(self, cos_theta, T, **options) -> np.ndarray:
+        """The flat textured view's colour at ``cos_theta`` of texture values ``T`` (the shader's ``surface_reflectance``)."""
+        return self.textured_reflectance(cos_theta, T, **options)
+
     def textured_mirror_reflection(self, V, N, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
         cos_theta = np.clip(np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1), 0.0, 1.0)

@@ -149,6 +149,10 @@ class ThinFilmModel:
             rgb[samples] = film_rgb(self.method, (eta_1, slots[..., 2][samples], eta_3, kappa_3), cos_theta[samples], slots[..., 0][samples])
         return rgb
 
+    def surface_reflectance(self, cos_theta, value, **options) -> np.ndarray:
+        """The flat textured view's colour at ``cos_theta`` of surface values ``value`` (the shader's ``surface_reflectance``)."""
+        return self.textured_reflectance(cos_theta, value, np.zeros(np.shape(value)), False, **options)
+
     def textured_brdf(self, L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered: bool, mapping: str | None = None,
                       structures: np.ndarray | None = None) -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`brdf` with :meth:`textured_reflectance` per sample."""

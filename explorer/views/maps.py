@@ -48,6 +48,25 @@ def map_colours(model_name: str, fixed: Mapping[str, float], maps: Mapping[str, 
     return out.astype(np.float32)
 
 
+def flat_numpy(model, texture, theta_deg: float) -> np.ndarray:
+    """
+    The flat textured view by the numpy twin: one pixel a texel of ``texture`` (a surface texture of
+    :mod:`explorer.views.surface_texture`), its colour at ``theta_deg`` by the material's method (the twin's
+    ``surface_reflectance``). The twin of ``shaders/views/flat/textured.glsl`` (:func:`flat_gl`).
+    """
+    value = np.asarray(texture.d_inc, np.float64)
+    cos_theta = np.full(value.shape, float(np.float32(np.cos(np.radians(theta_deg)))))  # the shader's float32 uniform
+    return np.asarray(model.surface_reflectance(cos_theta, value, **texture.model_options()), np.float32)
+
+
+def flat_gl(renderer, material, values, texture, theta_deg: float) -> np.ndarray:
+    """The flat textured view on the GPU (``shaders/views/flat/textured.glsl``): :func:`flat_numpy`'s image."""
+    height, width = texture.d_inc.shape
+    arguments = texture.gl_arguments(material, values, width, height)
+    uniforms = {**arguments["uniforms"], "flat_cos_theta": float(np.float32(np.cos(np.radians(theta_deg))))}
+    return renderer.render(material, values, "flat/textured", width, height, inputs=arguments["inputs"], uniforms=uniforms)
+
+
 # --------------------------------------------------------------------------------------------------
 # Map folders and target images
 

@@ -54,6 +54,7 @@ from explorer.physics.bragg.approximation import (  # noqa: F401
     approximate_xyz_polarised,
     band_edge,
     fringe_average_under_host,
+    bloch_phase,
     fringe_count,
     fringe_sharpness,
     fringes_resolved,
