@@ -17,7 +17,7 @@ from explorer.physics import bragg, colorimetry, compensation, layered, microfac
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
-from explorer.materials.twins import TWINS, Capabilities, DesignModel, registry, twin
+from explorer.materials.twins import TWINS, Capabilities, DesignModel, StructureMaps, registry, twin
 
 #: Samples per numpy call of the stack's spectral Eq. 34 (Mitsuba's spectral variants; bounds the (samples, 471) temporaries).
 SPECTRAL_CHUNK = 1 << 14
@@ -222,13 +222,19 @@ BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh",
                            paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 
 
+#: Structure maps on a smooth mirror: each texel the whole mirror; the tabulated method's table is the material's, so
+#: each texel shows the improved approximation (as an export away from its table's values).
+BRAGG_MAPS = StructureMaps(fields=bragg.STRUCTURE_FIELDS, integer_fields=("N",),
+                           stand_ins={BraggMethod.TABULATED: BraggMethod.IMPROVED})
+
+
 @twin
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN, maps=BRAGG_MAPS)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -283,29 +289,32 @@ class BraggMirrorModel:
         """
         The twin of the shader's ``textured_reflectance``: the mirror at texture values ``T`` (per sample, in [0, 1])
         under ``mapping`` (supplemental Figure 7, :func:`explorer.physics.bragg.textured_mirror`), by ``method``.
-        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:func:`explorer.physics.bragg.structure_table`),
-        each texel its own mirror; the tabulated method has no table per texel and shows the improved approximation
-        there (as an export away from its table's values), 0 off the maps' mask.
+        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:data:`BRAGG_MAPS`' table), each texel its own
+        mirror, by its texel method (:meth:`explorer.materials.twins.StructureMaps.texel_method`), 0 off the maps' mask.
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         T = np.broadcast_to(np.asarray(T, dtype=np.float64), cos_theta.shape)
         if mapping == "maps":
             rgb = np.zeros(cos_theta.shape + (3,))
             for samples, mirror in bragg.mapped_mirrors(structures, T):
-                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod.IMPROVED)
+                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod(BRAGG_MAPS.texel_method(self.method)))
             return rgb
         if self.method == BraggMethod.TABULATED:
             return bragg.textured_tabulated_rgb(self.texture_table(mapping), cos_theta, T)
         return self._mirror_rgb(cos_theta, bragg.textured_mirror(self.mirror, T, mapping))
 
-    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, tabulated: BraggMethod | None = None) -> np.ndarray:
-        """A per-sample mirror's colours by ``method`` (``tabulated``: the method that stands for the tabulated one)."""
-        method = tabulated if self.method == BraggMethod.TABULATED else self.method
+    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, method: BraggMethod | None = None) -> np.ndarray:
+        """A per-sample mirror's colours by ``method`` (default the material's; not the tabulated one, which has a table)."""
+        method = self.method if method is None else method
         if method == BraggMethod.REFERENCE:
             return bragg.textured_reference_rgb(cos_theta, mirror, self.wavelength_step)
         s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[method]
         variant = {"variant": "improved"} if method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
+
+    def surface_reflectance(self, cos_theta, T, **options) -> np.ndarray:
+        """The flat textured view's colour at ``cos_theta`` of texture values ``T`` (the shader's ``surface_reflectance``)."""
+        return self.textured_reflectance(cos_theta, T, **options)
 
     def textured_mirror_reflection(self, V, N, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
