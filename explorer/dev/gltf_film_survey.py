@@ -55,13 +55,16 @@ def exhaustive(film: gltf_film.Film, dense_lab: np.ndarray) -> tuple[float, np.n
         order = np.argsort(best)[:12]
         best, points = best[order], points[order]
 
+    def inside(x):
+        return np.clip(x, [0.0, 1.0, 0.0, 1.0], [np.inf, 3.0, 1.0, 3.0])
+
     def median(x):
-        x = np.clip(x, [0.0, 1.0, 0.0, 1.0], [np.inf, 3.0, 1.0, 3.0])
+        x = inside(x)
         return float(np.median(gltf_film._films_delta_e(gltf_film._from_opd(x[None]), False, dense_lab, cos)))
 
     results = [minimize(median, x0, method="Nelder-Mead", options={"maxfev": 800}) for x0 in points]
     result = min(results, key=lambda r: r.fun)
-    return float(result.fun), result.x
+    return float(result.fun), inside(result.x)
 
 
 def main() -> None:
