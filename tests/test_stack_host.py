@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from conftest import one_line_error, run_cli
 from explorer.errors import LocatedError
@@ -21,6 +23,7 @@ from explorer.physics import colorimetry, dispersion, layered, position_free
 from explorer.physics.layered import LayeredBragg, RoughBraggLayer
 from explorer.physics.natural import NaturalMirror, mirror_spectrum
 from explorer.resources import material_path
+from test_energy import ALBEDO_TOLERANCE, SWEEP_SIZE, _albedo_values, _cheap, assert_passive, parameter_sets
 from test_position_free import _within, fresnel_unpolarised
 from twins import BRDF_TOLERANCE, assert_twins_equal, render_both
 
@@ -214,3 +217,26 @@ def test_position_free_lambertian_under_a_chitin_coating():
     # With one index (550 nm) for every wavelength the albedo's Dirac alone would be off by more than the noise.
     flat = fresnel_unpolarised(np.cos(theta), 1.0, stack.n1)[:, None]
     assert np.abs(colorimetry.spectrum_to_rgb(F) - flat).max() > 1e-4
+
+
+#: The library's media a host may be (lossless), by their medium_nh numbers.
+LOSSLESS_HOSTS = [number for number, name in enumerate(dispersion.LIBRARY, start=1) if not dispersion.LIBRARY[name].absorbing]
+
+
+@pytest.mark.gl
+@settings(max_examples=3, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_energy_sweep_with_a_dispersive_host(gl_renderer, data):
+    """tests/test_energy.py's sweep of the stack's box with the host a drawn lossless medium: the smooth limit
+    passive in GL and numpy and equal in both, and the numpy albedo at most 1."""
+    from explorer.views.albedo import albedo_numpy
+
+    mat, values = data.draw(parameter_sets("bragg_stack"))
+    values = _cheap("bragg_stack", {**values, "medium_nh": float(data.draw(st.sampled_from(LOSSLESS_HOSTS)))})
+    twins = render_both(gl_renderer, mat, values, "gradient", SWEEP_SIZE)
+    assert_passive(twins.reference, f"numpy {values}")
+    assert_passive(twins.gl, f"GL {values}")
+    assert_twins_equal(twins, f"{values}")
+    model = model_for(mat, mat.resolve(_albedo_values("bragg_stack", values)))
+    assert model.stack.dispersive_host
+    assert_passive(albedo_numpy(model, [50.0]), f"numpy albedo {values}", ALBEDO_TOLERANCE)
