@@ -36,6 +36,8 @@ CASES = {
     "coating off": {"layers": 2, "nh": 1.35, "coating": 0, "rho_d": 0.3},
     "jewel beetle (Appendix D)": {"n1_1": 1.59, "n2_1": 1.67, "Lambda_1": 160, "delta_1": 0.51, "N_1": 8, "alpha_1": 0.05},
     "large N, rough": {"layers": 2, "N_1": 300, "alpha_1": 0.6, "alpha_2": 0.01, "rho_d": 1},
+    # A dispersive host: every wavelength refracts its own way through the coating.
+    "chitin host, coated": {"layers": 2, "nh": "chitin", "rho_d": "0.5,0.3,0.2", "tau_h": 0.1},
 }
 
 

@@ -117,16 +117,22 @@ def test_sample_weight_is_eval_over_pdf(mi_llvm, name):
     np.testing.assert_allclose(weight[ok], value[ok] / pdf[ok, None], rtol=2e-3, atol=1e-6)
 
 
-@pytest.mark.parametrize("name", ["bragg_layer", "thin_film", "bragg_stack", "layered_lobes"])
-def test_rgb_eval_is_the_numpy_twin(mi_llvm, name, monkeypatch):
+#: Parameters beyond the defaults in the RGB evaluation: the tabulated method, and a stack in a dispersive host.
+RGB_EVAL_CASES = {"bragg_layer": ("bragg_layer", {"method": 3}), "thin_film": ("thin_film", {}), "bragg_stack": ("bragg_stack", {}),
+                  "layered_lobes": ("layered_lobes", {}),
+                  "bragg_stack, chitin host": ("bragg_stack", {"layers": 2, "nh": "chitin", "n1_1": "chitin", "rho_d": 0.4})}
+
+
+@pytest.mark.parametrize("case", list(RGB_EVAL_CASES))
+def test_rgb_eval_is_the_numpy_twin(mi_llvm, case, monkeypatch):
     """RGB variants give the explorer's colour: eval = model.brdf(L, V) cos(theta_L) at random directions,
     evaluated in chunks (as a wavefront of millions of samples is) of 128 here."""
     from explorer.mitsuba import bsdfs
 
     monkeypatch.setattr(bsdfs, "CHUNK", 128)
     mi = mi_llvm
+    name, overrides = RGB_EVAL_CASES[case]
     material = load_material(material_path(name))
-    overrides = {"method": 3} if name == "bragg_layer" else {}
     values = material.resolve(overrides)
     bsdf = _bsdf(mi, name, **{k: (mi.ScalarColor3f(*v) if isinstance(v, tuple) else v) for k, v in values.items()})
     rng = np.random.default_rng(5)

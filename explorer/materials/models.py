@@ -690,16 +690,18 @@ class BraggStackModel(CompensatedTwin):
                 k1=float(values.get(f"k1_{k}", 0.0)), k2=float(values.get(f"k2_{k}", 0.0)),
                 sigma=float(values.get(f"sigma_{k}", 0.0)), **media,
             ))
+        # A host naming a medium (medium_nh; --set nh=chitin): nh holds its n at 550 nm, the physics reads the medium.
+        host = index_value(values, "nh") if "medium_nh" in values else nh
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
-            tau_h=float(values.get("tau_h", 0.0)),
+            tau_h=float(values.get("tau_h", 0.0)), medium_n1=None if isinstance(host, float) else host,
         )
 
     @property
     def tables(self) -> tuple:
         """Every layer's tables (:func:`explorer.physics.layered.layer_tables`, cached per layer), built on first use."""
         if self._tables is None:
-            self._tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+            self._tables = tuple(_layer_tables(layer, self.stack.host) for layer in self.stack.layers)
             if self.facet_reflectance_override is not None:
                 self._tables = tuple(_flat_tables(t, float(self.facet_reflectance_override)) for t in self._tables)
         return self._tables
@@ -746,8 +748,7 @@ class BraggStackModel(CompensatedTwin):
     def mirror_reflection(self, V, N) -> np.ndarray:
         """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
         cos_theta = np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1)
-        F = layered.coating_reflectance(cos_theta, self.stack.n1) if self.stack.coating else np.zeros_like(cos_theta)
-        return np.repeat(np.asarray(F)[..., None], 3, axis=-1)
+        return layered.coating_rgb(self.stack, cos_theta)  # a dispersive host's: the RGB of F's spectrum
 
     def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
         """Eq. 34 per wavelength for Mitsuba (its layers and its base, the base's RGB albedo upsampled; with the
@@ -779,17 +780,24 @@ class BraggStackModel(CompensatedTwin):
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator); ``stack_transmittance``
         as ``stack_reflectance``: each smooth layer's ``T_lambda`` (exact for natural layers, else ``1 - R``).
         """
-        return self._textures_of(self.tables, self.compensation_rgb)
+        return {**self._textures_of(self.tables, self.compensation_rgb), "stack_host": self._host_texture()}
+
+    def _host_texture(self) -> np.ndarray:
+        """``stack_host``: ``(471, 3)``, channel 0 the host's index at each wavelength (the shader refracts per
+        wavelength with it where a coated host disperses; :meth:`explorer.physics.layered.LayeredBragg.host_index`)."""
+        host = np.zeros((colorimetry.WAVELENGTHS.size, 3), np.float32)
+        host[:, 0] = self.stack.host_index()
+        return host
 
     def draft_textures(self) -> dict[str, np.ndarray]:
         """
         Quick stand-ins for :meth:`textures` while a slider moves: the layers' tables from ``R_lambda`` at
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
-        tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
+        tables = tuple(layered.layer_tables(layer, self.stack.host, draft=True) for layer in self.stack.layers)
         # The multiple-scattering lobe is not drafted (its walk and quadratures take a second or more): a
         # draft shows Eq. 34 alone until the real textures follow on release.
-        return self._textures_of(tables, None)
+        return {**self._textures_of(tables, None), "stack_host": self._host_texture()}
 
     @staticmethod
     def _textures_of(tables, compensation_rgb=None) -> dict[str, np.ndarray]:
