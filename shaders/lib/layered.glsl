@@ -132,7 +132,7 @@ vec3 coating_rgb(float cos_theta, float nh, bool coating, bool dispersive, sampl
     return xyz_to_rgb(xyz);
 }
 
-// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl).
+// Multiple scattering (twin of BraggStackModel.brdf): Eq. 34 plus the host's lobe (lib/multiscatter.glsl) times its weight.
 vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
     int ki, ko;
     float fi, fo;
@@ -143,11 +143,11 @@ vec3 compensation_lobe(vec3 i, vec3 o, sampler2D lobe_table) {
 }
 
 vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, vec3 alphas, vec3 rho_d,
-                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float tau_h,
-                      bool dispersive, sampler2D host_table) {
+                      sampler2D reflectance_table, sampler2D transmissivity_table, sampler2D lobe_table, float weight,
+                      float tau_h, bool dispersive, sampler2D host_table) {
     return single_reflection_brdf(i, o, nh, coating, layer_count, alphas, rho_d, reflectance_table, transmissivity_table, tau_h,
                                   dispersive, host_table)
-         + compensation_lobe(i, o, lobe_table);
+         + weight * compensation_lobe(i, o, lobe_table);
 }
 
 // The smooth limit's specular colour at incidence cos_theta (what the gradient and sphere views show):
