@@ -188,15 +188,19 @@ void main() {
 """
 
 
+#: The layer choice's cases: and a host whose 550-nm index (2.65) lies beyond the nh slider's range (it shows 2.5).
+SAMPLING_CASES = {**CASES, "TiO2 host, coated": {"layers": 2, "nh": "TiO2", "rho_d": 0.4}}
+
+
 @pytest.mark.gl
-@pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)"])
+@pytest.mark.parametrize("case", ["two layers over a base", "three layers, coated", "jewel beetle (Appendix D)", "TiO2 host, coated"])
 def test_sampling_hook_is_eq35_of_the_numpy_twin(gl_renderer, stack_material, case):
     """The GLSL layer choice (sampling_lobes) equals explorer.physics.layered.layer_choice_probabilities (Eqs. 31, 35)."""
     from explorer.materials.glsl import ShaderBuilder
     from explorer.gpu.context import VERTEX_SHADER
     from explorer.resources import SHADER_DIR
 
-    values = stack_material.resolve(CASES[case])
+    values = stack_material.resolve(SAMPLING_CASES[case])
     builder = ShaderBuilder(include_dirs=[SHADER_DIR])
     builder.define("PROBE_COLUMNS", PROBE_COLUMNS)
     builder.add_source(stack_material.uniform_declarations(), "parameters")

@@ -63,6 +63,9 @@ def test_the_host_names_a_medium(stack_material, model):
     assert stack.layers[0].medium_n1 is CHITIN and stack.layers[1].n1 == 1.3 and stack.layers[1].medium_n1 is None
     assert all(table.n1 is CHITIN for table in model.tables)
     np.testing.assert_allclose(model.textures()["stack_host"][:, 0], stack.host_index(), rtol=1e-7)
+    # A medium beyond the slider's range: the slider shows 2.5, the physics takes TiO2's n at 550 nm (2.65).
+    tio2 = BraggStackModel.stack_of(stack_material.resolve({"nh": "TiO2"}))
+    assert tio2.n1 == pytest.approx(dispersion.LIBRARY["TiO2"].real_at(550.0)) and tio2.n1 > 2.6
     # A number replaces the medium.
     plain = BraggStackModel.stack_of(stack_material.resolve({**VALUES, "nh": "1.5"}))
     assert plain.medium_n1 is None and not plain.dispersive_host
@@ -148,7 +151,7 @@ def test_energy_and_reciprocity(stack_material, model):
     np.testing.assert_allclose(layered.single_reflection_brdf(model.stack, i, o, model.tables),
                                layered.single_reflection_brdf(model.stack, o, i, model.tables), rtol=1e-9, atol=1e-12)
     assert np.all(model.reflectance(np.linspace(0.0, 1.0, 33)) @ LUMINANCE <= 1.0 + 1e-3)
-    white = {**VALUES, "layers": "1", "rho_d": "1", "alpha_1": "0.4"}
+    white = {**VALUES, "layers": "1", "rho_d": "1", "alpha_1": "0.6", "multiple_scattering": "0"}
     single = albedo_numpy(model_for(stack_material, stack_material.resolve(white)), [40.0])
     multiple = albedo_numpy(model_for(stack_material, stack_material.resolve({**white, "multiple_scattering": "1"})), [40.0])
     for rgb in (single, multiple):

@@ -29,7 +29,7 @@ CASES = {
     "guanine": {"nh": "guanine", "n1_1": "guanine"},
 }
 BASE = {"layers": "2", "n2_1": "1.7", "Lambda_1": "380", "N_1": "8", "alpha_1": "0.2", "n1_2": "1.3",
-        "alpha_2": "0.3", "rho_d": "0.5,0.3,0.2"}
+        "alpha_2": "0.3", "rho_d": "0.5,0.3,0.2", "multiple_scattering": "0"}
 ANGLES = np.radians(np.arange(0.0, 86.0, 5.0))
 
 

@@ -673,7 +673,7 @@ class BraggStackModel(CompensatedTwin):
         count = round_integer(values["layers"])
         if not 1 <= count <= layered.MAX_LAYERS:
             raise ValueError(f"layers must be 1 to {layered.MAX_LAYERS}, got {values['layers']}")
-        from explorer.materials.media import index_value
+        from explorer.materials.media import SLIDER_WAVELENGTH_NM, index_value
 
         nh = _number(values, "nh")
         layers = []
@@ -692,9 +692,13 @@ class BraggStackModel(CompensatedTwin):
             ))
         # A host naming a medium (medium_nh; --set nh=chitin): nh holds its n at 550 nm, the physics reads the medium.
         host = index_value(values, "nh") if "medium_nh" in values else nh
+        medium = None if isinstance(host, float) else host
+        # A medium's n1 is its index at 550 nm (what Eq. 35's estimate and the multiple-scattering lobe take), not
+        # the slider's value, which its range may clamp (TiO2).
         return layered.LayeredBragg(
-            layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
-            tau_h=float(values.get("tau_h", 0.0)), medium_n1=None if isinstance(host, float) else host,
+            layers=tuple(layers), n1=nh if medium is None else medium.real_at(SLIDER_WAVELENGTH_NM),
+            rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
+            tau_h=float(values.get("tau_h", 0.0)), medium_n1=medium,
         )
 
     @property

@@ -155,52 +155,64 @@ vec3 compensated_brdf(vec3 i, vec3 o, float nh, bool coating, int layer_count, v
 // coating: theta' = theta, F = 0). Smooth layers transmit 1 - R (the rough layer's integrated
 // transmissivity would exceed it beside band edges: see explorer.physics.layered.stack_specular_rgb).
 // exact_transmittance: natural (absorbing) layers transmit transmittance_table's T < 1 - R (the host's exact table).
-// Where a coated host disperses (dispersive, host_table), theta', F and the gaps are taken per wavelength, and F
-// is a spectrum.
-vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h,
-                        bool exact_transmittance, sampler2D transmittance_table, bool dispersive, sampler2D host_table) {
-    bool per_wavelength = coating && dispersive;
-    float c0 = clamp(cos_theta, 0.0, 1.0), s0 = sqrt(max(1.0 - c0 * c0, 0.0));
+// The smooth limit's factors at one host index: the coating's F, the table row of theta', and a gap down and up.
+struct SmoothPath {
+    float F, through, g;
+    int k;
+    float f;
+};
+
+SmoothPath smooth_path(float c0, float s0, float nh, bool coating, float tau_h) {
+    SmoothPath p;
     float c = c0, s = s0;
-    float F = 0.0, through = 1.0;
+    p.F = 0.0;
+    p.through = 1.0;
     if (coating) {
-        F = coating_reflectance(c0, nh);
-        through = (1.0 - F) * (1.0 - F);
+        p.F = coating_reflectance(c0, nh);
+        p.through = (1.0 - p.F) * (1.0 - p.F);
         s = s0 / nh;
         c = sqrt(max(1.0 - s * s, 0.0));
     }
-    int k;
-    float f;
-    table_row(atan(s, c), k, f);
-    vec3 used = layer_mask(layer_count);
-    float g = gap_transmittance(tau_h, c);
-    g *= g;  // a gap down and up at theta'
-    through *= g;
-    vec3 xyz = vec3(0.0);
-    for (int j = 0; j < CMF_COUNT; ++j) {
-        float spectral_F = 0.0;
-        if (per_wavelength) {  // this wavelength's own refraction and Fresnel terms
-            float n = host_index_at(host_table, j);
-            spectral_F = coating_reflectance(c0, n);
-            s = s0 / n;
-            c = sqrt(max(1.0 - s * s, 0.0));
-            table_row(atan(s, c), k, f);
-            g = gap_transmittance(tau_h, c);
-            g *= g;
-            through = (1.0 - spectral_F) * (1.0 - spectral_F) * g;
-        }
-        vec3 R = table_fetch(reflectance_table, j, k, f) * used;
-        vec3 t;
-        if (exact_transmittance) {
-            vec3 T = table_fetch(transmittance_table, j, k, f);
-            t = T * T * g;
-        } else {
-            t = (1.0 - R) * (1.0 - R) * g;
-        }
-        xyz += colour_matching_functions(j) * (through * (R.x + t.x * (R.y + t.y * R.z)) + spectral_F);
+    table_row(atan(s, c), p.k, p.f);
+    p.g = gap_transmittance(tau_h, c);
+    p.g *= p.g;  // a gap down and up at theta'
+    p.through *= p.g;
+    return p;
+}
+
+// Wavelength j's reflected light in the smooth limit (without the coating's F), as XYZ.
+vec3 smooth_wavelength(int j, SmoothPath p, vec3 used, sampler2D reflectance_table, bool exact_transmittance,
+                       sampler2D transmittance_table) {
+    vec3 R = table_fetch(reflectance_table, j, p.k, p.f) * used;
+    vec3 t;
+    if (exact_transmittance) {
+        vec3 T = table_fetch(transmittance_table, j, p.k, p.f);
+        t = T * T * p.g;
+    } else {
+        t = (1.0 - R) * (1.0 - R) * p.g;
     }
-    if (per_wavelength) return xyz_to_rgb(xyz);
-    return xyz_to_rgb(xyz) + vec3(F);  // F is flat: white has rgb (1, 1, 1)
+    return colour_matching_functions(j) * (p.through * (R.x + t.x * (R.y + t.y * R.z)));
+}
+
+// Where a coated host disperses (dispersive, host_table), theta', F and the gaps are taken per wavelength, and F
+// is a spectrum. Two loops, so that a host of one index computes its angle once.
+vec3 stack_specular_rgb(float cos_theta, float nh, bool coating, int layer_count, sampler2D reflectance_table, float tau_h,
+                        bool exact_transmittance, sampler2D transmittance_table, bool dispersive, sampler2D host_table) {
+    float c0 = clamp(cos_theta, 0.0, 1.0), s0 = sqrt(max(1.0 - c0 * c0, 0.0));
+    vec3 used = layer_mask(layer_count);
+    vec3 xyz = vec3(0.0);
+    if (coating && dispersive) {
+        for (int j = 0; j < CMF_COUNT; ++j) {
+            SmoothPath p = smooth_path(c0, s0, host_index_at(host_table, j), coating, tau_h);
+            xyz += smooth_wavelength(j, p, used, reflectance_table, exact_transmittance, transmittance_table)
+                 + colour_matching_functions(j) * p.F;
+        }
+        return xyz_to_rgb(xyz);
+    }
+    SmoothPath p = smooth_path(c0, s0, nh, coating, tau_h);
+    for (int j = 0; j < CMF_COUNT; ++j)
+        xyz += smooth_wavelength(j, p, used, reflectance_table, exact_transmittance, transmittance_table);
+    return xyz_to_rgb(xyz) + vec3(p.F);  // F is flat: white has rgb (1, 1, 1)
 }
 
 // Eq. 31 with the wavelength-averaged numerator: the probability of transmission through a layer.
