@@ -121,7 +121,6 @@ class Film:
     base_color: tuple[float, float, float] = (0.0, 0.0, 0.0)  # baseColorFactor's RGB (the metal's F0)
     base_ior: float = 1.5  # KHR_materials_ior (the dielectric's)
     specular_color: tuple[float, float, float] = (1.0, 1.0, 1.0)  # KHR_materials_specular's specularColorFactor
-    specular: float = 1.0  # KHR_materials_specular's specularFactor
     mapping: str = "direct"  # "direct" (a thin film), "refined" (from the direct one) or "fit" (the nearest film)
     delta_e: np.ndarray = field(default_factory=lambda: np.zeros(0))  # ΔE2000 at THETA_DEG
     direct: "Film | None" = None  # a refined film's direct mapping
@@ -135,10 +134,10 @@ def specular_reflectance(film: Film, cos_theta) -> np.ndarray:
         plain = _schlick(f0, cos[..., None])  # conductor_fresnel
     else:
         # iridescent_dielectric_layer with KHR_materials_specular over a black base: F0 its colour times the
-        # index's, Schlick's plain Fresnel weighted by the specular factor, the film on weight * F0.
+        # index's (specularFactor 1, where engines agree: the sample viewer passes this F0, unweighted, to
+        # evalIridescence), Schlick's plain Fresnel and the film's second interface at that F0.
         f0 = np.minimum(_ior_to_f0(film.base_ior, 1.0) * np.asarray(film.specular_color, np.float64), 1.0)
-        plain = film.specular * _schlick(f0, cos[..., None])
-        f0 = film.specular * f0
+        plain = _schlick(f0, cos[..., None])
     iridescent = iridescent_fresnel(1.0, film.ior, f0, film.thickness, cos)
     return (1.0 - film.factor) * plain + film.factor * iridescent
 
@@ -175,17 +174,15 @@ def direct_film(model) -> Film | None:
 
 def _films_rgb(params: np.ndarray, metallic: bool, cos: np.ndarray) -> np.ndarray:
     """:func:`specular_reflectance` of many films at once: ``params`` ``(K, 6)`` (thickness, ior, factor, then
-    the base colour for a metal) or ``(K, 8)`` (then the base's index, the specular colour and factor for a
-    dielectric) -> ``(K, len(cos), 3)``."""
+    the base colour for a metal) or ``(K, 7)`` (then the base's index and the specular colour for a dielectric,
+    specularFactor 1) -> ``(K, len(cos), 3)``."""
     thickness, ior, factor = params[:, 0:1], params[:, 1:2], params[:, 2:3, None]
     if metallic:
         f0 = params[:, None, 3:6]
         plain = _schlick(f0, cos[None, :, None])
     else:
-        weight = params[:, None, 7:8]
         f0 = np.minimum(_ior_to_f0(params[:, None, 3:4], 1.0) * params[:, None, 4:7], 1.0)
-        plain = weight * _schlick(f0, cos[None, :, None])
-        f0 = weight * f0
+        plain = _schlick(f0, cos[None, :, None])
     iridescent = iridescent_fresnel(1.0, ior, f0, thickness, cos[None, :])
     return (1.0 - factor) * plain + factor * iridescent
 
@@ -207,7 +204,7 @@ def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: b
     """Bounded least squares on the ΔE2000 per angle from ``start`` (scipy), the Jacobian's differences in one batch."""
     from scipy.optimize import least_squares
 
-    steps = np.array([0.05] + [1e-4] * 7)[: len(start)]
+    steps = np.array([0.05] + [1e-4] * 6)[: len(start)]
 
     def jacobian(p):
         sign = np.where(p + steps <= upper, 1.0, -1.0)
@@ -225,7 +222,7 @@ def _film_of(params: np.ndarray, metallic: bool, mapping: str, target: np.ndarra
         film = Film(float(params[0]), float(params[1]), float(params[2]), 1.0, tuple(float(c) for c in params[3:6]), mapping=mapping)
     else:
         film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping,
-                    specular_color=tuple(float(c) for c in params[4:7]), specular=float(params[7]))
+                    specular_color=tuple(float(c) for c in params[4:7]))
     film.delta_e = delta_e(film, target)
     return film
 
@@ -261,41 +258,85 @@ def _median_band(e: np.ndarray) -> np.ndarray:
 
 #: The per-channel base index range of the global fit's second search (F0 up to 0.51).
 _BASE_INDEX_RANGE = (1.0, 6.0)
+#: The global fit's differential evolutions: generations at most.
+EVOLUTION_GENERATIONS = 120
 
 
 def _from_base_indices(x: np.ndarray) -> np.ndarray:
-    """Dielectric films ``(K, 7)`` (thickness, film index, factor, the base's index per channel, specular factor)
-    as :func:`_films_rgb`'s ``(K, 8)``: KHR_materials_ior at the top of :data:`IOR_RANGE`, its F0 coloured down."""
+    """Dielectric films ``(K, 6)`` (thickness, film index, factor, the base's index per channel) as
+    :func:`_films_rgb`'s ``(K, 7)``: KHR_materials_ior at the top of :data:`IOR_RANGE`, its F0 coloured down."""
     f0 = _ior_to_f0(x[:, 3:6], 1.0) / _ior_to_f0(IOR_RANGE[1], 1.0)
-    return np.column_stack([x[:, :3], np.full(len(x), IOR_RANGE[1]), f0, x[:, 6]])
+    return np.column_stack([x[:, :3], np.full(len(x), IOR_RANGE[1]), f0])
+
+
+#: The global search's seeds: a grid in the optical path difference at normal incidence (``D_inc = 2 n d``, nm;
+#: its fringes) every :data:`SEED_OPD_STEP` nm, film indices (offsets from the film's own), base indices (on
+#: either side of the film's: the second interface's phase, 0 or pi) and factors, white specular colour; its
+#: :data:`SEEDS` best points, each another fringe or another phase, join both evolutions' first populations.
+SEED_OPD_STEP = 20.0
+SEED_FILM_IOR_OFFSETS = (-0.3, -0.15, 0.0, 0.15, 0.3)
+SEED_BASE_IORS = (1.0, 1.5, 2.0, 2.5, 3.0)
+SEED_FACTORS = (0.5, 0.75, 1.0)
+SEEDS = 8
+
+
+def _seeds(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, lab: np.ndarray, cos: np.ndarray) -> np.ndarray:
+    """The path-difference grid's best distinct dielectric films ``(SEEDS, 7)`` (:data:`SEED_OPD_STEP`) against
+    ``lab`` at ``cos``, best first. The spec's Gaussian sensitivities fade at long paths faster than the CIE
+    functions, so a thick film's best match is often a shorter, weaker one, far from its own."""
+    d_own = 2.0 * start[1] * start[0]
+    d_top = max(2.0 * d_own, d_own + 1500.0)
+    film_iors = np.unique(np.clip(start[1] + np.asarray(SEED_FILM_IOR_OFFSETS), lower[1], upper[1]))
+    base_iors = np.unique(np.clip([start[3], *SEED_BASE_IORS], lower[3], upper[3]))
+    opd, n, factor, base = (a.ravel() for a in np.meshgrid(np.arange(0.0, d_top + SEED_OPD_STEP, SEED_OPD_STEP), film_iors,
+                                                             SEED_FACTORS, base_iors, indexing="ij"))
+    grid = np.column_stack([opd / (2.0 * n), n, factor, base, np.ones((len(n), 3))])
+    grid = np.clip(np.vstack([start, grid]), lower, upper)
+    cost = np.concatenate([_median_band(_films_delta_e(grid[i:i + 4096], False, lab, cos)) for i in range(0, len(grid), 4096)])
+    picked: list[np.ndarray] = []
+    for k in np.argsort(cost, kind="stable"):
+        p = grid[k]
+        if all(abs(2.0 * (p[0] * p[1] - q[0] * q[1])) > 6.0 * SEED_OPD_STEP or (p[3] > p[1]) != (q[3] > q[1]) for q in picked):
+            picked.append(p)
+        if len(picked) == SEEDS:
+            break
+    return np.array(picked)
 
 
 def _global(start, lower, upper, dense_lab, dense_cos) -> np.ndarray:
     """
-    A dielectric film ``(8,)`` of low :func:`_median_band`: differential evolution (scipy, seeded, so every run
-    writes the same film) over the box, and again with the base as an index per channel (the same films,
-    searched in other coordinates: either alone misses some minima), on every second degree; then Nelder-Mead
-    from the better one on every degree.
+    A dielectric film ``(7,)`` of low :func:`_median_band`: seeds from a path-difference grid (:func:`_seeds`),
+    then differential evolution (scipy, seeded, so every run writes the same film) over the box from a first
+    population of the seeds and a seeded Latin hypercube, and again with the base as an index per channel (the
+    same films, searched in other coordinates: either alone misses some minima), on every second degree; then
+    Nelder-Mead from the best of the two and the seeds on every degree.
     """
     from scipy.optimize import differential_evolution, minimize
+    from scipy.stats import qmc
 
     coarse_lab, coarse_cos = dense_lab[::2], dense_cos[::2]
+    seeds = _seeds(start, lower, upper, dense_lab[::5], dense_cos[::5])
 
-    def search(decode, bounds, x0, popsize):
+    def search(decode, bounds, first, popsize):
+        bounds = np.array(bounds, np.float64)
+        fill = qmc.LatinHypercube(d=len(bounds), seed=0).random(popsize * len(bounds) - len(first))
+        init = np.vstack([np.clip(first, bounds[:, 0], bounds[:, 1]), qmc.scale(fill, bounds[:, 0], bounds[:, 1])])
         result = differential_evolution(lambda x: _median_band(_films_delta_e(decode(x.T), False, coarse_lab, coarse_cos)),
-                                        bounds, x0=x0, vectorized=True, updating="deferred", popsize=popsize,
-                                        maxiter=200, tol=1e-8, seed=0, polish=False)
+                                        bounds, init=init, vectorized=True, updating="deferred",
+                                        maxiter=EVOLUTION_GENERATIONS, tol=1e-8, seed=0, polish=False)
         return decode(result.x[None])[0]
 
-    found = [search(lambda x: x, list(zip(lower, upper)), np.clip(start, lower, upper), 15)]
-    index_bounds = [(lower[0], upper[0]), IOR_RANGE, (0.0, 1.0), *[_BASE_INDEX_RANGE] * 3, (0.0, 1.0)]
-    found.append(search(_from_base_indices, index_bounds, np.array([*start[:3], *[start[3]] * 3, 1.0]), 20))
+    firsts = np.vstack([np.clip(start, lower, upper), seeds])
+    found = [search(lambda x: x, list(zip(lower, upper)), firsts, 15)]
+    index_bounds = [(lower[0], upper[0]), IOR_RANGE, (0.0, 1.0), *[_BASE_INDEX_RANGE] * 3]
+    as_indices = np.column_stack([firsts[:, :3], np.repeat(firsts[:, 3:4], 3, axis=1)])
+    found.append(search(_from_base_indices, index_bounds, as_indices, 20))
 
     def dense(p):
         return float(_median_band(_films_delta_e(np.clip(p, lower, upper)[None], False, dense_lab, dense_cos))[0])
 
-    best = min(found, key=dense)
-    polished = minimize(dense, best, method="Nelder-Mead", options={"maxfev": 1500, "xatol": 1e-4, "fatol": 1e-5})
+    best = min([*found, *seeds], key=dense)
+    polished = minimize(dense, best, method="Nelder-Mead", options={"maxfev": 1000, "xatol": 1e-4, "fatol": 1e-5})
     return np.clip(polished.x, lower, upper)
 
 
@@ -320,11 +361,11 @@ def refine_film(film: Film, dense_target: np.ndarray) -> Film:
     dense_target = np.asarray(dense_target, np.float64)
     target = dense_target[_REPORTED]
     metallic = film.metallic >= 0.5
-    base = film.base_color if metallic else (film.base_ior, *film.specular_color, film.specular)
+    base = film.base_color if metallic else (film.base_ior, *film.specular_color)
     start = np.array([film.thickness, film.ior, film.factor, *base])
-    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0, 0.0, 0.0, 0.0, 0.0))])
+    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0, 0.0, 0.0, 0.0))])
     upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0,
-                      *((1.0,) * 3 if metallic else (3.0, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, 1.0))])
+                      *((1.0,) * 3 if metallic else (3.0, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX))])
     film.delta_e = delta_e(film, target)
     candidates = [film]
     for loss in ("linear", "soft_l1"):
