@@ -371,7 +371,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
             break
         index = np.array([c for c, _ in tried])
         trial_U, trial_cost = _polish_many(runner, f"neighbours {round_ + 1}", model_name, ranges, fixed, angles,
-                                           colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]))
+                                           colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]), walk=True)
         for k, c in enumerate(index):
             if trial_cost[k] < cost[c] - 1e-12:
                 U[c], cost[c] = trial_U[k], trial_cost[k]
@@ -414,7 +414,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
             break
         index = np.array([c for c, _ in tried], dtype=np.int64)
         trial_U, _ = _polish_many(runner, f"spread {round_ + 1}", model_name, ranges, fixed, angles, colour_rgb[index],
-                                  colour_bounds[index], np.array([u for _, u in tried]))
+                                  colour_bounds[index], np.array([u for _, u in tried]), walk=True)
         pieces = [slice(s, s + CHUNK) for s in range(0, index.size, CHUNK)]
         results = runner.map(f"spread {round_ + 1} converged", converged_task,
                              [(model_name, dict(ranges), fixed, angles, colour_rgb[index[s]], colour_bounds[index[s]], trial_U[s]) for s in pieces])
@@ -448,8 +448,12 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
                        tasks=runner.tasks, critical_path=runner.critical_path, task_seconds=runner.task_seconds)
 
 
-def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, starts, walk=False):
-    """:func:`polish_task` over chunks of :data:`CHUNK` rows (``walk``: starts from other regions' structures)."""
+def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, starts, walk):
+    """
+    :func:`polish_task` over chunks of :data:`CHUNK` rows. ``walk``: counts walk freely where a start may lie in
+    another region (the clusters' structures, and the retries of colours their neighbours' start left poor); a
+    finer level's start from its nearest polished pixel only tries its count one either way.
+    """
     pieces = [slice(s, s + CHUNK) for s in range(0, rgb.shape[0], CHUNK)]
     results = runner.map(stage, polish_task, [(model_name, dict(ranges), fixed, angles, rgb[s], bounds[s], starts[s], walk) for s in pieces])
     return np.concatenate([r["U"] for r in results]), np.concatenate([r["cost"] for r in results])
