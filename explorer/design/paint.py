@@ -541,9 +541,9 @@ def _candidates(poor, cost, pairs, labels, centre_U, U, tried: dict[int, list[np
     out = {}
     for c in poor:
         neighbours = sorted((n for n in pairs.get(int(c), ()) if cost[n] < cost[c]), key=lambda n: (cost[n], n))
-        starts = [U[n] for n in neighbours[:NEIGHBOUR_STARTS]]
+        starts = [U[n].copy() for n in neighbours[:NEIGHBOUR_STARTS]]  # copies: U's rows change as colours improve
         if not starts and labels[c] >= 0:
-            starts.append(centre_U[labels[c]])
+            starts.append(centre_U[labels[c]].copy())
         before = [] if tried is None else tried.setdefault(int(c), [])
         distinct = []
         for s in starts:
