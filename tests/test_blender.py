@@ -149,6 +149,26 @@ def test_every_built_in_material_maps():
         assert inputs["Thin Film Thickness"].default_value > 0.0 or inputs["Coat Weight"].default_value == 1.0, name
 
 
+@pytest.mark.parametrize("twin", ["BraggLayerModel", "BraggStackModel"])
+def test_rough_bragg_export_carries_the_multiple_scattering_compensation(twin):
+    """At alpha 0.5 (the compensation at full weight, on by default) the exported Glossy's colour image carries
+    the compensated twin's albedo: clearly above the single-scattering table (Eq. 17 / Eq. 34 alone)."""
+    from explorer.blender import converged_tables, material
+    from explorer.materials import models
+    from explorer.materials.export_table import roughness_names
+
+    source = load_material(material_path(getattr(models, twin).name))
+    rough = {n: 0.5 for n in roughness_names(source)}
+    values = source.resolve(rough)
+    assert model_for(source, values).compensation_weight == 1.0
+    target = bpy.data.materials.new(f"compensated {twin}")
+    material(target, source, values)
+    image = next(n.image for n in target.node_tree.nodes if n.bl_idname == "ShaderNodeTexImage" and "converged" in n.image.name)
+    exported = np.asarray(image.pixels[:], np.float64).reshape(-1, 4)[:, :3]
+    single, _ = converged_tables(source, source.resolve({**rough, "multiple_scattering": 0}))
+    assert np.all(exported.mean(axis=0) > 1.2 * single.mean(axis=0)), (exported.mean(axis=0), single.mean(axis=0))
+
+
 def test_script_in_a_fresh_bpy_rebuilds_a_rough_material(tmp_path):
     """FILE.py of the thin film's default export, run by a fresh Python with bpy (its start-up cube active): the
     cube's material becomes the converged table driving a GGX Glossy, the same tree as the .blend's."""
