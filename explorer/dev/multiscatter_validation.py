@@ -35,7 +35,7 @@ THETA = (0.0, 20.0, 40.0, 55.0, 70.0)
 ALPHAS = (0.2, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0)
 #: Three one-layer presets over a black base, a two-layer stack over a black base, a layer over a grey base.
 PRESETS = ("figure1_left_alpha04", "figure1_right_alpha04", "figure7_A", "figure1_stacked_pair", "figure7_A_on_base")
-SAMPLES = 32768
+SAMPLES = 131072
 DOCS = SOURCE_ROOT / "docs"
 RESULTS = DOCS / "multiscatter_validation.json"
 FIGURE = DOCS / "figures" / "multiscatter_validation.png"
