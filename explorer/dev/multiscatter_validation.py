@@ -9,7 +9,7 @@ Per preset and ``alpha``: the directional albedo at :data:`THETA` by the three (
 quadrature of :func:`explorer.views.albedo.albedo_numpy`), the luminance gap ``Y(model) / Y(walk) - 1``
 and ΔE2000 (colour-science, through :func:`explorer.physics.colorimetry.delta_E_2000`) per angle.
 
-Regenerate (about 10-20 minutes on the shared 2 cores)::
+Regenerate (about 35 minutes of wall time on the shared 2 cores at load ~10)::
 
     python3 -m explorer.dev.multiscatter_validation           # docs/multiscatter_validation.json, docs/figures/multiscatter_validation.png
     python3 -m explorer.dev.multiscatter_validation --table   # the Markdown table of docs/layered_validation.md from the JSON
