@@ -148,6 +148,36 @@ def gl_renderer():
     return SESSION_RENDERERS[0]
 
 
+#: Fixture scopes whose one set-up serves several tests of one module (a class's or a module's).
+SHARED_SCOPES = ("class", "module", "package")
+
+
+def shared_set_up_group(item) -> str | None:
+    """
+    The test module of ``item`` when it uses a class- or module-scoped fixture of that module, else None.
+
+    The suite runs on every core (pyproject's ``-n logical --dist loadgroup``): a test in no group goes to
+    whichever worker is free, but a fixture shared by a module's tests is set up once per worker that runs
+    any of them, so those tests stay together and pay for it once (the design round trips, the exports, the
+    wheel). Conftest's fixtures (the GL renderer) serve the whole worker and group nothing.
+    """
+    module = item.nodeid.split("::")[0]
+    for definitions in item._fixtureinfo.name2fixturedefs.values():
+        fixture = definitions[-1]
+        if fixture.scope in SHARED_SCOPES and (fixture.baseid == module or fixture.baseid.startswith(module + "::")):
+            return module
+    return None
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Mark each test that shares a module's set-up with its group (read by xdist's ``--dist loadgroup``)."""
+    for item in items:
+        group = shared_set_up_group(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
+
+
 @pytest.fixture(scope="session")
 def bragg_material():
     """``shaders/bragg_mirror.brd``, parsed."""

@@ -1,0 +1,47 @@
+"""
+The suite runs on every core (pytest-xdist, ``--dist loadgroup``): what keeps that safe and cheap.
+
+Tests sharing a module's set-up are grouped onto one worker (conftest.shared_set_up_group), and the app
+tests' X servers, one per worker, pick their own display numbers.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from conftest import running_in_ci, shared_set_up_group
+
+SET_UPS: list[int] = []
+
+
+@pytest.fixture(scope="module")
+def shared_set_up():
+    SET_UPS.append(1)
+    return len(SET_UPS)
+
+
+def test_a_test_of_a_module_set_up_joins_the_module_group(request, shared_set_up):
+    assert shared_set_up == 1
+    assert shared_set_up_group(request.node) == request.node.nodeid.split("::")[0]
+    assert any(mark.args == (shared_set_up_group(request.node),) for mark in request.node.iter_markers("xdist_group"))
+
+
+def test_a_test_of_function_and_conftest_fixtures_goes_anywhere(request, tmp_path, bragg_material):
+    assert shared_set_up_group(request.node) is None
+    assert not list(request.node.iter_markers("xdist_group"))
+
+
+def test_virtual_displays_started_together_get_their_own_numbers():
+    from explorer.app.xvfb import XvfbUnavailable, virtual_display
+
+    try:
+        with virtual_display() as first, virtual_display() as second:
+            assert first != second
+            for display in (first, second):
+                assert os.path.exists(f"/tmp/.X11-unix/X{display.removeprefix(':')}"), display
+    except XvfbUnavailable as error:
+        if running_in_ci():
+            pytest.fail(f"CI=true and no Xvfb: {error}", pytrace=False)
+        pytest.skip(str(error))
