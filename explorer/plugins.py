@@ -13,7 +13,8 @@ compares both versions view by view. The built-in materials are plugins of the s
   docs/plugins.md).
 - :class:`Capabilities`: the declaration (methods, Dirac reflector, Bragg spectrum, engines, exports, design),
   with :data:`ALBEDO_ENGINES` and :data:`EXPORT_TARGETS`; :class:`DesignModel`: design's forward model and
-  parameters, which a designable twin declares (``Capabilities(design=DesignModel(...))``).
+  parameters, which a designable twin declares (``Capabilities(design=DesignModel(...))``); :class:`StructureMaps`:
+  the parameters a texel of a map folder holds (``Capabilities(maps=StructureMaps(...))``).
 - :class:`Method`: the base of a ``method`` parameter's enumeration; :class:`Values`: the typed, frozen
   values a twin receives; :func:`round_integer`: the one rounding rule of ``int`` parameters.
 """
@@ -21,7 +22,7 @@ compares both versions view by view. The built-in materials are plugins of the s
 from explorer.materials.brd import Values, round_integer
 from explorer.materials.methods import Method
 from explorer.materials.plugins import PluginError
-from explorer.materials.twins import ALBEDO_ENGINES, EXPORT_TARGETS, Capabilities, DesignModel, Twin, twin
+from explorer.materials.twins import ALBEDO_ENGINES, EXPORT_TARGETS, Capabilities, DesignModel, StructureMaps, Twin, twin
 
-__all__ = ["twin", "Twin", "Capabilities", "DesignModel", "ALBEDO_ENGINES", "EXPORT_TARGETS", "Method", "Values",
+__all__ = ["twin", "Twin", "Capabilities", "DesignModel", "StructureMaps", "ALBEDO_ENGINES", "EXPORT_TARGETS", "Method", "Values",
            "round_integer", "PluginError"]

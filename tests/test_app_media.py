@@ -32,3 +32,18 @@ def test_app_chooses_a_medium_by_name(x_display, tmp_path):  # noqa: F811
     assert values["n2"] == pytest.approx(dispersion.LIBRARY["chitin"].real_at(550.0))  # the slider shows its n
     assert values["medium_nh"] == 0  # melanin absorbs: refused, the host unchanged
     assert {f"medium_n2:{i}" for i in range(len(MEDIA) + 1)} <= set(report["items"])
+
+
+def test_app_chooses_a_stacks_host_medium(x_display, tmp_path):  # noqa: F811
+    """bragg_stack's host has its combo beside the nh slider: chitin is taken (the slider shows its n at 550 nm)."""
+    from conftest import REPO_ROOT
+
+    actions = [
+        {"wait": 4}, {"click": "param:medium_nh"}, {"wait": 1}, {"click": f"medium_nh:{MEDIA.index('chitin') + 1}"}, {"wait": 1},
+        {"wait_complete": True}, {"quit": True},
+    ]
+    _, report = run_session(x_display, REPO_ROOT / "shaders" / "bragg_stack.brd", actions, tmp_path)
+    values = report["values"]
+    assert values["medium_nh"] == MEDIA.index("chitin") + 1, report["script_log"]
+    assert values["nh"] == pytest.approx(dispersion.LIBRARY["chitin"].real_at(550.0))
+    assert {f"medium_nh:{i}" for i in range(len(MEDIA) + 1)} <= set(report["items"])

@@ -90,7 +90,7 @@ def test_base_term_is_rho_d_over_pi_times_the_transmission_table(layer_material)
     below = V * np.array([1.0, 1.0, -1.0])
     np.testing.assert_array_equal(with_base.brdf(L, below, N, None, None), 0.0)
     assert set(with_base.textures()) == {"bragg_table", "transmission_table", "layer_lobe"}
-    assert not with_base.textures()["layer_lobe"].any()  # multiple scattering off: no lobe
+    assert not with_base.textures()["layer_lobe"].any()  # alpha 0.1: the compensation's weight is 0, no lobe
 
 
 def test_alpha_out_of_range_is_one_line(tmp_path):

@@ -141,7 +141,8 @@ def slice_of_export(ctx, text):
 CASES = [("bragg_mirror", {"method": m}) for m in range(5)] + [
     ("thin_film", {"method": m, "alpha": 0.3}) for m in range(6)] + [
     ("bragg_layer", {"method": m, "rho_d": (0.3, 0.2, 0.1), "alpha": 0.25}) for m in (0, 1, 2, 3, 4)] + [
-    ("bragg_layer", {"method": 3, "rho_d": (0.3, 0.2, 0.1), "alpha": 0.8, "multiple_scattering": 1})]  # its lobe's table inlined
+    ("bragg_layer", {"method": 3, "rho_d": (0.3, 0.2, 0.1), "alpha": 0.8, "multiple_scattering": 1}),  # its lobe's table inlined
+    ("bragg_layer", {"method": 3, "rho_d": (0.3, 0.2, 0.1), "alpha": 0.45})]  # the lobe faded in: weight 0.5 from its alpha
 
 
 @pytest.mark.gl

@@ -162,7 +162,7 @@ def test_cli_set_and_engines_agree_on_a_half(gl_renderer, tmp_path):
 SHIPPED_INTEGERS = {
     "bragg_mirror.brd": {"N", "method", "s", "medium_n1", "medium_n2", "medium_nh"},
     "bragg_layer.brd": {"N", "method", "s", "medium_n1", "medium_n2", "medium_nh"},
-    "bragg_stack.brd": {"layers", "N_1", "N_2", "N_3", *(f"medium_{n}_{k}" for n in ("n1", "n2") for k in (1, 2, 3))},
+    "bragg_stack.brd": {"layers", "medium_nh", "N_1", "N_2", "N_3", *(f"medium_{n}_{k}" for n in ("n1", "n2") for k in (1, 2, 3))},
     "thin_film.brd": {"method"},
     "layered_lobes.brd": {"layers"},
     "ggx_schlick.brd": set(),

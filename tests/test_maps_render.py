@@ -28,7 +28,7 @@ def write_map_folder(folder, maps: dict[str, np.ndarray], fixed: dict | None = N
     folder.mkdir(parents=True, exist_ok=True)
     for name, image in maps.items():
         write_image(np.repeat(np.asarray(image, np.float32)[..., None], 3, axis=-1), folder / f"{name}.exr")
-    params = {"material": "bragg_mirror", "model": model, "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0} if fixed is None else fixed,
+    params = {"material": model, "model": model, "fixed": {"n1": 1.0, "n2": 1.5, "nh": 0.0} if fixed is None else fixed,
               "free": list(maps), "angles_deg": [0.0], "seed": 0, "shape": list(next(iter(maps.values())).shape)}
     (folder / "params.json").write_text(json.dumps(params), encoding="utf-8")
 
@@ -108,21 +108,22 @@ def test_maps_textured_gl_equals_numpy(gl_renderer, folder, mirror, method):
 
 
 @pytest.mark.gl
-def test_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
+@pytest.mark.parametrize("method", [0, 4])
+def test_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror, method):
     """
     The env view: each texel's Dirac under the environment (exact after one sample), against the exact integral; by the
-    spectral reference, smooth in the angle (the approximations' discrete choices of boxes may flip between float32
-    and float64 where a normal's angle sits on a threshold, and the environment magnifies any difference).
+    spectral reference and the improved approximation (the tabulated method's stand-in per texel; its fringe count takes
+    the band edges' Bloch phase exactly, so float32 no longer moves its sub-boxes: explorer.physics.bragg.bloch_phase).
     """
     from explorer.gpu.env import render_env
     from explorer.materials.models import model_for
     from explorer.views.env import EnvironmentMap, env_integral_numpy
 
-    texture, values = map_texture(folder, mirror, method=0)
+    texture, values = map_texture(folder, mirror, method=method)
     environment = EnvironmentMap.default()
     gl = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer, surface=texture)
     reference = env_integral_numpy(model_for(mirror, values), environment, *SIZE, surface=texture)
-    assert_twins_equal(Twins.of(gl, reference, "env"), "maps env")
+    assert_twins_equal(Twins.of(gl, reference, "env"), f"maps env method {method}")
     plain = render_env(mirror, values, *SIZE, environment=environment, spp=1, renderer=gl_renderer)
     assert np.abs(plain - gl).max() > 0.02  # the maps show
 
@@ -166,19 +167,20 @@ def test_maps_on_a_mesh_gl_equals_numpy(gl_renderer, folder, mirror, shape):
 
 
 @pytest.mark.gl
-def test_maps_on_a_mesh_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror):
+@pytest.mark.parametrize("method", [0, 4])
+def test_maps_on_a_mesh_under_an_environment_gl_equals_numpy(gl_renderer, folder, mirror, method):
     from explorer.gpu.env import render_env
     from explorer.materials.models import model_for
     from explorer.views.env import EnvironmentMap, env_integral_numpy
     from explorer.views.mesh import torus
 
     mesh, size = torus(), 32
-    texture, values = map_texture(folder, mirror, method=0)  # the reference: see the sphere's test above
+    texture, values = map_texture(folder, mirror, method=method)  # see the sphere's test above
     environment = EnvironmentMap.default()
     gl = render_env(mirror, values, size, size, environment=environment, spp=1, renderer=gl_renderer, surface=texture, mesh=mesh)
     reference = env_integral_numpy(model_for(mirror, values), environment, size, size, surface=texture, mesh=mesh)
     safe = mesh_safe_pixels(mesh, size, MAP_SIZE)
-    assert_twins_equal(Twins(gl, reference, safe, "env", None), "maps on the torus under the environment")
+    assert_twins_equal(Twins(gl, reference, safe, "env", None), f"maps on the torus under the environment, method {method}")
 
 
 def test_obj_texture_coordinates(tmp_path):
@@ -264,14 +266,21 @@ def test_cli_render_maps_bad_folders(folder, tmp_path):
 
 def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror):  # noqa: F811
     """
-    ``open --maps DIR`` (the material from the folder): the Texture window draws the maps on the mirror, as the
-    headless render does, and shows each map with its range.
+    ``open --maps DIR`` (the material from the folder): the Texture window shows each map with its range and draws the
+    maps on the sphere, then on the torus, lit and under the environment: each image's mean RGB equals what ``render
+    --maps DIR [--mesh torus] --view textured|env`` draws (:func:`explorer.rendering.render_material` and
+    :func:`explorer.gpu.env.render_env`; the smooth mirror's Dirac is exact after one sample).
     """
     from test_app import run_session
 
-    # Then under the environment for a few frames (it crashed once: the session must end cleanly).
-    actions = [{"set": {"method": 4}}, {"view_size": 128}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
-               {"click": "texture_env"}, {"wait": 3}, {"quit": True}]
+    from explorer.gpu.env import render_env
+    from explorer.rendering import render_material
+    from explorer.views.env import ENVIRONMENTS
+    from explorer.views.mesh import mesh_named
+
+    actions = [{"set": {"method": 4}}, {"view_size": 64}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"},
+               {"click": "texture_model_combo"}, {"wait": 2}, {"click": "texture_model:torus"}, {"wait": 3}, {"wait_for": "texture_view"},
+               {"click": "texture_env"}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
     _, report = run_session(x_display, "bragg_mirror", actions, tmp_path, "--maps", str(folder))
     shown = report["texture_view"]
     assert "clicked texture_env" in report["script_log"], report["script_log"]
@@ -281,18 +290,59 @@ def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror
     for name, image in maps.items():
         assert shown["maps"][name]["size"] == list(MAP_SIZE)
         np.testing.assert_allclose([shown["maps"][name]["min"], shown["maps"][name]["max"]], [np.nanmin(image), np.nanmax(image)], rtol=1e-6)
+    assert shown["model"] == "torus" and set(shown["shown"]) == {"textured:sphere", "textured:torus", "env:torus"}, shown
     values = mirror.resolve(shown["values"])
     assert (values["n1"], values["n2"], values["method"]) == (1.0, 1.5, 4)
     texture, _ = map_texture(folder, mirror, **shown["values"])
     width, height = shown["size"]
+    torus = mesh_named("torus")
     theta = np.degrees(np.arccos(np.clip(shown["light"][2], -1.0, 1.0)))
     phi = np.degrees(np.arctan2(shown["light"][1], shown["light"][0]))
-    image = gl_renderer.render(mirror, values, "textured", width, height, light=(theta, phi),
-                               **texture.gl_arguments(mirror, values, width, height))
-    assert np.abs(image).max() > 0.05
-    np.testing.assert_allclose(shown["mean_rgb"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)
+    images = {f"textured:{name}": render_material(mirror, values, "textured", width, height, "gl", light=(theta, phi), thickness=texture,
+                                                  mesh=mesh, renderer=gl_renderer)
+              for name, mesh in (("sphere", None), ("torus", torus))}
+    images["env:torus"] = render_env(mirror, values, width, height, environment=ENVIRONMENTS[shown["environment"]](), spp=1,
+                                     renderer=gl_renderer, surface=texture, mesh=torus)
+    for name, image in images.items():
+        assert np.abs(image).max() > 0.05, name
+        np.testing.assert_allclose(shown["shown"][name], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5, err_msg=name)
+    assert np.abs(np.subtract(shown["shown"]["textured:torus"], shown["shown"]["env:torus"])).max() > 1e-3
 
 
 def test_open_with_a_bad_map_folder_is_one_line(tmp_path):
     line = one_line_error(run_cli("open", "bragg_mirror", "--maps", tmp_path / "nowhere"))
     assert "nowhere/params.json" in line, line
+
+
+
+# -- the flat image (--theta): one pixel a texel ------------------------------------------------------------
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("method", [0, 4])
+def test_flat_maps_gl_equals_numpy(gl_renderer, folder, mirror, method):
+    """``shaders/views/flat/textured.glsl`` against its twin (flat_numpy), at 0 and 45 degrees; off the mask black."""
+    from explorer.materials.models import model_for
+    from explorer.views.maps import flat_gl, flat_numpy
+
+    texture, values = map_texture(folder, mirror, method=method)
+    for theta in (0.0, 45.0):
+        gl = flat_gl(gl_renderer, mirror, values, texture, theta)
+        reference = flat_numpy(model_for(mirror, values), texture, theta)
+        assert gl.shape == reference.shape == (MAP_SIZE[1], MAP_SIZE[0], 3)
+        assert np.abs(reference).max() > 0.3 and np.all(reference[MAP_SIZE[1] // 2, MAP_SIZE[0] // 2] == 0.0)
+        assert_twins_equal(Twins(gl, reference, np.ones(gl.shape[:2], bool), "gradient"), f"flat maps method {method} at {theta:g}")
+
+
+@pytest.mark.gl
+def test_cli_flat_maps_gl_is_near_the_converged_colours(folder, tmp_path):
+    """``render --maps --theta`` by GL at the spectral reference: within 1e-2 of ``--engine numpy``'s converged colours."""
+    images = {}
+    for engine in ("gl", "numpy"):
+        out = tmp_path / f"{engine}.npy"
+        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", "textured", "--engine", engine,
+                                                              "--set", "method=0", "--theta", "30", "--out", out)
+        assert run.returncode == 0, run.stderr
+        images[engine] = np.load(out)
+    assert images["gl"].shape == (MAP_SIZE[1], MAP_SIZE[0], 3)
+    assert np.abs(images["gl"] - images["numpy"]).max() < 1e-2

@@ -341,7 +341,8 @@ def _errors(function):
 @click.option("--ndotl", is_flag=True, help="Plots: times N.L (the albedo plot: times cos theta_i).")
 @click.option("--maps", "maps_dir", metavar="DIR", help="textured (lit) and env views: the structure maps design --target-image wrote, "
               "each texel its own mirror on the sphere; with --theta (--engine numpy): one pixel a texel, its colour at that angle.")
-@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees.")
+@click.option("--theta", "maps_theta", type=float, help="--maps: the flat image of the maps' colours at this viewing angle in degrees "
+              "(--engine numpy: converged spectral colours; gl: by the material's method).")
 @_errors
 def render(material, view, assignments, size, out, engine, light, preset, params_file, exposure, tonemap, fill, texture, dinc_range,
            prefilter, env_file, spp, variant, mesh, env_rotation, background, theta_d, theta_h, phi_v, log_scale, channel,
@@ -362,7 +363,7 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     if maps_dir is not None and maps_theta is not None:
         from explorer.cli.paint import render_maps_command
 
-        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure)
+        render_maps_command(material, maps_dir, view, maps_theta, out, engine, exposure, assignments)
         return
     if maps_theta is not None:
         raise click.UsageError("--theta goes with --maps")
@@ -496,8 +497,10 @@ def render(material, view, assignments, size, out, engine, light, preset, params
     what = ", ".join([f"{width}x{height}", view, engine] + ([f"method {method}"] if method else []))
     if maps_dir is not None:
         h, w = thickness.index.shape
-        tabulated = method_labels(loaded).get(4) if round_integer(values["method"]) == 3 else None
-        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {tabulated} per texel" if tabulated else "")
+        chosen = round_integer(values["method"]) if "method" in values else None
+        texel = None if chosen is None else thickness.declaration.texel_method(chosen)  # a table's method: its stand-in
+        stand_in = method_labels(loaded).get(texel) if texel != chosen else None
+        what += f"; {', '.join(thickness.maps)} from {w}x{h} maps" + (f", method {stand_in} per texel" if stand_in else "")
     click.echo(f"wrote {out} ({what})" + (f"; {bad} non-finite values!" if bad else ""))
     from explorer.cli.accuracy import accuracy_note
 

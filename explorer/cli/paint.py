@@ -130,8 +130,13 @@ def paint_command(loaded, fixed: dict, image: str, image_2: str | None, angles_t
     click.echo(f"maps: {out}/ ({', '.join(f'{n}.exr' for n in result.maps)}, params.json, report.json)")
 
 
-def render_maps_command(material: str | None, maps: str, view: str, theta: float | None, out: str, engine: str, exposure: str | None) -> None:
-    """``render MATERIAL --maps DIR --view textured [--theta DEG]``: the maps' colours at one angle, one pixel a texel."""
+def render_maps_command(material: str | None, maps: str, view: str, theta: float | None, out: str, engine: str, exposure: str | None,
+                        assignments=()) -> None:
+    """
+    ``render MATERIAL --maps DIR --view textured --theta DEG``: the maps' colours at one angle, one pixel a texel. ``--engine
+    numpy``: each texel's converged spectral colour (the design's forward model, what the round trip measures); ``--engine
+    gl``: by the material's method (``--set method=N``; the flat textured view, twin of :func:`explorer.views.maps.flat_numpy`).
+    """
     from explorer.design import DesignError, design_model
     from explorer.views.maps import read_maps
     from explorer.materials.brd import load_material
@@ -142,9 +147,9 @@ def render_maps_command(material: str | None, maps: str, view: str, theta: float
 
     if view != "textured":
         raise click.UsageError(f"--maps with --theta renders the textured view flat (the maps' colours at --theta), not {view}")
-    if engine != "numpy":
-        raise click.UsageError("--maps with --theta renders with --engine numpy (each texel's converged spectral colour); "
-                               "without --theta the maps are drawn on the sphere, in GL or numpy")
+    if engine not in ("numpy", "gl"):
+        raise click.UsageError("--maps with --theta renders with --engine numpy (each texel's converged spectral colour) or gl "
+                               "(by the material's method)")
     try:
         exposure_factor = 1.0 if exposure is None else float(exposure)
     except ValueError:
@@ -163,9 +168,22 @@ def render_maps_command(material: str | None, maps: str, view: str, theta: float
         _fail(str(error))
     if model.name != params.get("model"):
         _fail(f"--maps {maps}: maps of a {params.get('model')}, not of {model.name} ({material})")
-    image = map_colours(model.name, params.get("fixed", {}), arrays, theta)
+    if engine == "gl":
+        from explorer.cli.materials import resolve_values
+        from explorer.gpu import Renderer
+        from explorer.views.maps import flat_gl
+        from explorer.views.surface_texture import MapTexture
+
+        try:
+            texture, values = MapTexture.from_folder(maps, loaded, resolve_values(loaded, None, None, assignments))
+            image = flat_gl(Renderer(), loaded, loaded.resolve(values), texture, theta)
+        except LocatedError as error:
+            _fail(str(error))
+    else:
+        image = map_colours(model.name, params.get("fixed", {}), arrays, theta)
     try:
         write_image(image, Path(out), exposure=exposure_factor)
     except OutputError as error:
         _fail(str(error))
-    click.echo(f"wrote {out} ({image.shape[1]}x{image.shape[0]}, the maps' colours at {theta:g} degrees)")
+    how = "by the material's method, gl" if engine == "gl" else "converged spectral colours, numpy"
+    click.echo(f"wrote {out} ({image.shape[1]}x{image.shape[0]}, the maps' colours at {theta:g} degrees; {how})")

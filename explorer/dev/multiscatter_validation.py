@@ -60,6 +60,7 @@ def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0) -> d
     for k in range(1, 4):
         values[f"alpha_{k}"] = float(alpha)
     compensated_model = model_for(material, {**values, "multiple_scattering": True})
+    compensated_model.full_compensation = True  # the whole lobe at every alpha: what the fade leaves out at alpha <= 0.4
     single_model = model_for(material, {**values, "multiple_scattering": False})
     start = time.perf_counter()
     reference = PositionFree(compensated_model.stack, compensated_model.tables, "walk").albedo(THETA, samples, seed)

@@ -51,7 +51,7 @@ def build_program_source(material: Material, view: str, constants: tuple[tuple[s
     builder.define("VIEW_" + "".join(c if c.isalnum() else "_" for c in view.upper()), 1)  # mesh/lit -> VIEW_MESH_LIT
     from explorer.views.geometry import VIEW_REGISTRY
 
-    registered = VIEW_REGISTRY.get(view.removeprefix("mesh/"))  # a mesh's template: the view it replaces
+    registered = VIEW_REGISTRY.get(view.rpartition("/")[2])  # a template (mesh/lit, flat/textured): the view it draws
     if registered is not None and registered.surface_texture:
         builder.define("SURFACE_TEXTURE", 1)
     builder.add_source(material.uniform_declarations(), f"{material.path} (parameters)")

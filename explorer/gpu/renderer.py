@@ -28,7 +28,7 @@ from explorer.gpu.resources import (
 
 #: The views' own uniforms at their headless values, bound to every draw that does not set them (a
 #: program is shared: the app's Slice window may have set another phi_d on it).
-VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2), "fill": 0.0, "surface_nearest": False}
+VIEW_UNIFORM_DEFAULTS = {"slice_phi_d": float(np.pi / 2), "fill": 0.0, "surface_nearest": False, "texture_mapping": 0}
 #: Fill tables kept (explorer.views.fill): the shown material's, Compare's two, a few more.
 FILL_TABLES_KEPT = 8
 

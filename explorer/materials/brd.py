@@ -491,7 +491,7 @@ class Material:
         if "medium_nh" in values:  # a host naming a medium must be lossless (explorer.materials.media)
             from explorer.materials.media import host_problem
 
-            problem = host_problem(values)
+            problem = host_problem(values, self.parameter("nh").min)
             if problem:
                 raise MaterialError(self.path, self.parameter("medium_nh").line, problem)
         return Values(values)

@@ -31,7 +31,6 @@ from explorer.materials import gltf_film
 
 EXTENSION = "KHR_materials_iridescence"
 IOR_EXTENSION = "KHR_materials_ior"
-SPECULAR_EXTENSION = "KHR_materials_specular"
 #: The UV sphere's segments around and rings from pole to pole.
 SEGMENTS, RINGS = 64, 32
 #: The orthographic camera's distance from the centre (it looks along -z, as the env view's).
@@ -156,9 +155,6 @@ def gltf_bytes(material, values, film: gltf_film.Film, mesh: tuple[np.ndarray, n
     if film.metallic < 0.5:
         extensions[IOR_EXTENSION] = {"ior": film.base_ior}
         used.append(IOR_EXTENSION)
-        if film.specular != 1.0 or any(c != 1.0 for c in film.specular_color):
-            extensions[SPECULAR_EXTENSION] = {"specularFactor": film.specular, "specularColorFactor": list(film.specular_color)}
-            used.append(SPECULAR_EXTENSION)
     delta = np.asarray(film.delta_e, dtype=np.float64)
     extras = {
         "material": name,
@@ -219,7 +215,7 @@ def describe(film: gltf_film.Film) -> str:
     pairs = "  ".join(f"{t:g}:{e:.2f}" for t, e in zip(gltf_film.THETA_DEG, film.delta_e))
     how = {"direct": "direct mapping", "refined": "thin film, refined", "fit": "nearest single film"}[film.mapping]
     return (f"{how}: thickness {film.thickness:.1f} nm, film IOR {film.ior:.4f}, factor {film.factor:.3f}, "
-            f"{'metal, base colour ' + ', '.join(f'{c:.4f}' for c in film.base_color) if film.metallic >= 0.5 else f'dielectric, IOR {film.base_ior:.4f}, specular {film.specular:.3f}, colour ' + ', '.join(f'{c:.3f}' for c in film.specular_color)}\n"
+            f"{'metal, base colour ' + ', '.join(f'{c:.4f}' for c in film.base_color) if film.metallic >= 0.5 else f'dielectric, IOR {film.base_ior:.4f}'}\n"
             f"ΔE2000 by theta (deg:ΔE): {pairs}\n"
             f"median {np.median(film.delta_e):.2f}, max {np.max(film.delta_e):.2f}"
             + (f" (the direct mapping's: median {np.median(film.direct.delta_e):.2f}, max {np.max(film.direct.delta_e):.2f})"

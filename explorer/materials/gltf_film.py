@@ -50,8 +50,15 @@ _XYZ_TO_REC709 = np.array([
 #: and an index >= 1).
 THICKNESS_RANGE = (0.0, 1500.0)
 IOR_RANGE = (1.0, 3.0)
-#: The largest specularColorFactor the dielectric's fit may write (the extension allows any >= 0; F0 is clamped to 1).
-SPECULAR_COLOR_MAX = 4.0
+#: The dielectric's search: its grid's step in the optical path difference at normal incidence
+#: (``D_inc = 2 n d``, nm), film indices (offsets from the film's own), base indices and factors; the grid's
+#: best distinct starts polished; differential evolution's population per coordinate and generations.
+GRID_OPD_STEP = 10.0
+GRID_FILM_IOR_OFFSETS = (-0.3, -0.15, 0.0, 0.15, 0.3)
+GRID_BASE_IORS = (1.0, 1.5, 2.0, 2.5, 3.0)
+GRID_FACTORS = (0.4, 0.6, 0.8, 1.0)
+POLISHED_STARTS = 4
+EVOLUTION = (20, 200)
 
 
 def _schlick(f0, cos):
@@ -120,8 +127,6 @@ class Film:
     metallic: float  # metallicFactor: 0 or 1
     base_color: tuple[float, float, float] = (0.0, 0.0, 0.0)  # baseColorFactor's RGB (the metal's F0)
     base_ior: float = 1.5  # KHR_materials_ior (the dielectric's)
-    specular_color: tuple[float, float, float] = (1.0, 1.0, 1.0)  # KHR_materials_specular's specularColorFactor
-    specular: float = 1.0  # KHR_materials_specular's specularFactor
     mapping: str = "direct"  # "direct" (a thin film), "refined" (from the direct one) or "fit" (the nearest film)
     delta_e: np.ndarray = field(default_factory=lambda: np.zeros(0))  # ΔE2000 at THETA_DEG
     direct: "Film | None" = None  # a refined film's direct mapping
@@ -134,11 +139,10 @@ def specular_reflectance(film: Film, cos_theta) -> np.ndarray:
         f0 = np.asarray(film.base_color, np.float64)
         plain = _schlick(f0, cos[..., None])  # conductor_fresnel
     else:
-        # iridescent_dielectric_layer with KHR_materials_specular over a black base: F0 its colour times the
-        # index's, Schlick's plain Fresnel weighted by the specular factor, the film on weight * F0.
-        f0 = np.minimum(_ior_to_f0(film.base_ior, 1.0) * np.asarray(film.specular_color, np.float64), 1.0)
-        plain = film.specular * _schlick(f0, cos[..., None])
-        f0 = film.specular * f0
+        # iridescent_dielectric_layer over a black base: F0 from KHR_materials_ior, Schlick's plain Fresnel, and
+        # the film's second interface at the same F0.
+        f0 = np.full(3, _ior_to_f0(film.base_ior, 1.0))
+        plain = _schlick(f0, cos[..., None])
     iridescent = iridescent_fresnel(1.0, film.ior, f0, film.thickness, cos)
     return (1.0 - film.factor) * plain + film.factor * iridescent
 
@@ -175,17 +179,10 @@ def direct_film(model) -> Film | None:
 
 def _films_rgb(params: np.ndarray, metallic: bool, cos: np.ndarray) -> np.ndarray:
     """:func:`specular_reflectance` of many films at once: ``params`` ``(K, 6)`` (thickness, ior, factor, then
-    the base colour for a metal) or ``(K, 8)`` (then the base's index, the specular colour and factor for a
-    dielectric) -> ``(K, len(cos), 3)``."""
+    the base colour for a metal) or ``(K, 4)`` (then the base's index for a dielectric) -> ``(K, len(cos), 3)``."""
     thickness, ior, factor = params[:, 0:1], params[:, 1:2], params[:, 2:3, None]
-    if metallic:
-        f0 = params[:, None, 3:6]
-        plain = _schlick(f0, cos[None, :, None])
-    else:
-        weight = params[:, None, 7:8]
-        f0 = np.minimum(_ior_to_f0(params[:, None, 3:4], 1.0) * params[:, None, 4:7], 1.0)
-        plain = weight * _schlick(f0, cos[None, :, None])
-        f0 = weight * f0
+    f0 = params[:, None, 3:6] if metallic else np.repeat(_ior_to_f0(params[:, None, 3:4], 1.0), 3, axis=-1)
+    plain = _schlick(f0, cos[None, :, None])
     iridescent = iridescent_fresnel(1.0, ior, f0, thickness, cos[None, :])
     return (1.0 - factor) * plain + factor * iridescent
 
@@ -207,7 +204,7 @@ def _refine(start: np.ndarray, lower: np.ndarray, upper: np.ndarray, metallic: b
     """Bounded least squares on the ΔE2000 per angle from ``start`` (scipy), the Jacobian's differences in one batch."""
     from scipy.optimize import least_squares
 
-    steps = np.array([0.05] + [1e-4] * 7)[: len(start)]
+    steps = np.array([0.05] + [1e-4] * 5)[: len(start)]
 
     def jacobian(p):
         sign = np.where(p + steps <= upper, 1.0, -1.0)
@@ -224,8 +221,7 @@ def _film_of(params: np.ndarray, metallic: bool, mapping: str, target: np.ndarra
     if metallic:
         film = Film(float(params[0]), float(params[1]), float(params[2]), 1.0, tuple(float(c) for c in params[3:6]), mapping=mapping)
     else:
-        film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping,
-                    specular_color=tuple(float(c) for c in params[4:7]), specular=float(params[7]))
+        film = Film(float(params[0]), float(params[1]), float(params[2]), 0.0, base_ior=float(params[3]), mapping=mapping)
     film.delta_e = delta_e(film, target)
     return film
 
@@ -259,44 +255,70 @@ def _median_band(e: np.ndarray) -> np.ndarray:
     return middle.mean(axis=1) + TAIL_WEIGHT * e.mean(axis=1)
 
 
-#: The per-channel base index range of the global fit's second search (F0 up to 0.51).
-_BASE_INDEX_RANGE = (1.0, 6.0)
+def _from_opd(x: np.ndarray) -> np.ndarray:
+    """Dielectric films ``(K, 4)`` as (``D_inc = 2 n d``, film index, factor, base index) -> :func:`_films_rgb`'s ``(K, 4)``."""
+    return np.column_stack([x[:, 0] / (2.0 * x[:, 1]), x[:, 1:]])
 
 
-def _from_base_indices(x: np.ndarray) -> np.ndarray:
-    """Dielectric films ``(K, 7)`` (thickness, film index, factor, the base's index per channel, specular factor)
-    as :func:`_films_rgb`'s ``(K, 8)``: KHR_materials_ior at the top of :data:`IOR_RANGE`, its F0 coloured down."""
-    f0 = _ior_to_f0(x[:, 3:6], 1.0) / _ior_to_f0(IOR_RANGE[1], 1.0)
-    return np.column_stack([x[:, :3], np.full(len(x), IOR_RANGE[1]), f0, x[:, 6]])
+def _dielectric_objective(x: np.ndarray, lab: np.ndarray, cos: np.ndarray, batch: int = 4096) -> np.ndarray:
+    """:func:`_median_band` of dielectric films ``x`` (:func:`_from_opd`'s coordinates) against ``lab`` at ``cos``."""
+    return np.concatenate([_median_band(_films_delta_e(_from_opd(x[i:i + batch]), False, lab, cos))
+                           for i in range(0, len(x), batch)])
 
 
-def _global(start, lower, upper, dense_lab, dense_cos) -> np.ndarray:
+def search_dielectric(film: Film, dense_lab: np.ndarray, evolution: tuple[int, int] = EVOLUTION,
+                      starts: int = POLISHED_STARTS) -> np.ndarray:
     """
-    A dielectric film ``(8,)`` of low :func:`_median_band`: differential evolution (scipy, seeded, so every run
-    writes the same film) over the box, and again with the base as an index per channel (the same films,
-    searched in other coordinates: either alone misses some minima), on every second degree; then Nelder-Mead
-    from the better one on every degree.
+    The dielectric film (:func:`_films_rgb`'s ``(4,)``) of least :func:`_median_band` against ``dense_lab`` (the
+    material at :data:`DENSE_THETA_DEG`), from the direct mapping ``film``. Deterministic (a grid and a seeded
+    search), in the coordinates the formula's colours follow: the optical path difference at normal incidence
+    ``D_inc = 2 n d`` (its fringes), the film's index (their shift with angle, Snell in cos theta2, and the first
+    interface), the factor and the base's index (the second interface; on either side of the film's it sets the
+    phase, 0 or pi).
+
+    1. A grid over ``D_inc`` from 0 to ``max(2 D, D + 1500)`` nm (``D`` the film's own) every :data:`GRID_OPD_STEP`
+       nm, the film's index and its neighbours, the base's index and :data:`GRID_BASE_IORS`, and
+       :data:`GRID_FACTORS`, on every fifth degree. The spec's Gaussian sensitivities fade at long paths faster
+       than the CIE functions, so a thick film's best match is often a shorter, weaker one, far from its own.
+    2. Differential evolution (scipy, seed 0) over the box, on every third degree, seeded with the grid's best.
+    3. Nelder-Mead on every degree from the evolution's result and the grid's best ``starts`` distinct points.
     """
     from scipy.optimize import differential_evolution, minimize
 
-    coarse_lab, coarse_cos = dense_lab[::2], dense_cos[::2]
+    dense_cos = np.cos(np.radians(DENSE_THETA_DEG))
+    d_own = 2.0 * film.ior * film.thickness
+    d_top = max(2.0 * d_own, d_own + 1500.0)
+    lower = np.array([0.0, IOR_RANGE[0], 0.0, IOR_RANGE[0]])
+    upper = np.array([d_top, IOR_RANGE[1], 1.0, IOR_RANGE[1]])
+    own = np.array([d_own, film.ior, film.factor, film.base_ior])
+    film_iors = np.unique(np.clip(film.ior + np.asarray(GRID_FILM_IOR_OFFSETS), *IOR_RANGE))
+    base_iors = np.unique(np.clip([film.base_ior, *GRID_BASE_IORS], *IOR_RANGE))
+    grid = np.stack(np.meshgrid(np.arange(0.0, d_top + GRID_OPD_STEP, GRID_OPD_STEP), film_iors, GRID_FACTORS, base_iors,
+                                indexing="ij"), axis=-1).reshape(-1, 4)
+    grid = np.vstack([own, grid])
+    cost = _dielectric_objective(grid, dense_lab[::5], dense_cos[::5])
+    picked: list[np.ndarray] = []
+    for k in np.argsort(cost, kind="stable"):  # the best points, each another fringe or another phase
+        if all(abs(grid[k, 0] - p[0]) > 6.0 * GRID_OPD_STEP or (grid[k, 3] > grid[k, 1]) != (p[3] > p[1]) for p in picked):
+            picked.append(grid[k])
+        if len(picked) == starts:
+            break
+    popsize, generations = evolution
+    evolved = differential_evolution(lambda x: _dielectric_objective(x.T, dense_lab[::3], dense_cos[::3]),
+                                     list(zip(lower, upper)), x0=picked[0], vectorized=True, updating="deferred",
+                                     popsize=popsize, maxiter=generations, tol=0.0, seed=0, polish=False)
 
-    def search(decode, bounds, x0, popsize):
-        result = differential_evolution(lambda x: _median_band(_films_delta_e(decode(x.T), False, coarse_lab, coarse_cos)),
-                                        bounds, x0=x0, vectorized=True, updating="deferred", popsize=popsize,
-                                        maxiter=200, tol=1e-8, seed=0, polish=False)
-        return decode(result.x[None])[0]
+    def dense(x):
+        return float(_dielectric_objective(np.clip(x, lower, upper)[None], dense_lab, dense_cos)[0])
 
-    found = [search(lambda x: x, list(zip(lower, upper)), np.clip(start, lower, upper), 15)]
-    index_bounds = [(lower[0], upper[0]), IOR_RANGE, (0.0, 1.0), *[_BASE_INDEX_RANGE] * 3, (0.0, 1.0)]
-    found.append(search(_from_base_indices, index_bounds, np.array([*start[:3], *[start[3]] * 3, 1.0]), 20))
-
-    def dense(p):
-        return float(_median_band(_films_delta_e(np.clip(p, lower, upper)[None], False, dense_lab, dense_cos))[0])
-
-    best = min(found, key=dense)
-    polished = minimize(dense, best, method="Nelder-Mead", options={"maxfev": 1500, "xatol": 1e-4, "fatol": 1e-5})
-    return np.clip(polished.x, lower, upper)
+    scale = np.array([20.0, 0.05, 0.1, 0.1])  # the first simplex: a sixth of a fringe, and small index steps
+    polished = []
+    for x0 in [evolved.x, *picked]:
+        simplex = np.vstack([x0, x0 + np.diag(scale)])
+        result = minimize(dense, x0, method="Nelder-Mead",
+                          options={"maxfev": 400, "xatol": 1e-3, "fatol": 1e-4, "initial_simplex": simplex})
+        polished.append((result.fun, tuple(np.clip(result.x, lower, upper))))
+    return _from_opd(np.array([min(polished)[1]]))[0]
 
 
 def dense_delta_e(film: Film, dense_target: np.ndarray) -> np.ndarray:
@@ -306,33 +328,34 @@ def dense_delta_e(film: Film, dense_target: np.ndarray) -> np.ndarray:
 
 def refine_film(film: Film, dense_target: np.ndarray) -> Film:
     """
-    ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour; the
-    dielectric's index, specular colour and factor: KHR_materials_specular) moved to lower the ΔE2000 to
-    ``dense_target`` (the material at :data:`DENSE_THETA_DEG`).
+    ``film`` (a direct mapping) with its thickness, film index, factor and base (the metal's colour, the
+    dielectric's index: KHR_materials_ior) moved to lower the ΔE2000 to ``dense_target`` (the material at
+    :data:`DENSE_THETA_DEG`).
 
     The spec's formula (Gaussian sensitivities, a matrix without white balance, unpolarised Schlick
     interfaces) cannot follow the polarised film at every angle with one set of parameters; least squares
     over all angles (plain and soft L1, from ``film``) lets the rim pull the centre, and stays near
-    ``film``. A global search (:func:`_global`) of the median over every degree finds films that match
-    the centre of the view closely and give way at the rim. Of ``film`` and the three, the one of least
-    median ΔE2000 over :data:`DENSE_THETA_DEG` is kept; its ΔE is reported at :data:`THETA_DEG`.
+    ``film``. For a dielectric base, a global search of the median over every degree
+    (:func:`search_dielectric`) finds films that match the centre of the view closely and give way at the
+    rim. Of ``film`` and the candidates, the one of least median ΔE2000 over :data:`DENSE_THETA_DEG` is kept;
+    its ΔE is reported at :data:`THETA_DEG`. KHR_materials_specular is not written: engines differ in whether
+    its colour reaches the film's second interface.
     """
     dense_target = np.asarray(dense_target, np.float64)
     target = dense_target[_REPORTED]
     metallic = film.metallic >= 0.5
-    base = film.base_color if metallic else (film.base_ior, *film.specular_color, film.specular)
+    base = film.base_color if metallic else (film.base_ior,)
     start = np.array([film.thickness, film.ior, film.factor, *base])
-    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (1.0, 0.0, 0.0, 0.0, 0.0))])
+    lower = np.array([THICKNESS_RANGE[0], IOR_RANGE[0], 0.0, *((0.0,) * 3 if metallic else (IOR_RANGE[0],))])
     upper = np.array([max(THICKNESS_RANGE[1], 2.0 * film.thickness), IOR_RANGE[1], 1.0,
-                      *((1.0,) * 3 if metallic else (3.0, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, SPECULAR_COLOR_MAX, 1.0))])
+                      *((1.0,) * 3 if metallic else (IOR_RANGE[1],))])
     film.delta_e = delta_e(film, target)
     candidates = [film]
     for loss in ("linear", "soft_l1"):
         params, _ = _refine(start, lower, upper, metallic, _lab(target), np.cos(np.radians(THETA_DEG)), loss)
         candidates.append(_film_of(params, metallic, "refined", target))
     if not metallic:
-        dense_cos = np.cos(np.radians(DENSE_THETA_DEG))
-        candidates.append(_film_of(_global(start, lower, upper, _lab(dense_target), dense_cos), False, "refined", target))
+        candidates.append(_film_of(search_dielectric(film, _lab(dense_target)), False, "refined", target))
 
     def key(f: Film):
         e = dense_delta_e(f, dense_target)

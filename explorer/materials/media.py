@@ -73,16 +73,21 @@ def file_media_in(values: Mapping[str, object]) -> list[str]:
             if key.startswith("medium_") and int(round(float(values[key] or 0))) > len(MEDIA)]
 
 
-def host_problem(values: Mapping[str, object]) -> str | None:
+def host_problem(values: Mapping[str, object], minimum: float | None = None) -> str | None:
     """
     Why the host ``medium_nh`` selects cannot be one (an absorbing medium: light comes from a lossless,
-    semi-infinite host, where an absorbing one would leave no wave to reflect), or None.
+    semi-infinite host, where an absorbing one would leave no wave to reflect; or, given the ``nh`` parameter's
+    ``minimum``, a medium whose ``n`` drops below it somewhere from 360 to 830 nm), or None.
     """
     value = index_value(values, "nh")
     if isinstance(value, dispersion.Dispersion) and value.absorbing:
         lossless = [name for name in MEDIA if not dispersion.LIBRARY[name].absorbing]
         return (f"parameter 'nh': {value.name} absorbs (k > 0) and the host must be lossless; "
                 f"a number or one of {', '.join(lossless)}")
+    if isinstance(value, dispersion.Dispersion) and minimum is not None:
+        n, at = value.lowest_real()
+        if n < minimum:
+            return f"parameter 'nh': {value.name} has n = {n:.4g} at {at:g} nm, below the host's minimum {minimum:g}"
     return None
 
 

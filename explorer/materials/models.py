@@ -13,11 +13,11 @@ import functools
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, microfacet, multiscatter_stack, natural
+from explorer.physics import bragg, colorimetry, compensation, layered, microfacet, multiscatter_stack, natural
 from explorer.materials.brd import round_integer
 from explorer.physics.fresnel import fresnel_schlick
 from explorer.materials.methods import BraggMethod
-from explorer.materials.twins import TWINS, Capabilities, DesignModel, registry, twin
+from explorer.materials.twins import TWINS, Capabilities, DesignModel, StructureMaps, registry, twin
 
 #: Samples per numpy call of the stack's spectral Eq. 34 (Mitsuba's spectral variants; bounds the (samples, 471) temporaries).
 SPECTRAL_CHUNK = 1 << 14
@@ -222,13 +222,19 @@ BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh",
                            paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 
 
+#: Structure maps on a smooth mirror: each texel the whole mirror; the tabulated method's table is the material's, so
+#: each texel shows the improved approximation (as an export away from its table's values).
+BRAGG_MAPS = StructureMaps(fields=bragg.STRUCTURE_FIELDS, integer_fields=("N",),
+                           stand_ins={BraggMethod.TABULATED: BraggMethod.IMPROVED})
+
+
 @twin
 class BraggMirrorModel:
     """Twin of ``shaders/bragg_mirror.brd``: its ``reflectance(cos_theta)`` for every ``method``."""
 
     name = "bragg_mirror"
     capabilities = Capabilities(methods=BraggMethod, dirac=True, bragg_spectrum=True, numpy=True, albedo=("numpy", "gl"),
-                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN)
+                                exports=("mitsuba", "brdf", "table", "gltf"), design=BRAGG_DESIGN, maps=BRAGG_MAPS)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -283,29 +289,32 @@ class BraggMirrorModel:
         """
         The twin of the shader's ``textured_reflectance``: the mirror at texture values ``T`` (per sample, in [0, 1])
         under ``mapping`` (supplemental Figure 7, :func:`explorer.physics.bragg.textured_mirror`), by ``method``.
-        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:func:`explorer.physics.bragg.structure_table`),
-        each texel its own mirror; the tabulated method has no table per texel and shows the improved approximation
-        there (as an export away from its table's values), 0 off the maps' mask.
+        ``mapping="maps"``: ``T`` is a texel index of ``structures`` (:data:`BRAGG_MAPS`' table), each texel its own
+        mirror, by its texel method (:meth:`explorer.materials.twins.StructureMaps.texel_method`), 0 off the maps' mask.
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
         T = np.broadcast_to(np.asarray(T, dtype=np.float64), cos_theta.shape)
         if mapping == "maps":
             rgb = np.zeros(cos_theta.shape + (3,))
             for samples, mirror in bragg.mapped_mirrors(structures, T):
-                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod.IMPROVED)
+                rgb[samples] = self._mirror_rgb(cos_theta[samples], mirror, BraggMethod(BRAGG_MAPS.texel_method(self.method)))
             return rgb
         if self.method == BraggMethod.TABULATED:
             return bragg.textured_tabulated_rgb(self.texture_table(mapping), cos_theta, T)
         return self._mirror_rgb(cos_theta, bragg.textured_mirror(self.mirror, T, mapping))
 
-    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, tabulated: BraggMethod | None = None) -> np.ndarray:
-        """A per-sample mirror's colours by ``method`` (``tabulated``: the method that stands for the tabulated one)."""
-        method = tabulated if self.method == BraggMethod.TABULATED else self.method
+    def _mirror_rgb(self, cos_theta: np.ndarray, mirror: bragg.BraggMirror, method: BraggMethod | None = None) -> np.ndarray:
+        """A per-sample mirror's colours by ``method`` (default the material's; not the tabulated one, which has a table)."""
+        method = self.method if method is None else method
         if method == BraggMethod.REFERENCE:
             return bragg.textured_reference_rgb(cos_theta, mirror, self.wavelength_step)
         s = {BraggMethod.BASIC: 0, BraggMethod.SUBDIVIDED: self.s, BraggMethod.IMPROVED: self.s}[method]
         variant = {"variant": "improved"} if method == BraggMethod.IMPROVED else {}
         return bragg.approximate_rgb(cos_theta, mirror, s, **variant)
+
+    def surface_reflectance(self, cos_theta, T, **options) -> np.ndarray:
+        """The flat textured view's colour at ``cos_theta`` of texture values ``T`` (the shader's ``surface_reflectance``)."""
+        return self.textured_reflectance(cos_theta, T, **options)
 
     def textured_mirror_reflection(self, V, N, T, mapping: str = "both", structures: np.ndarray | None = None) -> np.ndarray:
         """The env view's Dirac at texture values ``T``: :meth:`textured_reflectance` at ``cos theta = V.N`` (the shader's)."""
@@ -401,8 +410,45 @@ def _transmission_rgb_table(mirror: bragg.BraggMirror, alpha: float, size: int) 
     return table
 
 
+class CompensatedTwin:
+    """
+    What the rough Bragg twins (``bragg_layer``, ``bragg_stack``) share about multiple scattering
+    (:mod:`explorer.physics.multiscatter_stack`): the compensation's weight by roughness, its lobe's RGB table and
+    two hooks. A twin defines ``multiple_scattering``, ``compensation`` (unweighted, None when the weight is 0),
+    ``_roughness`` (the alpha that decides the weight) and ``_base_albedo`` (the base the lobe bounces on).
+    """
+
+    #: The furnace's test hook: when set (a number in [0, 1]), every layer's facets reflect this at every angle and
+    #: wavelength (``R_lambda = value``, the transmissivity of Eq. 28 from ``1 - value``), in the tables the numpy twin,
+    #: the shader and the random walk read alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
+    facet_reflectance_override: float | None = None
+    #: The studies' hook (numpy only): the compensation at full weight whatever the roughness, to show what the fade
+    #: leaves out at alpha <= 0.4 (``explorer.dev.multiscatter_validation``). The app, GL and exports never set it.
+    full_compensation: bool = False
+
+    @property
+    def compensation_weight(self) -> float:
+        """
+        The share of the compensation added: :func:`explorer.physics.compensation.compensation_weight` of
+        ``_roughness`` (0 up to alpha = 0.4: Eq. 17 / Eq. 34 as published; 1 from 0.5), 0 when ``multiple_scattering``
+        is off. The shader computes the same from its uniforms (``compensation_weight`` in lib/multiscatter.glsl).
+        """
+        if not self.multiple_scattering:
+            return 0.0
+        return 1.0 if self.full_compensation else float(compensation.compensation_weight(self._roughness))
+
+    @property
+    def compensation_rgb(self) -> np.ndarray | None:
+        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
+        if self.compensation is None:
+            return None
+        if self._compensation_rgb is None:
+            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self._base_albedo)
+        return self._compensation_rgb
+
+
 @twin
-class BraggLayerModel(BraggMirrorModel):
+class BraggLayerModel(CompensatedTwin, BraggMirrorModel):
     """
     Twin of ``shaders/bragg_layer.brd``: one rough Bragg layer (Eq. 17, GGX microfacets that are Bragg
     mirrors) over a Lambertian base of RGB albedo ``rho_d``:
@@ -426,58 +472,82 @@ class BraggLayerModel(BraggMirrorModel):
         self.alpha = float(values["alpha"])
         microfacet.check_alpha(self.alpha)
         self.rho_d = np.broadcast_to(np.asarray(values.get("rho_d", 0.0), dtype=np.float64), (3,)).copy()
-        self.multiple_scattering = bool(values.get("multiple_scattering", False))
+        self.multiple_scattering = bool(values.get("multiple_scattering", True))
         self._compensation = None
         self._compensation_rgb: np.ndarray | None = None
+        # The furnace hook flattens the tables (the tabulated method's bragg_table, Eq. 28's transmission_table, the
+        # compensation's layer tables): the other methods compute Yeh's reflectance in the shader, out of its reach.
+        if (self.facet_reflectance_override is not None and self.natural is None
+                and self.method != BraggMethod.TABULATED):
+            raise ValueError("the facet reflectance hook acts on the tables: it needs the tabulated method")
+
+    @property
+    def _roughness(self) -> float:
+        return self.alpha
+
+    @property
+    def layer_structure(self) -> tuple[layered.LayeredBragg, tuple[layered.LayerTables]]:
+        """
+        The one-layer structure the compensation is built for, and its tables: the layer seen from inside its host,
+        no coating, over the base (as ``bragg_stack``'s one layer; a dispersive host at its index at 550 nm), with
+        :attr:`facet_reflectance_override`'s flat tables when set. What the random walk's reference simulates.
+        """
+        nat = self.natural
+        if nat is None:
+            host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
+            n1, n2, media, k1, k2, sigma = self.mirror.n1, self.mirror.n2, {}, 0.0, 0.0, 0.0
+        else:
+            # A dispersive host enters the compensation at its index at 550 nm (its angles need one number).
+            nh = nat.nh if nat.nh is not None else nat.n1  # no host given: the host is n1
+            host = float(nh) if isinstance(nh, (int, float)) else float(nh.real_at(550.0))
+            media = {f"medium_{k}": m for k, m in (("n1", nat.n1), ("n2", nat.n2)) if not isinstance(m, float)}
+            n1 = nat.n1 if isinstance(nat.n1, float) else host + 1.0  # a medium stands for n1: not the host
+            n2 = nat.n2 if isinstance(nat.n2, float) else 1.5
+            k1, k2, sigma = nat.k1, nat.k2, nat.sigma
+        layer = layered.RoughBraggLayer(
+            n2=float(n2), Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
+            n1=None if n1 == host else float(n1), k1=k1, k2=k2, sigma=sigma, **media)
+        stack = layered.LayeredBragg(layers=(layer,), n1=host, rho_d=tuple(self.rho_d), coating=False)
+        table = _layer_tables(layer, host)
+        if self.facet_reflectance_override is not None:
+            table = _flat_tables(table, float(self.facet_reflectance_override))
+        return stack, (table,)
 
     @property
     def compensation(self):
         """
         The layer's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`, as
-        ``bragg_stack``'s for one layer seen from inside its host, no coating, over the base), or None when off.
-        Natural layers (absorbing, disordered, dispersive) as ``bragg_stack``'s; a dispersive host at 550 nm.
+        ``bragg_stack``'s for :attr:`layer_structure`; natural layers as ``bragg_stack``'s), or None when off or
+        when its weight is 0 (alpha <= 0.4: no table is built). Unweighted: :attr:`compensation_weight` scales it.
         """
-        if not self.multiple_scattering:
+        if self.compensation_weight == 0.0:
             return None
         if self._compensation is None:
-            nat = self.natural
-            if nat is None:
-                host = self.mirror.nh if self.mirror.nh is not None else self.mirror.n1
-                n1, n2, media, k1, k2, sigma = self.mirror.n1, self.mirror.n2, {}, 0.0, 0.0, 0.0
-            else:
-                # A dispersive host enters the compensation at its index at 550 nm (its angles need one number).
-                nh = nat.nh if nat.nh is not None else nat.n1  # no host given: the host is n1
-                host = float(nh) if isinstance(nh, (int, float)) else float(nh.real_at(550.0))
-                media = {f"medium_{k}": m for k, m in (("n1", nat.n1), ("n2", nat.n2)) if not isinstance(m, float)}
-                n1 = nat.n1 if isinstance(nat.n1, float) else host + 1.0  # a medium stands for n1: not the host
-                n2 = nat.n2 if isinstance(nat.n2, float) else 1.5
-                k1, k2, sigma = nat.k1, nat.k2, nat.sigma
-            layer = layered.RoughBraggLayer(
-                n2=float(n2), Lambda=self.mirror.Lambda, delta=self.mirror.delta, N=self.mirror.N, alpha=self.alpha,
-                n1=None if n1 == host else float(n1), k1=k1, k2=k2, sigma=sigma, **media)
-            stack = layered.LayeredBragg(layers=(layer,), n1=host, rho_d=tuple(self.rho_d), coating=False)
-            table = _layer_tables(layer, host)
-            self._compensation = multiscatter_stack.stack_compensation(stack, (table,), (_layer_terms(table),))
+            stack, (table,) = self.layer_structure
+            terms = None if self.facet_reflectance_override is not None else (_layer_terms(table),)
+            self._compensation = multiscatter_stack.stack_compensation(stack, (table,), terms)
         return self._compensation
 
     @property
-    def compensation_rgb(self) -> np.ndarray | None:
-        """The compensation's lobe in RGB over (theta_i, theta_o) in air (:func:`explorer.physics.multiscatter_stack.rgb_table`)."""
-        if self.compensation is None:
-            return None
-        if self._compensation_rgb is None:
-            self._compensation_rgb = multiscatter_stack.rgb_table(self.compensation, self._base_albedo)
-        return self._compensation_rgb
+    def _base_albedo(self):
+        return self.rho_d
 
     @property
-    def _base_albedo(self):
-        """The base's albedo the compensation's lobe bounces on."""
-        return self.rho_d
+    def table(self) -> np.ndarray:
+        """The tabulated method's RGB over cos(theta); with :attr:`facet_reflectance_override`, that of the flat spectrum."""
+        if self.facet_reflectance_override is None:
+            return super().table
+        rgb = colorimetry.spectrum_to_rgb(np.full(colorimetry.WAVELENGTHS.size, float(self.facet_reflectance_override)))
+        return np.broadcast_to(rgb, (bragg.TABLE_SIZE, 3)).astype(np.float32)
 
     @property
     def transmission_table(self) -> np.ndarray:
         """``T_rgb`` at ``cos theta = k / 255`` (Eq. 28 in RGB), ``(256, 3)`` float32."""
         alpha = float(microfacet.check_alpha(self.alpha))
+        if self.facet_reflectance_override is not None:  # the hook's flat facets: Eq. 28 of 1 - value
+            (table,) = self.layer_structure[1]
+            T_rgb = colorimetry.spectrum_to_rgb(table.transmissivity)
+            return layered.lookup(T_rgb, np.arccos(np.linspace(0.0, 1.0, bragg.TABLE_SIZE))).astype(np.float32)
         if self.natural is not None:
             return _natural_transmission_rgb_table(self.natural, alpha, bragg.TABLE_SIZE)
         return _transmission_rgb_table(self.mirror, alpha, bragg.TABLE_SIZE)
@@ -498,7 +568,8 @@ class BraggLayerModel(BraggMirrorModel):
         if self.compensation_rgb is not None:
             # The lobe needs the polar angles only: atan2(|d - (d.n) n|, d.n), as the shader's atan(length(xy), z).
             polar = lambda d, c: np.arctan2(np.linalg.norm(np.broadcast_to(d, N.shape)[above] - c[:, None] * N[above], axis=-1), c)  # noqa: E731
-            result[above] += multiscatter_stack.lookup_rgb(self.compensation_rgb, polar(L, cos_i), polar(V, cos_o))
+            lobe_rgb = multiscatter_stack.lookup_rgb(self.compensation_rgb, polar(L, cos_i), polar(V, cos_o))
+            result[above] += np.float32(self.compensation_weight) * lobe_rgb
         return result
 
     spectral_reflectance = None
@@ -521,7 +592,8 @@ class BraggLayerModel(BraggMirrorModel):
             To = _interp_wavelength(layered.lookup(T, _theta(o)), wavelengths)
             value = value + rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths) / np.pi * Ti * To
         if self.compensation is not None:
-            value = value + _spectral_lobe(self.compensation, i, o, wavelengths, rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths))
+            rho = rgb_upsample(np.broadcast_to(self.rho_d, (i.shape[0], 3)), wavelengths)
+            value = value + self.compensation_weight * _spectral_lobe(self.compensation, i, o, wavelengths, rho)
         return value
 
     def sampling_lobes(self, cos_o):
@@ -572,7 +644,7 @@ def _number(values: Mapping[str, object], name: str) -> float:
 
 
 @twin
-class BraggStackModel:
+class BraggStackModel(CompensatedTwin):
     """
     Twin of ``shaders/bragg_stack.brd``: the single-reflection BRDF (Eq. 34) of 1 to 3 rough Bragg layers
     in a host ``nh`` over a Lambertian base, under a coating (:func:`explorer.physics.layered.single_reflection_brdf`
@@ -583,17 +655,13 @@ class BraggStackModel:
     """
 
     name = "bragg_stack"
-    #: The furnace's test hook: when set (a number in [0, 1]), every layer's facets reflect this at every angle
-    #: and wavelength (``R_lambda = value``, the transmissivity of Eq. 28 from ``1 - value``), in the numpy twin
-    #: and in the textures the shader reads alike: the same code path with white (``1.0``) facets. ``None``: Yeh's.
-    facet_reflectance_override: float | None = None
     capabilities = Capabilities(methods=None, dirac=False, bragg_spectrum=False, numpy=True,
                                 albedo=("numpy", "gl", "position-free"), exports=("mitsuba", "table", "gltf"), design=None)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
         self.stack = self.stack_of(values)
-        self.multiple_scattering = bool(values.get("multiple_scattering", False))
+        self.multiple_scattering = bool(values.get("multiple_scattering", True))
         self._tables: tuple | None = None
         self._compensation = None
         self._compensation_rgb: np.ndarray | None = None
@@ -622,31 +690,37 @@ class BraggStackModel:
                 k1=float(values.get(f"k1_{k}", 0.0)), k2=float(values.get(f"k2_{k}", 0.0)),
                 sigma=float(values.get(f"sigma_{k}", 0.0)), **media,
             ))
+        # A host naming a medium (medium_nh; --set nh=chitin): nh holds its n at 550 nm, the physics reads the medium.
+        host = index_value(values, "nh") if "medium_nh" in values else nh
         return layered.LayeredBragg(
             layers=tuple(layers), n1=nh, rho_d=values.get("rho_d", 0.0), coating=bool(values.get("coating", True)),
-            tau_h=float(values.get("tau_h", 0.0)),
+            tau_h=float(values.get("tau_h", 0.0)), medium_n1=None if isinstance(host, float) else host,
         )
 
     @property
     def tables(self) -> tuple:
         """Every layer's tables (:func:`explorer.physics.layered.layer_tables`, cached per layer), built on first use."""
         if self._tables is None:
-            self._tables = tuple(_layer_tables(layer, self.stack.n1) for layer in self.stack.layers)
+            self._tables = tuple(_layer_tables(layer, self.stack.host) for layer in self.stack.layers)
             if self.facet_reflectance_override is not None:
                 self._tables = tuple(_flat_tables(t, float(self.facet_reflectance_override)) for t in self._tables)
         return self._tables
 
     @property
+    def _roughness(self) -> float:
+        """The roughest used layer's alpha decides the compensation's weight (the shader's ``compensation_fade``)."""
+        return max(layer.alpha for layer in self.stack.layers)
+
+    @property
     def compensation(self):
-        """The structure's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`), or None when off."""
-        if not self.multiple_scattering:
+        """The structure's multiple-scattering compensation (:mod:`explorer.physics.multiscatter_stack`), or None when
+        off or when its weight is 0 (every layer at alpha <= 0.4: no table is built). Unweighted, as the layer's."""
+        if self.compensation_weight == 0.0:
             return None
         if self._compensation is None:
             terms = None if self.facet_reflectance_override is not None else tuple(_layer_terms(t) for t in self.tables)
             self._compensation = multiscatter_stack.stack_compensation(self.stack, self.tables, terms)
         return self._compensation
-
-    compensation_rgb = BraggLayerModel.compensation_rgb
 
     @property
     def _base_albedo(self):
@@ -667,14 +741,14 @@ class BraggStackModel:
         value = layered.single_reflection_brdf(self.stack, i, o, self.tables)
         if self.compensation_rgb is not None:
             above = ((i[..., 2] > 0.0) & (o[..., 2] > 0.0))[..., None]
-            value = value + np.where(above, multiscatter_stack.lookup_rgb(self.compensation_rgb, *multiscatter_stack.air_angles(i, o)), 0.0)
+            lobe_rgb = np.float32(self.compensation_weight) * multiscatter_stack.lookup_rgb(self.compensation_rgb, *multiscatter_stack.air_angles(i, o))
+            value = value + np.where(above, lobe_rgb, 0.0)
         return value
 
     def mirror_reflection(self, V, N) -> np.ndarray:
         """The weight of the coating's Dirac reflection (Eq. 34's f_r,0) into reflect(-V, N): ``(..., 3)``."""
         cos_theta = np.sum(np.asarray(V, np.float64) * np.asarray(N, np.float64), axis=-1)
-        F = layered.coating_reflectance(cos_theta, self.stack.n1) if self.stack.coating else np.zeros_like(cos_theta)
-        return np.repeat(np.asarray(F)[..., None], 3, axis=-1)
+        return layered.coating_rgb(self.stack, cos_theta)  # a dispersive host's: the RGB of F's spectrum
 
     def spectral_brdf(self, i, o, wavelengths, rgb_upsample) -> np.ndarray:
         """Eq. 34 per wavelength for Mitsuba (its layers and its base, the base's RGB albedo upsampled; with the
@@ -689,7 +763,7 @@ class BraggStackModel:
             base = _interp_wavelength(spectra.base, wavelengths[part])
             value[part] = layers + rho * base
             if self.compensation is not None:
-                value[part] += _spectral_lobe(self.compensation, i[part], o[part], wavelengths[part], rho)
+                value[part] += self.compensation_weight * _spectral_lobe(self.compensation, i[part], o[part], wavelengths[part], rho)
         return value
 
     def sampling_lobes(self, cos_o):
@@ -706,17 +780,24 @@ class BraggStackModel:
         ``(361, 3)``, each layer's wavelength-averaged transmissivity (Eq. 31's numerator); ``stack_transmittance``
         as ``stack_reflectance``: each smooth layer's ``T_lambda`` (exact for natural layers, else ``1 - R``).
         """
-        return self._textures_of(self.tables, self.compensation_rgb)
+        return {**self._textures_of(self.tables, self.compensation_rgb), "stack_host": self._host_texture()}
+
+    def _host_texture(self) -> np.ndarray:
+        """``stack_host``: ``(471, 3)``, channel 0 the host's index at each wavelength (the shader refracts per
+        wavelength with it where a coated host disperses; :meth:`explorer.physics.layered.LayeredBragg.host_index`)."""
+        host = np.zeros((colorimetry.WAVELENGTHS.size, 3), np.float32)
+        host[:, 0] = self.stack.host_index()
+        return host
 
     def draft_textures(self) -> dict[str, np.ndarray]:
         """
         Quick stand-ins for :meth:`textures` while a slider moves: the layers' tables from ``R_lambda`` at
         every nm (``layered.layer_tables(draft=True)``), not converged; the real ones follow on release.
         """
-        tables = tuple(layered.layer_tables(layer, self.stack.n1, draft=True) for layer in self.stack.layers)
+        tables = tuple(layered.layer_tables(layer, self.stack.host, draft=True) for layer in self.stack.layers)
         # The multiple-scattering lobe is not drafted (its walk and quadratures take a second or more): a
         # draft shows Eq. 34 alone until the real textures follow on release.
-        return self._textures_of(tables, None)
+        return {**self._textures_of(tables, None), "stack_host": self._host_texture()}
 
     @staticmethod
     def _textures_of(tables, compensation_rgb=None) -> dict[str, np.ndarray]:

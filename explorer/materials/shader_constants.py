@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from explorer.physics import bragg, colorimetry, layered, lobes, lobes_fgd, microfacet, multiscatter_stack, thinfilm
+from explorer.physics import bragg, colorimetry, compensation, layered, lobes, lobes_fgd, microfacet, multiscatter_stack, structure_maps, thinfilm
 
 
 def declaration(name: str, value) -> str:
@@ -61,8 +61,11 @@ GENERATED: dict[str, Callable[[], str]] = {
         "N_RESOLVE": bragg.N_RESOLVE,
         "GROW_EXPONENT": bragg.GROW_EXPONENT,
         "MAX_RESOLVED_PIECES": bragg.MAX_RESOLVED_PIECES,
-        "TEXTURE_MAPS": bragg.MAPS_MAPPING,
     }, "explorer/physics/bragg/"),
+    "generated/structure_maps.glsl": lambda: _block({
+        "TEXTURE_MAPS": structure_maps.MAPS_MAPPING,
+        "STRUCTURE_TEXELS": structure_maps.STRUCTURE_TEXELS,
+    }, "explorer/physics/structure_maps.py"),
     "generated/colorimetry.glsl": lambda: _block({
         "CMF_COUNT": colorimetry.WAVELENGTHS.size,
         "CMF_FIRST_WAVELENGTH": float(colorimetry.WAVELENGTH_MIN),
@@ -81,7 +84,9 @@ GENERATED: dict[str, Callable[[], str]] = {
     "generated/multiscatter.glsl": lambda: _block({
         "COMPENSATION_ROWS": multiscatter_stack.TABLE_ROWS,
         "COMPENSATION_STEP_DEG": float(multiscatter_stack.TABLE_STEP_DEG),
-    }, "explorer/physics/multiscatter_stack.py"),
+        "COMPENSATION_FADE_START": compensation.FADE_START,
+        "COMPENSATION_FADE_END": compensation.FADE_END,
+    }, "explorer/physics/multiscatter_stack.py and compensation.py"),
     "generated/lobes.glsl": lambda: _block({
         "LOBES_MAX": lobes.MAX_INTERFACES,
         "FGD_COS_COUNT": lobes_fgd.FGD_COS_COUNT,

@@ -19,7 +19,7 @@ from typing import Mapping
 import numpy as np
 
 from explorer.physics import colorimetry, microfacet, thinfilm
-from explorer.materials.twins import Capabilities, DesignModel, twin
+from explorer.materials.twins import Capabilities, DesignModel, StructureMaps, twin
 from explorer.materials.brd import round_integer
 from explorer.materials.methods import ThinFilmMethod
 
@@ -77,6 +77,10 @@ THIN_FILM_DESIGN = DesignModel(parameters=("d", "eta1", "eta2", "eta3", "kappa3"
                                paint_free=("d",))
 
 
+#: Structure maps on a film: each texel its own film (the shader's ``textured_reflectance`` under ``TEXTURE_MAPS``).
+THIN_FILM_MAPS = StructureMaps(fields=("d", "eta1", "eta2", "eta3", "kappa3"))
+
+
 @twin
 class ThinFilmModel:
     """Twin of ``shaders/thin_film.brd``: ``reflectance(cos_theta)`` and ``brdf(L, V, N, X, Y)``, every method."""
@@ -84,7 +88,7 @@ class ThinFilmModel:
     name = "thin_film"
     capabilities = Capabilities(methods=ThinFilmMethod, dirac=False, bragg_spectrum=False, numpy=True,
                                 albedo=("numpy", "gl"), exports=("mitsuba", "brdf", "table", "materialx", "gltf"),
-                                design=THIN_FILM_DESIGN)
+                                design=THIN_FILM_DESIGN, maps=THIN_FILM_MAPS)
 
     def __init__(self, values: Mapping[str, object]):
         self.values = dict(values)
@@ -111,14 +115,18 @@ class ThinFilmModel:
         """The smooth film's linear RGB reflectance at incidence ``cos_theta`` (shape ``(..., 3)``)."""
         return film_rgb(self.method, self.film, np.asarray(cos_theta, dtype=np.float64), self.thickness_d)
 
-    def textured_reflectance(self, cos_theta, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
+    def textured_reflectance(self, cos_theta, D_inc, sigma_D_inc, prefiltered: bool, mapping: str | None = None,
+                             structures: np.ndarray | None = None) -> np.ndarray:
         """
         The twin of the shader's ``textured_reflectance``: the film of OPD ``D_inc`` (nm, per sample) at
         normal incidence (:func:`explorer.physics.thinfilm.film_from_D_inc`) instead of ``d``; with ``prefiltered``
         (methods 1-3), Eq. 10 averaged over a Gaussian of ``D_inc`` of standard deviation ``sigma_D_inc``
-        (:func:`explorer.physics.thinfilm.fourier_rgb_prefiltered`, Section 5).
+        (:func:`explorer.physics.thinfilm.fourier_rgb_prefiltered`, Section 5). ``mapping="maps"``: ``D_inc`` is a
+        texel index of ``structures`` (:data:`THIN_FILM_MAPS`' table), each texel its own film, 0 off the maps' mask.
         """
         cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        if mapping == "maps":
+            return self._mapped_reflectance(cos_theta, np.broadcast_to(np.asarray(D_inc, np.float64), cos_theta.shape), structures)
         eta_2, d = thinfilm.film_from_D_inc(D_inc, self.eta_1, self.eta_2)
         film = (self.eta_1, eta_2, self.eta_3, self.kappa_3)
         if prefiltered:
@@ -128,10 +136,29 @@ class ThinFilmModel:
             return thinfilm.fourier_rgb_prefiltered(*film, cos_theta, d, sigma_D_inc, m_max=self.method.m_max)
         return film_rgb(self.method, film, cos_theta, d)
 
-    def textured_brdf(self, L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered: bool) -> np.ndarray:
+    def _mapped_reflectance(self, cos_theta: np.ndarray, index: np.ndarray, structures: np.ndarray) -> np.ndarray:
+        """Each sample's texel film (float32 fields, as the shader reads them) by ``method``, grouped by its scalar indices."""
+        from explorer.physics.structure_maps import structure_texels
+
+        inside, slots = structure_texels(structures, index)
+        rgb = np.zeros(cos_theta.shape + (3,))
+        scalars = slots[..., [1, 3, 4]]  # eta1, eta3, kappa3 (d and eta2 go per sample)
+        for key in np.unique(scalars[inside], axis=0):
+            samples = inside & np.all(scalars == key, axis=-1)
+            eta_1, eta_3, kappa_3 = (float(v) for v in key)
+            rgb[samples] = film_rgb(self.method, (eta_1, slots[..., 2][samples], eta_3, kappa_3), cos_theta[samples], slots[..., 0][samples])
+        return rgb
+
+    def surface_reflectance(self, cos_theta, value, **options) -> np.ndarray:
+        """The flat textured view's colour at ``cos_theta`` of surface values ``value`` (the shader's ``surface_reflectance``)."""
+        return self.textured_reflectance(cos_theta, value, np.zeros(np.shape(value)), False, **options)
+
+    def textured_brdf(self, L, V, N, X, Y, D_inc, sigma_D_inc, prefiltered: bool, mapping: str | None = None,
+                      structures: np.ndarray | None = None) -> np.ndarray:
         """The shader's ``textured_BRDF``: :meth:`brdf` with :meth:`textured_reflectance` per sample."""
         D_inc, sigma_D_inc = np.asarray(D_inc, np.float64), np.asarray(sigma_D_inc, np.float64)
-        return self._brdf(L, V, N, lambda cos_d, above: self.textured_reflectance(cos_d, D_inc[above], sigma_D_inc[above], prefiltered))
+        return self._brdf(L, V, N, lambda cos_d, above: self.textured_reflectance(cos_d, D_inc[above], sigma_D_inc[above], prefiltered,
+                                                                                  mapping, structures))
 
     def brdf(self, L, V, N, X, Y) -> np.ndarray:
         """The shader's ``BRDF`` (see :meth:`_brdf`) with the film's uniform thickness ``d``."""

@@ -83,6 +83,45 @@ class DesignModel:
 
 
 @dataclass(frozen=True, kw_only=True)
+class StructureMaps:
+    """
+    Structure maps (``design --out-maps``) drawn on a material, declared by its twin (``Capabilities(maps=...)``):
+    each texel its own structure, the parameters ``fields`` from their maps or the material's values, packed in order
+    (:func:`explorer.physics.structure_maps.structure_table`). The shader's ``textured_reflectance`` reads them under
+    ``texture_mapping == TEXTURE_MAPS`` (lib/structure_maps.glsl), the twin's ``textured_brdf`` with
+    ``mapping="maps"`` and ``structures`` (the table).
+    """
+
+    #: The parameters a texel holds, in the table's order (at most :data:`explorer.physics.structure_maps.MAX_STRUCTURE_FIELDS`).
+    fields: tuple[str, ...]
+    #: Those rounded per texel (a count).
+    integer_fields: tuple[str, ...] = ()
+    #: ``{method: method}``: a method that needs a table of the whole material (built per material, not per texel)
+    #: and the method each texel shows instead.
+    stand_ins: Mapping[int, int] = ()
+
+    def __post_init__(self):
+        from explorer.physics.structure_maps import MAX_STRUCTURE_FIELDS
+
+        if not 0 < len(self.fields) <= MAX_STRUCTURE_FIELDS:
+            raise ValueError(f"structure maps hold 1 to {MAX_STRUCTURE_FIELDS} fields, not {len(self.fields)}")
+        stray = [p for p in self.integer_fields if p not in self.fields]
+        if stray:
+            raise ValueError(f"structure maps round {stray[0]!r}, not one of their fields ({', '.join(self.fields)})")
+        object.__setattr__(self, "stand_ins", dict(self.stand_ins))
+
+    def table(self, values: Mapping[str, float], maps: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The shader's table of ``maps`` over ``values`` (:func:`explorer.physics.structure_maps.structure_table`)."""
+        from explorer.physics.structure_maps import structure_table
+
+        return structure_table(self.fields, values, maps, self.integer_fields)
+
+    def texel_method(self, method: int) -> int:
+        """The method each texel shows for the material's ``method``."""
+        return int(self.stand_ins.get(int(method), method))
+
+
+@dataclass(frozen=True, kw_only=True)
 class Capabilities:
     """
     What a material can do, declared by its twin class (every field, no default: a built-in states each).
@@ -105,8 +144,11 @@ class Capabilities:
     albedo: tuple[str, ...]
     exports: tuple[str, ...]
     design: DesignModel | None
+    maps: StructureMaps | None = None
 
     def __post_init__(self):
+        if not (self.maps is None or isinstance(self.maps, StructureMaps)):
+            raise TypeError("maps must be a StructureMaps(...) (the parameters a texel holds), or None")
         if not (self.design is None or self.design is False or isinstance(self.design, DesignModel)):
             raise TypeError("design must be a DesignModel(...) (its parameters and forward model), or None")
         unknown = [e for e in self.albedo if e not in ALBEDO_ENGINES] + [e for e in self.exports if e not in EXPORT_TARGETS]
@@ -120,7 +162,7 @@ class Capabilities:
             return f"GL only (no numpy twin); albedo {', '.join(self.albedo)}"
         kinds = [k for k, on in (("a Dirac reflector", self.dirac), ("a Bragg spectrum", self.bragg_spectrum)) if on]
         parts = ["render gl, numpy", f"albedo {', '.join(self.albedo)}", f"export {', '.join(self.exports) or 'none'}",
-                 f"design {'yes' if self.design else 'no'}"]
+                 f"design {'yes' if self.design else 'no'}", f"maps {', '.join(self.maps.fields) if self.maps else 'no'}"]
         return "; ".join(parts + kinds)
 
     def as_json(self) -> dict:
@@ -128,6 +170,7 @@ class Capabilities:
         document = {f.name: getattr(self, f.name) for f in fields(self)}
         document["methods"] = None if self.methods is None else [m.name for m in self.methods]
         document["design"] = bool(self.design)
+        document["maps"] = None if self.maps is None else list(self.maps.fields)
         document.update(albedo=list(self.albedo), exports=list(self.exports))
         return document
 

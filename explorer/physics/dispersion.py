@@ -81,6 +81,13 @@ class Dispersion:
         """Whether ``k > 0`` anywhere in :data:`RANGE_NM` (sampled every nm)."""
         return bool(np.any(self.index(np.arange(RANGE_NM[0], RANGE_NM[1] + 1.0)).imag > 0.0))
 
+    def lowest_real(self) -> tuple[float, float]:
+        """``(n, wavelength)``: the smallest ``n`` in :data:`RANGE_NM` (sampled every nm) and where it is."""
+        wavelength = np.arange(RANGE_NM[0], RANGE_NM[1] + 1.0)
+        n = self.index(wavelength).real
+        at = int(np.argmin(n))
+        return float(n[at]), float(wavelength[at])
+
     def real_at(self, wavelength_nm: float) -> float:
         """``n`` at one wavelength (a number for a slider's position or a landmark)."""
         return float(self.index(wavelength_nm).real)

@@ -38,7 +38,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import bragg, colorimetry, microfacet
-from explorer.physics.fresnel import fresnel_reflectance
+from explorer.physics.dispersion import Dispersion
+from explorer.physics.fresnel import fresnel_r_p, fresnel_r_s, fresnel_reflectance
 
 #: At most this many rough Bragg layers in a stack.
 MAX_LAYERS = 3
@@ -122,14 +123,18 @@ class RoughBraggLayer:
         return (self.k1 > 0.0 or self.k2 > 0.0 or self.sigma > 0.0
                 or self.medium_n1 is not None or self.medium_n2 is not None)
 
-    def natural_mirror(self, host_n1: float):
-        """The layer's :class:`explorer.physics.natural.NaturalMirror` in a host of index ``host_n1`` (lossless)."""
+    def natural_mirror(self, host_n1):
+        """
+        The layer's :class:`explorer.physics.natural.NaturalMirror` in a lossless host ``host_n1``: a number, or a
+        dispersive medium (:class:`explorer.physics.dispersion.Dispersion`; then ``n1`` unset is that medium too).
+        """
         from explorer.physics import natural
 
-        n1 = self.medium_n1 if self.medium_n1 is not None else (host_n1 if self.n1 is None else float(self.n1))
+        host = host_n1 if isinstance(host_n1, Dispersion) else float(host_n1)
+        n1 = self.medium_n1 if self.medium_n1 is not None else (host if self.n1 is None else float(self.n1))
         n2 = self.medium_n2 if self.medium_n2 is not None else float(self.n2)
         return natural.NaturalMirror(n1=n1, n2=n2, Lambda=float(self.Lambda), delta=float(self.delta), N=int(self.N),
-                                     nh=float(host_n1), k1=float(self.k1), k2=float(self.k2), sigma=float(self.sigma))
+                                     nh=host, k1=float(self.k1), k2=float(self.k2), sigma=float(self.sigma))
 
 
 @dataclass(frozen=True)
@@ -153,6 +158,11 @@ class LayeredBragg:
         The host's optical depth, at normal incidence, of each gap a path crosses: below the coating,
         between consecutive layers, above the base. Crossing one at ``theta_t`` in the host attenuates by
         ``exp(-tau_h / cos theta_t)`` (Beer-Lambert; Section 6's absorption between the layers). >= 0.
+    medium_n1 : explorer.physics.dispersion.Dispersion, optional
+        A dispersive host instead of the number ``n1`` (which then stands for it at 550 nm, as a slider does):
+        lossless, ``n >= 1`` from 360 to 830 nm. Every wavelength then has its own refraction angle into the
+        host, coating Fresnel terms and ``1/n1^2`` (:meth:`host_index`), and the layers' tables are taken with
+        the host's index at each wavelength (:func:`layer_tables`).
     """
 
     layers: tuple = ()
@@ -160,6 +170,7 @@ class LayeredBragg:
     rho_d: tuple = (0.0, 0.0, 0.0)
     coating: bool = True
     tau_h: float = 0.0
+    medium_n1: object = None
 
     def __post_init__(self):
         layers = tuple(self.layers) if not isinstance(self.layers, RoughBraggLayer) else (self.layers,)
@@ -182,6 +193,48 @@ class LayeredBragg:
         if not (float(self.tau_h) >= 0.0 and np.isfinite(self.tau_h)):
             raise ValueError(f"tau_h must be >= 0, got {self.tau_h}")
         object.__setattr__(self, "tau_h", float(self.tau_h))
+        if self.medium_n1 is not None:
+            if not isinstance(self.medium_n1, Dispersion):
+                raise ValueError(f"the host's medium must be a dispersion, got {type(self.medium_n1).__name__}")
+            problem = host_medium_problem(self.medium_n1)
+            if problem:
+                raise ValueError(problem)
+
+    @property
+    def host(self):
+        """The host as the layers' tables take it: its medium, or the number ``n1``."""
+        return self.medium_n1 if self.medium_n1 is not None else self.n1
+
+    @property
+    def dispersive_host(self) -> bool:
+        """Whether the host names a dispersive medium (its index differs per wavelength)."""
+        return self.medium_n1 is not None
+
+    def host_index(self, wavelength: ArrayLike | None = None) -> np.ndarray:
+        """The host's (real) index at ``wavelength`` (nm; the CMFs' 471 by default): ``n1`` everywhere, or its medium's."""
+        wavelength = colorimetry.WAVELENGTHS if wavelength is None else np.asarray(wavelength, dtype=np.float64)
+        if self.medium_n1 is None:
+            return np.full(np.shape(wavelength), self.n1)
+        return np.asarray(self.medium_n1.index(wavelength).real, dtype=np.float64)
+
+    def coating_indices(self) -> np.ndarray:
+        """
+        The host's index along the last (wavelength) axis of the coating's per-direction terms: ``(471,)`` when a
+        coated host disperses (every wavelength refracts its own way), else ``(1,)`` (one direction for all).
+        """
+        if self.coating and self.dispersive_host:
+            return self.host_index()
+        return np.array([self.n1])
+
+
+def host_medium_problem(medium: Dispersion) -> str | None:
+    """Why ``medium`` cannot be a stack's host (it absorbs, or its ``n`` drops below 1 somewhere), or None."""
+    if medium.absorbing:
+        return f"the host {medium.name} absorbs (k > 0): a stack's host must be lossless"
+    n, at = medium.lowest_real()
+    if n < 1.0:
+        return f"the host {medium.name} has n = {n:.4g} < 1 at {at:g} nm: a stack's host has n >= 1"
+    return None
 
 
 #: Cosines of the host angles are kept above this in the gaps' attenuation (exp(-tau / cos) is 0 there anyway).
@@ -272,7 +325,27 @@ def coating_reflectance(cos_theta_i: ArrayLike, n1: ArrayLike) -> np.ndarray:
     Point lights never meet a Dirac; the directional albedo adds it.
     """
     cos_theta_i = np.clip(np.asarray(cos_theta_i, dtype=np.float64), microfacet.COS_THETA_MIN, 1.0)
+    if np.size(n1) > 1:
+        # A dispersive host, one index per wavelength (n >= 1: from air, never total reflection): the same
+        # amplitudes in real arithmetic, several times quicker over (directions, 471) than the complex path.
+        n1 = np.asarray(n1, dtype=np.float64)
+        cos_t = np.sqrt(1.0 - (1.0 - cos_theta_i**2) / (n1 * n1))
+        r_s, r_p = fresnel_r_s(1.0, cos_theta_i, n1, cos_t), fresnel_r_p(1.0, cos_theta_i, n1, cos_t)
+        return 0.5 * (r_s * r_s + r_p * r_p)
     return fresnel_reflectance(cos_theta_i, 1.0, n1)
+
+
+def coating_rgb(stack: LayeredBragg, cos_theta_i: ArrayLike) -> np.ndarray:
+    """
+    The coating's Dirac reflection (:func:`coating_reflectance`) in linear sRGB, ``(..., 3)``: flat (white times
+    ``F``) in a host of one index, the RGB of the spectrum ``F(theta, n1(lambda))`` in a dispersive one; 0 uncoated.
+    """
+    cos_theta_i = np.asarray(cos_theta_i, dtype=np.float64)
+    if not stack.coating:
+        return np.zeros(cos_theta_i.shape + (3,))
+    if stack.dispersive_host:
+        return colorimetry.spectrum_to_rgb(coating_reflectance(cos_theta_i[..., None], stack.host_index()))
+    return np.repeat(coating_reflectance(cos_theta_i, stack.n1)[..., None], 3, axis=-1)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -316,8 +389,8 @@ class LayerTables:
     Attributes
     ----------
     layer : RoughBraggLayer
-    n1 : float
-        The host index they were built in.
+    n1 : float or explorer.physics.dispersion.Dispersion
+        The host index (or dispersive medium) they were built in.
     theta : ndarray, shape (361,)
         Rows: ``theta = k * 0.25 deg`` (radians), in the host medium.
     reflectance : ndarray, shape (361, 471), float32
@@ -333,7 +406,7 @@ class LayerTables:
     """
 
     layer: RoughBraggLayer
-    n1: float
+    n1: object
     theta: np.ndarray = field(repr=False)
     reflectance: np.ndarray = field(repr=False)
     transmissivity: np.ndarray = field(repr=False)
@@ -359,8 +432,8 @@ def layer_tables(
     Parameters
     ----------
     layer : RoughBraggLayer
-    n1 : float
-        Index of the host medium.
+    n1 : float or explorer.physics.dispersion.Dispersion
+        Index of the host medium, or its dispersive medium (the exact multilayer's tables, per wavelength).
     transmission_filter : explorer.physics.microfacet.TransmissionFilter, optional
         ``F_alpha`` for the layer's ``alpha``; the cached one by default.
     cached : bool
@@ -384,14 +457,17 @@ def layer_tables(
         raise ValueError(f"the transmission filter is for alpha={F.alpha:g}, the layer has alpha={layer.alpha:g}")
     start = time.perf_counter()
     theta = F.theta
-    if layer.natural:  # absorbing, dispersive or disordered: the exact multilayer (no draft), Eq. 28 over its T
+    host = n1 if isinstance(n1, Dispersion) else float(n1)
+    if layer.natural or isinstance(host, Dispersion):
+        # Absorbing, dispersive or disordered, or in a dispersive host (each column then in the host's index at
+        # its wavelength, the rows at angles in the host): the exact multilayer (no draft), Eq. 28 over its T.
         from explorer.physics import natural
 
-        R, T = (np.asarray(a, dtype=np.float32) for a in natural.spectral_tables(layer.natural_mirror(float(n1)), theta))
+        R, T = (np.asarray(a, dtype=np.float32) for a in natural.spectral_tables(layer.natural_mirror(host), theta))
         transmissivity = F.weights.astype(np.float32) @ T
         for a in (R, T, transmissivity):
             a.setflags(write=False)
-        return LayerTables(layer, float(n1), theta, R, transmissivity, time.perf_counter() - start, transmittance=T)
+        return LayerTables(layer, host, theta, R, transmissivity, time.perf_counter() - start, transmittance=T)
     mirror = layer.mirror(float(n1))
     if draft:
         reflectance = bragg.reflectance_spectra(np.cos(theta), mirror).astype(np.float32)
@@ -409,7 +485,7 @@ def layer_tables(
 
 def stack_tables(stack: LayeredBragg) -> tuple[LayerTables, ...]:
     """The tables of every layer of ``stack``, top to bottom."""
-    return tuple(layer_tables(layer, stack.n1) for layer in stack.layers)
+    return tuple(layer_tables(layer, stack.host) for layer in stack.layers)
 
 
 def lookup(table: np.ndarray, theta: ArrayLike) -> np.ndarray:
@@ -430,17 +506,41 @@ def lookup(table: np.ndarray, theta: ArrayLike) -> np.ndarray:
     return out
 
 
+def lookup_columns(table: np.ndarray, theta: ArrayLike) -> np.ndarray:
+    """
+    :func:`lookup` with one angle per wavelength: ``theta`` ``(..., W)`` in radians, column ``j`` of ``table`` read at
+    ``theta[..., j]`` (a dispersive host refracts each wavelength its own way), interpolated as :func:`lookup` does.
+    A last axis of 1 is one angle for every column (:func:`lookup` itself). Shape ``(..., W)``.
+    """
+    theta = np.asarray(theta, dtype=np.float64)
+    if theta.shape[-1] == 1:
+        return lookup(table, theta[..., 0])
+    x = np.clip(theta, 0.0, 0.5 * np.pi) / microfacet.THETA_STEP
+    k = np.minimum(np.floor(x).astype(np.intp), table.shape[0] - 2)
+    f = (x - k).astype(table.dtype, copy=False)
+    width = table.shape[1]
+    flat = np.ascontiguousarray(table).reshape(-1)
+    index = k * width + np.arange(width)  # a 1D gather: several times quicker than table[k, columns]
+    low = flat[index]
+    out = flat[index + width]
+    out -= low
+    out *= f
+    out += low
+    return out
+
+
 # --------------------------------------------------------------------------------------------------
 # The single-reflection BRDF (Eq. 34)
 
 
-def refract_into_host(direction: ArrayLike, n1: float) -> np.ndarray:
+def refract_into_host(direction: ArrayLike, n1: ArrayLike) -> np.ndarray:
     """
     Snell's law through the smooth coating, from air into the host ``n1 >= 1``: the direction keeps its
-    azimuth, ``sin theta' = sin theta / n1`` (Eq. 34's refracted ``i`` and ``o``), and stays above.
+    azimuth, ``sin theta' = sin theta / n1`` (Eq. 34's refracted ``i`` and ``o``), and stays above. ``n1``
+    broadcasts against ``direction[..., 0]`` (one index per path, or per wavelength of a dispersive host).
     """
     d = np.asarray(direction, dtype=np.float64)
-    tangent = d[..., :2] / n1
+    tangent = d[..., :2] / np.asarray(n1, dtype=np.float64)[..., None]
     cos_t = np.sqrt(np.maximum(1.0 - np.sum(tangent * tangent, axis=-1), 0.0))
     return np.concatenate([tangent, cos_t[..., None]], axis=-1)
 
@@ -502,47 +602,60 @@ def single_reflection_spectra(
         raise ValueError(f"{len(tables)} layer tables for {len(stack.layers)} layers")
     i = np.asarray(i, dtype=np.float64)
     o = np.asarray(o, dtype=np.float64)
-    cos_i, cos_o = i[..., 2], o[..., 2]
-    above = (cos_i > 0.0) & (cos_o > 0.0)
-    n1 = stack.n1
+    above = (i[..., 2] > 0.0) & (o[..., 2] > 0.0)
+    # A last axis for the wavelengths the directions depend on: 1 (one refraction for all), or 471 when a
+    # coated host disperses (each wavelength's own Snell angle, Fresnel terms and 1/n1^2).
+    cos_i, cos_o = i[..., 2, None], o[..., 2, None]
+    # The directions' tangential parts: Snell keeps their azimuth and divides them by n1 (refract_into_host);
+    # kept as squared lengths, so that a wavelength's directions in the host cost a few scalars each.
+    tangent_i = np.sum(i[..., :2] ** 2, axis=-1)[..., None]
+    tangent_o = np.sum(o[..., :2] ** 2, axis=-1)[..., None]
+    tangent_sum = np.sum((i[..., :2] + o[..., :2]) ** 2, axis=-1)[..., None]
+    tangent_difference = np.sum((i[..., :2] - o[..., :2]) ** 2, axis=-1)[..., None]
     if stack.coating:
+        n1 = stack.coating_indices()
         # f_t,0 = 1 - F at the angles in air; i, o refracted into the host; radiance scaled by 1/n1^2.
         path = (1.0 - coating_reflectance(cos_i, n1)) * (1.0 - coating_reflectance(cos_o, n1)) / (n1 * n1)
-        i_host, o_host = refract_into_host(i, n1), refract_into_host(o, n1)
+        scale = 1.0 / (n1 * n1)
+        tangent_i, tangent_o = tangent_i * scale, tangent_o * scale
+        tangent_sum, tangent_difference = tangent_sum * scale, tangent_difference * scale
+        cos_i = np.sqrt(np.maximum(1.0 - tangent_i, 0.0))
+        cos_o = np.sqrt(np.maximum(1.0 - tangent_o, 0.0))
     else:
         path = np.ones(np.broadcast_shapes(cos_i.shape, cos_o.shape))
-        i_host, o_host = i, o
-    path = np.where(above, path, 0.0)[..., None]
-    # Angles for the table lookups by atan2 (precise near 0, unlike acos; what the GLSL twin should do):
-    # theta = atan2(|v_xy|, v_z), and theta_d = angle(i, h) = atan2(|i - o|, |i + o|).
-    theta_i = np.arctan2(np.linalg.norm(i_host[..., :2], axis=-1), np.maximum(i_host[..., 2], 0.0))
-    theta_o = np.arctan2(np.linalg.norm(o_host[..., :2], axis=-1), np.maximum(o_host[..., 2], 0.0))
-    h = microfacet.half_vector(i_host, o_host)
-    cos_theta_d = microfacet.half_vector_cosine(i_host, o_host)
-    theta_d = np.arctan2(np.linalg.norm(i_host - o_host, axis=-1), np.linalg.norm(i_host + o_host, axis=-1))
-    cos_i_host = np.maximum(i_host[..., 2], 0.0)
-    cos_o_host = np.maximum(o_host[..., 2], 0.0)
+    path = np.where(above[..., None], path, 0.0)
+    # Angles for the table lookups by atan2 (precise near 0, unlike acos; what the GLSL twin does):
+    # theta = atan2(|v_xy|, v_z), and theta_d = angle(i, h) = atan2(|i - o|, |i + o|), with h = (i + o) / |i + o|.
+    theta_i = np.arctan2(np.sqrt(tangent_i), np.maximum(cos_i, 0.0))
+    theta_o = np.arctan2(np.sqrt(tangent_o), np.maximum(cos_o, 0.0))
+    length_sum = np.sqrt(tangent_sum + (cos_i + cos_o) ** 2)
+    length_difference = np.sqrt(tangent_difference + (cos_i - cos_o) ** 2)
+    h_z = np.where(length_sum > 1e-12, (cos_i + cos_o) / np.maximum(length_sum, 1e-300), 1.0)  # microfacet.half_vector's
+    cos_theta_d = np.clip(0.5 * length_sum, 0.0, 1.0)  # microfacet.half_vector_cosine's |i + o| / 2
+    theta_d = np.arctan2(length_difference, length_sum)
+    cos_i_host = np.maximum(cos_i, 0.0)
+    cos_o_host = np.maximum(cos_o, 0.0)
     # The host's absorption: each gap above a layer (and above the base) crossed down along i' and up along o'.
-    gap = (gap_transmittance(stack.tau_h, cos_i_host) * gap_transmittance(stack.tau_h, cos_o_host))[..., None]
+    gap = gap_transmittance(stack.tau_h, cos_i_host) * gap_transmittance(stack.tau_h, cos_o_host)
     layers = 0.0
     for l, (layer, table) in enumerate(zip(stack.layers, tables)):
         path = path * gap
         # Eq. 17: D(h) G1(i) G1(o) R(i.h) / (4 cos_i cos_o), G1/cos finite at grazing angles.
         lobe = (
             0.25
-            * microfacet.ggx_D(h[..., 2], layer.alpha)
+            * microfacet.ggx_D(h_z, layer.alpha)
             * microfacet.smith_G1_over_cos(cos_i_host, layer.alpha)
             * microfacet.smith_G1_over_cos(cos_o_host, layer.alpha)
         )
-        if exact_reflectance and not layer.natural:
+        if exact_reflectance and not layer.natural and not stack.dispersive_host:
             R = bragg.bragg_reflectance(
-                np.maximum(cos_theta_d, microfacet.COS_THETA_MIN)[..., None], colorimetry.WAVELENGTHS, layer.mirror(n1)
+                np.maximum(cos_theta_d, microfacet.COS_THETA_MIN), colorimetry.WAVELENGTHS, layer.mirror(stack.n1)
             )
         else:
-            R = lookup(table.reflectance, theta_d)
+            R = lookup_columns(table.reflectance, theta_d)
         # The per-direction factors first (cheap), then one product per wavelength.
-        layers = layers + (lobe[..., None] * path) * R
-        path = path * (lookup(table.transmissivity, theta_i) * lookup(table.transmissivity, theta_o))
+        layers = layers + (lobe * path) * R
+        path = path * (lookup_columns(table.transmissivity, theta_i) * lookup_columns(table.transmissivity, theta_o))
     path = path * gap
     return SingleReflectionSpectra(layers=np.broadcast_to(layers, path.shape) * 1.0, base=path / np.pi)
 
@@ -605,17 +718,20 @@ def stack_specular_rgb(stack: LayeredBragg, cos_theta: ArrayLike, tables: Sequen
     what the layers above let through), so the luminance of the colour is too.
     """
     tables = stack_tables(stack) if tables is None else tuple(tables)
-    theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
-    through = ((1.0 - F) ** 2)[..., None]
-    gap = (gap_transmittance(stack.tau_h, np.cos(theta)) ** 2)[..., None]  # a gap down and up at theta'
+    # Per wavelength where a coated host disperses (theta', F of shape (..., 471)), else one angle (..., 1).
+    theta, F = _host_angle(np.asarray(cos_theta, dtype=np.float64)[..., None], stack.coating_indices(), stack.coating)
+    through = (1.0 - F) ** 2
+    gap = gap_transmittance(stack.tau_h, np.cos(theta)) ** 2  # a gap down and up at theta'
     spectrum = 0.0
     for table in tables:
         through = through * gap
-        R = lookup(table.reflectance, theta)
+        R = lookup_columns(table.reflectance, theta)
         spectrum = spectrum + through * R
-        T = 1.0 - R if table.transmittance is None else lookup(table.transmittance, theta)  # absorbing: T < 1 - R
+        T = 1.0 - R if table.transmittance is None else lookup_columns(table.transmittance, theta)  # absorbing: T < 1 - R
         through = through * T ** 2
-    return colorimetry.spectrum_to_rgb(spectrum) + F[..., None]  # F is flat: white is (1, 1, 1)
+    if F.shape[-1] > 1:  # a dispersive coating's Fresnel reflectance is a spectrum
+        return colorimetry.spectrum_to_rgb(spectrum + F)
+    return colorimetry.spectrum_to_rgb(spectrum) + F  # F is flat: white is (1, 1, 1)
 
 
 def transmission_probability(mean_transmissivity: ArrayLike, cos_theta: ArrayLike, alpha: ArrayLike) -> np.ndarray:
@@ -641,6 +757,7 @@ def layer_choice_probabilities(
     p_base : ndarray, shape (...)
     """
     tables = stack_tables(stack) if tables is None else tuple(tables)
+    # A dispersive host: its index at 550 nm (n1), one set of probabilities for every wavelength (an estimate's).
     theta, F = _host_angle(cos_theta, stack.n1, stack.coating)
     reach = 1.0 - F
     p_refl = []

@@ -28,6 +28,10 @@ At each event:
   multiplied by ``rho_d / max(rho_d)``.
 - Russian roulette ends paths of low throughput (unbiased: survivors are divided by their probability).
 
+A dispersive host (:attr:`explorer.physics.layered.LayeredBragg.medium_n1`) under the coating refracts each
+wavelength its own way: a path then carries its hero wavelength alone and refracts, reflects at the coating and
+leaves it with the host's index at that wavelength.
+
 The BRDF ``f(i, o)`` comes by next-event estimation toward ``o``: at every reflection on a layer from
 above and at every base bounce, the vertex's BRDF toward the refracted ``o'``, times the ballistic
 transmissivity of the layers above along ``o'``, the coating's ``1 - F(theta_o)`` and the radiance's
@@ -161,7 +165,12 @@ class PositionFree:
         self.rgb_weight = self.rgb / self.pdf[:, None]  # M(lambda) / p(lambda)
         self.rho = np.asarray(stack.rho_d, dtype=np.float64)
         self.n1 = stack.n1 if stack.coating else 1.0
-        self.refracts = stack.coating and stack.n1 != 1.0
+        # A coated dispersive host refracts each wavelength its own way: a path carries its hero wavelength
+        # alone (K = 1; the others would need directions of their own) and refracts with its index.
+        self.dispersive = bool(stack.coating and stack.dispersive_host)
+        self.host_n = stack.host_index() if self.dispersive else None
+        self.hero_wavelengths = 1 if self.dispersive else HERO_WAVELENGTHS
+        self.refracts = stack.coating and (stack.n1 != 1.0 or self.dispersive)
         self.tau_h = float(stack.tau_h)
 
     # ----------------------------------------------------------------------------------------------
@@ -181,32 +190,33 @@ class PositionFree:
         k = k[:, None]
         return table[k, wavelength] * (1.0 - f) + table[k + 1, wavelength] * f
 
-    def _coating_F_air(self, cos_air: np.ndarray) -> np.ndarray:
-        """The coating's Fresnel reflectance seen from air (0 when it does not refract)."""
+    def _coating_F_air(self, cos_air: np.ndarray, n=None) -> np.ndarray:
+        """The coating's Fresnel reflectance seen from air (0 when it does not refract); ``n``: the host's index per
+        row (a dispersive host's at each path's wavelength), ``n1`` by default."""
         if not self.refracts:
             return np.zeros_like(cos_air)
-        return layered.coating_reflectance(cos_air, self.n1)
+        return layered.coating_reflectance(cos_air, self.n1 if n is None else n)
 
-    def _coating_F_host(self, cos_host: np.ndarray) -> np.ndarray:
+    def _coating_F_host(self, cos_host: np.ndarray, n=None) -> np.ndarray:
         """The coating's Fresnel reflectance seen from the host, total internal reflection included."""
         if not self.refracts:
             return np.zeros_like(cos_host)
-        return fresnel_reflectance(np.clip(cos_host, 1e-12, 1.0), self.n1, 1.0)
+        return fresnel_reflectance(np.clip(cos_host, 1e-12, 1.0), self.n1 if n is None else n, 1.0)
 
-    def _into_host(self, direction_air: np.ndarray) -> np.ndarray:
+    def _into_host(self, direction_air: np.ndarray, n=None) -> np.ndarray:
         """An upward direction in air as seen in the host (Snell), unchanged when the coating does not refract."""
         if not self.refracts:
             return np.asarray(direction_air, dtype=np.float64)
-        return layered.refract_into_host(direction_air, self.n1)
+        return layered.refract_into_host(direction_air, self.n1 if n is None else n)
 
     def sample_wavelengths(self, count: int, groups: int, rng: np.random.Generator) -> np.ndarray:
         """
-        :data:`HERO_WAVELENGTHS` wavelength indices per path for ``groups`` consecutive runs of ``count``
+        :data:`HERO_WAVELENGTHS` wavelength indices per path (1 in a coated dispersive host) for ``groups`` consecutive runs of ``count``
         paths: the first (the hero) drawn from :func:`wavelength_pdf` and stratified within each run, the
         others at the hero's quantile plus ``k / K`` (mod 1), so that each is distributed as the hero
         (Wilkie et al. 2014). Shape ``(groups * count, K)``.
         """
-        K = HERO_WAVELENGTHS
+        K = self.hero_wavelengths
         u = ((np.arange(count)[None, :] + rng.random((groups, count))) / count).reshape(-1, 1)
         u = (u + np.arange(K)[None, :] / K) % 1.0
         return np.minimum(np.searchsorted(self.cdf, u, side="right"), self.pdf.size - 1)
@@ -259,10 +269,12 @@ class PositionFree:
             value = value / np.maximum(pi[rows].mean(axis=1), 1e-300)[:, None]
             np.add.at(into, pid[rows], np.einsum("nk,nkc->nc", value, rgb_weight[pid[rows]]) * colour[rows])
 
+        # The host's index per path: n1, or a dispersive host's at the path's (only) wavelength.
+        n_path = self.host_n[wl[:, 0]] if self.dispersive else None
         # Entering: the part 1 - F crosses the coating (its reflection F is the Dirac, tallied apart).
-        beta = np.repeat((1.0 - self._coating_F_air(np.clip(i_air[:, 2], 0.0, 1.0)))[:, None], K, axis=1)
+        beta = np.repeat((1.0 - self._coating_F_air(np.clip(i_air[:, 2], 0.0, 1.0), n_path))[:, None], K, axis=1)
         pi = np.ones((P, K))
-        d = -self._into_host(i_air)  # propagation direction in the host, going down
+        d = -self._into_host(i_air, n_path)  # propagation direction in the host, going down
         gap = np.zeros(P, dtype=np.int64)  # between interfaces gap and gap + 1 (0: coating, L + 1: base)
         colour = np.ones((P, 3))  # the base's RGB albedo, once per bounce on it
         pid = np.arange(P)
@@ -271,8 +283,9 @@ class PositionFree:
         if nee:
             # What a vertex below layer k sends along o, per unit radiance toward o' in the host:
             # (1 - F(theta_o)) / n1^2 times Eq. 28's transmissivity of every layer above (Eq. 34's factors).
-            o_host = self._into_host(o_air)
-            exit_weight = (1.0 - self._coating_F_air(np.clip(o_air[:, 2], 0.0, 1.0))) / (self.n1 * self.n1)
+            o_host = self._into_host(o_air, n_path)
+            n_exit = self.n1 if n_path is None else n_path
+            exit_weight = (1.0 - self._coating_F_air(np.clip(o_air[:, 2], 0.0, 1.0), n_path)) / (n_exit * n_exit)
             exit_weight = np.where((o_air[:, 2] > 0.0) & (i_air[:, 2] > 0.0), exit_weight, 0.0)
             # The host's gaps (tau_h): the one above a vertex and every one above it, crossed along o'.
             gap_o = layered.gap_transmittance(self.tau_h, o_host[:, 2])[:, None]
@@ -291,7 +304,7 @@ class PositionFree:
             # -- the coating, from inside: deterministic split (escape 1 - F, reflect F)
             at = np.flatnonzero(interface == 0)
             if at.size:
-                F = self._coating_F_host(d[at, 2])
+                F = self._coating_F_host(d[at, 2], None if n_path is None else n_path[pid[at]])
                 tally(albedo, at, beta[at] * (1.0 - F)[:, None])
                 beta[at] *= F[:, None]
                 d[at, 2] = -d[at, 2]
@@ -501,8 +514,9 @@ class PositionFree:
                 break
             rounds.append(self._replicates(i_air, None, int(samples), (seed, len(rounds)), progress))
         mean, stderr, _, _ = self._combine(np.concatenate(rounds))
-        F = self._coating_F_air(np.cos(theta))
-        return PositionFreeResult(mean + F[:, None], stderr, int(samples) * len(rounds), time.perf_counter() - start)
+        # The coating's Dirac, exactly: F (flat), or the RGB of its spectrum in a dispersive host.
+        F = layered.coating_rgb(self.stack, np.cos(theta)) if self.dispersive else self._coating_F_air(np.cos(theta))[:, None]
+        return PositionFreeResult(mean + F, stderr, int(samples) * len(rounds), time.perf_counter() - start)
 
     def brdf(self, i_air, o_air, samples: int = 256, seed: int = 0, progress=None) -> PositionFreeResult:
         """

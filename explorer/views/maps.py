@@ -48,6 +48,25 @@ def map_colours(model_name: str, fixed: Mapping[str, float], maps: Mapping[str, 
     return out.astype(np.float32)
 
 
+def flat_numpy(model, texture, theta_deg: float) -> np.ndarray:
+    """
+    The flat textured view by the numpy twin: one pixel a texel of ``texture`` (a surface texture of
+    :mod:`explorer.views.surface_texture`), its colour at ``theta_deg`` by the material's method (the twin's
+    ``surface_reflectance``). The twin of ``shaders/views/flat/textured.glsl`` (:func:`flat_gl`).
+    """
+    value = np.asarray(texture.d_inc, np.float64)
+    cos_theta = np.full(value.shape, float(np.float32(np.cos(np.radians(theta_deg)))))  # the shader's float32 uniform
+    return np.asarray(model.surface_reflectance(cos_theta, value, **texture.model_options()), np.float32)
+
+
+def flat_gl(renderer, material, values, texture, theta_deg: float) -> np.ndarray:
+    """The flat textured view on the GPU (``shaders/views/flat/textured.glsl``): :func:`flat_numpy`'s image."""
+    height, width = texture.d_inc.shape
+    arguments = texture.gl_arguments(material, values, width, height)
+    uniforms = {**arguments["uniforms"], "flat_cos_theta": float(np.float32(np.cos(np.radians(theta_deg))))}
+    return renderer.render(material, values, "flat/textured", width, height, inputs=arguments["inputs"], uniforms=uniforms)
+
+
 # --------------------------------------------------------------------------------------------------
 # Map folders and target images
 
@@ -121,17 +140,21 @@ def maps_material(folder: str | os.PathLike[str]) -> str:
 
 def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], material) -> dict[str, float]:
     """
-    The folder's fixed values, once its maps fit ``material`` (a Bragg mirror's structure: each map a parameter of it,
-    within its range); a one-line :class:`explorer.errors.LocatedError` naming the file otherwise.
+    The folder's fixed values, once its maps fit ``material`` (the structure its twin declares it maps,
+    :class:`explorer.materials.twins.StructureMaps`: each map a field of it, within its range); a one-line
+    :class:`explorer.errors.LocatedError` naming the file otherwise.
     """
     from explorer.errors import LocatedError
-    from explorer.physics.bragg import STRUCTURE_FIELDS
+    from explorer.materials.twins import capabilities_of
 
     declared = {p.name: p for p in material.parameters}
     if params.get("model") != material.model:
         raise LocatedError(folder / "params.json", None, f"maps of a {params.get('model')}, not of {material.model} ({Path(material.path).name})")
-    if material.texture != "bragg":
-        raise LocatedError(folder / "params.json", None, f"maps are drawn on a Bragg mirror's structure; {Path(material.path).name} has none")
+    declaration = capabilities_of(material).maps
+    if declaration is None:
+        raise LocatedError(folder / "params.json", None, f"maps are drawn on a structure a material's twin declares; "
+                                                         f"{Path(material.path).name} declares none")
+    fields = declaration.fields
     fixed = params.get("fixed") or {}
     if not isinstance(fixed, Mapping):
         raise LocatedError(folder / "params.json", None, "'fixed' is not an object of NAME: VALUE")
@@ -140,9 +163,9 @@ def check_maps(folder: Path, params: Mapping, maps: Mapping[str, np.ndarray], ma
             raise LocatedError(folder / "params.json", None, f"fixed {name} = {value!r}: not a number of a parameter of {Path(material.path).name}")
     for name, image in maps.items():
         path = folder / f"{name}.exr"
-        if name not in declared or name not in STRUCTURE_FIELDS:
+        if name not in declared or name not in fields:
             raise LocatedError(path, None, f"a map of {name}, which is not a structure parameter of {Path(material.path).name} "
-                                           f"({', '.join(n for n in STRUCTURE_FIELDS if n in declared)})")
+                                           f"({', '.join(n for n in fields if n in declared)})")
         parameter = declared[name]
         finite = np.isfinite(image)
         outside = finite & ((image < parameter.min) | (image > parameter.max))

@@ -83,31 +83,33 @@ class BraggTexture:
 @dataclass
 class MapTexture:
     """
-    Structure maps (``design --target-image``'s output, :mod:`explorer.views.maps`) on a Bragg mirror: each texel its
-    own mirror, the mapped parameters from their maps, the others the mirror's values (``values``: the folder's fixed
-    ones over the material's). Read as the textured view reads ``T`` (planar, ``shaders/views/textured.glsl``), but
-    the nearest texel unfiltered: ``T`` is the texel's index into :func:`explorer.physics.bragg.structure_table`
-    (``mapped_mirror`` in lib/bragg.glsl). Off the maps' mask the surface is black.
+    Structure maps (``design --target-image``'s output, :mod:`explorer.views.maps`) on a material that declares them
+    (:class:`explorer.materials.twins.StructureMaps`, its twin's ``Capabilities(maps=...)``): each texel its own
+    structure, the mapped parameters from their maps, the others the material's values (``values``: the folder's fixed
+    ones over the material's). Read as the textured view reads its texture (planar, ``shaders/views/textured.glsl``), but
+    the nearest texel unfiltered: the surface value is the texel's index into the declaration's table
+    (:func:`explorer.physics.structure_maps.structure_table`, lib/structure_maps.glsl). Off the maps' mask the surface
+    is black.
     """
 
     #: The maps as read (name: float ``(H, W)``, NaN off the mask), for the Texture window.
     maps: dict
-    #: The mirror's values the maps complete (the material's, the folder's fixed ones over them).
+    #: The material's values the maps complete (the material's, the folder's fixed ones over them).
     values: dict
+    #: What the material declares a texel holds (:class:`explorer.materials.twins.StructureMaps`).
+    declaration: object
     source: str = "<maps>"
     prefilter = False
 
     def __post_init__(self):
-        from explorer.materials.models import mirror_of
-        from explorer.physics.bragg import structure_table
-
-        self.structures = structure_table(mirror_of(self.values), self.maps)
+        self.structures = self.declaration.table(self.values, self.maps)
         height, width = next(iter(self.maps.values())).shape
         self.index = np.arange(height * width, dtype=np.float32).reshape(height, width)
 
     @classmethod
     def from_folder(cls, folder, material, values) -> tuple["MapTexture", dict]:
         """The maps of ``folder`` on ``material`` and the values they complete (``values`` with the folder's fixed ones)."""
+        from explorer.materials.twins import capabilities_of
         from explorer.views.maps import check_maps, read_maps
 
         try:
@@ -117,7 +119,7 @@ class MapTexture:
             raise LocatedError(path, None, message) from None
         fixed = check_maps(Path(folder), params, maps, material)
         values = {**values, **fixed}
-        return cls(maps, values, str(folder)), values
+        return cls(maps, values, capabilities_of(material).maps, str(folder)), values
 
     @property
     def d_inc(self) -> np.ndarray:  # the texture's array, as ThicknessTexture names it (size checks)
@@ -141,7 +143,7 @@ class MapTexture:
 
     def gl_arguments(self, material, values, width: int, height: int, draft: bool = False) -> dict:
         """``inputs`` and ``uniforms`` of :meth:`explorer.gpu.Renderer.render`: the texel indices and the structure table."""
-        from explorer.physics.bragg import MAPS_MAPPING
+        from explorer.physics.structure_maps import MAPS_MAPPING
 
         inputs = {"surface_texture": self.index[..., None], "surface_moments": np.zeros((1, 1, 2), np.float32),
                   "bragg_texture_table": np.zeros((1, 1, 3), np.float32), "structure_maps": self.structures}

@@ -350,9 +350,17 @@ float subdivisions_by_mass(vec3 C_low, vec3 C_high, float s) {
 // exact reflectance (explorer/physics/bragg/approximation.py has the reasoning).
 
 // Fringes of Eq. 2 in a pass-band box: N |Delta K Lambda| / pi.
-float fringe_count(float omega_low, float omega_high, CellGeometry g) {
-    float t_low = acos(clamp(cos_K_Lambda(omega_low, g), -1.0, 1.0));
-    float t_high = acos(clamp(cos_K_Lambda(omega_high, g), -1.0, 1.0));
+// The Bloch phase K Lambda in [0, pi] (Eq. 8); at a band edge exactly 0 or pi by the sign of cos K Lambda (acos is
+// ill-conditioned there: float32's rounding of a bisected edge would move the fringe count, a step of the colour).
+float bloch_phase(float omega, CellGeometry g, bool at_edge) {
+    float a = cos_K_Lambda(omega, g);
+    if (at_edge) return a >= 0.0 ? 0.0 : PI;
+    return acos(clamp(a, -1.0, 1.0));
+}
+
+float fringe_count(float omega_low, float omega_high, CellGeometry g, bool low_at_edge, bool high_at_edge) {
+    float t_low = bloch_phase(omega_low, g, low_at_edge);
+    float t_high = bloch_phase(omega_high, g, high_at_edge);
     return g.N * abs(t_high - t_low) / PI;
 }
 
@@ -369,16 +377,18 @@ bool fringes_resolved(float edge_low, float edge_high, float s, CellGeometry g) 
     if (s <= 0.0 || SAMPLES_PER_FRINGE * g.N > RESOLVE_BUDGET) return false;
     float low = max(edge_low, OMEGA_LOW), high = min(edge_high, OMEGA_HIGH);  // the pass band's visible part
     if (high <= low) return false;
-    float fringes = max(fringe_count(low, high, g), 1e-9);
+    float fringes = max(fringe_count(low, high, g, edge_low >= OMEGA_LOW, edge_high <= OMEGA_HIGH), 1e-9);
     float width_nm = wavelength_of(low) - wavelength_of(high);
     float grow = pow(max(1.0, g.N / N_RESOLVE), GROW_EXPONENT);
     return width_nm * fringe_sharpness(g) * s > FRINGE_RESOLVE_NM * grow * fringes;
 }
 
-float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, bool resolved) {
+float subdivisions_resolving_fringes(float omega_low, float omega_high, vec3 C_low, vec3 C_high, float s, CellGeometry g, bool resolved,
+                                     int edge) {
     float by_mass = subdivisions_by_mass(C_low, C_high, s);
     if (!resolved) return by_mass;
-    float pieces = min(ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, g) / fringe_sharpness(g)), MAX_RESOLVED_PIECES);
+    float fringes = fringe_count(omega_low, omega_high, g, edge < 0, edge > 0);
+    float pieces = min(ceil(SAMPLES_PER_FRINGE * fringes / fringe_sharpness(g)), MAX_RESOLVED_PIECES);
     return max(pieces, by_mass);
 }
 
@@ -457,7 +467,7 @@ vec3 approximate_xyz_polarised(CellGeometry g, float s, bool absolute_numbering,
             if (hi <= lo) continue;
             int edge = improved ? box - 1 : 0;
             vec3 C_high = cmf_cumulative_at(wavelength_of(hi));
-            if (improved) pieces = subdivisions_resolving_fringes(lo, hi, C_previous, C_high, s, g, resolved);
+            if (improved) pieces = subdivisions_resolving_fringes(lo, hi, C_previous, C_high, s, g, resolved, edge);
             for (float k = 0.0; k < pieces; k += 1.0) {
                 float j = edge > 0 ? pieces - 1.0 - k : k;  // keep omega increasing
                 float sub_lo, centre, sub_hi;
@@ -524,19 +534,15 @@ BraggMirror textured_mirror(BraggMirror mirror, float T, int mapping) {
 
 // Only in the views that read a surface texture (the host defines SURFACE_TEXTURE): no sampler in a .brdf export.
 #ifdef SURFACE_TEXTURE
-// Structure maps (design --target-image's output): texture_mapping TEXTURE_MAPS gives each texel its own mirror, T
-// the nearest texel's index (row-major). The host's table holds two RGBA texels a map texel, (n1, n2, Lambda, delta)
-// and (N, nh, inside, 0); false off the maps' mask (TEXTURE_MAPS: generated). Twin: explorer.physics.bragg.mapped_mirrors
-// (structure_table).
+#include "lib/structure_maps.glsl"
 
+// Structure maps (lib/structure_maps.glsl): the texel's mirror, its fields (n1, n2, Lambda, delta) and (N, nh) in the
+// order of explorer.physics.bragg.STRUCTURE_FIELDS; false off the maps' mask. Twin: explorer.physics.bragg.mapped_mirrors.
 bool mapped_mirror(sampler2D table, float T, out BraggMirror mirror) {
-    int width = textureSize(table, 0).x / 2;
-    int index = int(T);  // an integer below 2^24: exact in float32
-    ivec2 texel = ivec2(2 * (index % width), index / width);
-    vec4 a = texelFetch(table, texel, 0);
-    vec4 b = texelFetch(table, texel + ivec2(1, 0), 0);
-    mirror = BraggMirror(a.x, a.y, a.z, a.w, b.x, b.y);
-    return b.z > 0.5;
+    vec4 a, b;
+    bool inside = structure_texels(table, T, a, b);
+    mirror = BraggMirror(a.x, a.y, a.z, a.w, max(b.x, 1.0), b.y);
+    return inside;
 }
 
 // The tabulated method of a textured mirror: the table over (cos theta across, T down), rows at T = k / (rows - 1),

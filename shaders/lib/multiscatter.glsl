@@ -16,3 +16,9 @@ bool compensation_cell(vec3 i, vec3 o, out int ki, out float fi, out int ko, out
     compensation_row(atan(length(o.xy), max(o.z, 0.0)), ko, fo);
     return i.z > 0.0 && o.z > 0.0;
 }
+
+// The compensation's weight by roughness (twin of explorer.physics.compensation.compensation_weight): 0 up to
+// alpha = 0.4 (Eqs. 17 and 34 as published, the paper's validated range), 1 from 0.5, smoothstep between.
+float compensation_weight(float alpha) {
+    return smoothstep(COMPENSATION_FADE_START, COMPENSATION_FADE_END, alpha);
+}

@@ -1,8 +1,9 @@
 """
 The Texture window: the textured view (:mod:`explorer.views.surface_texture`) of a material that declares
 ``# texture:``: a thin film's D_inc over a range, or a Bragg mirror's Lambda and/or delta (supplemental
-Figure 7), from a grey image (the shipped noise by default), lit by the app's light; or a mirror's structure maps
-(a folder ``design --target-image`` wrote, :class:`explorer.views.surface_texture.MapTexture`), each map shown below.
+Figure 7), from a grey image (the shipped noise by default), lit by the app's light; or structure maps (a folder
+``design --target-image`` wrote, :class:`explorer.views.surface_texture.MapTexture`), each map shown below. On the
+sphere or a mesh (by its texture coordinates), lit or under the environment, as ``render --mesh --view textured|env``.
 """
 
 from __future__ import annotations
@@ -14,7 +15,10 @@ import numpy as np
 from explorer.rendering import request_view
 from explorer.app.camera import light_vector
 from explorer.app.panels.base import Panel, combo, record, show_image
+from explorer.app.scheduler import model_mesh
+from explorer.app.state import SPHERE_MODELS
 from explorer.errors import LocatedError
+from explorer.materials.twins import capabilities_of
 from explorer.resources import DEFAULT_TEXTURE
 from explorer.views.surface_texture import MAPPINGS, TEXTURE_KINDS, BraggTexture, MapTexture, textured_builtins
 from explorer.views.thickness import DEFAULT_DINC_RANGE, DINC_MAX, ThicknessTexture
@@ -60,13 +64,19 @@ class TexturePanel(Panel):
         #: Under the environment: the env view's progressive Monte Carlo with the surface texture.
         self.environment = False
         self._env = None  # (key, ProgressiveEnvRender, AccumulatedImage)
+        self._env_reported = None  # the env render last reported
         #: A map folder (open --maps, or typed here): its maps on the mirror instead of the grey image.
         self.maps_path = app.state.maps_folder
         self._map_textures: dict = {}  # map name -> texture of its image, for the current folder
+        #: The sphere or a mesh of SPHERE_MODELS (render --mesh), the texture carried by its coordinates.
+        self.model = "sphere"
+        self._mesh_inputs = None  # (model, size, {"mesh_normals", "mesh_uvs"}) of the mesh shown
+        #: The mean RGB of each image shown, by "textured:MODEL" or "env:MODEL", for the current values (reported).
+        self._shown: dict = {}
 
-    def _texture(self, kind: str):
+    def _texture(self, kind: str, mappable: bool):
         """The surface texture of the current settings (loaded again only when they change)."""
-        maps = self.maps_path.strip() if kind == "bragg" else ""
+        maps = self.maps_path.strip() if mappable else ""
         key = (kind, self.path, self.mapping, tuple(self.dinc_range), maps)
         if key != self._surface_key:
             self._surface_key = key
@@ -93,13 +103,15 @@ class TexturePanel(Panel):
             imgui.text_wrapped(text)
             state.texture_view = {"message": text}
             return
-        if kind == "bragg":
+        mappable = capabilities_of(state.material).maps is not None
+        if mappable:
             _, self.maps_path = imgui.input_text("map folder (design --out-maps)", self.maps_path)
             record(state, "maps_folder")
-        if not (kind == "bragg" and self.maps_path.strip()):
+        maps = mappable and bool(self.maps_path.strip())
+        if not maps:
             _, self.path = imgui.input_text("texture (grey image)", self.path)
-        if kind == "bragg" and self.maps_path.strip():
-            imgui.text_wrapped("each texel its own mirror: the maps below, the other values the folder's")
+        if maps:
+            imgui.text_wrapped("each texel its own structure: the maps below, the other values the folder's")
         elif kind == "bragg":
             self.mapping = combo(state, "mapping", self.mapping, [(n, n) for n in MAPPINGS], self.mapping, "mapping",
                                  "mapping_combo") or self.mapping
@@ -109,7 +121,10 @@ class TexturePanel(Panel):
             self.dinc_range = list(self.dinc_range)
         _, self.environment = imgui.checkbox("under the environment (env view)", self.environment)
         record(state, "texture_env")
-        surface = self._texture(kind)
+        imgui.set_next_item_width(110)
+        self.model = combo(state, "model##texture", self.model, [(n, n) for n in SPHERE_MODELS], self.model, "texture_model",
+                           "texture_model_combo") or self.model
+        surface = self._texture(kind, mappable)
         if self.message:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), self.message)
         if surface is None:
@@ -150,11 +165,24 @@ class TexturePanel(Panel):
         if self.environment:
             source = self._env_source(surface, size)
             show_image(state, self.scheduler.show("textured_env", size, source), size, "textured_image")
-            done = "done" if source.render.samples >= self._env_samples else "refining"
-            imgui.text(f"env: {source.render.samples} samples per pixel ({done})")
+            done = source.render.samples >= self._env_samples
+            imgui.text(f"env: {source.render.samples} samples per pixel ({'done' if done else 'refining'})")
+            if not done:
+                state.texture_view = {"running": True, "draft": self._draft}
+            elif self._env_reported is not self._env:
+                self._env_reported = self._env
+                self._report(kind, surface, size, f"env:{self.model}", source.render.image())
             return
-        request_view(job, state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
-                     surface=self._arguments, dragging=self.app.dragging)
+        mesh = self._mesh()
+        if mesh is not None:  # its rasterised normals and texture coordinates (explorer.gpu.mesh), once per model and size
+            from explorer.gpu.mesh import MESH_TEMPLATES
+
+            request_view(job, state.material, self._values, MESH_TEMPLATES["textured"], size, light=light_vector(state.light, state.camera),
+                         surface=self._arguments, inputs=self._mesh_surface(mesh, size), inputs_key=(self.model, size, self._arguments_key),
+                         dragging=self.app.dragging)
+        else:
+            request_view(job, state.material, self._values, "textured", size, light=light_vector(state.light, state.camera),
+                         surface=self._arguments, dragging=self.app.dragging)
         show_image(state, self.scheduler.show("textured", size, job), size, "textured_image")
         imgui.text(("done" if job.complete else f"refining {100 * job.progress:.0f}%") + ("  (draft table)" if self._draft else "")
                    + (f"  {job.error}" if job.error else ""))
@@ -162,14 +190,36 @@ class TexturePanel(Panel):
             state.texture_view = {"running": True, "draft": self._draft}
         elif job.generation != self._generation or not state.texture_view or state.texture_view.get("running"):
             self._generation = job.generation
-            image = job.read()
-            state.texture_view = {"kind": kind, "path": self.path, "mapping": self.mapping, "dinc_range": list(self.dinc_range),
-                                  "values": {k: (list(v) if isinstance(v, tuple) else v) for k, v in self._values.items()},
-                                  "light": list(light_vector(state.light, state.camera)), "size": list(size), "draft": False,
-                                  "mean_rgb": np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()}
-            if isinstance(surface, MapTexture):
-                state.texture_view["maps_folder"] = self.maps_path.strip()
-                state.texture_view["maps"] = {name: shown for name, (_, shown) in self._map_textures.items()}
+            self._report(kind, surface, size, f"textured:{self.model}", job.read())
+
+    def _report(self, kind: str, surface, size, shown: str, image) -> None:
+        """``state.texture_view``: the settings, the values and the image's mean RGB (and every image's shown at these values)."""
+        state = self.state
+        mean = np.asarray(image, np.float64).reshape(-1, 3).mean(axis=0).tolist()
+        values = {k: (list(v) if isinstance(v, tuple) else v) for k, v in self._values.items()}
+        if self._shown.get("values") != values:
+            self._shown = {"values": values, "means": {}}
+        self._shown["means"][shown] = mean
+        state.texture_view = {"kind": kind, "path": self.path, "mapping": self.mapping, "dinc_range": list(self.dinc_range),
+                              "values": values, "light": list(light_vector(state.light, state.camera)), "size": list(size),
+                              "draft": False, "model": self.model, "environment": state.environment if self.environment else None,
+                              "mean_rgb": mean, "shown": dict(self._shown["means"])}
+        if isinstance(surface, MapTexture):
+            state.texture_view["maps_folder"] = self.maps_path.strip()
+            state.texture_view["maps"] = {name: shown for name, (_, shown) in self._map_textures.items()}
+
+    def _mesh(self):
+        """The mesh chosen (None: the sphere)."""
+        return model_mesh(self.model, self.scheduler.env.meshes)
+
+    def _mesh_surface(self, mesh, size) -> dict:
+        """The mesh's normals and texture coordinates at ``size`` (:func:`explorer.gpu.mesh.mesh_surface`), once per model and size."""
+        if self._mesh_inputs is None or self._mesh_inputs[:2] != (self.model, size):
+            from explorer.gpu.mesh import mesh_surface
+
+            normals, uvs = mesh_surface(self.scheduler.renderer, mesh, *size)
+            self._mesh_inputs = (self.model, size, {"mesh_normals": normals, "mesh_uvs": uvs})
+        return self._mesh_inputs[2]
 
     def _map_images(self, surface: MapTexture) -> None:
         """Each map as a grey image (its finite range black to white, off the mask dark red), uploaded once per folder."""
@@ -206,19 +256,20 @@ class TexturePanel(Panel):
         from explorer.gpu.display import AccumulatedImage
         from explorer.gpu.env import ProgressiveEnvRender
 
-        if self._env is None or self._env[0] != self._arguments_key:
+        key = (self._arguments_key, self.model, self.state.environment, self.state.env_rotation)
+        if self._env is None or self._env[0] != key:
             if self._env is not None:
                 self._env[1].release()
             # The env mode's environment and probe rotation (its loaded maps: EnvScheduler.environment).
             environment = self.scheduler.env.environment(self.state.environment).rotated(self.state.env_rotation)
             # The tables are those the worker built for these values (cached): no wait here.
             render = ProgressiveEnvRender(self.scheduler.renderer, self.state.material, self._values, environment, *size,
-                                          surface=surface)
+                                          surface=surface, mesh=self._mesh())
             from explorer.materials.models import model_for
 
             model = model_for(self.state.material, self._values)
             self._env_samples = 1 if getattr(model, "mirror_only", False) else ENV_SAMPLES
-            self._env = (self._arguments_key, render, AccumulatedImage(render))
+            self._env = (key, render, AccumulatedImage(render))
         return self._env[2]
 
     def gl_jobs(self) -> list:

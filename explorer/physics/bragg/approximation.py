@@ -252,14 +252,27 @@ GROW_EXPONENT = 2.0
 MAX_RESOLVED_PIECES = 48.0
 
 
-def fringe_count(omega_low: ArrayLike, omega_high: ArrayLike, geometry: CellGeometry) -> np.ndarray:
+def bloch_phase(omega: ArrayLike, geometry: CellGeometry, at_edge: ArrayLike = False) -> np.ndarray:
+    """
+    The Bloch phase ``K Lambda`` in ``[0, pi]`` (Eq. 8) at ``omega``; where ``at_edge`` (a band edge, ``|cos K Lambda| = 1``)
+    exactly 0 or pi by the sign of ``cos K Lambda``. ``arccos`` is ill-conditioned there (``arccos(1 - e) ~ sqrt(2 e)``):
+    float32's rounding of a bisected edge would move the phase by ~1e-3 and with it the fringe count that sets the
+    sub-boxes (:func:`subdivisions_resolving_fringes`), a step of the colour.
+    """
+    a = cos_K_Lambda(omega, geometry)
+    return np.where(at_edge, np.where(a >= 0.0, 0.0, np.pi), np.arccos(np.clip(a, -1.0, 1.0)))
+
+
+def fringe_count(omega_low: ArrayLike, omega_high: ArrayLike, geometry: CellGeometry, low_at_edge: ArrayLike = False,
+                 high_at_edge: ArrayLike = False) -> np.ndarray:
     """
     How many fringes of Eq. 2 lie in a pass-band box: ``N |Delta K Lambda| / pi``. Between zeros of
     ``sin N K Lambda`` the Bloch phase ``K Lambda`` advances by ``pi / N``, and it is monotone across a
-    pass band (Eq. 8 with ``|cos K Lambda| <= 1``).
+    pass band (Eq. 8 with ``|cos K Lambda| <= 1``). ``low_at_edge``, ``high_at_edge``: the box ends at a band edge
+    (:func:`bloch_phase`).
     """
-    t_low = np.arccos(np.clip(cos_K_Lambda(omega_low, geometry), -1.0, 1.0))
-    t_high = np.arccos(np.clip(cos_K_Lambda(omega_high, geometry), -1.0, 1.0))
+    t_low = bloch_phase(omega_low, geometry, low_at_edge)
+    t_high = bloch_phase(omega_high, geometry, high_at_edge)
     return geometry.N * np.abs(t_high - t_low) / np.pi
 
 
@@ -280,7 +293,7 @@ def fringes_resolved(edge_low: ArrayLike, edge_high: ArrayLike, s: int, geometry
     low, high = np.maximum(edge_low, OMEGA_LOW), np.minimum(edge_high, OMEGA_HIGH)
     visible = high > low
     high = np.where(visible, high, low)
-    fringes = np.maximum(fringe_count(low, high, geometry), 1e-9)
+    fringes = np.maximum(fringe_count(low, high, geometry, edge_low >= OMEGA_LOW, edge_high <= OMEGA_HIGH), 1e-9)
     width_nm = wavelength_of(low) - wavelength_of(high)
     # The width (nm) to resolve grows beyond N_RESOLVE cells, as the cost of resolving them does.
     grow = max(1.0, geometry.N / N_RESOLVE) ** GROW_EXPONENT
@@ -289,17 +302,19 @@ def fringes_resolved(edge_low: ArrayLike, edge_high: ArrayLike, s: int, geometry
 
 
 def subdivisions_resolving_fringes(
-    omega_low: ArrayLike, omega_high: ArrayLike, s: int, geometry: CellGeometry, resolved: ArrayLike,
+    omega_low: ArrayLike, omega_high: ArrayLike, s: int, geometry: CellGeometry, resolved: ArrayLike, edge: int = 0,
 ) -> np.ndarray:
     """
     Sub-boxes of the improved variant (ours) in a pass-band box: :func:`subdivisions_by_mass`, and where
     the fringes are resolved (:func:`fringes_resolved`) at least :data:`SAMPLES_PER_FRINGE` per fringe
-    feature (:func:`fringe_count`, :func:`fringe_sharpness`), at most :data:`MAX_RESOLVED_PIECES`.
+    feature (:func:`fringe_count`, :func:`fringe_sharpness`), at most :data:`MAX_RESOLVED_PIECES`. ``edge``: the box's
+    band edge (-1 at ``omega_low``, +1 at ``omega_high``, 0 none; as :func:`_sub_box`).
     """
     by_mass = subdivisions_by_mass(omega_low, omega_high, s)
     if not np.any(resolved):
         return by_mass
-    pieces = np.ceil(SAMPLES_PER_FRINGE * fringe_count(omega_low, omega_high, geometry) / fringe_sharpness(geometry))
+    fringes = fringe_count(omega_low, omega_high, geometry, edge < 0, edge > 0)
+    pieces = np.ceil(SAMPLES_PER_FRINGE * fringes / fringe_sharpness(geometry))
     pieces = np.minimum(pieces, MAX_RESOLVED_PIECES)
     return np.where(resolved, np.maximum(pieces, by_mass), by_mass)
 
@@ -415,7 +430,7 @@ def piecewise_constant_boxes(
         yield omega_m, edge_low, gap_low if improved else ones, active
         for lo, hi, edge in boxes:
             if improved:
-                pieces = subdivisions_resolving_fringes(lo, hi, s, geometry, resolved)
+                pieces = subdivisions_resolving_fringes(lo, hi, s, geometry, resolved, edge)
             else:
                 pieces = subdivisions(m, m_first, s, mode_numbering)
             for j in range(int(np.max(np.where(active, pieces, 1.0)))):

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 from explorer.physics import colorimetry
 from explorer.physics.bragg.mirror import BraggMirror
 from explorer.physics.bragg.reference import _spectra
+from explorer.physics.structure_maps import structure_texels
 from explorer.physics.bragg.tables import TABLE_TOLERANCE, _interpolation_error_estimate, converged_rgb
 
 # --------------------------------------------------------------------------------------------------
@@ -136,47 +137,21 @@ def textured_tabulated_rgb(table: np.ndarray, cos_theta: ArrayLike, T: ArrayLike
 # --------------------------------------------------------------------------------------------------
 # Structure maps (``design --target-image``'s output): each texel its own mirror
 
-#: The shaders' ``texture_mapping`` of structure maps: each texel's mirror from its maps, not from ``T`` (a bit beside
-#: Figure 7's 1 and 2; ``TEXTURE_MAPS`` in lib/bragg.glsl). ``T`` is then the nearest texel's index.
-MAPS_MAPPING = 4
-#: The mirror's values a structure table holds per texel, in order: (n1, n2, Lambda, delta) then (N, nh, inside, 0).
+#: The mirror's values a structure table holds per texel, in order (:func:`explorer.physics.structure_maps.structure_table`;
+#: ``nh`` below 1: the host is n1; ``N`` rounded, a count of cells).
 STRUCTURE_FIELDS = ("n1", "n2", "Lambda", "delta", "N", "nh")
-
-
-def structure_table(mirror: BraggMirror, maps: dict[str, np.ndarray]) -> np.ndarray:
-    """
-    Per texel of ``maps`` (name: ``(H, W)``, NaN off the mask; names among :data:`STRUCTURE_FIELDS`) the whole
-    mirror, ``mirror``'s values where no map is given: float32 ``(H, 2 W, 4)``, two RGBA texels a map texel,
-    ``(n1, n2, Lambda, delta)`` and ``(N, nh, inside, 0)`` (``nh`` 0: the host is n1; ``N`` rounded, a count of cells).
-    What ``mapped_mirror`` (lib/bragg.glsl) reads.
-    """
-    shape = next(iter(maps.values())).shape
-    inside = np.logical_and.reduce([np.isfinite(m) for m in maps.values()])
-    fields = {"n1": mirror.n1, "n2": mirror.n2, "Lambda": mirror.Lambda, "delta": mirror.delta, "N": mirror.N,
-              "nh": 0.0 if mirror.nh is None else mirror.nh}
-    columns = [np.where(inside, maps[name], 0.0) if name in maps else np.full(shape, float(fields[name])) for name in STRUCTURE_FIELDS]
-    columns[4] = np.where(inside, np.maximum(np.rint(columns[4]), 1.0), 0.0)
-    table = np.zeros(shape + (2, 4), np.float32)
-    table[..., 0, :] = np.stack(columns[:4], axis=-1)
-    table[..., 1, :3] = np.stack([columns[4], columns[5], inside.astype(np.float64)], axis=-1)
-    table = np.ascontiguousarray(table.reshape(shape[0], 2 * shape[1], 4))
-    table.setflags(write=False)
-    return table
 
 
 def mapped_mirrors(table: np.ndarray, T: ArrayLike) -> Iterator[tuple[np.ndarray, BraggMirror]]:
     """
-    The twin of ``mapped_mirror`` (lib/bragg.glsl): the mirrors at texel indices ``T`` (per sample, row-major), grouped
-    by what the approximations take as scalars. Yields ``(samples, mirror)``: a bool mask of ``T``'s shape and a mirror
-    whose ``Lambda`` and ``delta`` are those samples' (float32 values, as the shader reads them); texels off the mask yield none.
+    The twin of ``mapped_mirror`` (lib/bragg.glsl): the mirrors at texel indices ``T`` (per sample, row-major) of a
+    structure table of :data:`STRUCTURE_FIELDS`, grouped by what the approximations take as scalars. Yields
+    ``(samples, mirror)``: a bool mask of ``T``'s shape and a mirror whose ``Lambda`` and ``delta`` are those samples'
+    (float32 values, as the shader reads them); texels off the mask yield none.
     """
-    width = table.shape[1] // 2
-    index = np.asarray(T, dtype=np.float64).astype(np.int64)
-    a = table.reshape(-1, width, 2, 4)[index // width, index % width].astype(np.float64)
-    first, second = a[..., 0, :], a[..., 1, :]
-    inside = second[..., 2] > 0.5
-    scalars = np.stack([first[..., 0], first[..., 1], second[..., 0], second[..., 1]], axis=-1)
+    inside, slots = structure_texels(table, T)
+    scalars = slots[..., [0, 1, 4, 5]]  # n1, n2, N, nh
     for key in np.unique(scalars[inside], axis=0):
         samples = inside & np.all(scalars == key, axis=-1)
         n1, n2, N, nh = (float(v) for v in key)
-        yield samples, BraggMirror(n1, n2, first[..., 2][samples], first[..., 3][samples], int(N), None if nh < 1.0 else nh)
+        yield samples, BraggMirror(n1, n2, slots[..., 2][samples], slots[..., 3][samples], max(int(N), 1), None if nh < 1.0 else nh)
