@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import os
+import shutil
 import subprocess
+import tempfile
 import sys
 import warnings
 from dataclasses import dataclass
@@ -146,6 +149,64 @@ def gl_renderer():
     if not SESSION_RENDERERS:
         SESSION_RENDERERS.append(_new_renderer())
     return SESSION_RENDERERS[0]
+
+
+#: Fixture scopes whose one set-up serves several tests of one module (a class's or a module's).
+SHARED_SCOPES = ("class", "module", "package")
+#: The key of xdist's ``workerinput`` naming the file where each worker writes its tests' groups.
+GROUPS_KEY = "shared_set_up_groups"
+
+
+def shared_set_up_group(item) -> str | None:
+    """
+    The test module of ``item`` when it uses a class- or module-scoped fixture of that module, else None.
+
+    The suite runs on every core (pyproject's ``-n logical``): a test in no group goes to whichever worker is
+    free, but a fixture shared by a module's tests is set up once per worker that runs any of them, so those
+    tests stay together and pay for it once (the design round trips, the exports, the wheel). Conftest's
+    fixtures (the GL renderer) serve the whole worker and group nothing.
+    """
+    module = item.nodeid.split("::")[0]
+    for definitions in item._fixtureinfo.name2fixturedefs.values():
+        fixture = definitions[-1]
+        if fixture.scope in SHARED_SCOPES and (fixture.baseid == module or fixture.baseid.startswith(module + "::")):
+            return module
+    return None
+
+
+def pytest_collection_modifyitems(config, items):
+    """In an xdist worker: write each grouped test's group where the controller's scheduler reads it."""
+    path = getattr(config, "workerinput", {}).get(GROUPS_KEY)
+    if path is not None:
+        from explorer.files import write_text_atomic
+
+        groups = {item.nodeid: group for item in items if (group := shared_set_up_group(item)) is not None}
+        write_text_atomic(Path(path) / f"{config.workerinput['workerid']}.json", json.dumps(groups))
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """xdist's controller, per worker: where it writes its groups (one folder per run)."""
+    config = node.config
+    if not hasattr(config, "_shared_set_up_groups"):
+        config._shared_set_up_groups = tempfile.mkdtemp(prefix="pytest-groups-")
+    node.workerinput[GROUPS_KEY] = config._shared_set_up_groups
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``-n``'s default distribution, with the tests of one group (:func:`shared_set_up_group`) on one worker."""
+    if config.getoption("dist") != "load":
+        return None  # a distribution asked for on the command line
+    from parallel import SharedSetUpScheduling
+
+    return SharedSetUpScheduling(config, log, lambda: getattr(config, "_shared_set_up_groups", None))
+
+
+def pytest_unconfigure(config):
+    folder = getattr(config, "_shared_set_up_groups", None)
+    if folder is not None:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture(scope="session")

@@ -200,3 +200,39 @@ def test_the_polish_levels_hold_every_colour_once_coarse_grid_first():
     assert len(levels) == 3 and len(levels[0][0]) == COARSEST_GRID**2 - 1  # the masked corner's colour comes later
     for members, where in levels:
         assert all(colours[y, x] == c for c, (y, x) in zip(members, where))
+
+
+def test_a_start_one_cell_off_finds_its_count_without_walking():
+    """
+    Seeded random mirrors started from their own structure with one cell more or fewer (a smooth map's neighbour):
+    those the held polish cannot fit move by the step of one cell either way, with no free walk of the counts.
+    """
+    from explorer.design.pixels import COUNT_WALK_DELTA_E, polish_rows, polish_whole
+
+    rows = _row_model()
+    rng = np.random.default_rng(11)
+    count = 16
+    truth = {"Lambda": rng.uniform(150.0, 320.0, count), "delta": rng.uniform(0.3, 0.7, count), "N": rng.integers(8, 29, count).astype(float)}
+    target = rows.rgb(rows.unit(truth))
+    U0 = rows.unit({**truth, "N": truth["N"] + rng.choice([-1.0, 1.0], count)})
+    _, held_cost = polish_rows(rows, target, None, U0, held=[p.integer for p in rows.free])
+    U, cost = polish_whole(rows, target, None, U0, walk=False)
+    assert np.mean(np.sqrt(cost / len(ANGLES)) < COUNT_WALK_DELTA_E) >= 0.9, np.sqrt(cost / len(ANGLES))
+    assert np.all(cost <= held_cost + 1e-12)
+    # Other counts fit too (Lambda and delta make up for a cell), but the rows the held count left poor moved.
+    stepped = held_cost > COUNT_WALK_DELTA_E**2 * len(ANGLES)
+    assert stepped.any() and np.all(cost[stepped] < held_cost[stepped]), (held_cost, cost)
+
+
+def test_a_neighbour_round_never_repeats_a_start():
+    from explorer.design.paint import _candidates
+
+    U = np.array([[0.1, 0.2, 0.3], [0.4, 0.5, 0.6], [0.7, 0.8, 0.9]])
+    cost = np.array([5.0, 1.0, 0.5])
+    pairs = {0: {1, 2}, 1: {0}, 2: {0}}
+    labels, centre_U, tried = np.zeros(3, dtype=np.int64), U[2:], {}
+    first = _candidates([0], cost, pairs, labels, centre_U, U, tried)
+    assert [list(s) for s in first[0]] == [list(U[2]), list(U[1])]  # the better neighbours, best first
+    assert _candidates([0], cost, pairs, labels, centre_U, U, tried)[0] == []  # nothing new: no second polish
+    U[1] += 0.05  # a neighbour improved: its new structure is a new start
+    assert [list(s) for s in _candidates([0], cost, pairs, labels, centre_U, U, tried)[0]] == [list(U[1])]

@@ -133,12 +133,15 @@ def design_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds:
             "seconds": time.perf_counter() - start}
 
 
-def polish_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds: np.ndarray, starts: np.ndarray) -> dict:
-    """Colours ``rgb`` ``(B, A, 3)`` polished from unit rows ``starts`` ``(B, P)`` on the coarse model."""
+def polish_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds: np.ndarray, starts: np.ndarray, walk: bool = True) -> dict:
+    """
+    Colours ``rgb`` ``(B, A, 3)`` polished from unit rows ``starts`` ``(B, P)`` on the coarse model; ``walk``: the
+    counts may walk freely (starts from other regions' structures; :func:`explorer.design.pixels.polish_whole`).
+    """
     start = time.perf_counter()
     model, _, free, cos_theta = _problem_parts(model_name, ranges, fixed, angles)
     rows = RowModel(model, free, fixed, cos_theta)
-    U, cost = polish_whole(rows, rgb, bounds if np.any(bounds) else None, starts)
+    U, cost = polish_whole(rows, rgb, bounds if np.any(bounds) else None, starts, walk=walk)
     return {"U": U, "cost": cost, "seconds": time.perf_counter() - start}
 
 
@@ -348,7 +351,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
                 tried = [(c, U[nearest[y, x]]) for c, (y, x) in zip(members, where)]
             index = np.array([c for c, _ in tried], dtype=np.int64)
             trial_U, trial_cost = _polish_many(runner, f"polish level {level + 1} of {len(levels)}", model_name, ranges, fixed, angles,
-                                               colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]))
+                                               colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]), walk=level == 0)
             for k, c in enumerate(index):
                 if trial_cost[k] < cost[c]:
                     U[c], cost[c] = trial_U[k], trial_cost[k]
@@ -357,17 +360,18 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
 
     # 5. Neighbours' structures for colours left above POLISHED_DELTA_E.
     neighbour_pairs = _neighbour_colours(pixel_colour)
+    tried_starts: dict[int, list[np.ndarray]] = {}
     for round_ in range(NEIGHBOUR_ROUNDS):
         poor = live[np.sqrt(cost[live] / len(angles)) > POLISHED_DELTA_E]
         if poor.size == 0:
             break
-        candidates_of = _candidates(poor, cost, neighbour_pairs, labels, centre_U, U)
+        candidates_of = _candidates(poor, cost, neighbour_pairs, labels, centre_U, U, tried_starts)
         tried = [(c, u) for c in poor for u in candidates_of[c]]
-        if not tried:
+        if not tried:  # no new start: another round would repeat this one
             break
         index = np.array([c for c, _ in tried])
         trial_U, trial_cost = _polish_many(runner, f"neighbours {round_ + 1}", model_name, ranges, fixed, angles,
-                                           colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]))
+                                           colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]), walk=True)
         for k, c in enumerate(index):
             if trial_cost[k] < cost[c] - 1e-12:
                 U[c], cost[c] = trial_U[k], trial_cost[k]
@@ -401,15 +405,16 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
                 structure = {k: float(v[0]) for k, v in rows_of.values(U[c][None], whole=True).items()}
                 achieved[c] = model.converged(structure, rows_of.cos_theta, final=True)
                 delta_e[c] = delta_e_rows(achieved[c][None], colour_rgb[c][None], colour_bounds[c][None])[0]
+    spread_starts: dict[int, list[np.ndarray]] = {}
     for round_ in range(NEIGHBOUR_ROUNDS if chosen else 0):
         score = np.sum(delta_e**2, axis=1)
         poor = live[np.max(delta_e[live], axis=1) > REACHABLE_DELTA_E]
-        tried = [(c, u) for c, starts in _candidates(poor, score, neighbour_pairs, labels, centre_U, U).items() for u in starts]
+        tried = [(c, u) for c, starts in _candidates(poor, score, neighbour_pairs, labels, centre_U, U, spread_starts).items() for u in starts]
         if not tried:
             break
         index = np.array([c for c, _ in tried], dtype=np.int64)
         trial_U, _ = _polish_many(runner, f"spread {round_ + 1}", model_name, ranges, fixed, angles, colour_rgb[index],
-                                  colour_bounds[index], np.array([u for _, u in tried]))
+                                  colour_bounds[index], np.array([u for _, u in tried]), walk=True)
         pieces = [slice(s, s + CHUNK) for s in range(0, index.size, CHUNK)]
         results = runner.map(f"spread {round_ + 1} converged", converged_task,
                              [(model_name, dict(ranges), fixed, angles, colour_rgb[index[s]], colour_bounds[index[s]], trial_U[s]) for s in pieces])
@@ -443,10 +448,14 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
                        tasks=runner.tasks, critical_path=runner.critical_path, task_seconds=runner.task_seconds)
 
 
-def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, starts):
-    """:func:`polish_task` over chunks of :data:`CHUNK` rows."""
+def _polish_many(runner, stage, model_name, ranges, fixed, angles, rgb, bounds, starts, walk):
+    """
+    :func:`polish_task` over chunks of :data:`CHUNK` rows. ``walk``: counts walk freely where a start may lie in
+    another region (the clusters' structures, and the retries of colours their neighbours' start left poor); a
+    finer level's start from its nearest polished pixel only tries its count one either way.
+    """
     pieces = [slice(s, s + CHUNK) for s in range(0, rgb.shape[0], CHUNK)]
-    results = runner.map(stage, polish_task, [(model_name, dict(ranges), fixed, angles, rgb[s], bounds[s], starts[s]) for s in pieces])
+    results = runner.map(stage, polish_task, [(model_name, dict(ranges), fixed, angles, rgb[s], bounds[s], starts[s], walk) for s in pieces])
     return np.concatenate([r["U"] for r in results]), np.concatenate([r["cost"] for r in results])
 
 
@@ -524,17 +533,22 @@ NEIGHBOUR_STARTS = 2
 OTHER_CLUSTERS = 2
 
 
-def _candidates(poor, cost, pairs, labels, centre_U, U) -> dict[int, list[np.ndarray]]:
-    """Per poor colour, distinct starts: its better polished neighbours' structures (its cluster's when it has none)."""
+def _candidates(poor, cost, pairs, labels, centre_U, U, tried: dict[int, list[np.ndarray]] | None = None) -> dict[int, list[np.ndarray]]:
+    """
+    Per poor colour, distinct starts: its better polished neighbours' structures (its cluster's when it has none),
+    less those it has already been polished from (``tried``, updated: a round repeats no polish).
+    """
     out = {}
     for c in poor:
         neighbours = sorted((n for n in pairs.get(int(c), ()) if cost[n] < cost[c]), key=lambda n: (cost[n], n))
-        starts = [U[n] for n in neighbours[:NEIGHBOUR_STARTS]]
+        starts = [U[n].copy() for n in neighbours[:NEIGHBOUR_STARTS]]  # copies: U's rows change as colours improve
         if not starts and labels[c] >= 0:
-            starts.append(centre_U[labels[c]])
+            starts.append(centre_U[labels[c]].copy())
+        before = [] if tried is None else tried.setdefault(int(c), [])
         distinct = []
         for s in starts:
-            if all(np.max(np.abs(s - d)) > 1e-6 for d in distinct) and np.max(np.abs(s - U[c])) > 1e-6:
+            if all(np.max(np.abs(s - d)) > 1e-6 for d in distinct + before) and np.max(np.abs(s - U[c])) > 1e-6:
                 distinct.append(s)
+        before.extend(distinct)
         out[int(c)] = distinct
     return out

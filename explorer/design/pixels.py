@@ -19,7 +19,7 @@ from explorer.physics import colorimetry
 #: Damped Gauss-Newton steps of :func:`polish_rows` (each ~P + 1 batch evaluations of the active rows).
 POLISH_STEPS = 14
 #: A row stops once its RMS CIEDE2000 per angle is below this.
-POLISH_TOLERANCE = 0.05
+POLISH_TOLERANCE = 0.1
 #: ... or once an accepted step lowers its cost by less than this share (a minimum: a held count that does not fit).
 POLISH_STALL = 0.01
 #: ... or once its damping, raised fourfold by each rejected step, passes this (five rejections in a row from the
@@ -160,23 +160,44 @@ def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | Non
 
 
 def polish_whole(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,
-                 steps: int = POLISH_STEPS) -> tuple[np.ndarray, np.ndarray]:
+                 steps: int = POLISH_STEPS, walk: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """
     Every row polished from ``U0`` (whole counts: a neighbour's or a design's structure) with its integer
     parameters (``N``) held, which is all a start that close needs; the rows left above
-    :data:`COUNT_WALK_DELTA_E` then walk their counts too (:func:`polish_rounded`), and keep the better end.
+    :data:`COUNT_WALK_DELTA_E` then try their counts one step either way (held again, from where they stopped: a
+    smooth map's neighbours differ by a cell or none), and with ``walk`` those still above it walk their counts
+    freely (:func:`polish_rounded`: for starts from another region's structure; from a neighbour's it rescues few
+    rows at the cost of the two steps before). Each row keeps its best.
     Returns the rows' structures with whole counts, and their coarse costs.
     """
     held = [p.integer for p in rows.free]
     U, cost = polish_rows(rows, target_rgb, bounds, U0, held=held if any(held) else None, steps=steps)
     if not any(held):
         return U, cost
-    poor = np.flatnonzero(cost > COUNT_WALK_DELTA_E**2 * rows.cos_theta.size)
+    limit = COUNT_WALK_DELTA_E**2 * rows.cos_theta.size
+    poor = np.flatnonzero(cost > limit)
     if poor.size:
+        V = np.concatenate([_count_step(rows, U[poor], side) for side in (-1.0, 1.0)])
+        twice = np.concatenate([poor, poor])
+        V, c = polish_rows(rows, target_rgb[twice], None if bounds is None else bounds[twice], V, held=held, steps=steps)
+        for k, row in enumerate(twice):
+            if c[k] < cost[row]:
+                U[row], cost[row] = V[k], c[k]
+    poor = np.flatnonzero(cost > limit) if walk else []
+    if len(poor):
         V, c = polish_rounded(rows, target_rgb[poor], None if bounds is None else bounds[poor], U0[poor], max(4, steps // 2))
         better = c < cost[poor]
         U[poor[better]], cost[poor[better]] = V[better], c[better]
     return U, cost
+
+
+def _count_step(rows: RowModel, U: np.ndarray, side: float) -> np.ndarray:
+    """Unit rows ``U`` with each integer parameter one whole step to ``side`` (within its range)."""
+    V = U.copy()
+    for k, p in enumerate(rows.free):
+        if p.integer:
+            V[:, k] = np.clip(p.to_unit(np.clip(np.round(p.from_unit(U[:, k])) + side, p.low, p.high)), 0.0, 1.0)
+    return V
 
 
 def polish_rounded(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,

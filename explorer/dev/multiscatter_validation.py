@@ -9,7 +9,7 @@ Per preset and ``alpha``: the directional albedo at :data:`THETA` by the three (
 quadrature of :func:`explorer.views.albedo.albedo_numpy`), the luminance gap ``Y(model) / Y(walk) - 1``
 and ΔE2000 (colour-science, through :func:`explorer.physics.colorimetry.delta_E_2000`) per angle.
 
-Regenerate (about 10-20 minutes on the shared 2 cores)::
+Regenerate (about 35 minutes of wall time on the shared 2 cores at load ~10)::
 
     python3 -m explorer.dev.multiscatter_validation           # docs/multiscatter_validation.json, docs/figures/multiscatter_validation.png
     python3 -m explorer.dev.multiscatter_validation --table   # the Markdown table of docs/layered_validation.md from the JSON
@@ -35,7 +35,7 @@ THETA = (0.0, 20.0, 40.0, 55.0, 70.0)
 ALPHAS = (0.2, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0)
 #: Three one-layer presets over a black base, a two-layer stack over a black base, a layer over a grey base.
 PRESETS = ("figure1_left_alpha04", "figure1_right_alpha04", "figure7_A", "figure1_stacked_pair", "figure7_A_on_base")
-SAMPLES = 32768
+SAMPLES = 131072
 DOCS = SOURCE_ROOT / "docs"
 RESULTS = DOCS / "multiscatter_validation.json"
 FIGURE = DOCS / "figures" / "multiscatter_validation.png"

@@ -150,7 +150,8 @@ def stack_compensation(stack: layered.LayeredBragg, tables: Sequence[layered.Lay
     base = np.zeros_like(host)
     for l, (table, term) in enumerate(zip(tables, terms)):
         (direct, _), (_, single) = multiscatter.reflection_albedos(table.reflectance, table.transmissivity, theta_table,
-                                                                    table.layer.alpha, [exit_b, exit_34])
+                                                                    table.layer.alpha, [exit_b, exit_34],
+                                                                    table.transmittance)
         exit_avg = avg(multiscatter.rows_at(exit_b, rows, step))
         up_source, down_source = l, L + 1 + (l + 1)  # the gap above layer l (up), the gap below (down)
         host += arrive * (direct + term.reflection * (escape[:, up_source] - exit_avg)
