@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 from explorer.materials.brd import load_material
-from explorer.materials.models import model_for
+from explorer.materials.models import BraggStackModel, model_for
+from explorer.materials.twins import shipped_file
 from explorer.physics import colorimetry, layered
-from explorer.resources import material_path
 
 #: Two layers under each host, a coloured base (the hosts the library has that a stack takes).
 CASES = {
@@ -45,7 +45,7 @@ def _at_550(material, values, model):
 def colour_rows() -> list[str]:
     from explorer.views.albedo import albedo_numpy
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     rows = ["| host | n at 400 / 550 / 700 nm | gradient ΔE2000, max (angle) | albedo ΔE2000 at 0 / 40 / 70° | numpy albedo CPU s (one index) |",
             "|---|---|---|---|---|"]
     for name, host in CASES.items():
@@ -74,7 +74,7 @@ def gl_rows(repeats: int = 3) -> list[str]:
     from explorer.gpu.renderer import Renderer
     from explorer.views.albedo import albedo_gl
 
-    material = load_material(material_path("bragg_stack"))
+    material = load_material(shipped_file(BraggStackModel))
     renderer = Renderer()
     values = {name: material.resolve({**BASE, **host}) for name, host in (("chitin", CASES["chitin"]), ("one index", {"nh": "1.5561", "n1_1": "1.5561"}))}
     models = {name: model_for(material, v) for name, v in values.items()}
