@@ -13,6 +13,7 @@ Regenerate (about 35 minutes of wall time on the shared 2 cores at load ~10)::
 
     python3 -m explorer.dev.multiscatter_validation           # docs/multiscatter_validation.json, docs/figures/multiscatter_validation.png
     python3 -m explorer.dev.multiscatter_validation --table   # the Markdown table of docs/layered_validation.md from the JSON
+    python3 -m explorer.dev.multiscatter_validation --presets figure7_A --alphas 1.0   # only these rows; the others are kept
 
 References
 ----------
@@ -75,6 +76,15 @@ def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0) -> d
         row[f"{key}_dY"] = (rgb @ LUMINANCE / Y - 1.0).tolist()
         row[f"{key}_dE"] = colorimetry.delta_E_2000(reference.value, rgb).tolist()
     return row
+
+
+def merged(rows: list[dict]) -> list[dict]:
+    """``rows`` in place of the stored rows of the same preset and alpha, the others kept, in the default order."""
+    stored = json.loads(RESULTS.read_text(encoding="utf-8")) if RESULTS.exists() else []
+    by_key = {(r["preset"], float(r["alpha"])): r for r in stored}
+    by_key.update({(r["preset"], float(r["alpha"])): r for r in rows})
+    rank = {name: k for k, name in enumerate(PRESETS)}
+    return sorted(by_key.values(), key=lambda r: (rank.get(r["preset"], len(rank)), r["preset"], float(r["alpha"])))
 
 
 def table(rows: list[dict]) -> str:
@@ -184,6 +194,7 @@ def main(argv=None) -> int:
                 print(f"{name} alpha={alpha:g}: single max|dY| {100 * np.abs(r['single_dY']).max():.1f} % median dE "
                       f"{np.median(r['single_dE']):.2f}; compensated {100 * np.abs(r['compensated_dY']).max():.1f} % "
                       f"{np.median(r['compensated_dE']):.2f}", file=sys.stderr, flush=True)
+        rows = merged(rows)
         write_text_atomic(RESULTS, json.dumps(rows, indent=1) + "\n")
         figure(rows, FIGURE)
     rows = json.loads(RESULTS.read_text(encoding="utf-8"))
