@@ -48,6 +48,9 @@ class DesignModel:
     batch: Callable
     #: ``converged(values: dict of floats, cos_theta (A,), final: bool) -> (A, 3)``: the reference when ``final``.
     converged: Callable
+    #: Optional ``gradient(values, cos_theta (A,), step=COARSE_STEP) -> (rgb (B, A, 3), {name: d rgb / d name})`` of the
+    #: batch model, or None for rows it does not cover (the caller then differences the batch).
+    gradient: Callable | None = None
     #: A parameter whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
     host_parameter: str | None = None
     host_threshold: float = 1.0
