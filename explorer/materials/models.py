@@ -152,6 +152,15 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     return bragg.converged_rgb(cos_theta, mirror)
 
 
+def bragg_converged_many(values: Mapping[str, np.ndarray], cos_theta) -> np.ndarray:
+    """:func:`bragg_converged_rgb` (final) of many mirrors ``values`` (arrays ``(B,)``): ``(B, A, 3)``, in one refinement."""
+    rows = np.asarray(values["Lambda"]).shape[0]
+    if natural_values(values):
+        return np.array([natural_converged({k: float(v[i]) for k, v in values.items()}, {}, cos_theta, True) for i in range(rows)])
+    mirrors = [mirror_of({k: float(v[i]) for k, v in values.items()}) for i in range(rows)]
+    return bragg.reference_rgb_many(np.asarray(cos_theta, dtype=np.float64), mirrors)
+
+
 # Natural mirrors in design: indices naming media (explorer.design.media), absorbing and disordered layers.
 
 #: The index parameters that may name a medium.
@@ -235,6 +244,7 @@ def natural_converged(values: Mapping[str, float], media: Mapping, cos_theta, fi
 #: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
 BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
                            integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, gradient=bragg_rgb_gradient,
+                           converged_many=bragg_converged_many,
                            host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
                            paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 

@@ -129,15 +129,18 @@ def bragg_reflectance_batch(
     cos_2 = cos_theta_transmitted(cos_h, np.where(nh >= 1.0, nh, n1), n2)
     cos_1 = cos_theta_transmitted(cos_h, np.where(nh >= 1.0, nh, n1), n1)
     simple = ((nh < 1.0) | (nh == n1)) & (np.imag(cos_1) == 0.0) & (np.imag(cos_2) == 0.0)
-    simple = np.all(simple.reshape(rows, -1), axis=1)
-    shape = (rows, cos_h.shape[1], wavelengths.shape[2])
+    simple = np.all(np.broadcast_to(simple, np.broadcast_shapes(simple.shape, (rows, cos_h.shape[1], 1))), axis=2)  # (B, A)
     if simple.all():
         return _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, smooth)[0]
-    out = np.empty(shape)
+    out = np.empty((rows, cos_h.shape[1], wavelengths.shape[2]))
     if simple.any():
-        pick = lambda v: v[simple]  # noqa: E731
-        out[simple] = _lossless_reflectance(*map(pick, (n1, n2, Lambda, delta, N)), cos_h, wavelengths, step, smooth)[0]
-    out[~simple] = _host_reflectance(*(v[~simple] for v in (n1, n2, Lambda, delta, N, nh)), cos_h, wavelengths, step, smooth)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            out[...] = _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, smooth)[0]
+    # Each other (mirror, angle) through the complex coefficients, one row per pair.
+    row, angle = np.nonzero(~simple)
+    pairs = _host_reflectance(*(v[row] for v in (n1, n2, Lambda, delta, N, nh)), cos_h[0, angle, 0].reshape(-1, 1, 1), wavelengths,
+                              step, smooth)
+    out[row, angle] = pairs[:, 0]
     return out
 
 
@@ -190,6 +193,8 @@ def _host_reflectance(n1, n2, Lambda, delta, N, nh, cos_h, wavelengths, step, sm
     return np.clip(total / 2.0, 0.0, 1.0)
 
 
+#: A cell whose ``|r1|^2 / |t1|^2`` is below this reflects nothing (its phases at multiples of pi, to rounding).
+ABSENTEE = 1e-24
 #: Below this ``|sin K Lambda|`` or ``Im K Lambda`` the derivatives of ``U_{N-1}`` take their series at the band
 #: edge (``dU/da = N (N^2 - 1) / 3``): the closed forms cancel there.
 SERIES_EDGE = 1e-4
@@ -313,7 +318,8 @@ def _polarisation(cell: _Cell, r12, half_omega, gradient: bool):
     if cell.blended:
         s2_avg = np.where(band, s2, 0.0)  # sin^2 K Lambda: 0 in a gap, whose average is 1
         D_avg = r1_2 + t1_2 * s2_avg
-        rho = np.divide(t1_2 * s2_avg, D_avg, out=np.ones(shape), where=D_avg > 0.0)
+        # A cell that reflects nothing (an absentee cell: |r1|^2 at rounding) has no gap and no fringes: R = 0, not 0/0.
+        rho = np.divide(t1_2 * s2_avg, D_avg, out=np.ones(shape), where=(D_avg > 0.0) & (r1_2 > ABSENTEE * t1_2))
         root = np.sqrt(rho)
         R_avg = 1.0 - root
         R = w * R_point + (1.0 - w) * R_avg
