@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
+from conftest import REPO_ROOT, one_line_error, run_cli
 from test_maps_render import mesh_safe_pixels, render_maps_by_both_engines, write_map_folder
 from twins import Twins, assert_twins_equal, render_both
 
