@@ -6,6 +6,11 @@ differences for comparison), and the converged reference colour per structure (o
 :meth:`explorer.materials.twins.DesignModel.converged_rows`), on the round trip's box (:mod:`explorer.bench.paint`).
 
     .venv/bin/python -m explorer.dev.paint_cost       # ~1 minute
+
+With ``--round-trip SIZE``: instead, ``bench --paint``'s round trip at SIZE x SIZE painted in this one process (no Dask),
+its CPU seconds (all threads), the stages' wall seconds and the share of pixels within CIEDE2000 1 at both angles.
+
+    .venv/bin/python -m explorer.dev.paint_cost --round-trip 64       # ~3-8 minutes
 """
 
 from __future__ import annotations
@@ -63,5 +68,37 @@ def main() -> None:
           f"{1e3 * many / STRUCTURES:.2f} ms each all at once")
 
 
+def round_trip(size: int, seed: int = 0) -> None:
+    """``bench --paint``'s round trip painted here, in one process: CPU seconds and the share within 1 (re-rendered)."""
+    from explorer.bench.paint import ANGLES, ROUND_TRIP_BOX, _targets, smooth_random_maps
+    from explorer.design import ranges_of
+    from explorer.design.forward import design_model
+    from explorer.design.paint import paint
+    from explorer.materials.brd import load_material
+    from explorer.materials.models import BraggMirrorModel
+    from explorer.materials.twins import shipped_file
+    from explorer.physics.colorimetry import delta_E_2000
+    from explorer.views.maps import map_colours
+
+    material = load_material(shipped_file(BraggMirrorModel))
+    model = design_model(material.model)
+    defaults = material.resolve({})
+    fixed = {name: float(defaults[name]) for name in model.parameters if name not in ROUND_TRIP_BOX}
+    targets = _targets(model.name, fixed, smooth_random_maps(size, seed))
+    start = time.process_time()
+    result = paint(model.name, ranges_of(material), fixed, targets, seed=seed)
+    cpu = time.process_time() - start
+    again = np.stack([map_colours(model.name, result.fixed, result.maps, a) for a in ANGLES]).astype(np.float64)
+    within = float(np.mean(np.all(delta_E_2000(again, targets.rgb) <= 1.0, axis=0)))
+    print(f"round trip {size}x{size}, one process: {cpu:.1f} CPU s; {100 * within:.1f} % of pixels within ΔE2000 1 at "
+          f"{' and '.join(f'{a:g}' for a in ANGLES)} degrees; {result.colours} colours, {result.clusters} clusters")
+    print("  stages (wall s): " + ", ".join(f"{k} {v:.1f}" for k, v in result.stages.items()))
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+
+    if len(sys.argv) == 3 and sys.argv[1] == "--round-trip":
+        round_trip(int(sys.argv[2]))
+    else:
+        main()
