@@ -130,12 +130,12 @@ def bragg_reflectance_batch(
     cos_1 = cos_theta_transmitted(cos_h, np.where(nh >= 1.0, nh, n1), n1)
     simple = ((nh < 1.0) | (nh == n1)) & (np.imag(cos_1) == 0.0) & (np.imag(cos_2) == 0.0)
     simple = np.all(np.broadcast_to(simple, np.broadcast_shapes(simple.shape, (rows, cos_h.shape[1], 1))), axis=2)  # (B, A)
-    if simple.all():
-        return _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, smooth)[0]
     out = np.empty((rows, cos_h.shape[1], wavelengths.shape[2]))
     if simple.any():
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            out[...] = _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, smooth)[0]
+        for at, part in _row_blocks(rows, cos_h, wavelengths, (n1, n2, Lambda, delta, N)):
+            out[at] = _lossless_reflectance(*part, cos_h, wavelengths, step, smooth)[0]
+    if simple.all():
+        return out
     # Each other (mirror, angle) through the complex coefficients, one row per pair.
     row, angle = np.nonzero(~simple)
     pairs = _host_reflectance(*(v[row] for v in (n1, n2, Lambda, delta, N, nh)), cos_h[0, angle, 0].reshape(-1, 1, 1), wavelengths,
@@ -162,7 +162,25 @@ def bragg_reflectance_batch_gradient(
     if np.any(nh >= 1.0) or np.any(np.imag(cos_2) != 0.0):
         return None
     wavelengths = np.asarray(wavelengths, dtype=np.float64).reshape(1, 1, -1)
-    return _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, smooth, gradient=True)
+    R = np.empty((rows, cos_h.shape[1], wavelengths.shape[2]))
+    grads = {name: np.empty_like(R) for name in ("Lambda", "delta", "N")}
+    for at, part in _row_blocks(rows, cos_h, wavelengths, (n1, n2, Lambda, delta, N)):
+        R[at], block = _lossless_reflectance(*part, cos_h, wavelengths, step, smooth, gradient=True)
+        for name, value in block.items():
+            grads[name][at] = value
+    return R, grads
+
+
+#: Samples (rows x angles x wavelengths) per block of the lossless path: its ~40 temporaries stay in cache.
+BLOCK_SAMPLES = 1 << 13
+
+
+def _row_blocks(rows: int, cos_h, wavelengths, columns):
+    """``(slice, columns[slice])`` over blocks of rows of about :data:`BLOCK_SAMPLES` samples each."""
+    size = max(1, BLOCK_SAMPLES // max(1, cos_h.shape[1] * wavelengths.shape[2]))
+    for start in range(0, rows, size):
+        at = slice(start, start + size)
+        yield at, tuple(v[at] for v in columns)
 
 
 def _host_reflectance(n1, n2, Lambda, delta, N, nh, cos_h, wavelengths, step, smooth) -> np.ndarray:
@@ -232,10 +250,11 @@ def _lossless_reflectance(n1, n2, Lambda, delta, N, cos_h, wavelengths, step, sm
     same = np.all(np.broadcast_to(same_polarisations(r12_s * r12_s, r12_p * r12_p, half_s, half_p),
                                   np.broadcast_shapes(r12_s.shape, half_s.shape, (1, shape[1], 1))), axis=(0, 2))
     twice = np.where(same, 2.0, 1.0).reshape(1, -1, 1)
-    terms = [(_polarisation(cell, r12_s, half_s, gradient), twice)]
     differ = np.flatnonzero(~same)
-    if differ.size:
-        terms.append((_polarisation(cell.at(differ), r12_p[:, differ], half_p[:, differ], gradient), differ))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        terms = [(_polarisation(cell, r12_s, half_s, gradient), twice)]
+        if differ.size:
+            terms.append((_polarisation(cell.at(differ), r12_p[:, differ], half_p[:, differ], gradient), differ))
     total = terms[0][0][0] * twice
     if differ.size:
         total[:, differ] += terms[1][0][0]
@@ -291,41 +310,51 @@ def _polarisation(cell: _Cell, r12, half_omega, gradient: bool):
     N, w = cell.N, cell.w
     shape = w.shape
     a = cell.cos_cos - half_omega * cell.sin_sin  # Eq. 8
-    r1_2 = 4.0 * (r12 * r12) * cell.sin2_phi
-    t1_2 = np.broadcast_to((1.0 - r12 * r12) ** 2, shape)
+    r12_2 = r12 * r12
+    r1_2 = (4.0 * r12_2) * cell.sin2_phi
+    t1_2 = (1.0 - r12_2) ** 2  # (B, A, 1), broadcast
     band = np.abs(a) < 1.0
     gap = ~band
-    a_band = np.where(band, a, 0.0)
-    s2 = 1.0 - a_band * a_band
-    sin_t = np.sqrt(s2)
+    any_gap = bool(gap.any())
+    a_band = np.where(band, a, 0.0) if any_gap else a
+    s2 = 1.0 - a_band * a_band  # sin^2 K Lambda in the band (1 in a gap, unused there)
     t = np.arccos(a_band)
     Nt = N * t
     sin_Nt = np.sin(Nt)
-    edge = band & (sin_t < BATCH_EDGE)
-    U = np.where(edge, N, sin_Nt / np.where(edge, 1.0, sin_t))
-    # In a gap (Eq. 9): x = Im K Lambda = acosh |a|, S = 1 / U = sinh x / sinh N x (only there: where= skips the rest).
+    edge = s2 < BATCH_EDGE * BATCH_EDGE
+    # In the band R = |r1|^2 G / (|r1|^2 G + |t1|^2), G = U^2 = sin^2 N t / sin^2 t (N^2 at a band edge).
+    G = sin_Nt * sin_Nt / np.where(edge, 1.0, s2)
+    if edge.any():
+        G = np.where(edge, N * N, G)
+    D = r1_2 * G + t1_2
+    R_point = np.divide(r1_2 * G, D, out=np.zeros(shape), where=D > 0.0)
+    # In a gap (Eq. 9): x = Im K Lambda = acosh |a|, S = 1 / U = sinh x / sinh N x, R = |r1|^2 / (|r1|^2 + |t1|^2 S^2).
     x = np.ones(shape)
-    np.arccosh(np.abs(a), out=x, where=gap)
-    x = np.maximum(x, 1e-12)
     S = np.zeros(shape)
-    if gap.any():
-        Nb = np.broadcast_to(N, shape)
-        S[gap] = (np.exp(-(Nb[gap] - 1.0) * x[gap]) * np.expm1(-2.0 * x[gap]) / np.expm1(-2.0 * Nb[gap] * x[gap]))
-    G = U * U
-    D = np.where(band, r1_2 * G + t1_2, r1_2 + t1_2 * S * S)
-    R_point = np.divide(np.where(band, r1_2 * G, r1_2), D, out=np.zeros(shape), where=D > 0.0)
+    if any_gap:
+        Nb, r1_2b, t1_2b = (np.broadcast_to(v, shape) for v in (N, r1_2, t1_2))
+        xg = np.maximum(np.arccosh(np.abs(a[gap])), 1e-12)
+        Ng = Nb[gap]
+        Sg = np.exp(-(Ng - 1.0) * xg) * np.expm1(-2.0 * xg) / np.expm1(-2.0 * Ng * xg)
+        x[gap], S[gap] = xg, Sg
+        rg = r1_2b[gap]
+        Dg = rg + t1_2b[gap] * Sg * Sg
+        R_point[gap] = np.divide(rg, Dg, out=np.zeros(Dg.shape), where=Dg > 0.0)
     R, jump = R_point, None
     if cell.blended:
-        s2_avg = np.where(band, s2, 0.0)  # sin^2 K Lambda: 0 in a gap, whose average is 1
+        s2_avg = np.where(band, s2, 0.0) if any_gap else s2  # sin^2 K Lambda: 0 in a gap, whose average is 1
         D_avg = r1_2 + t1_2 * s2_avg
         # A cell that reflects nothing (an absentee cell: |r1|^2 at rounding) has no gap and no fringes: R = 0, not 0/0.
         rho = np.divide(t1_2 * s2_avg, D_avg, out=np.ones(shape), where=(D_avg > 0.0) & (r1_2 > ABSENTEE * t1_2))
         root = np.sqrt(rho)
         R_avg = 1.0 - root
-        R = w * R_point + (1.0 - w) * R_avg
         jump = R_point - R_avg
+        R = R_avg + w * jump
     if not gradient:
         return R, jump, None, None, None
+    sin_t = np.sqrt(np.where(band, s2, 1.0))
+    U = np.where(edge, N, sin_Nt / np.where(edge, 1.0, sin_t))
+    D = np.where(band, D, r1_2 + t1_2 * S * S)
     cos_Nt = np.cos(Nt)
     small = sin_t < SERIES_EDGE
     safe = np.where(small, np.maximum(sin_t, BATCH_EDGE), sin_t)

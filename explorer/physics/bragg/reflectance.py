@@ -233,7 +233,7 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
 
 def same_polarisations(r12_2_s, r12_2_p, half_omega_s, half_omega_p) -> np.ndarray:
     """Where both polarisations' ``r12^2`` and ``Omega`` agree (to rounding: normal incidence), elementwise."""
-    return (np.isclose(r12_2_s, r12_2_p, rtol=1e-14, atol=1e-300) & np.isclose(half_omega_s, half_omega_p, rtol=1e-14, atol=1e-300))
+    return (np.abs(r12_2_s - r12_2_p) <= 1e-14 * np.abs(r12_2_p)) & (np.abs(half_omega_s - half_omega_p) <= 1e-14 * np.abs(half_omega_p))
 
 
 #: Rows of angles per block of the fast path: 32 x 471 float32 temporaries stay in cache.
