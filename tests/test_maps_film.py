@@ -10,9 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
-from test_app import x_display  # noqa: F401  (the session's Xvfb fixture)
-from test_maps_render import mesh_safe_pixels, write_map_folder
+from conftest import REPO_ROOT, one_line_error, run_cli
+from test_maps_render import mesh_safe_pixels, render_maps_by_both_engines, write_map_folder
 from twins import Twins, assert_twins_equal, render_both
 
 FILM = REPO_ROOT / "shaders" / "thin_film.brd"
@@ -153,15 +152,10 @@ def test_film_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, fil
 @pytest.mark.gl
 def test_cli_render_film_maps_gl_equals_numpy(folder, tmp_path):
     """``render --maps DIR`` of a film's folder (MATERIAL from params.json) by GL equals ``--engine numpy``."""
-    images = {}
-    for engine in ("gl", "numpy"):
-        out = tmp_path / f"{engine}.npy"
-        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", "textured", "--engine", engine,
-                                                              "--set", "method=3", "--size", "36x28", "--out", out)
-        assert run.returncode == 0, run.stderr
-        assert "d, eta2 from 12x10 maps" in run.stdout, run.stdout
-        images[engine] = np.load(out)
-    assert_twins_equal(Twins.of(images["gl"], images["numpy"], "textured"), "render --maps (film)")
+    shown = render_maps_by_both_engines(folder, tmp_path, "--set", "method=3", "--size", "36x28")
+    for stdout, _ in shown.values():
+        assert "d, eta2 from 12x10 maps" in stdout, stdout
+    assert_twins_equal(Twins.of(shown["gl"][1], shown["numpy"][1], "textured"), "render --maps (film)")
 
 
 def test_cli_a_material_without_maps_is_one_line(folder, tmp_path):

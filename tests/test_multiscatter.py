@@ -21,12 +21,13 @@ from conftest import REPO_ROOT
 from explorer.materials.brd import load_material
 from explorer.materials.models import BraggStackModel, model_for
 from explorer.physics import colorimetry, layered, multiscatter_stack, position_free
-from explorer.views.albedo import albedo_gl, albedo_numpy
+from explorer.views.albedo import albedo_numpy
 from test_bragg_layer import directions
+import white_furnace
+from white_furnace import FURNACE_ALPHAS
 
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-FURNACE_THETA = (0.0, 45.0, 70.0)
 ONE_LAYER = {"layers": 1, "nh": 1.0, "rho_d": 0.0, "N_1": 10, "multiple_scattering": 1}
 
 
@@ -37,25 +38,18 @@ def stack_material():
 
 @pytest.fixture
 def white_facets(monkeypatch):
-    monkeypatch.setattr(BraggStackModel, "facet_reflectance_override", 1.0)
+    white_furnace.white_facets(monkeypatch, BraggStackModel)
 
 
-@pytest.mark.parametrize("alpha", [0.6, 1.0])
+@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
 def test_white_furnace_numpy(stack_material, white_facets, alpha):
-    values = stack_material.resolve({**ONE_LAYER, "alpha_1": alpha})
-    albedo = albedo_numpy(model_for(stack_material, values), FURNACE_THETA)
-    assert np.all(albedo >= 0.99) and np.all(albedo <= 1.005), albedo
-    single = albedo_numpy(model_for(stack_material, {**values, "multiple_scattering": False}), (45.0,))
-    assert np.all(single < 0.8), single  # what the compensation puts back
+    white_furnace.assert_white_furnace_numpy(stack_material, stack_material.resolve({**ONE_LAYER, "alpha_1": alpha}))
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("alpha", [0.6, 1.0])
+@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
 def test_white_furnace_gl(gl_renderer, stack_material, white_facets, alpha):
-    values = stack_material.resolve({**ONE_LAYER, "alpha_1": alpha})
-    model = model_for(stack_material, values)
-    albedo = albedo_gl(stack_material, values, (0.0, 70.0), gl_renderer, size=256, model=model)
-    assert np.all(albedo >= 0.99) and np.all(albedo <= 1.005), albedo
+    white_furnace.assert_white_furnace_gl(gl_renderer, stack_material, stack_material.resolve({**ONE_LAYER, "alpha_1": alpha}))
 
 
 def test_transparent_facets_over_a_white_base(stack_material, monkeypatch):
