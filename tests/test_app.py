@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT
+from conftest import BRAGG_MATERIAL, BRDF_DATA, REPO_ROOT, one_line_error, run_cli
 
 from explorer.app.parameter_files import load_values, parse_bparam, save_values
 from explorer.materials.brd import load_material
@@ -246,6 +246,11 @@ def test_bench_app_measures_drag_frames(x_display, tmp_path):
     for row in views.values():
         assert row["frames"] >= least and 0.0 < row["median_ms"] <= row["max_ms"] and row["view_updates_per_s"] > 0.0, row
     assert views["textured"]["size"] == [128, 128] and views["textured"]["draft_fraction"] > 0.0, views["textured"]
+
+
+def test_bench_frames_goes_with_app():
+    assert "--frames goes with --app" in one_line_error(run_cli("bench", "--frames", "10"))
+    assert "'--frames': 2 is not in the range" in one_line_error(run_cli("bench", "--app", "--frames", "2"))
 
 
 def test_orbit_camera_turns_the_light_relative_to_the_view(x_display, tmp_path):
