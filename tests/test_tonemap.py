@@ -114,6 +114,7 @@ def test_gamut_overlay_judges_linear_values_before_the_curve(gl_renderer):
     assert differs[outside].mean() > 0.9
 
 
+@pytest.mark.slow
 def test_render_tonemap_png_and_linear_outputs(tmp_path):
     """
     ``render --tonemap``: the lit view's PNG is AgX of the exposed image by default (the .npy written beside it,

@@ -9,6 +9,7 @@ Also the clustering of target colours in CIELAB (k-means, scipy) that decides wh
 
 from __future__ import annotations
 
+import math
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -19,7 +20,7 @@ from explorer.physics import colorimetry
 #: Damped Gauss-Newton steps of :func:`polish_rows` (each ~P + 1 batch evaluations of the active rows).
 POLISH_STEPS = 14
 #: A row stops once its RMS CIEDE2000 per angle is below this.
-POLISH_TOLERANCE = 0.1
+POLISH_TOLERANCE = 0.2
 #: ... or once an accepted step lowers its cost by less than this share (a minimum: a held count that does not fit).
 POLISH_STALL = 0.01
 #: ... or once its damping, raised fourfold by each rejected step, passes this (five rejections in a row from the
@@ -84,6 +85,63 @@ class RowModel:
             out[start : start + batch] = self.model.batch(self.values(U[start : start + batch]), self.cos_theta, self.step)
         return out
 
+    def rgb_and_jacobian(self, U: np.ndarray, columns: Sequence[int], batch: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Colours ``(B, A, 3)`` of unit rows ``U`` and their derivatives ``(B, c, A, 3)`` by the unit parameters
+        ``columns``: the model's analytic gradient where it declares one for these rows (one evaluation), otherwise
+        forward differences of :data:`COARSE_DIFF_STEP` (``c`` more; backwards at the box's upper edge).
+        """
+        U = np.atleast_2d(np.asarray(U, dtype=np.float64))
+        columns = list(columns)
+        if self.model.gradient is not None:
+            rgb = np.empty((U.shape[0], self.cos_theta.size, 3))
+            J = np.empty((U.shape[0], len(columns), self.cos_theta.size, 3))
+            for start in range(0, U.shape[0], batch):
+                part = U[start : start + batch]
+                found = self.model.gradient(self.values(part), self.cos_theta, self.step)
+                if found is None or any(self.free[k].name not in found[1] for k in columns):
+                    break
+                rgb[start : start + batch] = found[0]
+                for j, k in enumerate(columns):
+                    J[start : start + batch, j] = found[1][self.free[k].name] * self._slope(k, part[:, k])[:, None, None]
+            else:
+                return rgb, J
+        rgb = self.rgb(U)
+        B, P = U.shape
+        h = np.where(U[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (B, c)
+        shifted = np.repeat(U[:, None, :], len(columns), axis=1)
+        shifted[:, np.arange(len(columns)), columns] += h
+        moved = self.rgb(shifted.reshape(-1, P)).reshape(B, len(columns), self.cos_theta.size, 3)
+        return rgb, (moved - rgb[:, None]) / h[:, :, None, None]
+
+    def _slope(self, k: int, u: np.ndarray) -> np.ndarray:
+        """``d value / d u`` of free parameter ``k`` at unit values ``u`` (:meth:`DesignParameter.from_unit`)."""
+        p = self.free[k]
+        if p.log:
+            return p.from_unit(u) * (math.log(p.high) - math.log(p.low))
+        return np.full(np.shape(u), p.high - p.low)
+
+
+def best_starts(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, candidates: np.ndarray) -> np.ndarray:
+    """
+    Per row, of its candidate starts ``candidates`` ``(B, K, P)`` (rows of NaN: none), the one whose colours lie
+    closest to its targets: one evaluation of the batch model per candidate, where a polish from each would cost
+    some fifteen. (Its counts one cell either way are not screened: with Lambda and delta unpolished, the screen
+    picks the right count for a quarter of a smooth map's pixels, fewer than the neighbour's own count does.)
+    Every row needs one finite candidate.
+    """
+    B, K, P = candidates.shape
+    valid = np.all(np.isfinite(candidates), axis=2)
+    b, k = np.nonzero(valid)
+    cost = np.full((B, K), np.inf)
+    cost[b, k] = _costs(rows, target_rgb[b], None if bounds is None else bounds[b], candidates[b, k])
+    return candidates[np.arange(B), np.argmin(cost, axis=1)]
+
+
+def _costs(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U: np.ndarray) -> np.ndarray:
+    """The coarse costs (sum over the angles of CIEDE2000 squared) of unit rows ``U``."""
+    return np.sum(residual_rows(rows.rgb(U), target_rgb, bounds) ** 2, axis=1)
+
 
 def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,
                 held: Sequence[bool] | None = None, steps: int = POLISH_STEPS) -> tuple[np.ndarray, np.ndarray]:
@@ -118,14 +176,16 @@ def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | Non
         differenced = active[fresh[active]]
         exact = fresh[active].copy()  # this step's Jacobian by differences, not carried on by Broyden
         if differenced.size:
-            Ud = U[differenced]
-            h = np.where(Ud[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (b, c)
-            shifted = np.repeat(Ud[:, None, :], c, axis=1)
-            shifted[:, np.arange(c), columns] += h
+            # The colours' Jacobian from the model (analytic where it declares one); the residuals' by differences
+            # along it, in colour space (no model evaluation): r(rgb + h dRGB/du) - r(rgb), over h.
+            rgb_d, J_rgb = rows.rgb_and_jacobian(U[differenced], columns)
+            h = COARSE_DIFF_STEP
+            stepped = (rgb_d[:, None] + h * J_rgb).reshape(-1, angles, 3)
             tr = np.repeat(target_rgb[differenced], c, axis=0)
             tb = None if bounds is None else np.repeat(bounds[differenced], c, axis=0)
-            r_shift = residual_rows(rows.rgb(shifted.reshape(-1, P)), tr, tb).reshape(differenced.size, c, -1)
-            J[differenced] = (r_shift - residuals[differenced][:, None, :]) / h[:, :, None]
+            r_shift = residual_rows(stepped, tr, tb).reshape(differenced.size, c, -1)
+            r_here = residual_rows(rgb_d, target_rgb[differenced], None if bounds is None else bounds[differenced])
+            J[differenced] = (r_shift - r_here[:, None, :]) / h
             fresh[differenced] = False
         Ua, ra, Ja = U[active], residuals[active], J[active]
         JTJ = np.einsum("bcr,bdr->bcd", Ja, Ja)
