@@ -184,7 +184,7 @@ def test_film_flat_maps_gl_equals_numpy(gl_renderer, folder, film):
     assert_twins_equal(Twins(gl, reference, np.ones(gl.shape[:2], bool), "gradient"), "film flat maps")
 
 
-def test_app_opens_a_film_map_folder(x_display, tmp_path, gl_renderer, folder, film):  # noqa: F811
+def test_app_opens_a_film_map_folder(x_display, tmp_path, gl_renderer, folder, film):
     """
     ``open FILM --maps DIR``: the Texture window shows the film's maps (``d`` and ``eta2``, each with its size and
     range) and draws them on the sphere; the image's mean RGB equals what ``render --maps DIR --view textured`` draws.

@@ -431,95 +431,129 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
 
 
 # --------------------------------------------------------------------------------------------------
-# The upward share of the light scattered among the facets: the random walk's paths, reweighted per wavelength
+# The upward share of the light scattered among the facets: the random walk itself, hero wavelengths
 
 #: Incidence angles (host, degrees) of the walked paths; the share is interpolated linearly between them.
-SHARE_THETA_DEG = (0.0, 20.0, 40.0, 60.0, 75.0, 88.0)
-#: Paths per angle, the facet events kept per path (later ones are taken as the reweighting's mean, 1), the seed.
-SHARE_PATHS = 60000
-SHARE_EVENTS = 10
+SHARE_THETA_DEG = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 88.0)
+#: Paths per angle, the facet events kept per path (later ones count 1 on both sides of a path's weight), the seed.
+SHARE_PATHS = 96000
+SHARE_EVENTS = 32
 SHARE_SEED = 2016
-#: The walk's facets reflect with this probability; any other reflectance reweighs the same paths.
-SHARE_SAMPLING_R = 0.5
-#: The share is reweighted every this many nm and interpolated between (a ratio: smoother than ``R``).
-SHARE_STEP_NM = 3
+#: The share is computed at this many wavelengths, evenly spread (about every 3 nm), and interpolated between
+#: (a ratio: smoother than ``R``); a multiple of SHARE_HEROES.
+SHARE_COLUMNS = 160
+#: Wavelengths per path: the hero, which makes the path's choices, and the others evenly spread around the
+#: columns (a rotation: the same set whichever of them is the hero, as Wilkie et al. 2014's balance heuristic needs).
+SHARE_HEROES = 8
+#: The least share of the paths a group of columns gets, against the group that weighs most in a colour.
+SHARE_GROUP_FLOOR = 0.1
 
 
-@functools.lru_cache(maxsize=8)
-def walk_ensemble(alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """
-    The random walk's paths through a layer of roughness ``alpha`` (:func:`explorer.physics.microsurface.walk`)
-    whose facets reflect with probability :data:`SHARE_SAMPLING_R`, :data:`SHARE_PATHS` per angle of
-    :data:`SHARE_THETA_DEG`, seeded: only those scattered among the facets (left upward after two reflections or
-    more, or downward after one or more). A path's geometry depends on its choices only, so the same paths serve
-    every reflectance (:func:`upward_share`).
-
-    Returns
-    -------
-    events : ndarray of int, shape (n, SHARE_EVENTS)
-        Per facet event, its row in a 0.25-degree table of ``theta_d`` plus 361 when it reflected; 722 (a row of
-        ones) after the path's last event.
-    up : ndarray of bool, shape (n,)
-    node : ndarray of int, shape (n,)
-        The path's angle, an index into :data:`SHARE_THETA_DEG`.
-    """
-    from explorer.physics import microsurface
-
-    rng = np.random.default_rng(SHARE_SEED)
-    nodes = len(SHARE_THETA_DEG)
-    n = SHARE_PATHS * nodes
-    node = np.repeat(np.arange(nodes), SHARE_PATHS)
-    theta = np.radians(np.asarray(SHARE_THETA_DEG))[node]
-    count = np.zeros(n, dtype=np.int64)
-    events = np.full((n, SHARE_EVENTS), 722, dtype=np.int64)
-
-    def record(rows, cos_d, reflect):
-        k = count[rows]
-        kept = k < SHARE_EVENTS
-        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
-        events[rows[kept], k[kept]] = row[kept] + 361 * reflect[kept]
-        count[rows] += 1
-
-    d = np.stack([-np.sin(theta), 0.0 * theta, -np.cos(theta)], axis=-1)
-    _, _, _, up, alive, _, reflections = microsurface.walk(
-        d, np.ones((n, 1)), np.ones((n, 1)), float(alpha),
-        lambda cos_d, rows: np.full((rows.size, 1), SHARE_SAMPLING_R), rng, record=record)
-    scattered = alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up))
-    return events[scattered], up[scattered], node[scattered]
+def share_columns(wavelengths: int) -> np.ndarray:
+    """The wavelength columns (of ``wavelengths``) the share is computed at: :data:`SHARE_COLUMNS`, evenly spread."""
+    return np.rint(np.linspace(0.0, wavelengths - 1.0, SHARE_COLUMNS)).astype(np.int64)
 
 
 def upward_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha: float) -> np.ndarray:
+    """:func:`walked_share` at the rows of :func:`compensation_theta` and every wavelength (:func:`share_rows`)."""
+    return share_rows(walked_share(reflectance, transmittance, alpha), np.shape(reflectance)[1])
+
+
+def walked_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha: float) -> np.ndarray:
     """
-    ``r``: of the light scattered among the facets, the part that leaves upward, per wavelength, at the rows of
-    :func:`compensation_theta`: the walk's scattered paths (:func:`walk_ensemble`) weighted by each event's
-    ``R / R_s`` (reflected) or ``T / (1 - R_s)`` (crossed), ``R_s`` :data:`SHARE_SAMPLING_R` (importance
-    reweighting: the walk with these facets, in expectation), the upward ones over all.
+    ``r``: of the light scattered among the facets (left upward after two reflections or more, or downward after
+    one or more), the part that leaves upward, at the angles :data:`SHARE_THETA_DEG` and the wavelengths
+    :func:`share_columns`, shape (angles, columns): the random walk (:func:`explorer.physics.microsurface.walk`)
+    through the layer, :data:`SHARE_PATHS` per angle, seeded.
+
+    Each path carries :data:`SHARE_HEROES` wavelengths of :func:`share_columns` (the hero, taken in turn, and
+    others evenly spread); the hero's ``R(theta_d)`` makes its choices. Each wavelength weighs it by its own
+    throughput (the product of each event's ``R``, reflected, or ``T``, crossed) over the mean over the path's
+    wavelengths of the chance of its choices (the balance heuristic of hero-wavelength sampling, Wilkie et al.
+    2014: at most ``SHARE_HEROES``). A walk with one fixed reflectance reweighted to the layer's spectrum had
+    effective sample sizes of 1-10 % of its paths where a Bragg band moves with ``theta_d``; this one is the
+    walk with the layer's own facets, its errors independent between wavelengths.
 
     ``reflectance``, ``transmittance``: the facets' ``R_lambda`` and ``T_lambda`` (``None``: ``1 - R``) at
     ``theta_d = k * 0.25 deg``, shape (361, 471).
     """
-    columns = np.unique(np.r_[np.arange(0, np.shape(reflectance)[1], SHARE_STEP_NM), np.shape(reflectance)[1] - 1])
-    R = np.asarray(reflectance, dtype=np.float32)[:, columns]
-    T = np.float32(1.0) - R if transmittance is None else np.asarray(transmittance, dtype=np.float32)[:, columns]
-    factors = np.concatenate([T / np.float32(1.0 - SHARE_SAMPLING_R), R / np.float32(SHARE_SAMPLING_R),
-                              np.ones((1, R.shape[1]), np.float32)])
-    events, up, node = walk_ensemble(float(alpha))
-    share = np.full((len(SHARE_THETA_DEG), R.shape[1]), 0.5)
-    for k in range(len(SHARE_THETA_DEG)):
-        at = np.flatnonzero(node == k)
-        if at.size == 0:
-            continue
-        weight = factors[events[at, 0]]
-        for j in range(1, SHARE_EVENTS):
-            going = np.flatnonzero(events[at, j] != 722)  # only the paths with a j-th event (most have 2 or 3)
+    from explorer.physics import microsurface
+
+    alpha = float(microfacet.check_alpha(alpha))
+    size = np.shape(reflectance)[1]
+    columns = share_columns(size)
+    R = np.asarray(reflectance, dtype=np.float64)[:, columns]
+    T = 1.0 - R if transmittance is None else np.asarray(transmittance, dtype=np.float64)[:, columns]
+    # Per event row (0.25-degree theta_d rows; + 361 reflected; 722 none): each wavelength's factor, and the
+    # chance of the choice were that wavelength the hero.
+    throughput = np.concatenate([T, R, np.ones((1, columns.size))])
+    chance = np.concatenate([1.0 - R, R, np.ones((1, columns.size))])
+    group = share_groups(size)  # each path's group of SHARE_HEROES adjacent columns
+    member = np.arange(group.size) % SHARE_HEROES  # its hero, taken in turn
+    hero = group * SHARE_HEROES + member
+    path_columns = group[:, None] * SHARE_HEROES + np.arange(SHARE_HEROES)[None, :]  # (paths, heroes)
+    share = np.full((len(SHARE_THETA_DEG), columns.size), 0.5)
+    for k, stream in enumerate(np.random.SeedSequence(SHARE_SEED).spawn(len(SHARE_THETA_DEG))):
+        rng = np.random.default_rng(stream)
+        n = group.size
+        count = np.zeros(n, dtype=np.int64)
+        events = np.full((n, SHARE_EVENTS), 722, dtype=np.int16)
+
+        def facet(cos_d, rows):
+            row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
+            return R[row, hero[rows]][:, None]
+
+        def record(rows, cos_d, reflect):
+            j = count[rows]
+            kept = j < SHARE_EVENTS
+            row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int16)
+            events[rows[kept], j[kept]] = row[kept] + 361 * reflect[kept]
+            count[rows] += 1
+
+        theta = np.radians(SHARE_THETA_DEG[k])
+        d = np.broadcast_to(np.array([-np.sin(theta), 0.0, -np.cos(theta)]), (n, 3))
+        _, _, _, up, alive, _, reflections = microsurface.walk(d, np.ones((n, 1)), np.ones((n, 1)), alpha, facet, rng,
+                                                                record=record)
+        scattered = np.flatnonzero(alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up)))
+        cols = path_columns[scattered]
+        weight = np.ones(cols.shape)
+        pdf = np.ones(cols.shape)
+        for j in range(SHARE_EVENTS):
+            going = np.flatnonzero(events[scattered, j] != 722)  # only the paths with a j-th event (most have 2 or 3)
             if going.size == 0:
                 break
-            weight[going] *= factors[events[at[going], j]]
-        upward = weight[up[at]].sum(axis=0, dtype=np.float64)
-        total = weight.sum(axis=0, dtype=np.float64)
+            row = events[scattered[going], j].astype(np.int64)[:, None]
+            weight[going] *= throughput[row, cols[going]]
+            pdf[going] *= chance[row, cols[going]]
+        weight /= np.maximum(pdf.mean(axis=1, keepdims=True), 1e-300)
+        upward = np.bincount(cols.ravel(), (weight * up[scattered, None]).ravel(), columns.size)
+        total = np.bincount(cols.ravel(), weight.ravel(), columns.size)
         share[k] = np.where(total > 0.0, upward / np.maximum(total, 1e-300), 0.5)
-    wavelengths = np.arange(np.shape(reflectance)[1])
-    share = np.stack([np.interp(wavelengths, columns, row) for row in share])
+    return share
+
+
+def share_groups(wavelengths: int) -> np.ndarray:
+    """
+    The group of each of an angle's :data:`SHARE_PATHS` paths: groups of :data:`SHARE_HEROES` adjacent columns of
+    :func:`share_columns`, given paths in proportion to what they weigh in a colour (the colour matching
+    functions' sum over the group, at least :data:`SHARE_GROUP_FLOOR` of the largest), a multiple of
+    SHARE_HEROES each. A column's share is a ratio over its own group's paths, so the allocation leaves it
+    unbiased and spends the paths where the colour is made.
+    """
+    from explorer.physics import colorimetry
+
+    columns = share_columns(wavelengths)
+    weight = colorimetry.colour_matching_functions()[columns].sum(axis=1).reshape(-1, SHARE_HEROES).sum(axis=1)
+    weight = np.maximum(weight, SHARE_GROUP_FLOOR * weight.max())
+    counts = SHARE_HEROES * np.floor(SHARE_PATHS / SHARE_HEROES * weight / weight.sum()).astype(np.int64)
+    return np.repeat(np.arange(weight.size), counts)
+
+
+def share_rows(share: np.ndarray, wavelengths: int) -> np.ndarray:
+    """The share at the walked angles and :func:`share_columns` to the rows of :func:`compensation_theta` and every
+    wavelength: linear in the wavelength, linear in the angle."""
+    columns = share_columns(wavelengths)
+    share = np.stack([np.interp(np.arange(wavelengths), columns, row) for row in share])
     rows = np.degrees(compensation_theta())
     return np.stack([np.interp(rows, SHARE_THETA_DEG, share[:, j]) for j in range(share.shape[1])], axis=-1)
 
