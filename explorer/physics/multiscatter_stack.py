@@ -117,19 +117,25 @@ def transfer_bins(edges_deg: Sequence[float] = TRANSFER_EDGES_DEG) -> tuple[np.n
 
 
 #: The walk that spreads a layer's scattered light over the bins: paths per bin (incidence drawn within it,
-#: as diffuse light in it), its seed; the facets reflect half the light, reweighted per wavelength as the
-#: upward share's walk (:func:`explorer.physics.multiscatter.upward_share`).
+#: as diffuse light in it), its seed; the facets reflect half the light, reweighted per wavelength (importance
+#: reweighting: the walk with the layer's own facets, in expectation).
 SPREAD_PATHS = 16000
 SPREAD_SEED = 2017
+#: The walk's facets reflect with this probability; any other reflectance reweighs the same paths.
+SPREAD_SAMPLING_R = 0.5
+#: The facet events kept per path (later ones are taken as the reweighting's mean, 1).
+SPREAD_EVENTS = 10
+#: The spread is reweighted every this many nm (a ratio: smoother than ``R``).
+SPREAD_STEP_NM = 3
 
 
 @functools.lru_cache(maxsize=8)
 def spread_ensemble(alpha: float, edges_deg: tuple = TRANSFER_EDGES_DEG) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """
     The random walk's paths through a layer of roughness ``alpha`` (facets reflecting
-    :data:`explorer.physics.multiscatter.SHARE_SAMPLING_R`), :data:`SPREAD_PATHS` per bin of ``edges_deg`` coming in
+    :data:`SPREAD_SAMPLING_R`), :data:`SPREAD_PATHS` per bin of ``edges_deg`` coming in
     with the flux of diffuse light in the bin (``sin^2 theta`` uniform in it), seeded: only those scattered among the
-    facets (as :func:`explorer.physics.multiscatter.walk_ensemble`). Returns their events (rows of ``theta_d``, plus
+    facets (left upward after two reflections or more, or downward after one or more). Returns their events (rows of ``theta_d``, plus
     361 when reflected, 722 after the last), the bin they came in, the bin they left in, and whether they left upward.
     """
     from explorer.physics import microsurface
@@ -143,11 +149,11 @@ def spread_ensemble(alpha: float, edges_deg: tuple = TRANSFER_EDGES_DEG) -> tupl
     sin2 = low + (high - low) * (np.arange(n) % SPREAD_PATHS + rng.random(n)) / SPREAD_PATHS  # stratified
     sin_t, cos_t = np.sqrt(sin2), np.sqrt(1.0 - sin2)
     count = np.zeros(n, dtype=np.int64)
-    events = np.full((n, multiscatter.SHARE_EVENTS), 722, dtype=np.int64)
+    events = np.full((n, SPREAD_EVENTS), 722, dtype=np.int64)
 
     def record(rows, cos_d, reflect):
         k = count[rows]
-        kept = k < multiscatter.SHARE_EVENTS
+        kept = k < SPREAD_EVENTS
         row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
         events[rows[kept], k[kept]] = row[kept] + 361 * reflect[kept]
         count[rows] += 1
@@ -155,7 +161,7 @@ def spread_ensemble(alpha: float, edges_deg: tuple = TRANSFER_EDGES_DEG) -> tupl
     d = np.stack([-sin_t, 0.0 * sin_t, -cos_t], axis=-1)
     out, _, _, up, alive, _, reflections = microsurface.walk(
         d, np.ones((n, 1)), np.ones((n, 1)), float(alpha),
-        lambda cos_d, rows: np.full((rows.size, 1), multiscatter.SHARE_SAMPLING_R), rng, record=record)
+        lambda cos_d, rows: np.full((rows.size, 1), SPREAD_SAMPLING_R), rng, record=record)
     scattered = alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up))
     theta_out = np.arccos(np.clip(np.abs(out[:, 2]), 0.0, 1.0))
     leave = np.clip(np.searchsorted(edges, theta_out, side="right") - 1, 0, B - 1)
@@ -175,10 +181,10 @@ def scattered_spread(reflectance: ArrayLike, transmittance: ArrayLike | None, al
     edges_deg = tuple(float(e) for e in edges_deg)
     B = len(edges_deg) - 1
     W = np.shape(reflectance)[1]
-    columns = np.unique(np.r_[np.arange(0, W, multiscatter.SHARE_STEP_NM), W - 1])
+    columns = np.unique(np.r_[np.arange(0, W, SPREAD_STEP_NM), W - 1])
     R = np.asarray(reflectance, dtype=np.float32)[:, columns]
     T = np.float32(1.0) - R if transmittance is None else np.asarray(transmittance, dtype=np.float32)[:, columns]
-    Rs = multiscatter.SHARE_SAMPLING_R
+    Rs = SPREAD_SAMPLING_R
     factors = np.concatenate([T / np.float32(1.0 - Rs), R / np.float32(Rs), np.ones((1, R.shape[1]), np.float32)])
     events, come, leave, up = spread_ensemble(float(alpha), edges_deg)
     weight = factors[events[:, 0]]
