@@ -1,4 +1,4 @@
-"""Shared fixtures: the repository root, the Bragg mirror material, and one GL renderer per session.
+"""Shared fixtures: the repository root, the Bragg mirror material, one GL renderer and one X display per session.
 
 GL tests (``@pytest.mark.gl``) take the ``gl_renderer`` fixture. Without an OpenGL 3.3 context
 through EGL they are skipped on a developer machine, but they fail when ``CI=true``: continuous
@@ -175,12 +175,20 @@ def shared_set_up_group(item) -> str | None:
 
 
 def pytest_collection_modifyitems(config, items):
-    """In an xdist worker: write each grouped test's group where the controller's scheduler reads it."""
+    """
+    In an xdist worker: order the tests as the scheduler hands them out (:func:`parallel.schedule_order`: the
+    units with a ``slow`` test first, so that no long test starts at the end of the run) and write each grouped
+    test's group where the controller's scheduler reads it.
+    """
     path = getattr(config, "workerinput", {}).get(GROUPS_KEY)
     if path is not None:
         from explorer.files import write_text_atomic
+        from parallel import schedule_order
 
         groups = {item.nodeid: group for item in items if (group := shared_set_up_group(item)) is not None}
+        slow = {item.nodeid for item in items if item.get_closest_marker("slow") is not None}
+        order = {nodeid: rank for rank, nodeid in enumerate(schedule_order([item.nodeid for item in items], groups, slow))}
+        items.sort(key=lambda item: order[item.nodeid])
         write_text_atomic(Path(path) / f"{config.workerinput['workerid']}.json", json.dumps(groups))
 
 
@@ -207,6 +215,25 @@ def pytest_unconfigure(config):
     folder = getattr(config, "_shared_set_up_groups", None)
     if folder is not None:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def x_display():
+    """
+    A virtual X display (Xvfb) for the app windows: one per test process, whichever modules use it. Without
+    Xvfb the tests that take it skip on a developer machine and fail when ``CI=true``, as the GL tests do.
+    """
+    from explorer.app.xvfb import XvfbUnavailable, virtual_display
+
+    try:
+        context = virtual_display()
+        display = context.__enter__()
+    except XvfbUnavailable as error:
+        if running_in_ci():
+            pytest.fail(f"CI=true and no X display for the app: {error}", pytrace=False)
+        pytest.skip(str(error))
+    yield display
+    context.__exit__(None, None, None)
 
 
 @pytest.fixture(scope="session")

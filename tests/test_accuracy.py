@@ -41,6 +41,7 @@ def test_preset_mirrors_cover_hosts_low_N_and_stack_layers(shipped_mirrors):
     assert len({entry.mirror for entry in shipped_mirrors}) == len(shipped_mirrors)
 
 
+@pytest.mark.slow
 def test_improved_method_median_within_limit_on_every_shipped_preset(shipped_mirrors):
     """Method 4 (ours): median ΔE2000 <= 2 against the converged reference on every shipped Bragg mirror."""
     cos_theta = gradient_cos_theta(TEST_WIDTH)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from conftest import REPO_ROOT
-from test_app import lit_fill, run_session, x_display  # noqa: F401  (the session's virtual display fixture)
+from test_app import lit_fill, run_session
 
 from explorer.materials.brd import load_material
 
@@ -18,7 +18,7 @@ GGX = REPO_ROOT / "shaders" / "ggx_schlick.brd"
 SIZE = 128
 
 
-def test_env_choice_rotation_model_and_converged_counter(x_display, tmp_path, gl_renderer):  # noqa: F811
+def test_env_choice_rotation_model_and_converged_counter(x_display, tmp_path, gl_renderer):
     from explorer.gpu.env import render_env
     from explorer.views.env import ENVIRONMENTS
     from explorer.views.mesh import torus
@@ -50,7 +50,7 @@ def test_env_choice_rotation_model_and_converged_counter(x_display, tmp_path, gl
     np.testing.assert_allclose(np.load(shot.with_suffix(".npy")), headless, rtol=1e-3, atol=2e-3)
 
 
-def test_lit_mesh_and_a_merl_file_in_the_app(x_display, tmp_path, gl_renderer):  # noqa: F811
+def test_lit_mesh_and_a_merl_file_in_the_app(x_display, tmp_path, gl_renderer):
     from explorer.gpu.mesh import render_mesh
     from explorer.materials.merl import tabulate, write_merl
     from explorer.views.mesh import teapot
@@ -70,7 +70,7 @@ def test_lit_mesh_and_a_merl_file_in_the_app(x_display, tmp_path, gl_renderer): 
     assert image.max() > 0.1 and (image == 0).all(axis=-1).mean() > 0.3  # a lit teapot on black
 
 
-def test_a_smooth_mirror_in_the_lit_mode_reflects_the_chosen_environment(x_display, tmp_path, gl_renderer):  # noqa: F811
+def test_a_smooth_mirror_in_the_lit_mode_reflects_the_chosen_environment(x_display, tmp_path, gl_renderer):
     """bragg_mirror in the lit mode: the environment combo and probe turn are offered, and the image is the headless lit mirror."""
     shot = tmp_path / "mirror.png"
     actions = [

@@ -11,7 +11,7 @@ import numpy as np
 from PIL import Image
 
 from conftest import BRAGG_MATERIAL, REPO_ROOT
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
+from test_app import run_session
 
 from explorer.materials.brd import load_material
 from explorer.materials.methods import BraggMethod
@@ -27,7 +27,7 @@ def _inside(rect, window, what: str) -> None:
     assert rect[2] <= window[2] + 0.5 and rect[0] >= window[0] - 0.5, f"{what}: {rect} beyond its window {window}"
 
 
-def test_help_strips_and_controls_at_1280x800(x_display, tmp_path):  # noqa: F811
+def test_help_strips_and_controls_at_1280x800(x_display, tmp_path):
     covered, shown = tmp_path / "slice.png", tmp_path / "help.png"
     actions = [
         {"wait": 3}, {"wait_complete": True}, {"focus": "Strips"}, {"wait": 3},
@@ -61,7 +61,7 @@ def test_help_strips_and_controls_at_1280x800(x_display, tmp_path):  # noqa: F81
     assert report["spectrum_legend"] == "right of the plot, outside its area"
 
 
-def test_polar_log_compare_f12_and_fitted_images(x_display, tmp_path, gl_renderer):  # noqa: F811
+def test_polar_log_compare_f12_and_fitted_images(x_display, tmp_path, gl_renderer):
     actions = [
         {"set": {"method": int(BraggMethod.TABULATED)}},  # exact and fast: the session stays short on a shared machine
         {"wait": 3}, {"focus": "Polar"}, {"wait": 20}, {"click": "polar_log:0"}, {"click": "polar_log:1"}, {"wait": 20},

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
+from test_app import run_session
 from twins import Twins, assert_twins_equal
 
 from explorer.app.dialogs import native_dialog_available, split_paths
@@ -35,7 +35,7 @@ def names(report, key="materials"):
     return [entry["path"].rsplit("/", 1)[-1] for entry in report[key]]
 
 
-def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_renderer):  # noqa: F811
+def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_renderer):
     from explorer.physics.colorimetry import delta_E_2000
     from explorer.views.geometry import view_cos_theta
 
@@ -91,7 +91,7 @@ def test_materials_list_overlays_dialog_and_compare(x_display, tmp_path, gl_rend
     assert report["mean_delta_e"] == pytest.approx(expected, rel=1e-3) and expected > 1.0
 
 
-def test_open_dialog_field_slice_phi_d_and_disabled_layers(x_display, tmp_path):  # noqa: F811
+def test_open_dialog_field_slice_phi_d_and_disabled_layers(x_display, tmp_path):
     """
     Without a dialog program: File > Open... shows a path field (two paths typed); the Slice window of the
     GGX (chosen in the Sphere window's combo) at phi_d dragged from 90 deg is its numpy twin's; a stack's
@@ -175,7 +175,7 @@ def test_materials_list_logic_without_a_window(tmp_path):
     assert len(state.materials) == 1
 
 
-def test_native_file_dialog_through_portable_file_dialogs(x_display, tmp_path, monkeypatch):  # noqa: F811
+def test_native_file_dialog_through_portable_file_dialogs(x_display, tmp_path, monkeypatch):
     """File > Open... starts portable-file-dialogs' zenity (a stand-in here, on PATH) and opens what it answers."""
     fake = tmp_path / "bin" / "zenity"
     fake.parent.mkdir()

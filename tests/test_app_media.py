@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conftest import BRAGG_MATERIAL
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
+from test_app import run_session
 
 from explorer.materials.brd import load_material
 from explorer.materials.media import MEDIA, medium_labels
@@ -19,7 +19,7 @@ def test_medium_labels_are_the_library_by_number():
     assert labels[int(values["medium_n2"])] == "melanin"
 
 
-def test_app_chooses_a_medium_by_name(x_display, tmp_path):  # noqa: F811
+def test_app_chooses_a_medium_by_name(x_display, tmp_path):
     actions = [
         {"wait": 4}, {"wheel": "param:n1", "y": -30}, {"wait": 1},
         {"click": "param:medium_n2"}, {"wait": 1}, {"click": f"medium_n2:{MEDIA.index('chitin') + 1}"}, {"wait": 1},
@@ -34,7 +34,7 @@ def test_app_chooses_a_medium_by_name(x_display, tmp_path):  # noqa: F811
     assert {f"medium_n2:{i}" for i in range(len(MEDIA) + 1)} <= set(report["items"])
 
 
-def test_app_chooses_a_stacks_host_medium(x_display, tmp_path):  # noqa: F811
+def test_app_chooses_a_stacks_host_medium(x_display, tmp_path):
     """bragg_stack's host has its combo beside the nh slider: chitin is taken (the slider shows its n at 550 nm)."""
     from conftest import REPO_ROOT
 

@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from conftest import BRAGG_MATERIAL, REPO_ROOT, one_line_error, run_cli, run_cli_process
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
+from test_app import run_session
 
 from explorer.app.parameter_files import ParameterFileError, inactive_parameters, load_values, load_view, save_values
 from explorer.materials.brd import load_material
@@ -24,7 +24,8 @@ from explorer.physics.colorimetry import encode_srgb8
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
 
 
-def test_app_first_screen_method_combo_help_and_saved_view(x_display, tmp_path):  # noqa: F811
+@pytest.mark.slow
+def test_app_first_screen_method_combo_help_and_saved_view(x_display, tmp_path):
     """One session: first screen, method combo, Help, a lit view orbited and saved; render --params redraws it."""
     shot, saved = tmp_path / "lit.png", tmp_path / "view.json"
     actions = [

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from conftest import run_cli_process as cli
 
 
+@pytest.mark.slow
 def test_bench_layers_json():
     run = cli("bench", "--layers", "--json", "--repeats", "1")
     assert run.returncode == 0, run.stderr

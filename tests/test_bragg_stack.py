@@ -147,6 +147,7 @@ def test_textures_pack_one_layer_per_channel(stack_material):
     assert textures["stack_sampling"].shape == (361, 3)
 
 
+@pytest.mark.slow
 def test_no_nan_or_inf_over_a_sweep(stack_material):
     rng = np.random.default_rng(7)
     L, V = directions(32, 5), directions(32, 6)

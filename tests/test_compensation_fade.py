@@ -5,8 +5,9 @@ figures kept, no table built), exactly 1 from alpha = 0.5, smoothstep between; n
 
 And ``bragg_layer``'s white furnace through its documented test hook
 ``BraggLayerModel.facet_reflectance_override`` (the tables the twin, the shader and the walk read): over a black
-base the compensated layer keeps its albedo at 0.99 or more at alpha = 0.6 and 1, theta <= 70 deg, in numpy and GL,
-and the microsurface random walk of the same layer gives 1 within its standard error.
+base the compensated layer keeps its albedo at 0.99 or more at alpha = 0.6 and 1, theta <= 70 deg, in numpy and GL
+(test_white_furnace.py, with the stack's layer), and the microsurface random walk of the same layer gives 1 within
+its standard error.
 """
 
 from __future__ import annotations
@@ -23,13 +24,12 @@ from explorer.materials.models import BraggLayerModel, model_for
 from explorer.materials.presets import presets_for
 from explorer.physics import compensation, position_free
 from explorer.resources import SHADER_DIR
-from explorer.views.albedo import albedo_gl, albedo_numpy
 from test_bragg_layer import directions
+from test_white_furnace import FURNACE_ALPHAS, FURNACE_THETA, FURNACES
 
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-FURNACE_THETA = (0.0, 45.0, 70.0)
 #: The walk's furnace: paths per angle, and how many standard errors its luminance may stray from 1.
 WALK_PATHS, SIGMAS = 2048, 3.0
 
@@ -150,7 +150,7 @@ def test_the_fade_in_numpy_and_gl(gl_renderer, layer_material, stack_material, w
 # --------------------------------------------------------------------------------------------------
 # bragg_layer's white furnace (facets that reflect everything, a black base)
 
-FURNACE = {"rho_d": 0.0, "N": 10, "method": 3, "multiple_scattering": 1}
+FURNACE = FURNACES[BraggLayerModel][0]
 
 
 @pytest.fixture
@@ -158,25 +158,7 @@ def white_facets(monkeypatch):
     monkeypatch.setattr(BraggLayerModel, "facet_reflectance_override", 1.0)
 
 
-@pytest.mark.parametrize("alpha", [0.6, 1.0])
-def test_layer_white_furnace_numpy(layer_material, white_facets, alpha):
-    values = layer_material.resolve({**FURNACE, "alpha": alpha})
-    albedo = albedo_numpy(model_for(layer_material, values), FURNACE_THETA)
-    assert np.all(albedo >= 0.99) and np.all(albedo <= 1.005), albedo
-    single = albedo_numpy(model_for(layer_material, {**values, "multiple_scattering": False}), (45.0,))
-    assert np.all(single < 0.8), single  # Eq. 17 with white facets: what the compensation puts back
-
-
-@pytest.mark.gl
-@pytest.mark.parametrize("alpha", [0.6, 1.0])
-def test_layer_white_furnace_gl(gl_renderer, layer_material, white_facets, alpha):
-    values = layer_material.resolve({**FURNACE, "alpha": alpha})
-    model = model_for(layer_material, values)
-    albedo = albedo_gl(layer_material, values, (0.0, 70.0), gl_renderer, size=256, model=model)
-    assert np.all(albedo >= 0.99) and np.all(albedo <= 1.005), albedo
-
-
-@pytest.mark.parametrize("alpha", [0.6, 1.0])
+@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
 def test_layer_white_furnace_walk(layer_material, white_facets, alpha):
     """The reference walks the layer's own structure and tables (the hook's): 1 within its standard error, where
     its single-scattering walk loses light."""

@@ -357,6 +357,7 @@ def round_trip_medians():
     return np.array([r.median_delta_e2000 for r in results])
 
 
+@pytest.mark.slow
 def test_round_trip_median(round_trip_medians):
     assert np.median(round_trip_medians) <= 0.5, round_trip_medians
 
@@ -381,6 +382,7 @@ def test_a_host_below_its_threshold_is_reported_as_no_host():
     assert solve._reported_values(fixed, found)["nh"] == 0.37
 
 
+@pytest.mark.slow
 def test_design_bench_draws_its_mirrors_from_the_seed():
     # Another seed is another set of mirrors (the docs' is seed 0): its truth is the seed's first draw.
     # One search (not the default 8): seed 3's mirror is not reached in one, so a second would double the time.

@@ -6,14 +6,16 @@ the window keeps drawing, the result applied to the mirror, and the reachable ch
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from conftest import BRAGG_MATERIAL
-from test_app import run_session, x_display  # noqa: F401  (the session's virtual display)
+from test_app import run_session
 
 from explorer.design import forward_rgb
 
 
-def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  # noqa: F811
+@pytest.mark.slow
+def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):
     window = tmp_path / "design.png"
     actions = [{"wait": 2}, {"view_size": 128}, {"focus": "Design"}, {"wait": 3}, {"click": "design:run"}, {"mark": "designing"},
                {"wait_for": "design", "timeout": 4000}, {"mark": None}, {"wait": 5}, {"window_screenshot": str(window)},
@@ -39,7 +41,8 @@ def test_design_panel_runs_in_the_background_and_applies(x_display, tmp_path):  
     assert window.is_file()
 
 
-def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_display, tmp_path):  # noqa: F811
+@pytest.mark.slow
+def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_display, tmp_path):
     # A render-style .npy strip of a vivid mirror (a negative red: outside sRGB): its colours are the
     # targets as they are, not the pickers' sRGB clipping of them.
     from explorer.design import targets_from_strip
@@ -62,7 +65,8 @@ def test_a_strip_typed_into_the_panel_is_designed_with_its_linear_colours(x_disp
     np.testing.assert_allclose([t["target_rgb"] for t in design["targets"]], [t.rgb for t in expected], atol=1e-12)
 
 
-def test_the_window_designs_with_a_medium_as_the_cli_does(x_display, tmp_path):  # noqa: F811
+@pytest.mark.slow
+def test_the_window_designs_with_a_medium_as_the_cli_does(x_display, tmp_path):
     # The mirror's n2 names chitin (its combo): the window designs with chitin's dispersion held, as
     # design --fix n2=chitin does, and reports it by name.
     import json

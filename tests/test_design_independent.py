@@ -97,6 +97,7 @@ CASES = {
 
 
 @pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.slow
 def test_achieved_colours_equal_tmm_and_colour_science(case):
     material, args, layers = CASES[case]
     run = run_cli("design", material, *args, "--tries", "1", "--json")  # one search: its colours are what is checked

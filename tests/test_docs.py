@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from conftest import REPO_ROOT, run_cli
 
 DOCS = REPO_ROOT / "docs"
@@ -65,6 +67,7 @@ def tutorial_commands() -> list[str]:
     return commands
 
 
+@pytest.mark.slow
 def test_tutorial_commands_run(tmp_path):
     """
     Each command of the tutorial, as written (``python3 -m explorer`` run by this interpreter; the GPU-free ones

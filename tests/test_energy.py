@@ -169,6 +169,7 @@ SWEEP = settings(max_examples=12, deadline=None, derandomize=True, suppress_heal
 @pytest.mark.parametrize("name", MATERIALS)
 @SWEEP
 @given(data=st.data())
+@pytest.mark.slow
 def test_specular_colours_are_passive_in_gl_and_numpy(gl_renderer, name, data):
     mat, values = data.draw(parameter_sets(name))
     values = _cheap(name, values)
@@ -261,6 +262,7 @@ ALBEDO_SWEEP = settings(max_examples=4, deadline=None, derandomize=True, suppres
 @pytest.mark.parametrize("name", MATERIALS)
 @ALBEDO_SWEEP
 @given(data=st.data())
+@pytest.mark.slow
 def test_albedo_is_passive_in_numpy(name, data):
     from explorer.views.albedo import albedo_numpy
 
@@ -274,6 +276,7 @@ def test_albedo_is_passive_in_numpy(name, data):
 @pytest.mark.parametrize("name", MATERIALS)
 @ALBEDO_SWEEP
 @given(data=st.data())
+@pytest.mark.slow
 def test_albedo_is_passive_in_gl(gl_renderer, name, data):
     from explorer.views.albedo import albedo_gl
 
@@ -288,6 +291,7 @@ def test_albedo_is_passive_in_gl(gl_renderer, name, data):
 @pytest.mark.parametrize("name", MATERIALS)
 @settings(max_examples=2, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
+@pytest.mark.slow
 def test_albedo_view_equals_the_albedo_everywhere(gl_renderer, name, data):
     """The albedo view (GL, one fragment a quadrature node) equals the albedo's numpy quadrature at drawn
     points, within 1 % of the luminance: no method's loops cut the view's sum short."""

@@ -263,6 +263,7 @@ def _check_run(argv, folder: Path) -> None:
 
 @settings(FUZZ, max_examples=2000)
 @given(command_lines())
+@pytest.mark.slow
 def test_fuzz_command_lines(fuzz_folder, argv):
     """At least 2,000 generated command lines (fixed seed), in this process: exit 0 or one line, nothing partial."""
     _check_run(argv, fuzz_folder)

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import REPO_ROOT, one_line_error, run_cli, run_cli_process
-from test_maps_render import mesh_safe_pixels, write_map_folder
+from conftest import REPO_ROOT, one_line_error, run_cli
+from test_maps_render import mesh_safe_pixels, render_maps_by_both_engines, write_map_folder
 from twins import Twins, assert_twins_equal, render_both
 
 FILM = REPO_ROOT / "shaders" / "thin_film.brd"
@@ -152,15 +152,10 @@ def test_film_maps_under_an_environment_gl_equals_numpy(gl_renderer, folder, fil
 @pytest.mark.gl
 def test_cli_render_film_maps_gl_equals_numpy(folder, tmp_path):
     """``render --maps DIR`` of a film's folder (MATERIAL from params.json) by GL equals ``--engine numpy``."""
-    images = {}
-    for engine in ("gl", "numpy"):
-        out = tmp_path / f"{engine}.npy"
-        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", "textured", "--engine", engine,
-                                                              "--set", "method=3", "--size", "36x28", "--out", out)
-        assert run.returncode == 0, run.stderr
-        assert "d, eta2 from 12x10 maps" in run.stdout, run.stdout
-        images[engine] = np.load(out)
-    assert_twins_equal(Twins.of(images["gl"], images["numpy"], "textured"), "render --maps (film)")
+    shown = render_maps_by_both_engines(folder, tmp_path, "--set", "method=3", "--size", "36x28")
+    for stdout, _ in shown.values():
+        assert "d, eta2 from 12x10 maps" in stdout, stdout
+    assert_twins_equal(Twins.of(shown["gl"][1], shown["numpy"][1], "textured"), "render --maps (film)")
 
 
 def test_cli_a_material_without_maps_is_one_line(folder, tmp_path):
@@ -187,3 +182,32 @@ def test_film_flat_maps_gl_equals_numpy(gl_renderer, folder, film):
     reference = flat_numpy(model_for(film, values), texture, 30.0)
     assert hue_spread(reference) > 0.05
     assert_twins_equal(Twins(gl, reference, np.ones(gl.shape[:2], bool), "gradient"), "film flat maps")
+
+
+def test_app_opens_a_film_map_folder(x_display, tmp_path, gl_renderer, folder, film):
+    """
+    ``open FILM --maps DIR``: the Texture window shows the film's maps (``d`` and ``eta2``, each with its size and
+    range) and draws them on the sphere; the image's mean RGB equals what ``render --maps DIR --view textured`` draws.
+    """
+    from test_app import run_session
+
+    from explorer.rendering import render_material
+
+    actions = [{"view_size": 64}, {"wait": 2}, {"focus": "Texture"}, {"wait": 3}, {"wait_for": "texture_view"}, {"quit": True}]
+    _, report = run_session(x_display, FILM, actions, tmp_path, "--maps", str(folder))
+    shown = report["texture_view"]
+    assert shown is not None and shown.get("maps_folder") == str(folder), shown
+    maps = film_ramps()
+    assert set(shown["maps"]) == set(maps)
+    for name, image in maps.items():
+        assert shown["maps"][name]["size"] == list(MAP_SIZE)
+        np.testing.assert_allclose([shown["maps"][name]["min"], shown["maps"][name]["max"]], [np.nanmin(image), np.nanmax(image)], rtol=1e-6)
+    assert set(shown["shown"]) == {"textured:sphere"}, shown
+    values = film.resolve(shown["values"])
+    texture, _ = map_texture(folder, film, **shown["values"])
+    width, height = shown["size"]
+    theta = np.degrees(np.arccos(np.clip(shown["light"][2], -1.0, 1.0)))
+    phi = np.degrees(np.arctan2(shown["light"][1], shown["light"][0]))
+    image = render_material(film, values, "textured", width, height, "gl", light=(theta, phi), thickness=texture, renderer=gl_renderer)
+    assert hue_spread(image) > 0.01
+    np.testing.assert_allclose(shown["shown"]["textured:sphere"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from conftest import one_line_error, run_cli, run_cli_process
-from test_app import x_display  # noqa: F401  (the session's Xvfb fixture)
 from twins import Twins, assert_twins_equal, render_both
 
 #: Not square, so that a swapped width and height or flipped rows show.
@@ -200,18 +199,28 @@ def test_obj_texture_coordinates(tmp_path):
 # -- the command line --------------------------------------------------------------------------------------
 
 
+def render_maps_by_both_engines(folder, tmp_path, *args, gl_view: str = "textured") -> dict[str, tuple[str, np.ndarray]]:
+    """
+    ``render --maps FOLDER ARGS`` to .npy by GL (in a subprocess: it draws; view ``gl_view``) and by ``--engine numpy``
+    (in this process; the textured view): each engine's stdout and image. Each run must succeed.
+    """
+    shown = {}
+    for engine, view in (("gl", gl_view), ("numpy", "textured")):
+        out = tmp_path / f"{engine}.npy"
+        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", view, "--engine", engine, *args,
+                                                              "--out", out)
+        assert run.returncode == 0, run.stderr
+        shown[engine] = (run.stdout, np.load(out))
+    return shown
+
+
 @pytest.mark.gl
 def test_cli_render_maps_gl_equals_numpy(folder, tmp_path):
     """``render --maps DIR`` (MATERIAL from params.json; lit = the textured view) by GL equals ``--engine numpy``."""
-    images = {}
-    for engine, view in (("gl", "lit"), ("numpy", "textured")):
-        out = tmp_path / f"{engine}.npy"
-        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", view, "--engine", engine,
-                                                              "--size", "36x28", "--out", out)
-        assert run.returncode == 0, run.stderr
-        assert "Lambda, delta, N from 12x10 maps" in run.stdout, run.stdout
-        images[engine] = np.load(out)
-    assert_twins_equal(Twins.of(images["gl"], images["numpy"], "textured"), "render --maps")
+    shown = render_maps_by_both_engines(folder, tmp_path, "--size", "36x28", gl_view="lit")
+    for stdout, _ in shown.values():
+        assert "Lambda, delta, N from 12x10 maps" in stdout, stdout
+    assert_twins_equal(Twins.of(shown["gl"][1], shown["numpy"][1], "textured"), "render --maps")
 
 
 def test_cli_render_maps_bad_folders(folder, tmp_path):
@@ -264,7 +273,7 @@ def test_cli_render_maps_bad_folders(folder, tmp_path):
 # -- the app -----------------------------------------------------------------------------------------------
 
 
-def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror):  # noqa: F811
+def test_app_opens_a_map_folder(x_display, tmp_path, gl_renderer, folder, mirror):
     """
     ``open --maps DIR`` (the material from the folder): the Texture window shows each map with its range and draws the
     maps on the sphere, then on the torus, lit and under the environment: each image's mean RGB equals what ``render
@@ -337,12 +346,7 @@ def test_flat_maps_gl_equals_numpy(gl_renderer, folder, mirror, method):
 @pytest.mark.gl
 def test_cli_flat_maps_gl_is_near_the_converged_colours(folder, tmp_path):
     """``render --maps --theta`` by GL at the spectral reference: within 1e-2 of ``--engine numpy``'s converged colours."""
-    images = {}
-    for engine in ("gl", "numpy"):
-        out = tmp_path / f"{engine}.npy"
-        run = (run_cli_process if engine == "gl" else run_cli)("render", "--maps", folder, "--view", "textured", "--engine", engine,
-                                                              "--set", "method=0", "--theta", "30", "--out", out)
-        assert run.returncode == 0, run.stderr
-        images[engine] = np.load(out)
+    shown = render_maps_by_both_engines(folder, tmp_path, "--set", "method=0", "--theta", "30")
+    images = {engine: image for engine, (_, image) in shown.items()}
     assert images["gl"].shape == (MAP_SIZE[1], MAP_SIZE[0], 3)
     assert np.abs(images["gl"] - images["numpy"]).max() < 1e-2

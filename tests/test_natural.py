@@ -208,6 +208,7 @@ def test_info_dispersions(capsys):
 # Fitting a measured spectrum
 
 
+@pytest.mark.slow
 def test_fit_recovers_random_absorbing_dispersive_mirrors(tmp_path, capsys):
     """Seeded random mirrors (chitin and an absorbing layer) from their own spectra: median RMS <= 0.01."""
     rng = np.random.default_rng(35)

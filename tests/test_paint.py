@@ -236,3 +236,38 @@ def test_a_neighbour_round_never_repeats_a_start():
     assert _candidates([0], cost, pairs, labels, centre_U, U, tried)[0] == []  # nothing new: no second polish
     U[1] += 0.05  # a neighbour improved: its new structure is a new start
     assert [list(s) for s in _candidates([0], cost, pairs, labels, centre_U, U, tried)[0]] == [list(U[1])]
+
+
+def test_a_two_worker_cluster_paints_a_film_image_that_renders_back(tmp_path):
+    """
+    ``design`` of a thin film (the film's thickness free) on a 2-worker local cluster, from an 8 x 8 image of two
+    films' colours at 0 and 45 degrees, then ``render --maps`` of the folder: the maps render back to the targets.
+    """
+    from explorer.design.forward import design_model
+    from explorer.views.maps import read_maps
+
+    model = design_model("thin_film")
+    fixed = {"eta1": 1.0, "eta2": 1.33, "eta3": 1.5, "kappa3": 0.0}
+    size, thicknesses = 8, (300.0, 450.0)
+    colours = [model.converged({**fixed, "d": d}, np.cos(np.radians(ANGLES)), final=True) for d in thicknesses]
+    image = np.zeros((2, size, size, 3))
+    image[:, :, : size // 2], image[:, :, size // 2 :] = colours[0][:, None, None], colours[1][:, None, None]
+    paths = []
+    for k, theta in enumerate(ANGLES):
+        paths.append(tmp_path / f"film_{theta:g}.npy")
+        np.save(paths[-1], image[k].astype(np.float32))
+    out = tmp_path / "film_maps"
+    run = run_cli("design", "thin_film", "--target-image", paths[0], "--target-image-2", paths[1], "--free", "d",
+                  *[a for name, value in fixed.items() for a in ("--fix", f"{name}={value}")],
+                  "--out-maps", out, "--workers", "2", "--seed", "1", "--tries", "1")
+    assert run.returncode == 0, run.stderr
+    assert "2 Dask workers (local)" in run.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["pixels"] == size * size and report["colours"] == 2 and report["within_1_at_every_angle"] == 1.0
+    _, maps = read_maps(out)
+    assert set(maps) == {"d"} and maps["d"].shape == (size, size)
+    for k, theta in enumerate(ANGLES):
+        rendered = tmp_path / f"film_again_{theta:g}.npy"
+        again = run_cli("render", "thin_film", "--maps", out, "--view", "textured", "--engine", "numpy", "--theta", theta, "--out", rendered)
+        assert again.returncode == 0, again.stderr
+        assert np.max(delta_E_2000(np.load(rendered).astype(float), image[k])) < 1.0

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from conftest import BRAGG_MATERIAL
-from test_app import run_session, x_display  # noqa: F401  (the session's Xvfb fixture)
+from test_app import run_session
 
 
-def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material):  # noqa: F811
+def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material):
     """theta_h chosen in the combo: the window's curve is the numpy twin's at the app's values (light irrelevant)."""
     from explorer.materials.models import model_for
     from explorer.views.geometry import light_direction
@@ -31,7 +32,7 @@ def test_plots_window_shows_the_chosen_plot(x_display, tmp_path, bragg_material)
     np.testing.assert_allclose(shown, expected, rtol=2e-3, atol=1e-5)
 
 
-def test_texture_window_shows_the_textured_mirror(x_display, tmp_path, gl_renderer, bragg_material):  # noqa: F811
+def test_texture_window_shows_the_textured_mirror(x_display, tmp_path, gl_renderer, bragg_material):
     """
     The Texture window on the default mirror, mapping delta chosen: its image is the headless textured render
     (at the improved method: the tabulated one's textured tables take seconds to build).
@@ -54,7 +55,8 @@ def test_texture_window_shows_the_textured_mirror(x_display, tmp_path, gl_render
     np.testing.assert_allclose(shown["mean_rgb"], image.reshape(-1, 3).mean(axis=0), rtol=1e-3, atol=1e-5)
 
 
-def test_texture_window_shows_drafts_while_dragging(x_display, tmp_path, gl_renderer, bragg_material):  # noqa: F811
+@pytest.mark.slow
+def test_texture_window_shows_drafts_while_dragging(x_display, tmp_path, gl_renderer, bragg_material):
     """
     The tabulated mirror's textured view while Lambda is dragged: frames show draft (cos theta, T) tables and the
     view follows the slider; on release it shows the exact table's image (the headless render's), not a draft.

@@ -347,6 +347,7 @@ def test_check_fails_a_plugin_whose_twin_disagrees_with_its_shader(tmp_path):
 
 
 @pytest.mark.gl
+@pytest.mark.slow
 def test_the_recipe_the_plugin_example_works_outside_the_repository(tmp_path):
     """docs/architecture.md's recipe, followed: the example copied out works with every command."""
     import json

@@ -50,6 +50,7 @@ CHEAP = [c for c in readme_commands() if not c.startswith(NOT_RUN) and c.split()
 
 @pytest.mark.gl
 @pytest.mark.parametrize("command", CHEAP, ids=[c.split()[3] + "-" + str(i) for i, c in enumerate(CHEAP)])
+@pytest.mark.slow
 def test_readme_command_runs(command, tmp_path, gl_renderer):
     argv = shlex.split(command)[3:]
     if "--out" in argv:  # write into the scratch folder, under the README's file name

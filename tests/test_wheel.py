@@ -161,6 +161,7 @@ def _render_jobs(installed: Installed) -> dict[str, list[str]]:
     return jobs
 
 
+@pytest.mark.slow
 def test_installed_package_renders_every_builtin(installed):
     """Every built-in material, by its bare name, renders finite and non-black; the installation is untouched."""
     before = snapshot(installed.venv)

@@ -29,17 +29,19 @@ APP_MODES = ("sphere", "lit")
 APP_ENV_MATERIAL = f"{BraggStackModel.name}.brd"
 APP_ENV_VALUES = {"layers": 2}
 APP_ENV_SLIDER = "param:Lambda_1"
+#: Frames per drag (``bench --app --frames``): about 2 px a frame (see :func:`_drag`).
+APP_FRAMES = 60
 #: The goals: frames while a slider moves, and the env view's first pass.
 APP_GOAL_FPS = 30.0
 APP_GOAL_FIRST_PASS_MS = 33.0
 
 
 def _drag(mark: str, slider: str, frames: int, **hold) -> list:
-    # About 2 px a frame: an integer slider (1 nm steps, ~8 nm a pixel) changes on every frame.
+    # About 2 px a frame at 60 frames (more with fewer): an integer slider (1 nm steps, ~8 nm a pixel) changes on every frame.
     return [{"mark": mark}, {"drag": slider, "from": 0.15, "to": 0.85, "frames": frames, **hold}, {"mark": None}, {"wait": 3}]
 
 
-def app_bench_script(frames: int = 60) -> list:
+def app_bench_script(frames: int = APP_FRAMES) -> list:
     """The scripted session of ``bench --app``: per mode of :data:`APP_MODES` and method, drag Lambda through the UI for ``frames`` frames."""
     script: list = [{"wait": 3}, {"wait_complete": True, "timeout": 600}]
     for mode in APP_MODES:
@@ -49,7 +51,7 @@ def app_bench_script(frames: int = 60) -> list:
     return script + app_view_steps(frames) + app_mesh_steps(frames) + [{"quit": True}]
 
 
-def app_env_script(frames: int = 60) -> list:
+def app_env_script(frames: int = APP_FRAMES) -> list:
     """The env session of ``bench --app`` (on :data:`APP_ENV_MATERIAL`): the mode's first frames, then a drag of :data:`APP_ENV_SLIDER`."""
     return ([{"wait": 3}, {"set": dict(APP_ENV_VALUES)}, {"wait": 3}, {"mark": "env open"}, {"click": "mode:env"}, {"wait": 10},
              {"mark": None}] + _drag("env", APP_ENV_SLIDER, frames) + [{"quit": True}])
@@ -118,7 +120,7 @@ def _app_session(material, script: list, size: int) -> dict:
         return json.loads(report.read_text())
 
 
-def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> list[dict]:
+def run_app_bench(as_json: bool = False, size: int = 512, frames: int = APP_FRAMES) -> list[dict]:
     """
     Open the explorer (on a virtual display when there is none) on the default mirror with a ``size``²
     sphere, drag the Lambda slider through the UI for ``frames`` frames per mode (:data:`APP_MODES`) and
@@ -139,7 +141,7 @@ def run_app_bench(as_json: bool = False, size: int = 512, frames: int = 60) -> l
     mesh_rows = summarise_mesh_frames(document["frames"])
     views = summarise_view_frames(document["frames"])
     if as_json:
-        print(json.dumps({"size": size, "window": list(document.get("window", [])), "rows": rows, "env": env,
+        print(json.dumps({"size": size, "frames": frames, "window": list(document.get("window", [])), "rows": rows, "env": env,
                           "mesh_rows": mesh_rows, "views": views}, indent=2))
         return rows + ([env] if env else [])
     print(f"Explorer frame times while dragging Lambda ({size}x{size} sphere, 1280x800 window, {os.cpu_count()} CPUs; goal >= {APP_GOAL_FPS:g} fps):")

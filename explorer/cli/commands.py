@@ -602,6 +602,8 @@ def presets(material, as_json):
               help="Instead: rough layers' host-table timings (F_alpha, a layer's tables) and the slice view's ΔE2000 (numpy, no GPU).")
 @click.option("--app", "app", is_flag=True,
               help="Instead: the explorer's frame times while a slider is dragged, per method (a scripted session; Xvfb when there is no display).")
+@click.option("--frames", "app_frames", type=click.IntRange(min=4), default=None, metavar="N",
+              help="With --app: frames per drag (default 60, the docs' tables; fewer for a quick check).")
 @click.option("--position-free", "position_free", is_flag=True,
               help="Instead: the position-free reference's time for a 9-angle albedo to a standard error of 2e-3 (numpy, no GPU).")
 @click.option("--design", "design_count", type=click.IntRange(min=1), metavar="COUNT",
@@ -624,7 +626,7 @@ def presets(material, as_json):
                    "image of 8 regions, their ΔE2000 and times.")
 @click.option("--workers", "paint_workers", type=click.IntRange(min=1), default=2, show_default=True, help="--paint: local Dask workers (the runs are timed on 1 worker and on this many).")
 @_errors
-def bench(as_json, size, repeats, film, layers, app, position_free, design_count, design_seed, design_tries, tables, scaling,
+def bench(as_json, size, repeats, film, layers, app, app_frames, position_free, design_count, design_seed, design_tries, tables, scaling,
           plot, markdown, mitsuba, spp, paint, paint_workers):
     """The paper's Table 1 on this machine: frame times, speed-ups and ΔE2000 of every method.
 
@@ -639,6 +641,8 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
         raise click.UsageError("--seed goes with --design")
     if design_tries is not None and design_count is None:
         raise click.UsageError("--tries goes with --design")
+    if app_frames is not None and not app:
+        raise click.UsageError("--frames goes with --app")
     if paint:
         from explorer.bench.paint import run_paint_bench
 
@@ -675,7 +679,7 @@ def bench(as_json, size, repeats, film, layers, app, position_free, design_count
     if app:
         from explorer.bench import run_app_bench
 
-        run_app_bench(as_json=as_json, size=size)
+        run_app_bench(as_json=as_json, size=size, **({} if app_frames is None else {"frames": app_frames}))
         return
     if layers:
         if film:

@@ -77,4 +77,5 @@ def with_media(model: DesignModel, media: Mapping[str, Dispersion], natural: boo
     def converged(values, cos_theta, final=True):
         return natural_converged(values, media, cos_theta, final)
 
-    return replace(model, batch=batch, spectra=spectra, converged=converged, rescreen=True)
+    return replace(model, batch=batch, spectra=spectra, converged=converged, rescreen=True, gradient=None,
+                   converged_many=None)

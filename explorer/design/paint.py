@@ -173,9 +173,7 @@ def converged_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, boun
 
 def _converged_rows(model, rows: RowModel, U: np.ndarray) -> np.ndarray:
     """The converged colours ``(B, A, 3)`` of unit rows (counts whole)."""
-    values = rows.values(U, whole=True)
-    return np.array([model.converged({k: float(v[i]) for k, v in values.items()}, rows.cos_theta, final=True)
-                     for i in range(U.shape[0])]).reshape(U.shape[0], rows.cos_theta.size, 3)
+    return model.converged_rows(rows.values(U, whole=True), rows.cos_theta)
 
 
 # --------------------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@ Also the clustering of target colours in CIELAB (k-means, scipy) that decides wh
 
 from __future__ import annotations
 
+import math
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -84,6 +85,42 @@ class RowModel:
             out[start : start + batch] = self.model.batch(self.values(U[start : start + batch]), self.cos_theta, self.step)
         return out
 
+    def rgb_and_jacobian(self, U: np.ndarray, columns: Sequence[int], batch: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Colours ``(B, A, 3)`` of unit rows ``U`` and their derivatives ``(B, c, A, 3)`` by the unit parameters
+        ``columns``: the model's analytic gradient where it declares one for these rows (one evaluation), otherwise
+        forward differences of :data:`COARSE_DIFF_STEP` (``c`` more; backwards at the box's upper edge).
+        """
+        U = np.atleast_2d(np.asarray(U, dtype=np.float64))
+        columns = list(columns)
+        if self.model.gradient is not None:
+            rgb = np.empty((U.shape[0], self.cos_theta.size, 3))
+            J = np.empty((U.shape[0], len(columns), self.cos_theta.size, 3))
+            for start in range(0, U.shape[0], batch):
+                part = U[start : start + batch]
+                found = self.model.gradient(self.values(part), self.cos_theta, self.step)
+                if found is None or any(self.free[k].name not in found[1] for k in columns):
+                    break
+                rgb[start : start + batch] = found[0]
+                for j, k in enumerate(columns):
+                    J[start : start + batch, j] = found[1][self.free[k].name] * self._slope(k, part[:, k])[:, None, None]
+            else:
+                return rgb, J
+        rgb = self.rgb(U)
+        B, P = U.shape
+        h = np.where(U[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (B, c)
+        shifted = np.repeat(U[:, None, :], len(columns), axis=1)
+        shifted[:, np.arange(len(columns)), columns] += h
+        moved = self.rgb(shifted.reshape(-1, P)).reshape(B, len(columns), self.cos_theta.size, 3)
+        return rgb, (moved - rgb[:, None]) / h[:, :, None, None]
+
+    def _slope(self, k: int, u: np.ndarray) -> np.ndarray:
+        """``d value / d u`` of free parameter ``k`` at unit values ``u`` (:meth:`DesignParameter.from_unit`)."""
+        p = self.free[k]
+        if p.log:
+            return p.from_unit(u) * (math.log(p.high) - math.log(p.low))
+        return np.full(np.shape(u), p.high - p.low)
+
 
 def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,
                 held: Sequence[bool] | None = None, steps: int = POLISH_STEPS) -> tuple[np.ndarray, np.ndarray]:
@@ -118,14 +155,16 @@ def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | Non
         differenced = active[fresh[active]]
         exact = fresh[active].copy()  # this step's Jacobian by differences, not carried on by Broyden
         if differenced.size:
-            Ud = U[differenced]
-            h = np.where(Ud[:, columns] + COARSE_DIFF_STEP <= 1.0, COARSE_DIFF_STEP, -COARSE_DIFF_STEP)  # (b, c)
-            shifted = np.repeat(Ud[:, None, :], c, axis=1)
-            shifted[:, np.arange(c), columns] += h
+            # The colours' Jacobian from the model (analytic where it declares one); the residuals' by differences
+            # along it, in colour space (no model evaluation): r(rgb + h dRGB/du) - r(rgb), over h.
+            rgb_d, J_rgb = rows.rgb_and_jacobian(U[differenced], columns)
+            h = COARSE_DIFF_STEP
+            stepped = (rgb_d[:, None] + h * J_rgb).reshape(-1, angles, 3)
             tr = np.repeat(target_rgb[differenced], c, axis=0)
             tb = None if bounds is None else np.repeat(bounds[differenced], c, axis=0)
-            r_shift = residual_rows(rows.rgb(shifted.reshape(-1, P)), tr, tb).reshape(differenced.size, c, -1)
-            J[differenced] = (r_shift - residuals[differenced][:, None, :]) / h[:, :, None]
+            r_shift = residual_rows(stepped, tr, tb).reshape(differenced.size, c, -1)
+            r_here = residual_rows(rgb_d, target_rgb[differenced], None if bounds is None else bounds[differenced])
+            J[differenced] = (r_shift - r_here[:, None, :]) / h
             fresh[differenced] = False
         Ua, ra, Ja = U[active], residuals[active], J[active]
         JTJ = np.einsum("bcr,bdr->bcd", Ja, Ja)

@@ -113,6 +113,23 @@ def bragg_rgb_batch(values: Mapping[str, np.ndarray], cos_theta, step: float = c
     return colorimetry.xyz_to_rgb(R @ weights)
 
 
+def bragg_rgb_gradient(values: Mapping[str, np.ndarray], cos_theta, step: float = colorimetry.COARSE_STEP):
+    """
+    :func:`bragg_rgb_batch` and its analytic derivatives by ``Lambda``, ``delta`` and ``N`` (``(B, A, 3)`` each), for
+    lossless mirrors without a separate host (:func:`explorer.physics.bragg.bragg_reflectance_batch_gradient`); None
+    for others (the caller differences).
+    """
+    if natural_values(values):
+        return None
+    nodes, weights = colorimetry.interpolant_nodes(step)
+    found = bragg.bragg_reflectance_batch_gradient(values["n1"], values["n2"], values["Lambda"], values["delta"], values["N"],
+                                                   values["nh"], cos_theta, nodes, step=step)
+    if found is None:
+        return None
+    R, grads = found
+    return colorimetry.xyz_to_rgb(R @ weights), {k: colorimetry.xyz_to_rgb(v @ weights) for k, v in grads.items()}
+
+
 def bragg_spectra_batch(values: Mapping[str, np.ndarray], cos_theta, wavelengths, smooth_relative: float) -> np.ndarray:
     """Screening spectra ``(B, A, W)``: fringes narrower than ~``smooth_relative`` lambda averaged out."""
     wavelengths = np.asarray(wavelengths, dtype=np.float64)
@@ -133,6 +150,15 @@ def bragg_converged_rgb(values: Mapping[str, float], cos_theta, final: bool = Tr
     if final:
         return bragg.reference_rgb(cos_theta, mirror)
     return bragg.converged_rgb(cos_theta, mirror)
+
+
+def bragg_converged_many(values: Mapping[str, np.ndarray], cos_theta) -> np.ndarray:
+    """:func:`bragg_converged_rgb` (final) of many mirrors ``values`` (arrays ``(B,)``): ``(B, A, 3)``, in one refinement."""
+    rows = np.asarray(values["Lambda"]).shape[0]
+    if natural_values(values):
+        return np.array([natural_converged({k: float(v[i]) for k, v in values.items()}, {}, cos_theta, True) for i in range(rows)])
+    mirrors = [mirror_of({k: float(v[i]) for k, v in values.items()}) for i in range(rows)]
+    return bragg.reference_rgb_many(np.asarray(cos_theta, dtype=np.float64), mirrors)
 
 
 # Natural mirrors in design: indices naming media (explorer.design.media), absorbing and disordered layers.
@@ -217,7 +243,8 @@ def natural_converged(values: Mapping[str, float], media: Mapping, cos_theta, fi
 #: What design fits of a Bragg mirror, and on which forward model: its specular colour (the rough layer's too: the
 #: smooth mirror's colour, which its gradient view shows), the period scanned, searched by optical thicknesses.
 BRAGG_DESIGN = DesignModel(parameters=("n1", "n2", "Lambda", "delta", "N", "nh", "k1", "k2", "sigma"), log_parameters=("N", "Lambda"),
-                           integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb,
+                           integer_parameters=("N",), batch=bragg_rgb_batch, converged=bragg_converged_rgb, gradient=bragg_rgb_gradient,
+                           converged_many=bragg_converged_many,
                            host_parameter="nh", scale_parameter="Lambda", optical=True, spectra=bragg_spectra_batch,
                            paint_free=("Lambda", "delta", "N"), held=("k1", "k2", "sigma"))
 

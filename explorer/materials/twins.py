@@ -48,6 +48,12 @@ class DesignModel:
     batch: Callable
     #: ``converged(values: dict of floats, cos_theta (A,), final: bool) -> (A, 3)``: the reference when ``final``.
     converged: Callable
+    #: Optional ``gradient(values, cos_theta (A,), step=COARSE_STEP) -> (rgb (B, A, 3), {name: d rgb / d name})`` of the
+    #: batch model, or None for rows it does not cover (the caller then differences the batch).
+    gradient: Callable | None = None
+    #: Optional ``converged_many(values: dict of (B,) arrays, cos_theta (A,)) -> (B, A, 3)``: the final ``converged``
+    #: colours of many structures at once (:meth:`converged_rows` loops over ``converged`` without it).
+    converged_many: Callable | None = None
     #: A parameter whose value below ``host_threshold`` means "no separate host" (a branch, not a slope).
     host_parameter: str | None = None
     host_threshold: float = 1.0
@@ -69,6 +75,15 @@ class DesignModel:
     held: tuple[str, ...] = ()
     #: The ``# model:`` name it designs: set by :func:`explorer.design.design_model` from the registry.
     name: str | None = None
+
+    def converged_rows(self, values: dict, cos_theta) -> np.ndarray:
+        """The final converged colours ``(B, A, 3)`` of structures ``values`` (arrays ``(B,)``)."""
+        cos_theta = np.asarray(cos_theta, dtype=np.float64)
+        if self.converged_many is not None:
+            return np.asarray(self.converged_many(values, cos_theta)).reshape(-1, cos_theta.size, 3)
+        rows = np.asarray(next(iter(values.values()))).shape[0]
+        return np.array([self.converged({k: float(v[i]) for k, v in values.items()}, cos_theta, final=True)
+                         for i in range(rows)]).reshape(rows, cos_theta.size, 3)
 
     def __post_init__(self):
         named = (*self.log_parameters, *self.integer_parameters, *self.paint_free, *self.held,

@@ -36,15 +36,13 @@ def map_colours(model_name: str, fixed: Mapping[str, float], maps: Mapping[str, 
     inside, values = map_structures(fixed, maps)
     cos_theta = np.array([np.cos(np.radians(theta_deg))])
     out = np.zeros(inside.shape + (3,))
-    colours = np.empty((int(inside.sum()), 3))
-    cache: dict[tuple, np.ndarray] = {}
-    for i in range(colours.shape[0]):
-        structure = {name: float(v[i]) for name, v in values.items()}
-        key = tuple(sorted(structure.items()))
-        if key not in cache:  # painted regions repeat one structure
-            cache[key] = model.converged(structure, cos_theta, final=True)[0]
-        colours[i] = cache[key]
-    out[inside] = colours
+    names = sorted(values)
+    if int(inside.sum()):
+        # Painted regions repeat one structure: each distinct one once, all of them in one call.
+        table = np.stack([np.asarray(values[name], dtype=np.float64) for name in names], axis=1)
+        distinct, index = np.unique(table, axis=0, return_inverse=True)
+        colours = model.converged_rows({name: distinct[:, k] for k, name in enumerate(names)}, cos_theta)[:, 0]
+        out[inside] = colours[np.ravel(index)]
     return out.astype(np.float32)
 
 

@@ -117,6 +117,7 @@ from explorer.physics.bragg.batch import (  # noqa: F401
     BATCH_EDGE,
     absorbing_reflectance_batch,
     bragg_reflectance_batch,
+    bragg_reflectance_batch_gradient,
     chebyshev_U_real_N,
 )
 from explorer.physics.bragg.mirror import (  # noqa: F401
@@ -137,6 +138,7 @@ from explorer.physics.bragg.reference import (  # noqa: F401
     _spectrum_function,
     converged_reflectance_spectra,
     reference_rgb,
+    reference_rgb_many,
     substeps_for,
 )
 from explorer.physics.bragg.reflectance import (  # noqa: F401

@@ -5,12 +5,14 @@ The converged spectral reference: Yeh's exact ``R_lambda`` integrated against th
 
 from __future__ import annotations
 
+from typing import Sequence
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from explorer.physics import colorimetry
 from explorer.physics.bragg.approximation import optical_thickness
-from explorer.physics.bragg.mirror import POLARISATIONS, BraggMirror, cell_geometry
+from explorer.physics.bragg.mirror import POLARISATIONS, BraggMirror, CellGeometry, cell_geometry
 from explorer.physics.bragg.reflectance import ROW_BLOCK, _reflectance_real, _take, reflectance_polarised, reflectance_spectra
 
 
@@ -141,3 +143,50 @@ def reference_rgb(cos_theta: ArrayLike, mirror: BraggMirror, step: float | None 
             lambda wavelengths, rows: _spectra(flat[rows], mirror, wavelengths, fast=False), flat.size, step
         )
     return colorimetry.spectrum_to_rgb(spectra).reshape(cos_theta.shape + (3,))
+
+
+def reference_rgb_many(cos_theta: ArrayLike, mirrors: Sequence[BraggMirror]) -> np.ndarray:
+    """
+    :func:`reference_rgb` of many mirrors at the angles ``cos_theta`` ``(A,)``: ``(len(mirrors), A, 3)``. Mirrors in
+    ``n1`` whose waves all propagate share one refinement per sampling floor (:func:`substeps_for`): their angles are
+    rows of :func:`explorer.physics.colorimetry.converged_spectra`, which refines each row on its own, so that each
+    colour is the one mirror's (to rounding); the others are taken one at a time.
+    """
+    cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
+    out = np.empty((len(mirrors), cos_theta.size, 3))
+    groups: dict[int, list[int]] = {}
+    geometry_of: dict[int, tuple[CellGeometry, ...]] = {}
+    for m, mirror in enumerate(mirrors):
+        geometry = cell_geometry(cos_theta, mirror, "s")
+        if geometry.host_is_n1 and not np.any(geometry.cos_theta_1.imag) and not np.any(geometry.cos_theta_2.imag):
+            # substeps_for's floor, from this geometry (its n_+ is the same for both polarisations).
+            floor = colorimetry.substeps_for_fringes(2.0 * mirror.N * float(np.max(optical_thickness(geometry), initial=0.0)))
+            groups.setdefault(floor, []).append(m)
+            geometry_of[m] = tuple(geometry if pol == "s" else cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
+        else:
+            out[m] = reference_rgb(cos_theta, mirror)
+    for floor, members in groups.items():
+        geometries = tuple(_stacked([geometry_of[m][k] for m in members]) for k in range(len(POLARISATIONS)))
+
+        def spectrum(wavelengths, rows, geometries=geometries):
+            omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
+            rows = np.asarray(rows)
+            block = max(1, ROW_BLOCK * 471 // max(omega.shape[-1], 1))
+            values = np.empty((rows.size, omega.shape[-1]))
+            for start in range(0, rows.size, block):
+                at = slice(start, start + block)
+                values[at] = _reflectance_real(omega[at] if omega.ndim == 2 else omega, geometries, rows[at], True)
+            return values
+
+        spectra, _ = colorimetry.converged_spectra(spectrum, len(members) * cos_theta.size, substeps_min=floor)
+        out[members] = colorimetry.spectrum_to_rgb(spectra).reshape(len(members), cos_theta.size, 3)
+    return out
+
+
+def _stacked(geometries: Sequence[CellGeometry]) -> CellGeometry:
+    """One geometry whose rows are the given ones' angles in turn, ``N`` per row."""
+    first = geometries[0]
+    fields = {k: np.concatenate([np.atleast_1d(getattr(g, k)) for g in geometries]) for k, v in vars(first).items()
+              if isinstance(v, np.ndarray)}
+    N = np.concatenate([np.full(np.size(g.p1), g.N) for g in geometries])
+    return CellGeometry(**fields, N=N, host_is_n1=True)

@@ -190,30 +190,50 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
     float64 above :data:`FLOAT32_MAX_N` cells, or when ``float64`` (the reference: then equal to the
     complex path to ~1e-12, several times faster).
     """
-    f32 = np.float32 if geometries[0].N <= FLOAT32_MAX_N and not float64 else np.float64
-    omega = omega.astype(f32)
     first = geometries[0]
+    counts = np.asarray(first.N)  # one count, or one per row (many mirrors' rows: :func:`reference_rgb_many`)
+    f32 = np.float32 if np.max(counts) <= FLOAT32_MAX_N and not float64 else np.float64
+    omega = omega.astype(f32)
     psi = omega * first.p1.real[rows, None].astype(f32)
     phi = omega * first.p2.real[rows, None].astype(f32)
     cos_psi, sin_psi, cos_phi, sin_phi = np.cos(psi), np.sin(psi), np.cos(phi), np.sin(phi)
     cos_cos, sin_sin, sin2_phi = cos_psi * cos_phi, sin_psi * sin_phi, f32(4.0) * sin_phi * sin_phi
-    N = f32(first.N)
+    N = counts[rows, None].astype(f32) if counts.ndim else f32(first.N)
     total = np.zeros_like(psi)
-    for geometry in geometries:
-        r12_2 = (geometry.r12.real[rows, None] ** 2).astype(f32)
-        a = cos_cos - (0.5 * geometry.Omega.real[rows, None]).astype(f32) * sin_sin
+    # Rows where both polarisations' terms agree (normal incidence) take one pass, counted twice.
+    terms = [(g.r12.real[rows, None] ** 2, 0.5 * g.Omega.real[rows, None]) for g in geometries]
+    twice = np.zeros(np.shape(rows), bool)
+    if len(terms) == 2:
+        twice = np.ravel(same_polarisations(terms[0][0], terms[1][0], terms[0][1], terms[1][1]))
+    for k, geometry in enumerate(geometries):
+        if k and twice.all():
+            break
+        r12_2, half_omega = terms[k]
+        r12_2 = r12_2.astype(f32)
+        a = cos_cos - half_omega.astype(f32) * sin_sin
         r1_2 = r12_2 * sin2_phi
         t1_2 = (f32(1.0) - r12_2) ** 2
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             a_band = np.clip(a, f32(-1.0), f32(1.0))
-            Q_band = (f32(1.0) - a_band * a_band) / np.sin(N * np.arccos(a_band)) ** 2
-            abs_a = np.maximum(np.abs(a), f32(1.0))
-            x = np.maximum(np.log(abs_a + np.sqrt(abs_a * abs_a - f32(1.0))), f32(1e-12))  # acosh|a|
-            h = lambda y: -np.expm1(f32(-2.0) * y)
-            Q_gap = (np.exp(-(N - f32(1.0)) * x) * h(x) / h(N * x)) ** 2
-            Q = np.where(np.abs(a) < f32(1.0), Q_band, Q_gap)
-            total += r1_2 / (r1_2 + t1_2 * Q)
+            Q = (f32(1.0) - a_band * a_band) / np.sin(N * np.arccos(a_band)) ** 2
+            gap = np.abs(a) >= f32(1.0)
+            if gap.any():  # Eq. 9's ratio, only in the gaps (a minority of samples)
+                abs_a = np.abs(a[gap])
+                N_gap = np.broadcast_to(N, a.shape)[gap]
+                x = np.maximum(np.log(abs_a + np.sqrt(abs_a * abs_a - f32(1.0))), f32(1e-12))  # acosh|a|
+                h = lambda y: -np.expm1(f32(-2.0) * y)  # noqa: E731
+                Q[gap] = (np.exp(-(N_gap - f32(1.0)) * x) * h(x) / h(N_gap * x)) ** 2
+            R = r1_2 / (r1_2 + t1_2 * Q)
+        if k == 0:
+            total += R * np.where(twice, f32(2.0), f32(1.0))[:, None].astype(f32)
+        else:
+            total += np.where(twice[:, None], f32(0.0), R)
     return f32(0.5) * total
+
+
+def same_polarisations(r12_2_s, r12_2_p, half_omega_s, half_omega_p) -> np.ndarray:
+    """Where both polarisations' ``r12^2`` and ``Omega`` agree (to rounding: normal incidence), elementwise."""
+    return (np.abs(r12_2_s - r12_2_p) <= 1e-14 * np.abs(r12_2_p)) & (np.abs(half_omega_s - half_omega_p) <= 1e-14 * np.abs(half_omega_p))
 
 
 #: Rows of angles per block of the fast path: 32 x 471 float32 temporaries stay in cache.
