@@ -30,8 +30,9 @@ from explorer.resources import material_path  # noqa: E402
 
 BUILT_IN = ["bragg_layer", "bragg_mirror", "bragg_stack", "ggx_schlick", "layered_lobes", "schlick_fresnel", "thin_film"]
 VALIDATE_JS = REPO_ROOT / "tests" / "gltf_validate.js"
-#: Two of the survey's seeded films (its index): a thick film of high index on a low base, and a thin one.
-SURVEY_CASES = (4, 8)
+#: Two of the survey's seeded films (its index): a thick film of high index on a low base, and one that only the
+#: trimmed search brings within 1 (the evolutions' film reads 1.40).
+SURVEY_CASES = (4, 11)
 
 
 def validate(paths) -> list[dict]:
