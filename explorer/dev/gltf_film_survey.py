@@ -1,12 +1,13 @@
 """
 How close glTF's one film comes to a thin film on a dielectric (docs/export.md, the glTF section): seeded random
 films over a box, each fitted as ``export --to gltf`` fits it (:func:`explorer.materials.gltf_film.refine_film`);
-per film the direct mapping's and the written film's median ΔE2000 over every degree 0-89 and the fit's CPU
-seconds, then the distribution. ``--exhaustive`` also searches each film above 1 with a dense grid of the
+per film the direct mapping's and the written film's median ΔE2000 over every degree 0-89 (the written one also
+with the base's F0 guarded as the Khronos sample viewer and three.js guard it) and the fit's CPU seconds, then the
+distribution. ``--exhaustive`` also searches each film above 1 with a dense grid of the
 formula's parameters (path difference, film index, factor, the base's F0 per channel) and Nelder-Mead from its
 best points: how far the export's search is from the best the formula reaches.
 
-    .venv/bin/python -m explorer.dev.gltf_film_survey              # 30 films, seed 0: ~3-4 CPU minutes
+    .venv/bin/python -m explorer.dev.gltf_film_survey              # 30 films, seed 0: ~5 CPU minutes
     .venv/bin/python -m explorer.dev.gltf_film_survey --exhaustive    # and a dense grid per film over 1: minutes each
 """
 
