@@ -5,8 +5,9 @@ figures kept, no table built), exactly 1 from alpha = 0.5, smoothstep between; n
 
 And ``bragg_layer``'s white furnace through its documented test hook
 ``BraggLayerModel.facet_reflectance_override`` (the tables the twin, the shader and the walk read): over a black
-base the compensated layer keeps its albedo at 0.99 or more at alpha = 0.6 and 1, theta <= 70 deg, in numpy and GL,
-and the microsurface random walk of the same layer gives 1 within its standard error.
+base the compensated layer keeps its albedo at 0.99 or more at alpha = 0.6 and 1, theta <= 70 deg, in numpy and GL
+(test_white_furnace.py, with the stack's layer), and the microsurface random walk of the same layer gives 1 within
+its standard error.
 """
 
 from __future__ import annotations
@@ -24,8 +25,7 @@ from explorer.materials.presets import presets_for
 from explorer.physics import compensation, position_free
 from explorer.resources import SHADER_DIR
 from test_bragg_layer import directions
-import white_furnace
-from white_furnace import FURNACE_ALPHAS, FURNACE_THETA
+from test_white_furnace import FURNACE_ALPHAS, FURNACE_THETA, FURNACES
 
 LAYER = REPO_ROOT / "shaders" / "bragg_layer.brd"
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
@@ -150,23 +150,12 @@ def test_the_fade_in_numpy_and_gl(gl_renderer, layer_material, stack_material, w
 # --------------------------------------------------------------------------------------------------
 # bragg_layer's white furnace (facets that reflect everything, a black base)
 
-FURNACE = {"rho_d": 0.0, "N": 10, "method": 3, "multiple_scattering": 1}
+FURNACE = FURNACES[BraggLayerModel][0]
 
 
 @pytest.fixture
 def white_facets(monkeypatch):
-    white_furnace.white_facets(monkeypatch, BraggLayerModel)
-
-
-@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
-def test_layer_white_furnace_numpy(layer_material, white_facets, alpha):
-    white_furnace.assert_white_furnace_numpy(layer_material, layer_material.resolve({**FURNACE, "alpha": alpha}))
-
-
-@pytest.mark.gl
-@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
-def test_layer_white_furnace_gl(gl_renderer, layer_material, white_facets, alpha):
-    white_furnace.assert_white_furnace_gl(gl_renderer, layer_material, layer_material.resolve({**FURNACE, "alpha": alpha}))
+    monkeypatch.setattr(BraggLayerModel, "facet_reflectance_override", 1.0)
 
 
 @pytest.mark.parametrize("alpha", FURNACE_ALPHAS)

@@ -1,10 +1,7 @@
 """Multiple scattering among a rough Bragg layer's facets in the explorer's model
 (:mod:`explorer.physics.multiscatter`, ``bragg_stack.brd``'s ``multiple_scattering``):
 
-- the white furnace, through the documented test hook ``BraggStackModel.facet_reflectance_override``
-  (the same code path, numpy and GL, with facets that reflect everything): one layer over a black base keeps
-  its directional albedo at 0.99 or more at alpha = 0.6 and 1 and theta <= 70 deg, where single scattering
-  (Eq. 34 as published) falls to ~0.3;
+- the white furnace (with the layer's: test_white_furnace.py);
 - the transparent limit: facets that let everything through over a white base give albedo 1 (Eq. 28's
   ballistic transmission loses ``1 - G1`` twice);
 - the compensation is reciprocal and vanishes for smooth layers;
@@ -23,33 +20,17 @@ from explorer.materials.models import BraggStackModel, model_for
 from explorer.physics import colorimetry, layered, multiscatter_stack, position_free
 from explorer.views.albedo import albedo_numpy
 from test_bragg_layer import directions
-import white_furnace
-from white_furnace import FURNACE_ALPHAS
+from test_white_furnace import FURNACES
 
 STACK = REPO_ROOT / "shaders" / "bragg_stack.brd"
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-ONE_LAYER = {"layers": 1, "nh": 1.0, "rho_d": 0.0, "N_1": 10, "multiple_scattering": 1}
+#: One rough layer of 10 cells over a black base, the compensation on (the furnace's).
+ONE_LAYER = FURNACES[BraggStackModel][0]
 
 
 @pytest.fixture(scope="module")
 def stack_material():
     return load_material(STACK)
-
-
-@pytest.fixture
-def white_facets(monkeypatch):
-    white_furnace.white_facets(monkeypatch, BraggStackModel)
-
-
-@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
-def test_white_furnace_numpy(stack_material, white_facets, alpha):
-    white_furnace.assert_white_furnace_numpy(stack_material, stack_material.resolve({**ONE_LAYER, "alpha_1": alpha}))
-
-
-@pytest.mark.gl
-@pytest.mark.parametrize("alpha", FURNACE_ALPHAS)
-def test_white_furnace_gl(gl_renderer, stack_material, white_facets, alpha):
-    white_furnace.assert_white_furnace_gl(gl_renderer, stack_material, stack_material.resolve({**ONE_LAYER, "alpha_1": alpha}))
 
 
 def test_transparent_facets_over_a_white_base(stack_material, monkeypatch):

@@ -238,42 +238,6 @@ def test_a_neighbour_round_never_repeats_a_start():
     assert [list(s) for s in _candidates([0], cost, pairs, labels, centre_U, U, tried)[0]] == [list(U[1])]
 
 
-def test_a_colour_starts_from_the_candidate_closest_to_its_targets():
-    """Of a row's candidate starts (NaN rows: none), the one whose coarse colours lie nearest its targets is polished."""
-    from explorer.design.pixels import best_starts
-
-    rows = _row_model()
-    rng = np.random.default_rng(3)
-    count = 6
-    truth = {"Lambda": rng.uniform(150.0, 320.0, count), "delta": rng.uniform(0.3, 0.7, count), "N": rng.integers(6, 31, count).astype(float)}
-    U = rows.unit(truth)
-    near = rows.unit({**truth, "Lambda": truth["Lambda"] * 1.01})
-    far = rows.unit({**truth, "Lambda": truth["Lambda"] * 1.3})
-    candidates = np.stack([far, np.full_like(U, np.nan), near], axis=1)
-    candidates[::2, [0, 2]] = candidates[::2, [2, 0]]  # the near one first in every other row
-    np.testing.assert_array_equal(best_starts(rows, rows.rgb(U), None, candidates), near)
-
-
-def test_a_finer_level_screens_its_polished_neighbours_and_their_interpolation():
-    from explorer.design.paint import NEARBY_STARTS, _nearby_starts
-    from explorer.design.base import DesignParameter
-
-    free = [DesignParameter("Lambda", 50.0, 1500.0), DesignParameter("N", 1.0, 1000.0, integer=True)]
-    colours = np.arange(25).reshape(5, 5)
-    done = np.zeros(25, bool)
-    done[[0, 2, 10, 12]] = True  # the corners of pixel (1, 1)'s cell, and pixel (2, 2)
-    U = np.zeros((25, 2))
-    U[[0, 2, 10, 12], 0] = [0.1, 0.2, 0.3, 0.4]
-    U[[0, 2, 10, 12], 1] = [0.5, 0.5, 0.5, 0.6]
-    starts = _nearby_starts(colours, done, U, [(1, 1), (0, 1)], free)
-    assert starts.shape == (2, NEARBY_STARTS + 1, 2)
-    np.testing.assert_array_equal(starts[0, :4, 0], [0.1, 0.2, 0.3, 0.4])  # equally near: in raster order
-    assert np.all(np.isnan(starts[0, 4:NEARBY_STARTS]))
-    np.testing.assert_allclose(starts[0, NEARBY_STARTS], [0.2, 0.5])  # the mean of those with the nearest's count
-    np.testing.assert_array_equal(starts[1, :2, 0], [0.1, 0.2])  # one pixel from two of them: only those
-    np.testing.assert_allclose(starts[1, NEARBY_STARTS], [0.15, 0.5])
-
-
 def test_a_two_worker_cluster_paints_a_film_image_that_renders_back(tmp_path):
     """
     ``design`` of a thin film (the film's thickness free) on a 2-worker local cluster, from an 8 x 8 image of two

@@ -37,7 +37,7 @@ import numpy as np
 
 from explorer.design.base import REACHABLE_DELTA_E, DesignError, DesignParameter
 from explorer.design.forward import design_model
-from explorer.design.pixels import RowModel, best_starts, cluster_centres, cluster_colours, delta_e_rows, polish_corrected, polish_whole
+from explorer.design.pixels import RowModel, cluster_centres, cluster_colours, delta_e_rows, polish_corrected, polish_whole
 from explorer.design.targets import Target, parameter_box
 from explorer.physics import colorimetry
 
@@ -141,10 +141,7 @@ def polish_task(model_name: str, ranges, fixed, angles, rgb: np.ndarray, bounds:
     start = time.perf_counter()
     model, _, free, cos_theta = _problem_parts(model_name, ranges, fixed, angles)
     rows = RowModel(model, free, fixed, cos_theta)
-    limits = bounds if np.any(bounds) else None
-    if starts.ndim == 3:  # candidates per colour: the one closest to its targets
-        starts = best_starts(rows, rgb, limits, starts)
-    U, cost = polish_whole(rows, rgb, limits, starts, walk=walk)
+    U, cost = polish_whole(rows, rgb, bounds if np.any(bounds) else None, starts, walk=walk)
     return {"U": U, "cost": cost, "seconds": time.perf_counter() - start}
 
 
@@ -348,7 +345,8 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
             if level == 0:
                 tried = [(c, u) for c in members for u in _cluster_starts(c, labels, centre_U, colour_lab, centres)]
             else:
-                tried = list(zip(members, _nearby_starts(pixel_colour, done, U, where, free)))
+                nearest = _nearest_done(pixel_colour, done)
+                tried = [(c, U[nearest[y, x]]) for c, (y, x) in zip(members, where)]
             index = np.array([c for c, _ in tried], dtype=np.int64)
             trial_U, trial_cost = _polish_many(runner, f"polish level {level + 1} of {len(levels)}", model_name, ranges, fixed, angles,
                                                colour_rgb[index], colour_bounds[index], np.array([u for _, u in tried]), walk=level == 0)
@@ -366,7 +364,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
         if poor.size == 0:
             break
         candidates_of = _candidates(poor, cost, neighbour_pairs, labels, centre_U, U, tried_starts)
-        tried = [(c, _stacked(candidates_of[c])) for c in poor if candidates_of[c]]
+        tried = [(c, u) for c in poor for u in candidates_of[c]]
         if not tried:  # no new start: another round would repeat this one
             break
         index = np.array([c for c, _ in tried])
@@ -409,7 +407,7 @@ def paint(model_name: str, ranges: Mapping[str, tuple[float, float]], fixed: Map
     for round_ in range(NEIGHBOUR_ROUNDS if chosen else 0):
         score = np.sum(delta_e**2, axis=1)
         poor = live[np.max(delta_e[live], axis=1) > REACHABLE_DELTA_E]
-        tried = [(c, _stacked(starts)) for c, starts in _candidates(poor, score, neighbour_pairs, labels, centre_U, U, spread_starts).items() if starts]
+        tried = [(c, u) for c, starts in _candidates(poor, score, neighbour_pairs, labels, centre_U, U, spread_starts).items() for u in starts]
         if not tried:
             break
         index = np.array([c for c, _ in tried], dtype=np.int64)
@@ -495,41 +493,14 @@ def _first_pixels(pixel_colour: np.ndarray, possible: np.ndarray, level: np.ndar
     return out
 
 
-#: A finer level's colour screens this many nearest polished colours' structures as its start.
-NEARBY_STARTS = 4
-
-
-def _nearby_starts(pixel_colour: np.ndarray, done: np.ndarray, U: np.ndarray, where: Sequence[tuple[int, int]],
-                   free: Sequence[DesignParameter]) -> np.ndarray:
-    """
-    Candidate starts ``(n, K + 1, P)`` (NaN rows: none) for pixels ``where``: the structures of the polished
-    colours around each (within the distance of the nearest, nearest first, at most :data:`NEARBY_STARTS`), and
-    their interpolation: the mean of those that share the nearest's whole counts (a smooth map's value between
-    its neighbours', a closer start than any one of them). :func:`polish_task` keeps the one closest to the targets.
-    """
+def _nearest_done(pixel_colour: np.ndarray, done: np.ndarray) -> np.ndarray:
+    """Per pixel, the colour of the nearest pixel whose colour is polished (a distance transform's indices)."""
     from scipy.ndimage import distance_transform_edt
 
-    H, W = pixel_colour.shape
     solved = pixel_colour >= 0
     solved[solved] = done[pixel_colour[solved]]
-    distance = distance_transform_edt(~solved)
-    integer = np.array([p.integer for p in free], bool)
-    out = np.full((len(where), NEARBY_STARTS + 1, U.shape[1]), np.nan)
-    for i, (y, x) in enumerate(where):
-        reach = max(1, int(np.ceil(distance[y, x] - 1e-9)))
-        y0, x0 = max(0, y - reach), max(0, x - reach)
-        ys, xs = np.nonzero(solved[y0 : y + reach + 1, x0 : x + reach + 1])
-        ys, xs = ys + y0, xs + x0
-        order = np.lexsort((xs, ys, (ys - y) ** 2 + (xs - x) ** 2))
-        colours = pixel_colour[ys[order], xs[order]]
-        _, first = np.unique(colours, return_index=True)
-        colours = colours[np.sort(first)][:NEARBY_STARTS]
-        rows = U[colours]
-        out[i, : len(colours)] = rows
-        same = np.all(np.abs(rows[:, integer] - rows[0, integer]) < 1e-12, axis=1)
-        if np.count_nonzero(same) > 1:
-            out[i, NEARBY_STARTS] = rows[same].mean(axis=0)
-    return out
+    _, (iy, ix) = distance_transform_edt(~solved, return_indices=True)
+    return pixel_colour[iy, ix]
 
 
 def _cluster_starts(c, labels, centre_U, colour_lab, centres) -> list[np.ndarray]:
@@ -554,17 +525,8 @@ def _neighbour_colours(pixel_colour: np.ndarray) -> dict[int, set[int]]:
     return pairs
 
 
-#: Starts screened per poor colour and round (the closest to its targets polished): its best neighbours' structures.
-NEIGHBOUR_STARTS = 4
-
-
-def _stacked(starts: list[np.ndarray]) -> np.ndarray:
-    """Starts as candidates ``(NEIGHBOUR_STARTS, P)``, NaN rows padding: :func:`polish_task` polishes the closest."""
-    out = np.full((NEIGHBOUR_STARTS, starts[0].size), np.nan)
-    out[: len(starts)] = starts[:NEIGHBOUR_STARTS]
-    return out
-
-
+#: Starts tried per poor colour and round: its best neighbours' structures.
+NEIGHBOUR_STARTS = 2
 #: The coarsest level's colours also start from this many nearest other clusters' structures.
 OTHER_CLUSTERS = 2
 

@@ -20,7 +20,7 @@ from explorer.physics import colorimetry
 #: Damped Gauss-Newton steps of :func:`polish_rows` (each ~P + 1 batch evaluations of the active rows).
 POLISH_STEPS = 14
 #: A row stops once its RMS CIEDE2000 per angle is below this.
-POLISH_TOLERANCE = 0.2
+POLISH_TOLERANCE = 0.1
 #: ... or once an accepted step lowers its cost by less than this share (a minimum: a held count that does not fit).
 POLISH_STALL = 0.01
 #: ... or once its damping, raised fourfold by each rejected step, passes this (five rejections in a row from the
@@ -120,27 +120,6 @@ class RowModel:
         if p.log:
             return p.from_unit(u) * (math.log(p.high) - math.log(p.low))
         return np.full(np.shape(u), p.high - p.low)
-
-
-def best_starts(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, candidates: np.ndarray) -> np.ndarray:
-    """
-    Per row, of its candidate starts ``candidates`` ``(B, K, P)`` (rows of NaN: none), the one whose colours lie
-    closest to its targets: one evaluation of the batch model per candidate, where a polish from each would cost
-    some fifteen. (Its counts one cell either way are not screened: with Lambda and delta unpolished, the screen
-    picks the right count for a quarter of a smooth map's pixels, fewer than the neighbour's own count does.)
-    Every row needs one finite candidate.
-    """
-    B, K, P = candidates.shape
-    valid = np.all(np.isfinite(candidates), axis=2)
-    b, k = np.nonzero(valid)
-    cost = np.full((B, K), np.inf)
-    cost[b, k] = _costs(rows, target_rgb[b], None if bounds is None else bounds[b], candidates[b, k])
-    return candidates[np.arange(B), np.argmin(cost, axis=1)]
-
-
-def _costs(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U: np.ndarray) -> np.ndarray:
-    """The coarse costs (sum over the angles of CIEDE2000 squared) of unit rows ``U``."""
-    return np.sum(residual_rows(rows.rgb(U), target_rgb, bounds) ** 2, axis=1)
 
 
 def polish_rows(rows: RowModel, target_rgb: np.ndarray, bounds: np.ndarray | None, U0: np.ndarray,

@@ -34,10 +34,8 @@ is invisible):
 3. **What is still missing**, ``m(theta) = 1 - E_r(theta) - t_b(theta)`` (``E_r`` the directional albedo
    of the reflection of (1), ``t_b`` of (2)), is light scattered among the facets: a part ``r`` leaves
    upward and ``1 - r`` downward (:class:`LayerTerms`). ``r`` comes from the random walk itself
-   (:func:`upward_share`): paths walked once per roughness with facets that reflect half the
-   light (:func:`walk_ensemble`), reweighted per wavelength by each event's ``R / 0.5`` or ``T / 0.5``. A
-   path's geometry depends only on its choices, so this is the walk with the layer's own ``R_lambda(theta_d)``
-   in expectation: the share follows the spectrum (light scattered twice is filtered twice), where a grey
+   (:func:`upward_share`), through the layer's own facets, with hero wavelengths: the share follows the
+   spectrum (light scattered twice is filtered twice), where a grey
    facets' share at the mean reflectance missed by up to 0.25 between two Bragg bands.
 
 For the structure (:mod:`explorer.physics.multiscatter_stack`) these are a layer's albedos; the lobe the
@@ -48,6 +46,8 @@ References
 Heitz, Hanika, d'Eon, Dachsbacher (2016). Multiple-scattering microfacet BSDFs with the Smith model. ACM
 TOG 35(4). Smith's occlusion as a process along the ray (the heights' ``C1``).
 Fourneau, Pacanowski, Barla (2024). Computer Graphics Forum 43(2). Eqs. 17-19, 28-30, 34.
+Wilkie, Nawaz, Droske, Weidlich, Hanika (2014). Hero wavelength spectral sampling. Computer Graphics Forum
+33(4). The upward share's walk.
 """
 
 from __future__ import annotations
@@ -436,14 +436,14 @@ def layer_terms(reflectance: ArrayLike, transmissivity: ArrayLike, theta: ArrayL
 #: Incidence angles (host, degrees) of the walked paths; the share is interpolated linearly between them.
 SHARE_THETA_DEG = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 88.0)
 #: Paths per angle, the facet events kept per path (later ones count 1 on both sides of a path's weight), the seed.
-SHARE_PATHS = 96000
+SHARE_PATHS = 192000
 SHARE_EVENTS = 32
 SHARE_SEED = 2016
 #: The share is computed at this many wavelengths, evenly spread (about every 3 nm), and interpolated between
 #: (a ratio: smoother than ``R``); a multiple of SHARE_HEROES.
 SHARE_COLUMNS = 160
-#: Wavelengths per path: the hero, which makes the path's choices, and the others evenly spread around the
-#: columns (a rotation: the same set whichever of them is the hero, as Wilkie et al. 2014's balance heuristic needs).
+#: Wavelengths per path, adjacent columns (:func:`share_groups`): the hero, which makes the path's choices, and the
+#: others of its group (the same set whichever of them is the hero, as Wilkie et al. 2014's balance heuristic needs).
 SHARE_HEROES = 8
 #: The least share of the paths a group of columns gets, against the group that weighs most in a colour.
 SHARE_GROUP_FLOOR = 0.1
@@ -466,13 +466,14 @@ def walked_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha:
     :func:`share_columns`, shape (angles, columns): the random walk (:func:`explorer.physics.microsurface.walk`)
     through the layer, :data:`SHARE_PATHS` per angle, seeded.
 
-    Each path carries :data:`SHARE_HEROES` wavelengths of :func:`share_columns` (the hero, taken in turn, and
-    others evenly spread); the hero's ``R(theta_d)`` makes its choices. Each wavelength weighs it by its own
-    throughput (the product of each event's ``R``, reflected, or ``T``, crossed) over the mean over the path's
-    wavelengths of the chance of its choices (the balance heuristic of hero-wavelength sampling, Wilkie et al.
-    2014: at most ``SHARE_HEROES``). A walk with one fixed reflectance reweighted to the layer's spectrum had
-    effective sample sizes of 1-10 % of its paths where a Bragg band moves with ``theta_d``; this one is the
-    walk with the layer's own facets, its errors independent between wavelengths.
+    Each path carries a group of :data:`SHARE_HEROES` adjacent columns of :func:`share_columns`
+    (:func:`share_groups`); one of them, the hero, taken in turn, makes its choices with its ``R(theta_d)``. Each
+    wavelength of the group weighs the path by its own throughput (the product of each event's ``R``, reflected,
+    or ``T``, crossed) over the mean over the group of the chance of its choices (the balance heuristic of
+    hero-wavelength sampling, Wilkie et al. 2014: weights at most ``SHARE_HEROES``). An earlier walk with facets
+    reflecting 0.5, reweighted to the layer's spectrum by ``R / 0.5`` and ``T / 0.5`` per event, kept 1-15 % of
+    its paths as effective samples on the presets' Bragg layers and did not settle with more paths (0.004 of
+    spread over seeds at 60000 and at 180000 paths per angle): its weights were heavy-tailed.
 
     ``reflectance``, ``transmittance``: the facets' ``R_lambda`` and ``T_lambda`` (``None``: ``1 - R``) at
     ``theta_d = k * 0.25 deg``, shape (361, 471).
@@ -513,7 +514,7 @@ def walked_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha:
         theta = np.radians(SHARE_THETA_DEG[k])
         d = np.broadcast_to(np.array([-np.sin(theta), 0.0, -np.cos(theta)]), (n, 3))
         _, _, _, up, alive, _, reflections = microsurface.walk(d, np.ones((n, 1)), np.ones((n, 1)), alpha, facet, rng,
-                                                                record=record)
+                                                                SHARE_EVENTS, record)
         scattered = np.flatnonzero(alive & (((reflections >= 2) & up) | ((reflections >= 1) & ~up)))
         cols = path_columns[scattered]
         weight = np.ones(cols.shape)

@@ -17,7 +17,10 @@ intended differences, each what a search over structures needs:
   exponentials, as in the dispersion relation, rather than only there.
 
 With complex indices (a medium's ``n + i k``) the characteristic-matrix form holds at each wavelength with a
-complex ``cos K Lambda`` (:func:`absorbing_reflectance_batch`).
+complex ``cos K Lambda`` (:func:`absorbing_reflectance_batch`). A mirror in ``n1`` whose waves all propagate (at an
+angle) takes a real-arithmetic path (:func:`_lossless_reflectance`, tested equal to the complex one to 1e-9), which
+also gives the analytic derivatives by ``Lambda``, ``delta`` and ``N`` that the paint's polish walks on
+(:func:`bragg_reflectance_batch_gradient`).
 """
 
 from __future__ import annotations

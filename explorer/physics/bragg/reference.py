@@ -155,14 +155,18 @@ def reference_rgb_many(cos_theta: ArrayLike, mirrors: Sequence[BraggMirror]) -> 
     cos_theta = np.asarray(cos_theta, dtype=np.float64).ravel()
     out = np.empty((len(mirrors), cos_theta.size, 3))
     groups: dict[int, list[int]] = {}
+    geometry_of: dict[int, tuple[CellGeometry, ...]] = {}
     for m, mirror in enumerate(mirrors):
         geometry = cell_geometry(cos_theta, mirror, "s")
         if geometry.host_is_n1 and not np.any(geometry.cos_theta_1.imag) and not np.any(geometry.cos_theta_2.imag):
-            groups.setdefault(substeps_for(mirror, cos_theta), []).append(m)
+            # substeps_for's floor, from this geometry (its n_+ is the same for both polarisations).
+            floor = colorimetry.substeps_for_fringes(2.0 * mirror.N * float(np.max(optical_thickness(geometry), initial=0.0)))
+            groups.setdefault(floor, []).append(m)
+            geometry_of[m] = tuple(geometry if pol == "s" else cell_geometry(cos_theta, mirror, pol) for pol in POLARISATIONS)
         else:
             out[m] = reference_rgb(cos_theta, mirror)
     for floor, members in groups.items():
-        geometries = tuple(_stacked([cell_geometry(cos_theta, mirrors[m], pol) for m in members]) for pol in POLARISATIONS)
+        geometries = tuple(_stacked([geometry_of[m][k] for m in members]) for k in range(len(POLARISATIONS)))
 
         def spectrum(wavelengths, rows, geometries=geometries):
             omega = 2.0 * np.pi / np.asarray(wavelengths, dtype=np.float64)
