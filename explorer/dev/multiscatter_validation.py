@@ -14,6 +14,7 @@ Regenerate (about 35 minutes of wall time on the shared 2 cores at load ~10)::
     python3 -m explorer.dev.multiscatter_validation           # docs/multiscatter_validation.json, docs/figures/multiscatter_validation.png
     python3 -m explorer.dev.multiscatter_validation --table   # the Markdown table of docs/layered_validation.md from the JSON
     python3 -m explorer.dev.multiscatter_validation --presets figure7_A --alphas 1.0   # only these rows; the others are kept
+    python3 -m explorer.dev.multiscatter_validation --rescore   # the models again against the stored walks (minutes)
 
 References
 ----------
@@ -45,8 +46,11 @@ LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 BEGIN, END = "<!-- multiscatter:begin -->", "<!-- multiscatter:end -->"
 
 
-def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0) -> dict:
-    """Single scattering and the compensated model against the random walk for preset ``name`` at ``alpha``."""
+def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0, stored: dict | None = None) -> dict:
+    """
+    Single scattering and the compensated model against the random walk for preset ``name`` at ``alpha``;
+    with ``stored`` (a row of the JSON), the models against that row's walk, which is not run again.
+    """
     from explorer.materials.brd import load_material
     from explorer.materials.models import model_for
     from explorer.materials.presets import presets_for
@@ -63,18 +67,23 @@ def compare(name: str, alpha: float, samples: int = SAMPLES, seed: int = 0) -> d
     compensated_model = model_for(material, {**values, "multiple_scattering": True})
     compensated_model.full_compensation = True  # the whole lobe at every alpha: what the fade leaves out at alpha <= 0.4
     single_model = model_for(material, {**values, "multiple_scattering": False})
-    start = time.perf_counter()
-    reference = PositionFree(compensated_model.stack, compensated_model.tables, "walk").albedo(THETA, samples, seed)
-    seconds = time.perf_counter() - start
+    if stored is None:
+        start = time.perf_counter()
+        reference = PositionFree(compensated_model.stack, compensated_model.tables, "walk").albedo(THETA, samples, seed)
+        seconds = time.perf_counter() - start
+        row = {"preset": name, "alpha": alpha, "layers": len(compensated_model.stack.layers),
+               "rho_d": list(compensated_model.stack.rho_d), "theta_deg": list(THETA), "reference_rgb": reference.value.tolist(),
+               "reference_stderr": reference.stderr.tolist(),
+               "reference_Y_stderr": np.sqrt(reference.stderr**2 @ LUMINANCE**2).tolist(), "reference_seconds": seconds}
+    else:
+        row = {key: value for key, value in stored.items() if not key.startswith(("single_", "compensated_"))}
+    reference_rgb = np.asarray(row["reference_rgb"])
     single, compensated = albedo_numpy(single_model, THETA), albedo_numpy(compensated_model, THETA)
-    Y = reference.value @ LUMINANCE
-    row = {"preset": name, "alpha": alpha, "layers": len(compensated_model.stack.layers), "rho_d": list(compensated_model.stack.rho_d),
-           "theta_deg": list(THETA), "reference_rgb": reference.value.tolist(), "reference_stderr": reference.stderr.tolist(),
-           "reference_Y_stderr": np.sqrt(reference.stderr**2 @ LUMINANCE**2).tolist(), "reference_seconds": seconds}
+    Y = reference_rgb @ LUMINANCE
     for key, rgb in (("single", single), ("compensated", compensated)):
         row[f"{key}_rgb"] = rgb.tolist()
         row[f"{key}_dY"] = (rgb @ LUMINANCE / Y - 1.0).tolist()
-        row[f"{key}_dE"] = colorimetry.delta_E_2000(reference.value, rgb).tolist()
+        row[f"{key}_dE"] = colorimetry.delta_E_2000(reference_rgb, rgb).tolist()
     return row
 
 
@@ -171,6 +180,8 @@ def main(argv=None) -> int:
     parser.add_argument("--presets", nargs="+", default=list(PRESETS))
     parser.add_argument("--alphas", nargs="+", type=float, default=list(ALPHAS))
     parser.add_argument("--samples", type=int, default=SAMPLES)
+    parser.add_argument("--rescore", action="store_true",
+                        help="the models again against the stored walks (after a change to the model; the walks are not rerun)")
     parser.add_argument("--cost", action="store_true", help="instead: the shader's cost with and without multiple scattering")
     args = parser.parse_args(argv)
     if args.cost:
@@ -187,9 +198,13 @@ def main(argv=None) -> int:
 
     if not args.table:
         rows = []
+        stored = {(r["preset"], float(r["alpha"])): r for r in json.loads(RESULTS.read_text(encoding="utf-8"))} if args.rescore else {}
         for name in args.presets:
             for alpha in args.alphas:
-                rows.append(compare(name, alpha, args.samples))
+                if args.rescore and (name, float(alpha)) not in stored:
+                    print(f"{RESULTS}: no stored walk for {name} at alpha {alpha:g}; run it without --rescore", file=sys.stderr)
+                    return 2
+                rows.append(compare(name, alpha, args.samples, stored=stored.get((name, float(alpha)))))
                 r = rows[-1]
                 print(f"{name} alpha={alpha:g}: single max|dY| {100 * np.abs(r['single_dY']).max():.1f} % median dE "
                       f"{np.median(r['single_dE']):.2f}; compensated {100 * np.abs(r['compensated_dY']).max():.1f} % "
