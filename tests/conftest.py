@@ -129,18 +129,21 @@ def _new_renderer():
     return Renderer(ctx)
 
 
-#: The renderer the modules share (compiled programs are cached in it); replaced by :func:`renew_gl_renderer`.
+#: The renderer the modules share (compiled programs are cached in it); given a new context by :func:`renew_gl_renderer`.
 SESSION_RENDERERS: list = []
 
 
 def renew_gl_renderer() -> None:
     """
-    Drop the shared renderer and its context: the next module gets a new one. tests/test_mitsuba.py calls it:
-    Dr.Jit's LLVM backend (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled
-    before it in that context (measured: later draws read their uniforms as 0 and some tables wrong).
+    Give the shared renderer a new context, in place: tests/test_mitsuba.py calls it. Dr.Jit's LLVM backend
+    (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled before it in that context
+    (measured: later draws read their uniforms as 0 and some tables wrong). In place, because a module that took
+    the renderer before may run its later tests after this (tests of several modules interleave on a worker):
+    a dropped renderer would leave it with programs of a released context.
     """
-    while SESSION_RENDERERS:
-        SESSION_RENDERERS.pop().ctx.release()
+    for renderer in SESSION_RENDERERS:
+        renderer.ctx.release()
+        renderer.__init__()
 
 
 @pytest.fixture(scope="module")

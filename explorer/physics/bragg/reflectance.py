@@ -231,7 +231,7 @@ def _reflectance_real(omega, geometries: tuple[CellGeometry, CellGeometry], rows
     return f32(0.5) * total
 
 
-def same_polarisations(r12_2_s, r12_2_p, half_omega_s, half_omega_p) -> np.ndarray:
+def same_polarisations(r12_2_s: np.ndarray, r12_2_p: np.ndarray, half_omega_s: np.ndarray, half_omega_p: np.ndarray) -> np.ndarray:
     """Where both polarisations' ``r12^2`` and ``Omega`` agree (to rounding: normal incidence), elementwise."""
     return (np.abs(r12_2_s - r12_2_p) <= 1e-14 * np.abs(r12_2_p)) & (np.abs(half_omega_s - half_omega_p) <= 1e-14 * np.abs(half_omega_p))
 
