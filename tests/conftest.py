@@ -129,21 +129,19 @@ def _new_renderer():
     return Renderer(ctx)
 
 
-#: The renderer the modules share (compiled programs are cached in it); given a new context by :func:`renew_gl_renderer`.
+#: The renderer the modules share (compiled programs are cached in it); replaced by :func:`renew_gl_renderer`.
 SESSION_RENDERERS: list = []
 
 
 def renew_gl_renderer() -> None:
     """
-    Give the shared renderer a new context, in place: tests/test_mitsuba.py calls it. Dr.Jit's LLVM backend
-    (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled before it in that context
-    (measured: later draws read their uniforms as 0 and some tables wrong). In place, because a module that took
-    the renderer before may run its later tests after this (tests of several modules interleave on a worker):
-    a dropped renderer would leave it with programs of a released context.
+    Drop the shared renderer and its context: the next module gets a new one. tests/test_mitsuba.py calls it:
+    Dr.Jit's LLVM backend (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled
+    before it in that context (measured: later draws read their uniforms as 0 and some tables wrong). Each worker
+    runs the modules in collection order (tests/parallel.py), so no module that took the old one runs after this.
     """
-    for renderer in SESSION_RENDERERS:
-        renderer.ctx.release()
-        renderer.__init__()
+    while SESSION_RENDERERS:
+        SESSION_RENDERERS.pop().ctx.release()
 
 
 @pytest.fixture(scope="module")
@@ -178,20 +176,12 @@ def shared_set_up_group(item) -> str | None:
 
 
 def pytest_collection_modifyitems(config, items):
-    """
-    In an xdist worker: order the tests as the scheduler hands them out (:func:`parallel.schedule_order`: the
-    units with a ``slow`` test first, so that no long test starts at the end of the run) and write each grouped
-    test's group where the controller's scheduler reads it.
-    """
+    """In an xdist worker: write each grouped test's group where the controller's scheduler reads it."""
     path = getattr(config, "workerinput", {}).get(GROUPS_KEY)
     if path is not None:
         from explorer.files import write_text_atomic
-        from parallel import schedule_order
 
         groups = {item.nodeid: group for item in items if (group := shared_set_up_group(item)) is not None}
-        slow = {item.nodeid for item in items if item.get_closest_marker("slow") is not None}
-        order = {nodeid: rank for rank, nodeid in enumerate(schedule_order([item.nodeid for item in items], groups, slow))}
-        items.sort(key=lambda item: order[item.nodeid])
         write_text_atomic(Path(path) / f"{config.workerinput['workerid']}.json", json.dumps(groups))
 
 

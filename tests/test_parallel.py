@@ -46,17 +46,6 @@ def test_the_schedule_keeps_a_group_in_one_unit_and_spreads_the_rest(tmp_path):
     assert units == ["tests/test_a.py", "tests/test_a.py", "tests/test_a.py::test_3"]
 
 
-def test_the_schedule_starts_the_slow_units_then_the_larger_ones():
-    """Units with a ``slow`` test first, then larger units; each unit's tests stay together and in order."""
-    from parallel import schedule_order
-
-    nodeids = ["a.py::t1", "b.py::t1", "b.py::t2", "c.py::t1", "d.py::t1", "d.py::t2", "d.py::t3", "e.py::t1"]
-    groups = {nodeid: nodeid.split("::")[0] for nodeid in nodeids if nodeid[0] in "bd"}
-    order = schedule_order(nodeids, groups, slow={"e.py::t1", "b.py::t2"})
-    assert order == ["b.py::t1", "b.py::t2", "e.py::t1", "d.py::t1", "d.py::t2", "d.py::t3", "a.py::t1", "c.py::t1"]
-    assert schedule_order(nodeids, {}, set()) == nodeids
-
-
 def test_virtual_displays_started_together_get_their_own_numbers():
     from explorer.app.xvfb import XvfbUnavailable, virtual_display
 
