@@ -53,6 +53,7 @@ Wilkie, Nawaz, Droske, Weidlich, Hanika (2014). Hero wavelength spectral samplin
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -449,6 +450,23 @@ SHARE_HEROES = 8
 SHARE_GROUP_FLOOR = 0.1
 
 
+def event_recorder(events: np.ndarray, count: np.ndarray) -> Callable[[np.ndarray, np.ndarray, np.ndarray], None]:
+    """
+    The walk's ``record`` hook (:func:`explorer.physics.microsurface.walk`): each path's facet events into the rows
+    of ``events`` (its 0.25-degree ``theta_d`` row, plus 361 when reflected), as many as it has columns; ``count``
+    counts every event of each path.
+    """
+
+    def record(rows: np.ndarray, cos_d: np.ndarray, reflect: np.ndarray) -> None:
+        j = count[rows]
+        kept = j < events.shape[1]
+        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(events.dtype)
+        events[rows[kept], j[kept]] = row[kept] + 361 * reflect[kept]
+        count[rows] += 1
+
+    return record
+
+
 def share_columns(wavelengths: int) -> np.ndarray:
     """The wavelength columns (of ``wavelengths``) the share is computed at: :data:`SHARE_COLUMNS`, evenly spread."""
     return np.rint(np.linspace(0.0, wavelengths - 1.0, SHARE_COLUMNS)).astype(np.int64)
@@ -504,12 +522,7 @@ def walked_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha:
             row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
             return R[row, hero[rows]][:, None]
 
-        def record(rows, cos_d, reflect):
-            j = count[rows]
-            kept = j < SHARE_EVENTS
-            row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int16)
-            events[rows[kept], j[kept]] = row[kept] + 361 * reflect[kept]
-            count[rows] += 1
+        record = event_recorder(events, count)
 
         theta = np.radians(SHARE_THETA_DEG[k])
         d = np.broadcast_to(np.array([-np.sin(theta), 0.0, -np.cos(theta)]), (n, 3))

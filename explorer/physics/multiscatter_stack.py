@@ -51,7 +51,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from explorer.physics import colorimetry, layered, microfacet, multiscatter
+from explorer.physics import colorimetry, layered, multiscatter
 from explorer.physics.fresnel import fresnel_reflectance
 
 #: Rows (and columns) of the lobe's table: theta in air = k * TABLE_STEP_DEG, k = 0..45.
@@ -151,13 +151,7 @@ def spread_ensemble(alpha: float, edges_deg: tuple = TRANSFER_EDGES_DEG) -> tupl
     count = np.zeros(n, dtype=np.int64)
     events = np.full((n, SPREAD_EVENTS), 722, dtype=np.int64)
 
-    def record(rows, cos_d, reflect):
-        k = count[rows]
-        kept = k < SPREAD_EVENTS
-        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
-        events[rows[kept], k[kept]] = row[kept] + 361 * reflect[kept]
-        count[rows] += 1
-
+    record = multiscatter.event_recorder(events, count)
     d = np.stack([-sin_t, 0.0 * sin_t, -cos_t], axis=-1)
     out, _, _, up, alive, _, reflections = microsurface.walk(
         d, np.ones((n, 1)), np.ones((n, 1)), float(alpha),
