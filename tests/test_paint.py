@@ -271,3 +271,20 @@ def test_a_two_worker_cluster_paints_a_film_image_that_renders_back(tmp_path):
         again = run_cli("render", "thin_film", "--maps", out, "--view", "textured", "--engine", "numpy", "--theta", theta, "--out", rendered)
         assert again.returncode == 0, again.stderr
         assert np.max(delta_E_2000(np.load(rendered).astype(float), image[k])) < 1.0
+
+
+def test_the_local_clusters_workers_run_without_dasks_malloc_trim_threshold():
+    # Dask sets MALLOC_TRIM_THRESHOLD_ in each worker it spawns; it turns glibc's adaptive mmap threshold off, which
+    # made the batched models' large temporaries cost ~1.5 times the CPU (explorer.design.paint.WORKER_ENVIRONMENT_UNSET).
+    import os
+
+    import dask
+    from distributed import Client
+
+    from explorer.design.paint import WORKER_ENVIRONMENT_UNSET, local_cluster
+
+    with local_cluster(1) as cluster, Client(cluster) as client:
+        seen = client.submit(lambda names: {n: os.environ.get(n) for n in names}, WORKER_ENVIRONMENT_UNSET).result()
+    assert seen == {name: None for name in WORKER_ENVIRONMENT_UNSET}
+    # Dask's own default is left as it was, for the clusters a user starts.
+    assert dask.config.get("distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_") is not None

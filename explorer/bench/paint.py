@@ -155,11 +155,10 @@ def run_paint_bench(workers: int = 2, seed: int = 0, size: int = 64, as_json: bo
     The round trip at ``size`` and the 256 x 256 8-region image on a local cluster of 1 worker, then of ``workers``;
     with the most workers, the smoothness against per-pixel-independent designs.
     """
-    import logging
-
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     from explorer.design import ranges_of
+    from explorer.design.paint import local_cluster
     from explorer.design.forward import design_model
     from explorer.materials.brd import load_material
     from explorer.materials.models import BraggMirrorModel
@@ -175,7 +174,7 @@ def run_paint_bench(workers: int = 2, seed: int = 0, size: int = 64, as_json: bo
     lines = {}
     for count in sorted({1, workers}, reverse=True):  # the most workers first: the headline numbers
         start = time.perf_counter()
-        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+        cluster = local_cluster(count)
         client = Client(cluster)
         up = time.perf_counter() - start
         try:

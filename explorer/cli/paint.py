@@ -57,7 +57,9 @@ def read_targets(image: str, image_2: str | None, angles: tuple[float, ...]):
 def start_client(workers: int | None, scheduler: str | None):
     """A ``distributed.Client``: on ``scheduler``'s cluster, or on a local cluster of ``workers`` processes (one thread each)."""
     try:
-        from distributed import Client, LocalCluster
+        from distributed import Client
+
+        from explorer.design.paint import local_cluster
     except ImportError:
         _fail("painting needs Dask: pip install 'bragg-explorer[paint]' (python3 -m explorer installs it)")
     import importlib.util
@@ -71,8 +73,7 @@ def start_client(workers: int | None, scheduler: str | None):
             _fail(f"--scheduler {scheduler}: cannot connect ({' '.join(str(error).split())[:160]})")
         return client, None
     dashboard = ":0" if importlib.util.find_spec("bokeh") is not None else None
-    cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=dashboard, silence_logs=logging.ERROR)
+    cluster = local_cluster(workers or os.cpu_count() or 1, dashboard)
     return Client(cluster), cluster
 
 

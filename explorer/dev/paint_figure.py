@@ -9,7 +9,6 @@ Dask cluster: the targets, the maps, the colours the maps show and the CIEDE2000
 from __future__ import annotations
 
 import argparse
-import logging
 import time
 from pathlib import Path
 
@@ -29,11 +28,11 @@ def main() -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     from explorer.bench.paint import ANGLES, ROUND_TRIP_BOX, _targets, region_maps
     from explorer.design import ranges_of
-    from explorer.design.paint import paint
+    from explorer.design.paint import local_cluster, paint
     from explorer.views.maps import map_colours
     from explorer.views.tonemap import display_srgb8
 
@@ -47,7 +46,7 @@ def main() -> None:
     maps = region_maps(args.size, 8, args.seed, ROUND_TRIP_BOX)
     targets = _targets(material.model, fixed, maps)
     start = time.perf_counter()
-    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None, silence_logs=logging.ERROR)
+    cluster = local_cluster(args.workers)
     client = Client(cluster)
     up = time.perf_counter() - start
     try:
