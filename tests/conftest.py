@@ -152,14 +152,6 @@ def gl_renderer():
     return SESSION_RENDERERS[0]
 
 
-@pytest.fixture(autouse=True)
-def _shared_context_current():
-    """Each test starts with the shared renderer's context current (a test may have made a renderer of its own,
-    whose context then stayed current): tests also make textures on ``gl_renderer.ctx`` directly."""
-    if SESSION_RENDERERS:
-        SESSION_RENDERERS[0].make_current()
-
-
 #: Fixture scopes whose one set-up serves several tests of one module (a class's or a module's).
 SHARED_SCOPES = ("class", "module", "package")
 #: The key of xdist's ``workerinput`` naming the file where each worker writes its tests' groups.

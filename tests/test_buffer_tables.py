@@ -161,23 +161,3 @@ def test_lookup_profile_reads_every_table_it_times(gl_renderer):
     expected = table[i] + (x - i)[:, None] * (table[i + 1] - table[i])
     for name in ("packed", "buffer2", "fetch2", "texture2", "block2", "linear32f", "linear16"):
         np.testing.assert_allclose(images[name][inside], expected, atol=2e-4, err_msg=name)
-
-
-@pytest.mark.gl
-def test_a_second_renderer_in_the_process_leaves_the_first_drawing_in_its_own_context(gl_renderer):
-    # A study that makes its own Renderer (a new context, current from then on) between two images of the shared
-    # one: the shared renderer's next image must still read its own programs and buffer tables, not the objects of
-    # the same names in the other context.
-    layer = load_material(LAYER)
-    values = layer.resolve({"method": 3, "alpha": 0.3})
-    before = gl_renderer.render(layer, values, "scatter", 16, 16, light=(30.0, 0.0))
-    other = Renderer()
-    mirror = load_material(MIRROR)
-    other.render(mirror, mirror.resolve({"method": 0}), "gradient", 8, 2)
-    try:
-        after = gl_renderer.render(layer, values, "scatter", 16, 16, light=(30.0, 0.0))
-    finally:
-        other.resources.close()
-        other.ctx.release()
-    np.testing.assert_array_equal(after, before)
-    assert before.max() > 0.0

@@ -124,14 +124,6 @@ class Renderer:
         self._inputs = {name: self.resources.texture(array, origin=name) for name, array in inputs.items()}
         return self._inputs
 
-    def make_current(self) -> None:
-        """
-        Make this renderer's context the current one. moderngl and PyOpenGL both draw in whichever context is
-        current, and a second renderer made in this process (a study's own, on a new context) leaves its own current:
-        without this, this renderer's next image would read the other context's objects of the same names.
-        """
-        self.ctx.__enter__()  # moderngl's way to make a context current; left current, as a new context is
-
     def program(self, material: Material, view: str, values: Mapping[str, object] | None = None):
         """The compiled program (cached), or :class:`ShaderError` naming the file and line."""
         constants = specialisation(material, values if values is not None else material.resolve())
@@ -391,7 +383,6 @@ class Renderer:
         """
         from explorer.views.geometry import VIEW_REGISTRY
 
-        self.make_current()
         registered = VIEW_REGISTRY.get(view)  # None for a mesh's templates (mesh/lit, mesh/env)
         if registered is not None and registered.summed:
             return self._render_summed(material, values, view, width, height, uniforms)
@@ -439,7 +430,6 @@ class Renderer:
         Time of one frame in ms, bounded by ``glFinish`` on both sides (tables already bound): on a
         software rasteriser such as llvmpipe this is the rendering time. ``light``, ``environment``: as in :meth:`render`.
         """
-        self.make_current()
         program, framebuffer, bindings = self._headless(material, values, view, width, height, light, inputs, uniforms, environment)
         try:
             return self.draw(program, framebuffer, **bindings)
