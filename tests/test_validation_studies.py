@@ -44,9 +44,11 @@ def test_exactness_tables():
 
 
 @pytest.mark.gl
-def test_lobes_table():
+def test_lobes_table(gl_renderer):
+    # The shared renderer: a second context made current in this process would leave the next module's shared
+    # renderer drawing in it.
     document = studies.lobes_rows(tmm_stacks=3, fgd_samples=2, fgd_count=40, furnace_count=12, gl_size=(9, 7), lit_size=16,
-                                  repeats=1, two_layer_samples=9)
+                                  repeats=1, two_layer_samples=9, renderer=gl_renderer)
     header, *body = md.parse_markdown_table(studies.lobes_markdown(document))
     assert header == ["check", "result"] and len(body) == 9
     assert document["round_trip"]["cases"] == len(studies.INVERSE_CASES) and document["round_trip"]["energy"] < 1e-3

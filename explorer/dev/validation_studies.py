@@ -356,8 +356,11 @@ def hemisphere(count: int):
 
 def lobes_rows(tmm_stacks: int = 20, fgd_samples: int = 150, fgd_count: int = 400, furnace_count: int = 96,
                gl_size: tuple[int, int] = (36, 28), lit_size: int = 256, repeats: int = 5, two_layer_samples: int = 31,
-               seed: int = 0, progress: Progress = None) -> dict:
-    """Every check of :func:`lobes_markdown`, as a JSON-able document (GL parts need an EGL context)."""
+               seed: int = 0, progress: Progress = None, renderer=None) -> dict:
+    """
+    Every check of :func:`lobes_markdown`, as a JSON-able document (GL parts need an EGL context). ``renderer``: the
+    :class:`explorer.gpu.Renderer` of the GL parts (default a new one, on a new context).
+    """
     from explorer.materials.brd import load_material
     from explorer.materials.lobes_model import LayeredLobesModel
     from explorer.materials.models import model_for
@@ -405,11 +408,11 @@ def lobes_rows(tmm_stacks: int = 20, fgd_samples: int = 150, fgd_count: int = 40
             brdf = model.brdf(L, o, np.array([0.0, 0.0, 1.0]), None, None)
             albedo = max(albedo, float((brdf * (o[:, 2] * d_omega)[:, None]).sum(axis=0).max()))
     document["furnace"] = {"stacks": len(FURNACE_STACKS), "max_albedo": albedo}
-    document.update(_lobes_gl(material, gl_size, lit_size, repeats, progress))
+    document.update(_lobes_gl(material, gl_size, lit_size, repeats, progress, renderer))
     return document
 
 
-def _lobes_gl(material, gl_size, lit_size: int, repeats: int, progress: Progress) -> dict:
+def _lobes_gl(material, gl_size, lit_size: int, repeats: int, progress: Progress, renderer=None) -> dict:
     from explorer.gpu import Renderer
     from explorer.materials.brd import load_material
     from explorer.materials.models import GGXSchlickModel, model_for
@@ -417,7 +420,7 @@ def _lobes_gl(material, gl_size, lit_size: int, repeats: int, progress: Progress
     from explorer.views.geometry import rim_distance
     from explorer.views.render import render_numpy
 
-    renderer = Renderer()
+    renderer = Renderer() if renderer is None else renderer
     width, height = gl_size
     _say(progress, f"lobes: GL against numpy, {len(GL_STACKS)} stacks x {len(GL_VIEWS)} views")
     worst = 0.0
