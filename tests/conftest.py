@@ -137,8 +137,9 @@ def renew_gl_renderer() -> None:
     """
     Drop the shared renderer and its context: the next module gets a new one. tests/test_mitsuba.py calls it:
     Dr.Jit's LLVM backend (libLLVM 19), once started in a process, breaks what llvmpipe (Mesa's LLVM) compiled
-    before it in that context (measured: later draws read their uniforms as 0 and some tables wrong). Each worker
-    runs the modules in collection order (tests/parallel.py), so no module that took the old one runs after this.
+    before it in that context (measured: later draws read their uniforms as 0 and some tables wrong). pytest tears a
+    module's fixtures down when a worker moves on to another module, so a module that comes back after this takes
+    the new one.
     """
     while SESSION_RENDERERS:
         SESSION_RENDERERS.pop().ctx.release()

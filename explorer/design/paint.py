@@ -199,7 +199,6 @@ def local_cluster(workers: int, dashboard: str | None = None):
                             silence_logs=logging.ERROR)
 
 
-
 class _Runner:
     """Submits tasks to a Dask client (or runs them here without one), each result cached under ``cache`` by its inputs' hash."""
 
