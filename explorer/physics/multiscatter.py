@@ -97,8 +97,12 @@ def _below_quadrature(alpha: float) -> np.ndarray:
     v = np.broadcast_to(v[:, None, :], (theta.size, k * k, 3))
     m = microfacet.sample_ggx_visible_normal(v, alpha, np.broadcast_to(u1.ravel(), (theta.size, k * k)),
                                              np.broadcast_to(u2.ravel(), (theta.size, k * k)))
-    cos_d = np.clip(np.sum(v * m, axis=-1), 0.0, 1.0)
-    return np.rint(np.arccos(cos_d) / microfacet.THETA_STEP).astype(np.int64)
+    return theta_d_row(np.sum(v * m, axis=-1))
+
+
+def theta_d_row(cos_d: np.ndarray) -> np.ndarray:
+    """The row of the facet tables' ``theta_d`` grid (:data:`explorer.physics.microfacet.THETA_STEP`) nearest each ``cos_d``."""
+    return np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
 
 
 def occluder_reflectance_below(transmittance: ArrayLike, alpha: float) -> np.ndarray:
@@ -460,7 +464,7 @@ def event_recorder(events: np.ndarray, count: np.ndarray) -> Callable[[np.ndarra
     def record(rows: np.ndarray, cos_d: np.ndarray, reflect: np.ndarray) -> None:
         j = count[rows]
         kept = j < events.shape[1]
-        row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(events.dtype)
+        row = theta_d_row(cos_d)
         events[rows[kept], j[kept]] = row[kept] + 361 * reflect[kept]
         count[rows] += 1
 
@@ -519,8 +523,7 @@ def walked_share(reflectance: ArrayLike, transmittance: ArrayLike | None, alpha:
         events = np.full((n, SHARE_EVENTS), 722, dtype=np.int16)
 
         def facet(cos_d, rows):
-            row = np.rint(np.arccos(np.clip(cos_d, 0.0, 1.0)) / microfacet.THETA_STEP).astype(np.int64)
-            return R[row, hero[rows]][:, None]
+            return R[theta_d_row(cos_d), hero[rows]][:, None]
 
         record = event_recorder(events, count)
 
